@@ -1,0 +1,2 @@
+//! The safe-capture command-line tool.
+fn main() {}

@@ -1,0 +1,1 @@
+//! iceoryx2 transport building blocks for the partition.

@@ -1,0 +1,1 @@
+//! Control barrier functions and the three safety filters.

@@ -1,0 +1,1 @@
+//! Interface control document: fixed-size messages of the partition.

@@ -1,0 +1,1 @@
+//! The mission in one process: phases, telemetry, summary.

@@ -1,0 +1,1 @@
+//! Frames, rotations, orbits, Hill frame, Clohessy-Wiltshire and rigid-body attitude models.

@@ -1,0 +1,1 @@
+//! The servicer as a free-flying multibody system loaded from URDF.

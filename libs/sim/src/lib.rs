@@ -1,0 +1,1 @@
+//! High-fidelity simulator core.
