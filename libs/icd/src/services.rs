@@ -1,0 +1,68 @@
+//! Service names of the partition. Every pub/sub service has an event service of
+//! the same name next to it (publish, then notify); see `docs/ICD.md`.
+//!
+//! The names are relative: sc-bus isolates runs by the iceoryx2 `global.prefix`,
+//! not by the service name, so the same names are used in every run.
+
+/// A service name plus the message type it carries (checked at compile time by sc-bus).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ServiceName(pub &'static str);
+
+impl ServiceName {
+    /// The name as a string.
+    pub const fn as_str(&self) -> &'static str {
+        self.0
+    }
+}
+
+impl core::fmt::Display for ServiceName {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.0)
+    }
+}
+
+/// [`crate::Tick`] of the main rate group. Publisher: scheduler. Subscribers: simulator, recorder.
+pub const TICK: ServiceName = ServiceName("safe_capture/scheduler/tick");
+/// [`crate::SimState`]. Publisher: simulator. Subscribers: the three nominal controllers,
+/// the three safety filters, scheduler (step completion), recorder.
+pub const SIM_STATE: ServiceName = ServiceName("safe_capture/sim/state");
+/// [`crate::NominalTranslational`]. Publisher: nominal translational controller.
+/// Subscribers: translational safety filter, recorder.
+pub const NOMINAL_TRANSLATIONAL: ServiceName = ServiceName("safe_capture/nominal/translational");
+/// [`crate::NominalAttitude`]. Publisher: nominal attitude controller.
+/// Subscribers: attitude safety filter, recorder.
+pub const NOMINAL_ATTITUDE: ServiceName = ServiceName("safe_capture/nominal/attitude");
+/// [`crate::NominalRobotic`]. Publisher: nominal robotic controller.
+/// Subscribers: robotic safety filter, recorder.
+pub const NOMINAL_ROBOTIC: ServiceName = ServiceName("safe_capture/nominal/robotic");
+/// [`crate::SafeTranslational`]. Publisher: translational safety filter.
+/// Subscribers: attitude safety filter (causal order), simulator, recorder.
+pub const SAFE_TRANSLATIONAL: ServiceName = ServiceName("safe_capture/safe/translational");
+/// [`crate::SafeAttitude`]. Publisher: attitude safety filter.
+/// Subscribers: robotic safety filter (causal order), simulator, recorder.
+pub const SAFE_ATTITUDE: ServiceName = ServiceName("safe_capture/safe/attitude");
+/// [`crate::SafeRobotic`]. Publisher: robotic safety filter.
+/// Subscribers: simulator (closes the step), scheduler, recorder.
+pub const SAFE_ROBOTIC: ServiceName = ServiceName("safe_capture/safe/robotic");
+/// [`crate::Health`]. Publishers: every process (up to 16). Subscribers: scheduler, recorder.
+pub const HEALTH: ServiceName = ServiceName("safe_capture/health");
+/// Start-up handshake (event services `<HANDSHAKE>/ready` and `<HANDSHAKE>/go`, no payload).
+/// Participants notify `ready` with their role id + 1; the coordinator (scheduler)
+/// notifies `go` once all expected participants were seen.
+pub const HANDSHAKE: ServiceName = ServiceName("safe_capture/handshake");
+
+/// All pub/sub services with their iceoryx2 type names, for tools and docs.
+pub const ALL: &[(ServiceName, &str)] = &[
+    (TICK, "safe_capture::v1::Tick"),
+    (SIM_STATE, "safe_capture::v1::SimState"),
+    (
+        NOMINAL_TRANSLATIONAL,
+        "safe_capture::v1::NominalTranslational",
+    ),
+    (NOMINAL_ATTITUDE, "safe_capture::v1::NominalAttitude"),
+    (NOMINAL_ROBOTIC, "safe_capture::v1::NominalRobotic"),
+    (SAFE_TRANSLATIONAL, "safe_capture::v1::SafeTranslational"),
+    (SAFE_ATTITUDE, "safe_capture::v1::SafeAttitude"),
+    (SAFE_ROBOTIC, "safe_capture::v1::SafeRobotic"),
+    (HEALTH, "safe_capture::v1::Health"),
+];
