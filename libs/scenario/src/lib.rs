@@ -1,1 +1,341 @@
-//! Scenario configuration: the mission as data.
+//! The scenario as data: `config/scenario.toml` parsed with serde
+//! (`deny_unknown_fields`) and validated with errors that name the key, the
+//! value and the rule broken.
+//!
+//! Units are part of every key's name (`_m`, `_s`, `_deg`, `_rad_s`, `_n`,
+//! `_nm`, `_kg`, …). Quaternions are scalar-first `[q0, q1, q2, q3]`.
+
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+mod validate;
+
+pub use validate::ScenarioError;
+
+/// Three-vector as written in the file.
+pub type V3 = [f64; 3];
+/// Seven joint values (one per arm joint).
+pub type J7 = [f64; 7];
+
+/// The whole scenario.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    pub orbit: Orbit,
+    pub reference_frame: ReferenceFrame,
+    pub servicer: Servicer,
+    pub target: Target,
+    pub mission: Mission,
+    pub limits: Limits,
+    pub safety: Safety,
+    pub nominal: Nominal,
+    /// Directory the scenario was loaded from; relative paths resolve against it.
+    #[serde(skip)]
+    pub base_dir: PathBuf,
+}
+
+/// Target orbit (circular) and the central body.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Orbit {
+    /// Gravitational parameter μ [m³/s²].
+    pub earth_mu_m3_s2: f64,
+    /// Equatorial radius [m].
+    pub earth_radius_m: f64,
+    /// Altitude of the circular target orbit [m].
+    pub altitude_m: f64,
+    pub inclination_deg: f64,
+    pub raan_deg: f64,
+    /// Argument of latitude of the target at t = 0 [deg].
+    pub argument_of_latitude_deg: f64,
+}
+
+/// The reference frame `F_R`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReferenceFrame {
+    /// `q_HR` at t = 0: rotates F_R vectors into the Hill frame (unit, scalar-first).
+    pub attitude_in_hill: [f64; 4],
+}
+
+/// The servicer: its URDF and its initial state.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Servicer {
+    /// URDF of base and arm, relative to the scenario file.
+    pub urdf: PathBuf,
+    /// Boresight `d_B`, unit vector in F_B.
+    pub boresight_body: V3,
+    /// Base origin relative to the target CoM, in F_R [m].
+    pub initial_position_m: V3,
+    /// Its time derivative in the non-rotating F_R [m/s].
+    pub initial_velocity_m_s: V3,
+    /// Base angular velocity ω_B in F_B [rad/s]; the initial attitude is F_R itself.
+    pub initial_omega_rad_s: V3,
+    pub initial_theta_rad: J7,
+    pub initial_theta_dot_rad_s: J7,
+}
+
+/// The tumbling target (torque-free rigid body).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Target {
+    pub mass_kg: f64,
+    /// Inertia about the CoM in F_T [kg m²].
+    pub inertia_kg_m2: [V3; 3],
+    /// `q_RT` at t = 0 (unit, scalar-first).
+    pub initial_attitude: [f64; 4],
+    /// ω_T in F_T [rad/s].
+    pub initial_omega_rad_s: V3,
+    /// Grasping point `p_G,T` in F_T [m].
+    pub grasp_point_m: V3,
+}
+
+/// Timing and phases of the mission.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Mission {
+    /// Control period T_s of every subsystem in the in-process run [s].
+    pub control_period_s: f64,
+    /// RK4 step of the simulator [s]; must divide the control period.
+    pub physics_step_s: f64,
+    /// End of the run if no capture happened [s].
+    pub duration_s: f64,
+    /// End-effector distance to the grasping point that counts as capture [m].
+    pub capture_tolerance_m: f64,
+    /// Relative speed of end-effector and grasping point that counts as capture [m/s].
+    pub capture_speed_tolerance_m_s: f64,
+    /// Phases in order of their start times.
+    pub phases: Vec<Phase>,
+}
+
+/// One mission phase and the nominal controller modes it activates.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Phase {
+    pub name: String,
+    pub start_s: f64,
+    pub translational: TranslationalMode,
+    pub attitude: AttitudeMode,
+    pub robotic: RoboticMode,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TranslationalMode {
+    /// Unconstrained MPC towards the Go-for-Capture point.
+    Approach,
+    /// Zero force.
+    Off,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AttitudeMode {
+    /// Boresight at the grasping point.
+    Point,
+    /// Boresight at the grasping point and body rate synchronised with the target.
+    PointAndSync,
+    /// Zero torque.
+    Off,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RoboticMode {
+    /// PD towards the initial joint angles.
+    Hold,
+    /// PD computed torque towards the IK solution of the grasping point.
+    Grasp,
+    /// Zero joint torque.
+    Off,
+}
+
+/// Actuator bounds, the input sets U of the paper.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Limits {
+    /// ‖f_B‖∞ [N].
+    pub force_max_n: f64,
+    /// ‖τ_B‖∞ [N m].
+    pub torque_max_nm: f64,
+    /// ‖τ_M‖∞ [N m].
+    pub joint_torque_max_nm: f64,
+}
+
+/// Parameters of the three safety filters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Safety {
+    /// γ_h of α(H) = γ_h H [1/s].
+    pub gamma_per_s: f64,
+    pub translational: SafetyTranslational,
+    pub attitude: SafetyAttitude,
+    pub robotic: SafetyRobotic,
+    pub solver: Solver,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SafetyTranslational {
+    /// Corridor axis d_R (unit, F_R), pointing from the target towards the servicer.
+    pub corridor_axis: V3,
+    /// ψ_AC [deg].
+    pub corridor_half_angle_deg: f64,
+    /// R_CAZ [m].
+    pub caz_radius_m: f64,
+    /// ε_AC [m/s].
+    pub eps_ac: f64,
+    /// ε_CAZ [m²/s].
+    pub eps_caz: f64,
+    /// u_max of the corridor's auxiliary barrier [m/s²].
+    pub u_max_ac_m_s2: f64,
+    /// u_max of the CAZ's auxiliary barrier [m²/s²].
+    pub u_max_caz_m2_s2: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SafetyAttitude {
+    /// β_ATT [deg].
+    pub los_half_angle_deg: f64,
+    /// Upper angular-rate limits [rad/s] per body axis.
+    pub omega_max_rad_s: V3,
+    /// Lower angular-rate limits [rad/s] per body axis.
+    pub omega_min_rad_s: V3,
+    /// ε_ATT [1/s].
+    pub eps_att: f64,
+    /// ε_ω [rad/s²].
+    pub eps_omega: f64,
+    /// γ_ω [1/s].
+    pub gamma_omega_per_s: f64,
+    /// u_max of the line-of-sight auxiliary barrier [1/s²].
+    pub u_max_att_per_s2: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SafetyRobotic {
+    pub theta_min_rad: J7,
+    pub theta_max_rad: J7,
+    /// Symmetric joint-velocity limits |θ̇_i| ≤ θ̇_max,i [rad/s].
+    pub theta_dot_max_rad_s: J7,
+    /// ε_θ [rad²/s].
+    pub eps_theta: f64,
+    /// ε_θ̇ [rad/s²].
+    pub eps_theta_dot: f64,
+    /// ε_LB [m²/s].
+    pub eps_lb: f64,
+    /// γ_θ̇ [1/s].
+    pub gamma_theta_dot_per_s: f64,
+    /// u_max of the joint-angle auxiliary barriers [rad²/s²].
+    pub u_max_theta_rad2_s2: f64,
+    /// u_max of the link–base auxiliary barriers [m²/s²].
+    pub u_max_lb_m2_s2: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Solver {
+    pub max_iterations: u32,
+    pub tolerance: f64,
+    /// Weight of the slack in the relaxed (always feasible) QP.
+    pub slack_weight: f64,
+}
+
+/// Tuning of the reference nominal controllers.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Nominal {
+    pub translational: NominalTranslational,
+    pub attitude: NominalAttitude,
+    pub robotic: NominalRobotic,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NominalTranslational {
+    pub horizon_steps: u32,
+    /// Distance of the Go-for-Capture point from the target CoM along d_R [m].
+    pub gfc_distance_m: f64,
+    pub weight_position: f64,
+    pub weight_velocity: f64,
+    pub weight_force: f64,
+    pub weight_terminal: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NominalAttitude {
+    pub kp_nm_per_rad: f64,
+    pub kd_nm_s_per_rad: f64,
+    pub sync_gain_nm_s_per_rad: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NominalRobotic {
+    pub kp_per_s2: f64,
+    pub kd_per_s: f64,
+    pub ik_iterations: u32,
+    pub ik_damping: f64,
+    pub ik_tolerance_m: f64,
+}
+
+impl Scenario {
+    /// Reads, parses and validates a scenario file.
+    pub fn load(path: &Path) -> Result<Self, ScenarioError> {
+        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Io {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Self::from_toml_str(&text, &base).map_err(|e| e.in_file(path))
+    }
+
+    /// Parses and validates scenario text; relative paths resolve against `base_dir`.
+    pub fn from_toml_str(text: &str, base_dir: &Path) -> Result<Self, ScenarioError> {
+        let mut s: Scenario = toml::from_str(text).map_err(|e| ScenarioError::parse(text, &e))?;
+        s.base_dir = base_dir.to_path_buf();
+        s.validate()?;
+        Ok(s)
+    }
+
+    /// The URDF path, resolved against the scenario's directory.
+    pub fn urdf_path(&self) -> PathBuf {
+        if self.servicer.urdf.is_absolute() {
+            self.servicer.urdf.clone()
+        } else {
+            self.base_dir.join(&self.servicer.urdf)
+        }
+    }
+
+    /// Serialises the scenario back to TOML (e.g. to store a dispersed run).
+    pub fn to_toml_string(&self) -> String {
+        toml::to_string(self).unwrap_or_default()
+    }
+
+    /// Index of the phase active at time `t` [s] (phases sorted by start time).
+    pub fn phase_index(&self, t: f64) -> usize {
+        let mut idx = 0;
+        for (i, p) in self.mission.phases.iter().enumerate() {
+            if t + 1e-9 >= p.start_s {
+                idx = i;
+            }
+        }
+        idx
+    }
+
+    /// Control steps per physics step ratio: physics steps per control period.
+    pub fn physics_substeps(&self) -> usize {
+        (self.mission.control_period_s / self.mission.physics_step_s).round() as usize
+    }
+
+    /// Number of control steps in the whole run.
+    pub fn control_steps(&self) -> usize {
+        (self.mission.duration_s / self.mission.control_period_s).round() as usize
+    }
+}
+
+/// Path of the default scenario shipped in `config/`, relative to the workspace root.
+pub const DEFAULT_SCENARIO: &str = "config/scenario.toml";

@@ -1,0 +1,379 @@
+//! Validation rules of the scenario. Every error names the key, the value and the
+//! rule it breaks, on one line.
+
+use crate::{Scenario, V3};
+use std::fmt::Debug;
+use std::path::PathBuf;
+
+/// Why a scenario was rejected.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ScenarioError {
+    #[error("cannot read {}: {message}", path.display())]
+    Io { path: PathBuf, message: String },
+    #[error("parse error at line {line}, column {column}: {message}")]
+    Parse {
+        line: usize,
+        column: usize,
+        message: String,
+    },
+    #[error("`{key}` = {value}: {rule}")]
+    Invalid {
+        key: String,
+        value: String,
+        rule: String,
+    },
+    #[error("{}: {inner}", path.display())]
+    InFile {
+        path: PathBuf,
+        inner: Box<ScenarioError>,
+    },
+}
+
+impl ScenarioError {
+    pub(crate) fn parse(text: &str, e: &toml::de::Error) -> Self {
+        let (line, column) = match e.span() {
+            Some(span) => {
+                let before = &text[..span.start.min(text.len())];
+                let line = before.matches('\n').count() + 1;
+                let column = before.len() - before.rfind('\n').map(|i| i + 1).unwrap_or(0) + 1;
+                (line, column)
+            }
+            None => (0, 0),
+        };
+        let message = e.message().replace('\n', " ").trim().to_string();
+        ScenarioError::Parse {
+            line,
+            column,
+            message,
+        }
+    }
+
+    pub(crate) fn in_file(self, path: &std::path::Path) -> Self {
+        match self {
+            e @ ScenarioError::Io { .. } => e,
+            e => ScenarioError::InFile {
+                path: path.to_path_buf(),
+                inner: Box::new(e),
+            },
+        }
+    }
+
+    /// The validation error without the file prefix.
+    pub fn root(&self) -> &ScenarioError {
+        match self {
+            ScenarioError::InFile { inner, .. } => inner.root(),
+            e => e,
+        }
+    }
+}
+
+fn invalid(key: &str, value: impl Debug, rule: impl Into<String>) -> ScenarioError {
+    ScenarioError::Invalid {
+        key: key.to_string(),
+        value: format!("{value:?}"),
+        rule: rule.into(),
+    }
+}
+
+fn finite(key: &str, v: f64) -> Result<(), ScenarioError> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(invalid(key, v, "must be a finite number"))
+    }
+}
+
+fn positive(key: &str, v: f64) -> Result<(), ScenarioError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(invalid(key, v, "must be a finite number > 0"))
+    }
+}
+
+fn non_negative(key: &str, v: f64) -> Result<(), ScenarioError> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(invalid(key, v, "must be a finite number >= 0"))
+    }
+}
+
+fn finite_all(key: &str, v: &[f64]) -> Result<(), ScenarioError> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(invalid(key, v, "every component must be finite"))
+    }
+}
+
+fn unit(key: &str, v: &[f64]) -> Result<(), ScenarioError> {
+    finite_all(key, v)?;
+    let n = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if (n - 1.0).abs() <= 1e-6 {
+        Ok(())
+    } else {
+        Err(invalid(
+            key,
+            v,
+            format!("must have unit norm (norm is {n:.6}, tolerance 1e-6)"),
+        ))
+    }
+}
+
+fn angle_deg(key: &str, v: f64) -> Result<(), ScenarioError> {
+    if v.is_finite() && v > 0.0 && v < 90.0 {
+        Ok(())
+    } else {
+        Err(invalid(key, v, "must be in (0, 90) degrees"))
+    }
+}
+
+fn inertia(key: &str, m: &[V3; 3]) -> Result<(), ScenarioError> {
+    finite_all(key, &m.concat())?;
+    for i in 0..3 {
+        for j in 0..3 {
+            if (m[i][j] - m[j][i]).abs() > 1e-9 * (1.0 + m[i][j].abs()) {
+                return Err(invalid(key, m, "must be symmetric"));
+            }
+        }
+    }
+    // Positive definiteness by leading principal minors (Sylvester).
+    let d1 = m[0][0];
+    let d2 = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+    let d3 = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    if !(d1 > 0.0 && d2 > 0.0 && d3 > 0.0) {
+        return Err(invalid(key, m, "must be positive definite"));
+    }
+    let (a, b, c) = (m[0][0], m[1][1], m[2][2]);
+    if a + b < c || b + c < a || a + c < b {
+        return Err(invalid(
+            key,
+            m,
+            "diagonal must satisfy the triangle inequality of a rigid body",
+        ));
+    }
+    Ok(())
+}
+
+impl Scenario {
+    /// Checks every rule; returns the first broken one.
+    pub fn validate(&self) -> Result<(), ScenarioError> {
+        let o = &self.orbit;
+        positive("orbit.earth_mu_m3_s2", o.earth_mu_m3_s2)?;
+        positive("orbit.earth_radius_m", o.earth_radius_m)?;
+        positive("orbit.altitude_m", o.altitude_m)?;
+        finite("orbit.inclination_deg", o.inclination_deg)?;
+        finite("orbit.raan_deg", o.raan_deg)?;
+        finite("orbit.argument_of_latitude_deg", o.argument_of_latitude_deg)?;
+
+        unit(
+            "reference_frame.attitude_in_hill",
+            &self.reference_frame.attitude_in_hill,
+        )?;
+
+        let s = &self.servicer;
+        let urdf = self.urdf_path();
+        if !urdf.is_file() {
+            return Err(invalid(
+                "servicer.urdf",
+                s.urdf.display().to_string(),
+                format!("file not found at {}", urdf.display()),
+            ));
+        }
+        unit("servicer.boresight_body", &s.boresight_body)?;
+        finite_all("servicer.initial_position_m", &s.initial_position_m)?;
+        finite_all("servicer.initial_velocity_m_s", &s.initial_velocity_m_s)?;
+        finite_all("servicer.initial_omega_rad_s", &s.initial_omega_rad_s)?;
+        finite_all("servicer.initial_theta_rad", &s.initial_theta_rad)?;
+        finite_all(
+            "servicer.initial_theta_dot_rad_s",
+            &s.initial_theta_dot_rad_s,
+        )?;
+
+        let t = &self.target;
+        positive("target.mass_kg", t.mass_kg)?;
+        inertia("target.inertia_kg_m2", &t.inertia_kg_m2)?;
+        unit("target.initial_attitude", &t.initial_attitude)?;
+        finite_all("target.initial_omega_rad_s", &t.initial_omega_rad_s)?;
+        finite_all("target.grasp_point_m", &t.grasp_point_m)?;
+
+        let m = &self.mission;
+        positive("mission.control_period_s", m.control_period_s)?;
+        positive("mission.physics_step_s", m.physics_step_s)?;
+        positive("mission.duration_s", m.duration_s)?;
+        positive("mission.capture_tolerance_m", m.capture_tolerance_m)?;
+        positive(
+            "mission.capture_speed_tolerance_m_s",
+            m.capture_speed_tolerance_m_s,
+        )?;
+        let ratio = m.control_period_s / m.physics_step_s;
+        if ratio < 1.0 - 1e-9 || (ratio - ratio.round()).abs() > 1e-9 * ratio {
+            return Err(invalid(
+                "mission.physics_step_s",
+                m.physics_step_s,
+                format!(
+                    "must divide mission.control_period_s = {} into a whole number of steps",
+                    m.control_period_s
+                ),
+            ));
+        }
+        if m.phases.is_empty() {
+            return Err(invalid(
+                "mission.phases",
+                "[]",
+                "at least one phase is required",
+            ));
+        }
+        for (i, p) in m.phases.iter().enumerate() {
+            let key = format!("mission.phases[{i}].start_s");
+            non_negative(&key, p.start_s)?;
+            if i == 0 && p.start_s != 0.0 {
+                return Err(invalid(&key, p.start_s, "the first phase must start at 0"));
+            }
+            if i > 0 && p.start_s <= m.phases[i - 1].start_s {
+                return Err(invalid(
+                    &key,
+                    p.start_s,
+                    "phases must start in strictly increasing order",
+                ));
+            }
+            if p.start_s >= m.duration_s {
+                return Err(invalid(
+                    &key,
+                    p.start_s,
+                    format!("must start before mission.duration_s = {}", m.duration_s),
+                ));
+            }
+        }
+
+        let l = &self.limits;
+        positive("limits.force_max_n", l.force_max_n)?;
+        positive("limits.torque_max_nm", l.torque_max_nm)?;
+        positive("limits.joint_torque_max_nm", l.joint_torque_max_nm)?;
+
+        let sf = &self.safety;
+        positive("safety.gamma_per_s", sf.gamma_per_s)?;
+        let tr = &sf.translational;
+        unit("safety.translational.corridor_axis", &tr.corridor_axis)?;
+        angle_deg(
+            "safety.translational.corridor_half_angle_deg",
+            tr.corridor_half_angle_deg,
+        )?;
+        positive("safety.translational.caz_radius_m", tr.caz_radius_m)?;
+        non_negative("safety.translational.eps_ac", tr.eps_ac)?;
+        non_negative("safety.translational.eps_caz", tr.eps_caz)?;
+        positive("safety.translational.u_max_ac_m_s2", tr.u_max_ac_m_s2)?;
+        positive("safety.translational.u_max_caz_m2_s2", tr.u_max_caz_m2_s2)?;
+
+        let at = &sf.attitude;
+        angle_deg("safety.attitude.los_half_angle_deg", at.los_half_angle_deg)?;
+        finite_all("safety.attitude.omega_max_rad_s", &at.omega_max_rad_s)?;
+        finite_all("safety.attitude.omega_min_rad_s", &at.omega_min_rad_s)?;
+        for i in 0..3 {
+            if at.omega_min_rad_s[i] >= at.omega_max_rad_s[i] {
+                return Err(invalid(
+                    &format!("safety.attitude.omega_min_rad_s[{i}]"),
+                    at.omega_min_rad_s[i],
+                    format!("limits with min >= max (max is {})", at.omega_max_rad_s[i]),
+                ));
+            }
+        }
+        non_negative("safety.attitude.eps_att", at.eps_att)?;
+        non_negative("safety.attitude.eps_omega", at.eps_omega)?;
+        positive("safety.attitude.gamma_omega_per_s", at.gamma_omega_per_s)?;
+        positive("safety.attitude.u_max_att_per_s2", at.u_max_att_per_s2)?;
+
+        let rb = &sf.robotic;
+        finite_all("safety.robotic.theta_min_rad", &rb.theta_min_rad)?;
+        finite_all("safety.robotic.theta_max_rad", &rb.theta_max_rad)?;
+        for i in 0..7 {
+            if rb.theta_min_rad[i] >= rb.theta_max_rad[i] {
+                return Err(invalid(
+                    &format!("safety.robotic.theta_min_rad[{i}]"),
+                    rb.theta_min_rad[i],
+                    format!("limits with min >= max (max is {})", rb.theta_max_rad[i]),
+                ));
+            }
+            positive(
+                &format!("safety.robotic.theta_dot_max_rad_s[{i}]"),
+                rb.theta_dot_max_rad_s[i],
+            )?;
+            let th = s.initial_theta_rad[i];
+            if th <= rb.theta_min_rad[i] || th >= rb.theta_max_rad[i] {
+                return Err(invalid(
+                    &format!("servicer.initial_theta_rad[{i}]"),
+                    th,
+                    format!(
+                        "must lie strictly inside the joint limits ({}, {})",
+                        rb.theta_min_rad[i], rb.theta_max_rad[i]
+                    ),
+                ));
+            }
+        }
+        non_negative("safety.robotic.eps_theta", rb.eps_theta)?;
+        non_negative("safety.robotic.eps_theta_dot", rb.eps_theta_dot)?;
+        non_negative("safety.robotic.eps_lb", rb.eps_lb)?;
+        positive(
+            "safety.robotic.gamma_theta_dot_per_s",
+            rb.gamma_theta_dot_per_s,
+        )?;
+        positive("safety.robotic.u_max_theta_rad2_s2", rb.u_max_theta_rad2_s2)?;
+        positive("safety.robotic.u_max_lb_m2_s2", rb.u_max_lb_m2_s2)?;
+
+        let so = &sf.solver;
+        if so.max_iterations == 0 {
+            return Err(invalid("safety.solver.max_iterations", 0, "must be >= 1"));
+        }
+        if !(so.tolerance > 0.0 && so.tolerance <= 1e-3) {
+            return Err(invalid(
+                "safety.solver.tolerance",
+                so.tolerance,
+                "must be in (0, 1e-3]",
+            ));
+        }
+        positive("safety.solver.slack_weight", so.slack_weight)?;
+
+        let nt = &self.nominal.translational;
+        if nt.horizon_steps == 0 {
+            return Err(invalid(
+                "nominal.translational.horizon_steps",
+                0,
+                "must be >= 1",
+            ));
+        }
+        positive("nominal.translational.gfc_distance_m", nt.gfc_distance_m)?;
+        if nt.gfc_distance_m <= tr.caz_radius_m {
+            return Err(invalid(
+                "nominal.translational.gfc_distance_m",
+                nt.gfc_distance_m,
+                format!(
+                    "the Go-for-Capture point must lie outside the CAZ (R_CAZ = {} m)",
+                    tr.caz_radius_m
+                ),
+            ));
+        }
+        non_negative("nominal.translational.weight_position", nt.weight_position)?;
+        non_negative("nominal.translational.weight_velocity", nt.weight_velocity)?;
+        positive("nominal.translational.weight_force", nt.weight_force)?;
+        non_negative("nominal.translational.weight_terminal", nt.weight_terminal)?;
+        let na = &self.nominal.attitude;
+        non_negative("nominal.attitude.kp_nm_per_rad", na.kp_nm_per_rad)?;
+        non_negative("nominal.attitude.kd_nm_s_per_rad", na.kd_nm_s_per_rad)?;
+        non_negative(
+            "nominal.attitude.sync_gain_nm_s_per_rad",
+            na.sync_gain_nm_s_per_rad,
+        )?;
+        let nr = &self.nominal.robotic;
+        non_negative("nominal.robotic.kp_per_s2", nr.kp_per_s2)?;
+        non_negative("nominal.robotic.kd_per_s", nr.kd_per_s)?;
+        if nr.ik_iterations == 0 {
+            return Err(invalid("nominal.robotic.ik_iterations", 0, "must be >= 1"));
+        }
+        positive("nominal.robotic.ik_damping", nr.ik_damping)?;
+        positive("nominal.robotic.ik_tolerance_m", nr.ik_tolerance_m)?;
+        Ok(())
+    }
+}

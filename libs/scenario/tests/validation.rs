@@ -1,0 +1,160 @@
+//! Every validation rule, one broken value at a time, against the shipped default.
+
+use sc_scenario::{Scenario, ScenarioError};
+use std::path::{Path, PathBuf};
+
+fn config_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config")
+}
+
+fn default_text() -> String {
+    std::fs::read_to_string(config_dir().join("scenario.toml")).unwrap()
+}
+
+/// Replaces the first line starting with `key =` inside `[section]`.
+fn with(section: &str, key: &str, value: &str) -> String {
+    let text = default_text();
+    let mut out = Vec::new();
+    let mut in_section = false;
+    let mut done = false;
+    for line in text.lines() {
+        let trimmed = line.trim_start();
+        if trimmed.starts_with('[') {
+            in_section = trimmed == format!("[{section}]");
+        }
+        if in_section && !done && trimmed.starts_with(&format!("{key} =")) {
+            out.push(format!("{key} = {value}"));
+            done = true;
+        } else {
+            out.push(line.to_string());
+        }
+    }
+    assert!(done, "{section}.{key} not found in the default scenario");
+    out.join("\n")
+}
+
+fn reject(text: &str) -> String {
+    match Scenario::from_toml_str(text, &config_dir()) {
+        Ok(_) => panic!("scenario was accepted"),
+        Err(e) => {
+            let msg = e.to_string();
+            assert!(!msg.contains('\n'), "error must be one line: {msg}");
+            msg
+        }
+    }
+}
+
+#[test]
+fn default_scenario_loads() {
+    let s = Scenario::load(&config_dir().join("scenario.toml")).unwrap();
+    assert_eq!(s.mission.phases.len(), 3);
+    assert_eq!(s.phase_index(0.0), 0);
+    assert_eq!(s.phase_index(60.0), 1);
+    assert_eq!(s.phase_index(150.0), 2);
+    assert_eq!(s.physics_substeps(), 10);
+    assert_eq!(s.limits.force_max_n, 7.0);
+    assert!(s.urdf_path().is_file());
+    // round trip through TOML keeps every value
+    let again = Scenario::from_toml_str(&s.to_toml_string(), &config_dir()).unwrap();
+    assert_eq!(again, s);
+}
+
+#[test]
+fn negative_mass_names_key_value_and_rule() {
+    let msg = reject(&with("target", "mass_kg", "-5.0"));
+    assert!(
+        msg.contains("target.mass_kg") && msg.contains("-5") && msg.contains("> 0"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn non_unit_axis_is_rejected() {
+    let msg = reject(&with(
+        "safety.translational",
+        "corridor_axis",
+        "[-2.0, 0.0, 0.0]",
+    ));
+    assert!(
+        msg.contains("corridor_axis") && msg.contains("unit norm"),
+        "{msg}"
+    );
+    let msg = reject(&with("servicer", "boresight_body", "[0.0, 0.0, 0.0]"));
+    assert!(msg.contains("boresight_body"), "{msg}");
+}
+
+#[test]
+fn limits_with_min_above_max_are_rejected() {
+    let msg = reject(&with(
+        "safety.robotic",
+        "theta_min_rad",
+        "[3.0, -2.0, -2.8, -0.1, -2.8, -2.0, -2.8]",
+    ));
+    assert!(
+        msg.contains("theta_min_rad[0]") && msg.contains("min >= max"),
+        "{msg}"
+    );
+    let msg = reject(&with(
+        "safety.attitude",
+        "omega_min_rad_s",
+        "[-0.2, 0.3, -0.2]",
+    ));
+    assert!(msg.contains("omega_min_rad_s[1]"), "{msg}");
+}
+
+#[test]
+fn missing_urdf_is_rejected() {
+    let msg = reject(&with("servicer", "urdf", "\"no_such_arm.urdf\""));
+    assert!(
+        msg.contains("servicer.urdf") && msg.contains("not found"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn unknown_key_and_bad_type_are_parse_errors_with_a_line() {
+    let text = default_text().replace("[limits]", "[limits]\nforce_mx_n = 3.0");
+    let msg = reject(&text);
+    assert!(msg.contains("force_mx_n") && msg.contains("line"), "{msg}");
+    let msg = reject(&with("limits", "force_max_n", "\"seven\""));
+    assert!(msg.contains("line"), "{msg}");
+}
+
+#[test]
+fn non_finite_and_bad_timing_are_rejected() {
+    let msg = reject(&with("limits", "force_max_n", "nan"));
+    assert!(msg.contains("limits.force_max_n"), "{msg}");
+    let msg = reject(&with("mission", "physics_step_s", "0.03"));
+    assert!(
+        msg.contains("physics_step_s") && msg.contains("whole number"),
+        "{msg}"
+    );
+    let msg = reject(&with("nominal.translational", "gfc_distance_m", "1.0"));
+    assert!(
+        msg.contains("gfc_distance_m") && msg.contains("CAZ"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn non_pd_inertia_is_rejected() {
+    let msg = reject(&with(
+        "target",
+        "inertia_kg_m2",
+        "[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 5.0]]",
+    ));
+    assert!(msg.contains("triangle"), "{msg}");
+    let msg = reject(&with(
+        "target",
+        "inertia_kg_m2",
+        "[[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]]",
+    ));
+    assert!(msg.contains("positive definite"), "{msg}");
+}
+
+#[test]
+fn load_error_names_the_file() {
+    let e = Scenario::load(Path::new("/nonexistent/scenario.toml")).unwrap_err();
+    assert!(matches!(e, ScenarioError::Io { .. }));
+    assert!(e.to_string().contains("/nonexistent/scenario.toml"));
+}
