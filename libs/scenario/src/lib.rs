@@ -173,6 +173,19 @@ pub struct Safety {
     pub attitude: SafetyAttitude,
     pub robotic: SafetyRobotic,
     pub solver: Solver,
+    pub fallback: Fallback,
+}
+
+/// Time constants of the bounded fallback commands (saturated brakes).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Fallback {
+    /// T of f_H = sat(−m v_H / T) [s].
+    pub translational_brake_time_s: f64,
+    /// T of τ_B = sat(−I (ω_B − ω_T,B) / T) [s].
+    pub attitude_brake_time_s: f64,
+    /// T of τ_M = sat(−M(θ) θ̇ / T) [s].
+    pub robotic_brake_time_s: f64,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

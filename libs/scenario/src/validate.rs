@@ -335,6 +335,10 @@ impl Scenario {
             ));
         }
         positive("safety.solver.slack_weight", so.slack_weight)?;
+        let fb = &sf.fallback;
+        positive("safety.fallback.translational_brake_time_s", fb.translational_brake_time_s)?;
+        positive("safety.fallback.attitude_brake_time_s", fb.attitude_brake_time_s)?;
+        positive("safety.fallback.robotic_brake_time_s", fb.robotic_brake_time_s)?;
 
         let nt = &self.nominal.translational;
         if nt.horizon_steps == 0 {
