@@ -50,9 +50,25 @@ def main():
     ap.add_argument("--out", default="tests/reference/pinocchio_reference.generated.json")
     ap.add_argument("--states", type=int, default=60)
     ap.add_argument("--seed", type=int, default=20240601)
+    ap.add_argument("--extra-urdf", action="append", default=None,
+                    help="further test models to include (default: libs/multibody/tests/data/generic_arm.urdf)")
     args = ap.parse_args()
+    extra = args.extra_urdf if args.extra_urdf is not None else ["libs/multibody/tests/data/generic_arm.urdf"]
 
-    urdf = rel(args.urdf)
+    out = generate(args.urdf, args.states, args.seed)
+    out["generator"] = "scripts/pinocchio_reference.py"
+    out["pinocchio_version"] = pin.__version__
+    out["extra_models"] = [generate(e, max(20, args.states // 2), args.seed + 1 + i) for i, e in enumerate(extra)]
+    path = rel(args.out)
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "w") as fh:
+        json.dump(out, fh, indent=1)
+    print(f"wrote {len(out['states'])} states (+{len(extra)} extra models) to {path} (pinocchio {pin.__version__})", file=sys.stderr)
+
+
+def generate(urdf_arg, n_states, seed):
+    """Reference quantities for one URDF."""
+    urdf = rel(urdf_arg)
     model = pin.buildModelFromUrdf(urdf, pin.JointModelFreeFlyer())
     model.gravity = pin.Motion.Zero()
     data = model.createData()
@@ -84,9 +100,9 @@ def main():
     lower = fmodel.lowerPositionLimit
     upper = fmodel.upperPositionLimit
     vlim = fmodel.velocityLimit
-    rng = np.random.default_rng(args.seed)
+    rng = np.random.default_rng(seed)
     states = []
-    for s in range(args.states):
+    for s in range(n_states):
         pos = rng.uniform(-5.0, 5.0, 3)
         quat = rng.normal(size=4)
         quat /= np.linalg.norm(quat)  # x y z w
@@ -178,20 +194,12 @@ def main():
             "spheres": sph,
         })
 
-    out = {
-        "generator": "scripts/pinocchio_reference.py",
-        "pinocchio_version": pin.__version__,
-        "urdf": args.urdf,
-        "seed": args.seed,
+    return {
+        "urdf": urdf_arg,
+        "seed": seed,
         "total_mass": float(sum(I.mass for I in model.inertias)),
         "states": states,
     }
-    path = rel(args.out)
-    os.makedirs(os.path.dirname(path), exist_ok=True)
-    with open(path, "w") as fh:
-        json.dump(out, fh, indent=1)
-    print(f"wrote {len(states)} states to {path} (pinocchio {pin.__version__})", file=sys.stderr)
-
 
 if __name__ == "__main__":
     main()

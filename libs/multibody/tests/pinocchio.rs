@@ -72,18 +72,36 @@ fn matches_pinocchio_reference() {
         }
     };
     let doc: Value = serde_json::from_str(&text).expect("valid JSON");
-    let urdf = doc["urdf"].as_str().unwrap_or("config/servicer.urdf");
-    let robot = Robot::from_urdf_file(&root().join(urdf)).expect("URDF loads");
-    let states = doc["states"].as_array().expect("states");
-    assert!(states.len() >= 50, "need >= 50 states, got {}", states.len());
-
     let mut c = Checker {
         worst: 0.0,
         failures: Vec::new(),
         count: 0,
     };
+    let n = check_model(&doc, &mut c);
+    assert!(n >= 50, "need >= 50 states for the servicer, got {n}");
+    let mut n_total = n;
+    for extra in doc["extra_models"].as_array().into_iter().flatten() {
+        n_total += check_model(extra, &mut c);
+    }
+    eprintln!(
+        "pinocchio cross-check: {} states, {} values, worst relative error {:.3e}",
+        n_total, c.count, c.worst
+    );
+    assert!(
+        c.failures.is_empty(),
+        "{} mismatches (first 20):\n{}",
+        c.failures.len(),
+        c.failures[..c.failures.len().min(20)].join("\n")
+    );
+}
+
+/// Compare one model's reference states; returns the number of states.
+fn check_model(doc: &Value, c: &mut Checker) -> usize {
+    let urdf = doc["urdf"].as_str().expect("urdf path");
+    let robot = Robot::from_urdf_file(&root().join(urdf)).expect("URDF loads");
+    let states = doc["states"].as_array().expect("states");
     c.check(
-        "total_mass",
+        &format!("{urdf} total_mass"),
         0,
         robot.total_mass(),
         doc["total_mass"].as_f64().expect("mass"),
@@ -197,16 +215,5 @@ fn matches_pinocchio_reference() {
             );
         }
     }
-    eprintln!(
-        "pinocchio cross-check: {} states, {} values, worst relative error {:.3e}",
-        states.len(),
-        c.count,
-        c.worst
-    );
-    assert!(
-        c.failures.is_empty(),
-        "{} mismatches (first 20):\n{}",
-        c.failures.len(),
-        c.failures[..c.failures.len().min(20)].join("\n")
-    );
+    states.len()
 }
