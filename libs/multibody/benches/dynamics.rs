@@ -18,8 +18,10 @@ fn bench(c: &mut Criterion) {
     let theta = Vector7::from_column_slice(&[0.1, -0.9, 0.3, 1.7, -0.2, -0.6, 0.4]);
     let theta_dot = Vector7::from_column_slice(&[0.05, -0.1, 0.2, 0.1, -0.3, 0.25, 0.1]);
     let mut nu = Vector13::zeros();
-    nu.fixed_rows_mut::<3>(0).copy_from(&Vector3::new(0.02, -0.01, 0.03));
-    nu.fixed_rows_mut::<3>(3).copy_from(&Vector3::new(0.05, -0.08, 0.02));
+    nu.fixed_rows_mut::<3>(0)
+        .copy_from(&Vector3::new(0.02, -0.01, 0.03));
+    nu.fixed_rows_mut::<3>(3)
+        .copy_from(&Vector3::new(0.05, -0.08, 0.02));
     nu.fixed_rows_mut::<7>(6).copy_from(&theta_dot);
     let u = Vector13::from_column_slice(&[
         3.0, -2.0, 1.0, 5.0, -4.0, 2.0, 1.0, -1.5, 0.5, 2.0, -0.7, 0.3, 1.1,

@@ -118,8 +118,7 @@ impl Robot {
             ic[i] = ic[i].add(&t);
         }
         let mut m = Matrix13::zeros();
-        m.fixed_view_mut::<6, 6>(0, 0)
-            .copy_from(&ic[0].to_matrix());
+        m.fixed_view_mut::<6, 6>(0, 0).copy_from(&ic[0].to_matrix());
         for i in 0..NJ {
             let s = Motion::new(Vector3::zeros(), self.joints[i].axis);
             let mut fi = ic[i + 1].mul_motion(&s);
@@ -134,7 +133,8 @@ impl Robot {
             }
             let fv = fi.to_vector6();
             m.fixed_view_mut::<6, 1>(0, NB + i).copy_from(&fv);
-            m.fixed_view_mut::<1, 6>(NB + i, 0).copy_from(&fv.transpose());
+            m.fixed_view_mut::<1, 6>(NB + i, 0)
+                .copy_from(&fv.transpose());
         }
         m
     }
@@ -142,7 +142,12 @@ impl Robot {
     /// Articulated-body algorithm: free-flyer forward dynamics `ν̇ = FD(θ, ν, u)` with exactly
     /// Pinocchio `aba`'s output convention (see the module doc). `None` only if the model is
     /// numerically singular (cannot happen for a validated model with finite inputs).
-    pub fn forward_dynamics(&self, theta: &Vector7, nu: &Vector13, u: &Vector13) -> Option<Vector13> {
+    pub fn forward_dynamics(
+        &self,
+        theta: &Vector7,
+        nu: &Vector13,
+        u: &Vector13,
+    ) -> Option<Vector13> {
         let v0 = Motion::new(nu.fixed_rows::<3>(0).into(), nu.fixed_rows::<3>(3).into());
         let qd: Vector7 = nu.fixed_rows::<NJ>(NB).into();
         self.aba(theta, &v0, &qd, u)
@@ -164,7 +169,12 @@ impl Robot {
         theta_dot: &Vector7,
         u: &Vector13,
     ) -> Option<Vector13> {
-        self.aba(theta, &Motion::new(Vector3::zeros(), *omega_b), theta_dot, u)
+        self.aba(
+            theta,
+            &Motion::new(Vector3::zeros(), *omega_b),
+            theta_dot,
+            u,
+        )
     }
 
     fn aba(&self, theta: &Vector7, v0: &Motion, qd: &Vector7, u: &Vector13) -> Option<Vector13> {
@@ -202,7 +212,8 @@ impl Robot {
             let u_i = u[NB + i] - s.dot(&pa[b].ang);
             let mut iab = ia[b];
             iab.sub_rank1(&ul_i, &ua_i, di);
-            let pab = pa[b] + iab.mul_motion(&c[b]) + Force::new(ul_i * (u_i * di), ua_i * (u_i * di));
+            let pab =
+                pa[b] + iab.mul_motion(&c[b]) + Force::new(ul_i * (u_i * di), ua_i * (u_i * di));
             let t = iab.transformed(&x[i]);
             ia[i].add_assign(&t);
             pa[i] = pa[i] + x[i].act_force(&pab);
@@ -240,7 +251,9 @@ impl Robot {
     pub fn arm_coriolis(&self, theta: &Vector7, theta_dot: &Vector7) -> Vector7 {
         let mut nu = Vector13::zeros();
         nu.fixed_rows_mut::<NJ>(NB).copy_from(theta_dot);
-        self.nonlinear_effects(theta, &nu).fixed_rows::<NJ>(NB).into()
+        self.nonlinear_effects(theta, &nu)
+            .fixed_rows::<NJ>(NB)
+            .into()
     }
 
     /// Fixed-base arm forward dynamics `θ̈ = M⁻¹ (τ_M − C θ̇)` (rad/s²).

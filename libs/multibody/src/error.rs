@@ -52,7 +52,9 @@ pub enum ModelError {
     UnsupportedJoint { joint: String, kind: String },
     #[error("found {found} revolute joints (rule: exactly {expected} revolute joints)")]
     JointCount { found: usize, expected: usize },
-    #[error("joint '{joint}' refers to unknown link '{link}' (rule: parent/child links must exist)")]
+    #[error(
+        "joint '{joint}' refers to unknown link '{link}' (rule: parent/child links must exist)"
+    )]
     UnknownLink { joint: String, link: String },
     #[error("duplicate {what} name '{name}' (rule: names must be unique)")]
     DuplicateName { what: &'static str, name: String },

@@ -314,7 +314,8 @@ impl ArticulatedInertia {
         let mut m = Matrix6::zeros();
         m.fixed_view_mut::<3, 3>(0, 0).copy_from(&self.a);
         m.fixed_view_mut::<3, 3>(0, 3).copy_from(&self.b);
-        m.fixed_view_mut::<3, 3>(3, 0).copy_from(&self.b.transpose());
+        m.fixed_view_mut::<3, 3>(3, 0)
+            .copy_from(&self.b.transpose());
         m.fixed_view_mut::<3, 3>(3, 3).copy_from(&self.d);
         m
     }

@@ -66,10 +66,16 @@ fn rnea_crba_aba_are_consistent() {
             let m = r.mass_matrix(&th);
             let b = r.nonlinear_effects(&th, &nu);
             let tau = r.rnea(&th, &nu, &nud);
-            assert!((tau - (m * nud + b)).amax() < 1e-10, "{name} rnea = M a + b");
+            assert!(
+                (tau - (m * nud + b)).amax() < 1e-10,
+                "{name} rnea = M a + b"
+            );
             let a = r.forward_dynamics(&th, &nu, &u).unwrap();
             let a_ref = m.cholesky().unwrap().solve(&(u - b));
-            assert!((a - a_ref).amax() < 1e-10 * a_ref.amax().max(1.0), "{name} aba");
+            assert!(
+                (a - a_ref).amax() < 1e-10 * a_ref.amax().max(1.0),
+                "{name} aba"
+            );
             // kinetic energy = ½ νᵀ M ν
             let ke = r.kinetic_energy(&th, &nu);
             assert!((ke - 0.5 * nu.dot(&(m * nu))).abs() < 1e-12 * ke.max(1.0));
@@ -94,15 +100,25 @@ fn internal_dynamics_do_not_depend_on_base_linear_velocity() {
             let w = Vector3::new(nu[3], nu[4], nu[5]);
             let qd: Vector7 = nu.fixed_rows::<7>(6).into();
             let sim = r.forward_dynamics_sim(&th, &w, &qd, &u).unwrap();
-            nu.fixed_rows_mut::<3>(0)
-                .copy_from(&Vector3::new(rng.uniform(-50.0, 50.0), 3.0, -20.0));
+            nu.fixed_rows_mut::<3>(0).copy_from(&Vector3::new(
+                rng.uniform(-50.0, 50.0),
+                3.0,
+                -20.0,
+            ));
             let v = Vector3::new(nu[0], nu[1], nu[2]);
             let a = r.forward_dynamics(&th, &nu, &u).unwrap();
             let cls = Vector3::new(a[0], a[1], a[2]) + w.cross(&v);
-            assert!((cls - sim.fixed_rows::<3>(0)).amax() < 1e-10, "{name} classical accel");
+            assert!(
+                (cls - sim.fixed_rows::<3>(0)).amax() < 1e-10,
+                "{name} classical accel"
+            );
             // precision degrades with |v_B| (large cancelling velocity terms): ~1e-15 |v_B| /m
             let err = (a.fixed_rows::<10>(3) - sim.fixed_rows::<10>(3)).amax();
-            assert!(err < 1e-11 * v.norm().max(1.0), "{name}: {err} at |v| = {}", v.norm());
+            assert!(
+                err < 1e-11 * v.norm().max(1.0),
+                "{name}: {err} at |v| = {}",
+                v.norm()
+            );
         }
     }
 }
@@ -115,7 +131,8 @@ fn reduced_arm_dynamics_equal_full_forward_dynamics() {
             let th = rng.theta(&r);
             let qd = rng.vec7(0.5);
             let w = Vector3::new(rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.2), 0.1);
-            let wrench = Vector6::from_fn(|i, _| rng.uniform(-10.0, 10.0) * if i < 3 { 0.7 } else { 1.0 });
+            let wrench =
+                Vector6::from_fn(|i, _| rng.uniform(-10.0, 10.0) * if i < 3 { 0.7 } else { 1.0 });
             let red = r.reduced_arm_dynamics(&th, &qd, &w, &wrench).unwrap();
             assert!((red.m_eff - red.m_eff.transpose()).amax() < 1e-14);
             assert!(red.m_eff.symmetric_eigen().eigenvalues.min() > 0.0);
@@ -130,7 +147,10 @@ fn reduced_arm_dynamics_equal_full_forward_dynamics() {
                 u.fixed_rows_mut::<7>(6).copy_from(&tm);
                 let full = r.forward_dynamics_sim(&th, &w, &qd, &u).unwrap();
                 let err = (full.fixed_rows::<7>(6) - qdd).amax();
-                assert!(err < 1e-11 * qdd.amax().max(1.0), "{name}: θ̈ mismatch {err}");
+                assert!(
+                    err < 1e-11 * qdd.amax().max(1.0),
+                    "{name}: θ̈ mismatch {err}"
+                );
             }
         }
     }
@@ -150,7 +170,9 @@ fn deriv(r: &Robot, s: &State) -> (Vector3<f64>, Matrix3<f64>, Vector7, Vector13
     let v = Vector3::new(s.nu[0], s.nu[1], s.nu[2]);
     let w = Vector3::new(s.nu[3], s.nu[4], s.nu[5]);
     let wx = Matrix3::new(0.0, -w.z, w.y, w.z, 0.0, -w.x, -w.y, w.x, 0.0);
-    let a = r.forward_dynamics(&s.th, &s.nu, &Vector13::zeros()).unwrap();
+    let a = r
+        .forward_dynamics(&s.th, &s.nu, &Vector13::zeros())
+        .unwrap();
     (s.rot * v, s.rot * wx, s.nu.fixed_rows::<7>(6).into(), a)
 }
 
@@ -208,8 +230,14 @@ fn free_flyer_conserves_momentum_and_energy_under_zero_input() {
             (l1 - l0).norm(),
             (e1 - e0) / e0
         );
-        assert!((p1 - p0).norm() < 1e-9 * p0.norm().max(1.0), "{name} linear momentum");
-        assert!((l1 - l0).norm() < 1e-8 * l0.norm().max(1.0), "{name} angular momentum");
+        assert!(
+            (p1 - p0).norm() < 1e-9 * p0.norm().max(1.0),
+            "{name} linear momentum"
+        );
+        assert!(
+            (l1 - l0).norm() < 1e-8 * l0.norm().max(1.0),
+            "{name} angular momentum"
+        );
         assert!(((e1 - e0) / e0).abs() < 1e-8, "{name} energy");
         // CoM moves uniformly: m ċ = P (checked on the momentum struct at the end state)
         let mo = r.momentum(&s.th, &s.nu);

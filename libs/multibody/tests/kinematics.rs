@@ -34,8 +34,14 @@ fn jacobians_match_finite_differences_of_fk() {
                 let dr = (r.ee_rotation(&kp) - r.ee_rotation(&km)) / (2.0 * h);
                 let w = vee(&(dr * r.ee_rotation(&kin).transpose()));
                 for k in 0..3 {
-                    assert!((je[(k, j)] - dp[k]).abs() < 1e-8, "{name} J_E lin ({k},{j})");
-                    assert!((je[(3 + k, j)] - w[k]).abs() < 1e-8, "{name} J_E ang ({k},{j})");
+                    assert!(
+                        (je[(k, j)] - dp[k]).abs() < 1e-8,
+                        "{name} J_E lin ({k},{j})"
+                    );
+                    assert!(
+                        (je[(3 + k, j)] - w[k]).abs() < 1e-8,
+                        "{name} J_E ang ({k},{j})"
+                    );
                 }
                 for (idx, s) in r.collision_spheres().iter().enumerate() {
                     let js = r.sphere_state(&kin, idx).unwrap().jacobian;
@@ -108,9 +114,15 @@ fn servicer_design_properties() {
         assert!(eff[i] >= 2.0);
     }
     // exactly one base sphere, three per arm link
-    assert_eq!(r.collision_spheres().iter().filter(|s| s.link == 0).count(), 1);
+    assert_eq!(
+        r.collision_spheres().iter().filter(|s| s.link == 0).count(),
+        1
+    );
     for k in 1..=NJ {
-        assert_eq!(r.collision_spheres().iter().filter(|s| s.link == k).count(), 3);
+        assert_eq!(
+            r.collision_spheres().iter().filter(|s| s.link == k).count(),
+            3
+        );
     }
     // reach: fully stretched along +x
     let kin = r.kinematics(&Vector7::zeros());
@@ -126,7 +138,10 @@ fn stowed_configuration_is_clear_of_the_base() {
     let th0 = Vector7::from_fn(|i, _| THETA0_DEG[i].to_radians());
     let (lo, hi, _, _) = r.joint_limit_arrays();
     for i in 0..NJ {
-        assert!(th0[i] > lo[i] + 0.1 && th0[i] < hi[i] - 0.1, "θ0 inside limits");
+        assert!(
+            th0[i] > lo[i] + 0.1 && th0[i] < hi[i] - 0.1,
+            "θ0 inside limits"
+        );
     }
     let clr = base_clearance(&r, &th0);
     eprintln!("stowed clearance to base sphere: {clr:.4} m");
@@ -138,8 +153,8 @@ fn stowed_configuration_is_clear_of_the_base() {
 #[test]
 fn reach_configuration_puts_ee_1p1_m_in_front_of_the_mount() {
     let r = servicer();
-    let th = Vector7::from_column_slice(&[0.0, -47.0, 0.0, 94.0, 0.0, -47.0, 0.0])
-        .map(f64::to_radians);
+    let th =
+        Vector7::from_column_slice(&[0.0, -47.0, 0.0, 94.0, 0.0, -47.0, 0.0]).map(f64::to_radians);
     let kin = r.kinematics(&th);
     let mount = kin.pose[1].trans;
     let d = r.ee_position(&kin) - mount;

@@ -40,8 +40,9 @@ impl Checker {
         let err = (got - want).abs() / want.abs().max(1.0);
         self.worst = self.worst.max(err);
         if err > TOL || !got.is_finite() {
-            self.failures
-                .push(format!("state {state} {what}: got {got:.15e}, pinocchio {want:.15e}"));
+            self.failures.push(format!(
+                "state {state} {what}: got {got:.15e}, pinocchio {want:.15e}"
+            ));
         }
     }
     fn check_slice(&mut self, what: &str, state: usize, got: &[f64], want: &[f64]) {
@@ -59,7 +60,10 @@ fn matches_pinocchio_reference() {
         Ok(t) => t,
         Err(e) => {
             if std::env::var("SC_SKIP_PINOCCHIO").as_deref() == Ok("1") {
-                eprintln!("SKIPPED: {} missing ({e}) and SC_SKIP_PINOCCHIO=1", file.display());
+                eprintln!(
+                    "SKIPPED: {} missing ({e}) and SC_SKIP_PINOCCHIO=1",
+                    file.display()
+                );
                 return;
             }
             panic!(
@@ -130,8 +134,18 @@ fn check_model(doc: &Value, c: &mut Checker) -> usize {
         let v_lin = Vector3::new(nu[0], nu[1], nu[2]);
         let a_ref = vecf(&st["aba"]);
         let a_cls = Vector3::new(a_ref[0], a_ref[1], a_ref[2]) + omega.cross(&v_lin);
-        c.check_slice("sim a_B classical", s, &sim.as_slice()[..3], a_cls.as_slice());
-        c.check_slice("sim omega_dot/theta_ddot", s, &sim.as_slice()[3..], &a_ref[3..]);
+        c.check_slice(
+            "sim a_B classical",
+            s,
+            &sim.as_slice()[..3],
+            a_cls.as_slice(),
+        );
+        c.check_slice(
+            "sim omega_dot/theta_ddot",
+            s,
+            &sim.as_slice()[3..],
+            &a_ref[3..],
+        );
 
         let kin = robot.kinematics_vel(&theta, &theta_dot);
         c.check_slice(
@@ -201,8 +215,18 @@ fn check_model(doc: &Value, c: &mut Checker) -> usize {
                 .unwrap_or_else(|| panic!("sphere {link}#{k} not in the Rust model"));
             let ss = robot.sphere_state(&kin, idx).expect("sphere");
             let what = format!("sphere {link}#{k}");
-            c.check(&format!("{what} radius"), s, ss.radius, rs["radius"].as_f64().unwrap());
-            c.check_slice(&format!("{what} centre"), s, ss.center.as_slice(), &vecf(&rs["center"]));
+            c.check(
+                &format!("{what} radius"),
+                s,
+                ss.radius,
+                rs["radius"].as_f64().unwrap(),
+            );
+            c.check_slice(
+                &format!("{what} centre"),
+                s,
+                ss.center.as_slice(),
+                &vecf(&rs["center"]),
+            );
             for (i, row) in mat(&rs["jacobian"]).iter().enumerate() {
                 let got: Vec<f64> = (0..7).map(|j| ss.jacobian[(i, j)]).collect();
                 c.check_slice(&format!("{what} J row {i}"), s, &got, row);
