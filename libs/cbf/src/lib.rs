@@ -1,1 +1,62 @@
-//! Control barrier functions and the three safety filters.
+//! Control barrier functions and the three CBF-QP safety filters of the paper
+//! (Sec. "Method"): translational → attitude → robotic, in causal order, each downstream
+//! filter taking the upstream safe commands as its known coupling ξ.
+//!
+//! * [`barrier`]: the generic rows — relative degree one `ḣ + γh − ε ≥ 0` and relative
+//!   degree two through the auxiliary barrier `H = h + |ḣ|ḣ/(2u_max)`.
+//! * [`translational`], [`attitude`], [`robotic`]: every constraint as its own function
+//!   citing its paper equation, and the filter.
+//! * [`qp`]: the Clarabel-based QP engine (built once, updated in place, skip path,
+//!   relaxed problem).
+//! * [`common`]: outputs, reports, [`faults`] flags.
+//!
+//! Every filter call is deterministic: the same input sequence gives bit-identical commands
+//! and reports (except `solve_time_ns`), and the result of a call does not depend on the
+//! calls before it. A filter never panics, never outputs a non-finite command and never
+//! one outside its input bounds.
+
+pub mod attitude;
+pub mod barrier;
+pub mod common;
+pub mod qp;
+pub mod robotic;
+pub mod translational;
+
+pub use attitude::{AttitudeFilter, AttitudeInput, AttitudeParams};
+pub use barrier::{RelDegOne, RelDegTwo, Row};
+pub use common::{FilterOutput, FilterReport, FilterStatus, faults};
+pub use qp::{QpDump, QpOutcome, SolverParams};
+pub use robotic::{RoboticFilter, RoboticInput, RoboticParams, robotic_input_from_model};
+pub use translational::{TranslationalFilter, TranslationalInput, TranslationalParams};
+
+/// Output of the translational filter: `u = f_H`, `actuated = f_B` (2 constraints).
+pub type TranslationalOutput = FilterOutput<3, { translational::N }>;
+/// Output of the attitude filter: `τ_B` (7 constraints).
+pub type AttitudeOutput = FilterOutput<3, { attitude::N }>;
+/// Output of the robotic filter: `τ_M` (42 constraints).
+pub type RoboticOutput = FilterOutput<7, { robotic::N }>;
+
+/// The three filters of the modular safety layer.
+pub struct SafetyLayer {
+    pub translational: TranslationalFilter,
+    pub attitude: AttitudeFilter,
+    pub robotic: RoboticFilter,
+}
+
+impl SafetyLayer {
+    /// All three filters from the scenario; `mass` is the servicer's total mass [kg].
+    pub fn from_scenario(s: &sc_scenario::Scenario, mass: f64) -> Self {
+        Self {
+            translational: TranslationalFilter::from_scenario(s, mass),
+            attitude: AttitudeFilter::from_scenario(s),
+            robotic: RoboticFilter::from_scenario(s),
+        }
+    }
+}
+
+/// Stable constraint names of the three filters, in report order.
+pub mod names {
+    pub use crate::attitude::NAMES as ATTITUDE;
+    pub use crate::robotic::NAMES as ROBOTIC;
+    pub use crate::translational::NAMES as TRANSLATIONAL;
+}

@@ -1,0 +1,208 @@
+//! Output, report, status and fault flags shared by the three filters, plus the input
+//! validation helpers.
+
+use crate::barrier::Row;
+use nalgebra::{SVector, Vector3};
+use sc_models::quat::{self, Quat};
+use serde::{Deserialize, Serialize};
+
+/// Fault flags (`FilterReport::faults`, a `u32` bitset). Stable: telemetry stores them.
+pub mod faults {
+    /// The state (or a parameter carried with it, e.g. the inertia) is non-finite or out of
+    /// its documented range; the fallback command is used (zero when the state itself
+    /// cannot be trusted).
+    pub const INVALID_STATE: u32 = 1 << 0;
+    /// The nominal command is non-finite or beyond `NOMINAL_RANGE × bound`; fallback used.
+    pub const INVALID_NOMINAL: u32 = 1 << 1;
+    /// The upstream coupling ξ is non-finite or out of range; fallback used (the
+    /// certificate cannot be computed without the coupling).
+    pub const INVALID_COUPLING: u32 = 1 << 2;
+    /// The CBF-QP was infeasible or failed; the relaxed QP (one slack on the barrier rows,
+    /// bounds hard) produced the command.
+    pub const QP_INFEASIBLE_RELAXED: u32 = 1 << 3;
+    /// The relaxed QP failed too (or no solver could be built); the bounded fallback was used.
+    pub const QP_FAILED_FALLBACK: u32 = 1 << 4;
+    /// Set by callers: the upstream safe command was missing (ξ assumed zero or stale).
+    pub const UPSTREAM_MISSING: u32 = 1 << 5;
+    /// The last-line clamp to the input bounds changed the command by more than 1e-9.
+    pub const OUTPUT_CLAMPED: u32 = 1 << 6;
+    /// All flags, for masks.
+    pub const ALL: u32 = (1 << 7) - 1;
+
+    /// Names of the flags in bit order.
+    pub const NAMES: [&str; 7] = [
+        "invalid_state",
+        "invalid_nominal",
+        "invalid_coupling",
+        "qp_infeasible_relaxed",
+        "qp_failed_fallback",
+        "upstream_missing",
+        "output_clamped",
+    ];
+}
+
+/// A nominal command is rejected when `‖u_nom‖∞ > NOMINAL_RANGE × bound` (it would only be
+/// clipped anyway, and astronomically large costs ruin the solver's conditioning).
+pub const NOMINAL_RANGE: f64 = 1e3;
+/// The QP's box is shrunk by this relative margin so that the solver's feasibility
+/// tolerance (1e-8) never pushes the solution beyond the true bound; the last-line clamp
+/// then only acts on genuine faults.
+pub const BOX_MARGIN: f64 = 1e-7;
+/// A constraint is reported active when `Φ(u) ≤ ACTIVE_TOL · max(1, ‖∂Φ/∂u‖)`.
+pub const ACTIVE_TOL: f64 = 1e-6;
+/// Changes of the last-line clamp above this are flagged [`faults::OUTPUT_CLAMPED`].
+pub const CLAMP_FLAG_TOL: f64 = 1e-9;
+/// Accepted deviation of a quaternion's norm from 1 (it is renormalised).
+pub const QUAT_NORM_TOL: f64 = 1e-3;
+
+/// How the command of one filter call was produced.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[repr(u8)]
+pub enum FilterStatus {
+    /// The nominal command satisfied every row and bound and was returned unchanged.
+    Skipped = 0,
+    /// The CBF-QP was solved.
+    Solved = 1,
+    /// The relaxed QP was solved (see [`faults::QP_INFEASIBLE_RELAXED`]).
+    Relaxed = 2,
+    /// The bounded fallback command was used (see the fault flags for why).
+    #[default]
+    Fallback = 3,
+}
+
+/// Per-call report of a filter with `N` constraints.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FilterReport<const N: usize> {
+    /// Barrier values `h_i` (NaN when the state is invalid).
+    pub h: [f64; N],
+    /// CBF conditions `Φ_i` (or `φ_i`) at the returned command (NaN when not computable).
+    pub phi: [f64; N],
+    /// Bit `i` set when constraint `i` is active (`Φ_i ≤ ACTIVE_TOL·max(1,‖∂Φ_i/∂u‖)`).
+    pub active: u64,
+    pub status: FilterStatus,
+    /// Interior-point iterations (hard + relaxed QP).
+    pub iterations: u32,
+    /// Wall time of the whole filter call [ns] — the only nondeterministic output.
+    pub solve_time_ns: u64,
+    /// [`faults`] bitset.
+    pub faults: u32,
+    /// Slack of the relaxed QP (0 otherwise), in units of the normalised rows.
+    pub slack: f64,
+}
+
+impl<const N: usize> Default for FilterReport<N> {
+    fn default() -> Self {
+        Self {
+            h: [f64::NAN; N],
+            phi: [f64::NAN; N],
+            active: 0,
+            status: FilterStatus::Fallback,
+            iterations: 0,
+            solve_time_ns: 0,
+            faults: 0,
+            slack: 0.0,
+        }
+    }
+}
+
+impl<const N: usize> FilterReport<N> {
+    /// Every field except the solve time, as bits — for determinism checks.
+    pub fn deterministic_bits(&self) -> Vec<u64> {
+        let mut v: Vec<u64> = self.h.iter().map(|x| x.to_bits()).collect();
+        v.extend(self.phi.iter().map(|x| x.to_bits()));
+        v.extend([
+            self.active,
+            self.status as u64,
+            self.iterations as u64,
+            self.faults as u64,
+            self.slack.to_bits(),
+        ]);
+        v
+    }
+}
+
+/// Safe command of a filter with `M` inputs and `N` constraints.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FilterOutput<const M: usize, const N: usize> {
+    /// The safe command in the filter's frame (`f_H`, `τ_B`, `τ_M`).
+    pub u: SVector<f64, M>,
+    /// The command in the actuator frame: `f_B = R_BH f_H` for the translational filter,
+    /// `u` itself for the others.
+    pub actuated: SVector<f64, M>,
+    pub report: FilterReport<N>,
+}
+
+/// `v · min(1, limit/‖v‖∞)`: saturation that keeps the direction (zero if not finite).
+pub fn sat_inf<const M: usize>(v: &SVector<f64, M>, limit: f64) -> SVector<f64, M> {
+    if !v.iter().all(|x| x.is_finite()) {
+        return SVector::zeros();
+    }
+    let m = v.amax();
+    if m > limit && m > 0.0 {
+        v * (limit / m)
+    } else {
+        *v
+    }
+}
+
+/// Clamps every component to `[−limit, limit]`; returns the clamped vector and whether
+/// any component moved by more than [`CLAMP_FLAG_TOL`]. Non-finite components become 0.
+pub fn clamp_box<const M: usize>(v: &SVector<f64, M>, limit: f64) -> (SVector<f64, M>, bool) {
+    let mut out = *v;
+    let mut flagged = false;
+    for x in out.iter_mut() {
+        let c = if x.is_finite() {
+            x.clamp(-limit, limit)
+        } else {
+            0.0
+        };
+        if !x.is_finite() || (c - *x).abs() > CLAMP_FLAG_TOL {
+            flagged = true;
+        }
+        *x = c;
+    }
+    (out, flagged)
+}
+
+/// All components finite.
+pub fn finite<const R: usize, const C: usize>(m: &nalgebra::SMatrix<f64, R, C>) -> bool {
+    m.iter().all(|x| x.is_finite())
+}
+
+/// All components finite and `‖v‖₂ ≤ max`.
+pub fn in_range3(v: &Vector3<f64>, max: f64) -> bool {
+    finite(v) && v.norm() <= max
+}
+
+/// A finite quaternion with `|‖q‖ − 1| ≤ QUAT_NORM_TOL`, renormalised.
+pub fn unit_quat(q: &Quat) -> Option<Quat> {
+    if !q.iter().all(|x| x.is_finite()) {
+        return None;
+    }
+    let n = quat::norm(q);
+    if (n - 1.0).abs() > QUAT_NORM_TOL {
+        return None;
+    }
+    quat::normalized(q)
+}
+
+/// A nominal command is valid when finite and `‖u‖∞ ≤ NOMINAL_RANGE × bound`.
+pub fn nominal_valid<const M: usize>(u: &SVector<f64, M>, bound: f64) -> bool {
+    finite(u) && u.amax() <= NOMINAL_RANGE * bound
+}
+
+/// Fills `h`, `phi` and the active mask from the rows at the returned command.
+pub fn evaluate_rows<const M: usize, const N: usize>(
+    rows: &[Row<M>; N],
+    u: &SVector<f64, M>,
+    report: &mut FilterReport<N>,
+) {
+    report.active = 0;
+    for (i, r) in rows.iter().enumerate() {
+        let phi = r.phi(u);
+        report.phi[i] = phi;
+        if phi <= ACTIVE_TOL * r.a.norm().max(1.0) {
+            report.active |= 1u64 << i;
+        }
+    }
+}
