@@ -1,0 +1,221 @@
+//! Nominal attitude controller: boresight pointing at the grasping point and, in the
+//! synchronisation phase, angular-rate synchronisation with the tumbling target
+//! (paper, Sec. "Concept of Operations", phase II, and Sec. "Nominal Controllers").
+//!
+//! The paper uses an attitude MPC [Stadler2026] with its constraints removed; this is
+//! an equivalent unconstrained tracking law: a geometric pointing PD with
+//! gyroscopic and reference-rate feed-forward,
+//! ```text
+//! τ_B = k_p φ ê + k_ω (ω_ref − ω_B) + ω_B × (I ω_B) + I ω̇_ref ,
+//! ```
+//! * `φ ê` (F_B): the smallest rotation that turns the boresight `d_B` onto the
+//!   line of sight `s_B = R_BR s_R` (paper, eq. of `s_R(t)`), `ê ∥ d_B × s_B`,
+//!   `φ = ∠(d_B, s_B)`; the rotation about the boresight is left free.
+//! * **point** mode: `ω_ref` is the inertial rate of the line of sight,
+//!   `ω_LOS = s_R × (v_G,R − v_R) / ρ` expressed in F_B, and `k_ω = k_d`.
+//! * **point and sync** mode: `ω_ref = R_BT ω_T` (the target's rate expressed in
+//!   F_B), and `k_ω = k_sync`. `ω̇_ref = −ω_B × ω_ref + R_BT ω̇_T` (torque-free
+//!   target, Euler's equation with the target inertia).
+//!
+//! The law is deliberately **unaware of the line-of-sight cone** (β_ATT) and of the
+//! angular-rate limits: with the servicer off the target's spin axis, the target
+//! rate is not consistent with keeping the grasping point on the boresight, and the
+//! stiff rate loop transiently drags the boresight out of the cone at the switch to
+//! synchronisation, which the attitude safety filter must prevent. `τ_B` [N m] is
+//! **not saturated**.
+
+use nalgebra::Matrix3;
+use sc_models::quat::{self, Quat};
+use sc_models::{Mat3, Vec3};
+
+/// Which reference the attitude controller tracks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AttitudeTask {
+    /// Boresight on the grasping point, rate reference = line-of-sight rate.
+    Point,
+    /// Boresight on the grasping point, rate reference = target rate.
+    PointAndSync,
+}
+
+/// Gains of [`AttitudeController`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AttitudeGains {
+    /// `k_p` [N m/rad].
+    pub kp: f64,
+    /// `k_d`, rate gain in point mode [N m s/rad].
+    pub kd: f64,
+    /// `k_sync`, rate gain in sync mode [N m s/rad].
+    pub k_sync: f64,
+}
+
+/// Observation needed by the attitude controller. SI units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AttitudeInput {
+    /// `q_RB`: servicer attitude, rotates F_B vectors into F_R.
+    pub q_rb: Quat,
+    /// `ω_B`: servicer angular velocity w.r.t. F_R (= inertial), in F_B [rad/s].
+    pub omega_b: Vec3,
+    /// Servicer inertia about its centre of mass, in F_B [kg m²].
+    pub inertia_b: Mat3,
+    /// `r_R`: servicer base origin w.r.t. the target CoM, in F_R [m].
+    pub r_r: Vec3,
+    /// `v_R = ṙ_R` in F_R [m/s].
+    pub v_r: Vec3,
+    /// Grasping point w.r.t. the target CoM, `R_RT p_G,T`, in F_R [m].
+    pub grasp_r: Vec3,
+    /// Its time derivative in F_R [m/s].
+    pub grasp_vel_r: Vec3,
+    /// `q_RT`: target attitude, rotates F_T vectors into F_R.
+    pub q_rt: Quat,
+    /// `ω_T`: target angular velocity, in F_T [rad/s].
+    pub omega_t: Vec3,
+}
+
+/// Result of one attitude step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AttitudeCommand {
+    /// Nominal torque `τ_B,nom` in F_B [N m], unsaturated. Zero when `valid` is false.
+    pub tau_b: Vec3,
+    /// Angle between boresight and line of sight [rad].
+    pub pointing_error_rad: f64,
+    /// `ω_B − ω_ref` in F_B [rad/s].
+    pub rate_error: Vec3,
+    /// False on non-finite input, a non-normalisable quaternion or a degenerate
+    /// line of sight (grasping point at the base origin); the torque is then zero.
+    pub valid: bool,
+}
+
+impl AttitudeCommand {
+    fn invalid() -> Self {
+        Self {
+            tau_b: Vec3::zeros(),
+            pointing_error_rad: 0.0,
+            rate_error: Vec3::zeros(),
+            valid: false,
+        }
+    }
+}
+
+/// Pointing / rate-synchronisation law (see the module doc).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AttitudeController {
+    gains: AttitudeGains,
+    /// Boresight `d_B` (unit, F_B).
+    boresight: Vec3,
+    /// Target inertia and its inverse (F_T), for `ω̇_T`; `None` ⇒ `ω̇_T = 0`.
+    target_inertia: Option<(Mat3, Mat3)>,
+}
+
+impl AttitudeController {
+    /// `boresight` is normalised; `target_inertia` (F_T, kg m²) is used for the
+    /// feed-forward of the target's torque-free angular acceleration (ignored if
+    /// not invertible). Returns `None` on non-finite gains or a zero boresight.
+    pub fn new(
+        gains: AttitudeGains,
+        boresight: Vec3,
+        target_inertia: Option<Mat3>,
+    ) -> Option<Self> {
+        let ok = [gains.kp, gains.kd, gains.k_sync]
+            .iter()
+            .all(|g| g.is_finite() && *g >= 0.0);
+        let n = boresight.norm();
+        if !ok || !n.is_finite() || n < 1e-9 {
+            return None;
+        }
+        let target_inertia = target_inertia.and_then(|i| i.try_inverse().map(|inv| (i, inv)));
+        Some(Self {
+            gains,
+            boresight: boresight / n,
+            target_inertia,
+        })
+    }
+
+    /// The gains.
+    pub fn gains(&self) -> &AttitudeGains {
+        &self.gains
+    }
+
+    /// One control step. Allocation-free; never panics.
+    pub fn command(&self, task: AttitudeTask, x: &AttitudeInput) -> AttitudeCommand {
+        let fin3 = |v: &Vec3| v.iter().all(|c| c.is_finite());
+        if !fin3(&x.omega_b)
+            || !fin3(&x.r_r)
+            || !fin3(&x.v_r)
+            || !fin3(&x.grasp_r)
+            || !fin3(&x.grasp_vel_r)
+            || !fin3(&x.omega_t)
+            || !x.inertia_b.iter().all(|c| c.is_finite())
+        {
+            return AttitudeCommand::invalid();
+        }
+        let (Some(q_rb), Some(q_rt)) = (quat::normalized(&x.q_rb), quat::normalized(&x.q_rt))
+        else {
+            return AttitudeCommand::invalid();
+        };
+        let r_rb = quat::to_matrix(&q_rb);
+        let r_br = r_rb.transpose();
+        let los = x.grasp_r - x.r_r;
+        let rho = los.norm();
+        if rho < 1e-6 {
+            return AttitudeCommand::invalid();
+        }
+        let s_r = los / rho;
+        let s_b = r_br * s_r;
+        let d = self.boresight;
+
+        // pointing error: rotation turning d_B onto s_B
+        let c = d.cross(&s_b);
+        let sin_phi = c.norm();
+        let cos_phi = d.dot(&s_b);
+        let phi = sin_phi.atan2(cos_phi);
+        let axis = if sin_phi > 1e-12 {
+            c / sin_phi
+        } else if cos_phi > 0.0 {
+            Vec3::zeros()
+        } else {
+            any_perpendicular(&d)
+        };
+        let rot_err = axis * phi;
+
+        let w = x.omega_b;
+        let (w_ref, w_ref_dot, k_w) = match task {
+            AttitudeTask::Point => {
+                let w_los_r = s_r.cross(&(x.grasp_vel_r - x.v_r)) / rho;
+                let w_ref = r_br * w_los_r;
+                (w_ref, -w.cross(&w_ref), self.gains.kd)
+            }
+            AttitudeTask::PointAndSync => {
+                let r_bt: Matrix3<f64> = r_br * quat::to_matrix(&q_rt);
+                let w_ref = r_bt * x.omega_t;
+                let w_t_dot = match &self.target_inertia {
+                    Some((it, it_inv)) => it_inv * (-x.omega_t.cross(&(it * x.omega_t))),
+                    None => Vec3::zeros(),
+                };
+                (w_ref, -w.cross(&w_ref) + r_bt * w_t_dot, self.gains.k_sync)
+            }
+        };
+        let rate_error = w - w_ref;
+        let tau = self.gains.kp * rot_err - k_w * rate_error
+            + w.cross(&(x.inertia_b * w))
+            + x.inertia_b * w_ref_dot;
+        if !fin3(&tau) {
+            return AttitudeCommand::invalid();
+        }
+        AttitudeCommand {
+            tau_b: tau,
+            pointing_error_rad: phi,
+            rate_error,
+            valid: true,
+        }
+    }
+}
+
+/// A unit vector perpendicular to the unit vector `d`.
+fn any_perpendicular(d: &Vec3) -> Vec3 {
+    let e = if d.x.abs() < 0.9 {
+        Vec3::x()
+    } else {
+        Vec3::y()
+    };
+    d.cross(&e).normalize()
+}
