@@ -1,0 +1,244 @@
+//! The Python mirror (`scripts/python/sc_icd.py`) must have exactly the Rust layout:
+//! same size, alignment, field names, offsets and sizes, and the same iceoryx2 type name.
+
+use core::mem::{align_of, offset_of, size_of};
+use sc_icd::*;
+use std::path::PathBuf;
+use std::process::Command;
+
+struct Layout {
+    name: &'static str,
+    type_name: &'static str,
+    size: usize,
+    align: usize,
+    fields: Vec<(&'static str, usize, usize)>,
+}
+
+fn field_size<T, F>(_: fn(&T) -> &F) -> usize {
+    size_of::<F>()
+}
+
+macro_rules! layout {
+    ($t:ident { $($f:ident),* $(,)? }) => {
+        Layout {
+            name: stringify!($t),
+            type_name: type_name_of::<$t>(),
+            size: size_of::<$t>(),
+            align: align_of::<$t>(),
+            fields: vec![$((stringify!($f), offset_of!($t, $f), field_size(|s: &$t| &s.$f))),*],
+        }
+    };
+}
+
+fn rust_layouts() -> Vec<Layout> {
+    vec![
+        layout!(Tick {
+            tick,
+            rate_group,
+            clock_mode,
+            t,
+            send_ns
+        }),
+        layout!(SimState {
+            step,
+            t,
+            phase,
+            _pad0,
+            r_h,
+            v_h,
+            r_r,
+            v_r,
+            q_rb,
+            w_b,
+            theta,
+            theta_dot,
+            q_rt,
+            w_t,
+            q_hr,
+            w_h,
+            dw_h,
+            n,
+            p_g_r,
+            v_g_r,
+            a_g_r,
+            p_ee_b,
+            publish_ns
+        }),
+        layout!(NominalTranslational {
+            tick,
+            t,
+            valid,
+            _pad0,
+            recv_ns,
+            publish_ns,
+            f_h
+        }),
+        layout!(NominalAttitude {
+            tick,
+            t,
+            valid,
+            _pad0,
+            recv_ns,
+            publish_ns,
+            tau_b
+        }),
+        layout!(NominalRobotic {
+            tick,
+            t,
+            valid,
+            _pad0,
+            recv_ns,
+            publish_ns,
+            tau_m
+        }),
+        layout!(SafeTranslational {
+            tick,
+            t,
+            recv_ns,
+            publish_ns,
+            active_mask,
+            solve_ns,
+            solver_status,
+            iterations,
+            fault_flags,
+            n_constraints,
+            h,
+            phi,
+            f_h,
+            f_b
+        }),
+        layout!(SafeAttitude {
+            tick,
+            t,
+            recv_ns,
+            publish_ns,
+            active_mask,
+            solve_ns,
+            solver_status,
+            iterations,
+            fault_flags,
+            n_constraints,
+            h,
+            phi,
+            tau_b
+        }),
+        layout!(SafeRobotic {
+            tick,
+            t,
+            recv_ns,
+            publish_ns,
+            active_mask,
+            solve_ns,
+            solver_status,
+            iterations,
+            fault_flags,
+            n_constraints,
+            h,
+            phi,
+            tau_m
+        }),
+        layout!(Health {
+            role,
+            pid,
+            state,
+            last_fault_flags,
+            ticks_handled,
+            deadline_misses,
+            cycle_slips,
+            last_tick,
+            publish_ns
+        }),
+    ]
+}
+
+#[test]
+fn rust_field_lists_cover_every_byte() {
+    // Guards the lists above: fields are contiguous and fill the struct, so no
+    // field can be missing from the comparison and no implicit padding exists.
+    for l in rust_layouts() {
+        let mut end = 0;
+        for (name, off, size) in &l.fields {
+            assert_eq!(*off, end, "{}.{name}: gap or overlap before it", l.name);
+            end = off + size;
+        }
+        assert_eq!(
+            end, l.size,
+            "{}: trailing padding or missing fields",
+            l.name
+        );
+    }
+}
+
+#[test]
+fn python_mirror_matches_rust_layout() {
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scripts/python/sc_icd.py");
+    let out = Command::new("python3")
+        .arg(&script)
+        .arg("--layout-json")
+        .output()
+        .expect("python3 must be installed to check the Python ICD mirror");
+    assert!(
+        out.status.success(),
+        "sc_icd.py failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let py: serde_json::Value = serde_json::from_slice(&out.stdout).expect("layout JSON");
+    let py = py.as_object().expect("object of types");
+    let rust = rust_layouts();
+    assert_eq!(
+        py.len(),
+        rust.len(),
+        "Python and Rust define different message sets"
+    );
+    for l in rust {
+        let p = py
+            .get(l.name)
+            .unwrap_or_else(|| panic!("{} missing in sc_icd.py", l.name));
+        assert_eq!(
+            p["type_name"].as_str(),
+            Some(l.type_name),
+            "{} type_name",
+            l.name
+        );
+        assert_eq!(p["size"].as_u64(), Some(l.size as u64), "{} size", l.name);
+        assert_eq!(
+            p["align"].as_u64(),
+            Some(l.align as u64),
+            "{} align",
+            l.name
+        );
+        let pf = p["fields"].as_array().expect("fields");
+        let py_fields: Vec<(String, u64, u64)> = pf
+            .iter()
+            .map(|f| {
+                (
+                    f["name"].as_str().unwrap_or_default().to_string(),
+                    f["offset"].as_u64().unwrap_or(u64::MAX),
+                    f["size"].as_u64().unwrap_or(u64::MAX),
+                )
+            })
+            .collect();
+        let rs_fields: Vec<(String, u64, u64)> = l
+            .fields
+            .iter()
+            .map(|(n, o, s)| (n.to_string(), *o as u64, *s as u64))
+            .collect();
+        assert_eq!(
+            py_fields, rs_fields,
+            "{} fields (name, offset, size)",
+            l.name
+        );
+    }
+}
+
+#[test]
+fn service_table_matches_type_names() {
+    let names: Vec<&str> = services::ALL.iter().map(|(_, t)| *t).collect();
+    for l in rust_layouts() {
+        assert!(
+            names.contains(&l.type_name),
+            "{} has no service",
+            l.type_name
+        );
+    }
+}
