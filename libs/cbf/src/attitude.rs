@@ -418,6 +418,16 @@ impl AttitudeFilter {
         tau
     }
 
+    /// Verification only: force the solver even when the nominal is feasible.
+    pub fn set_skip_enabled(&mut self, on: bool) {
+        self.qp.set_skip_enabled(on);
+    }
+
+    /// Multipliers λ_i ≥ 0 of the barrier rows of the last solve, in [`NAMES`] order.
+    pub fn row_duals(&self) -> &[f64] {
+        self.qp.row_duals()
+    }
+
     /// The last QP handed to the solver (for `--dump-qp`).
     pub fn dump_qp(&self) -> QpDump {
         self.qp.dump()

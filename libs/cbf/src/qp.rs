@@ -168,6 +168,7 @@ pub struct QpEngine {
     last_bound_duals: Vec<f64>,
     last_status: Option<SolverStatus>,
     last: Option<QpResult>,
+    skip_enabled: bool,
 }
 
 impl QpEngine {
@@ -227,7 +228,14 @@ impl QpEngine {
             last_bound_duals: vec![0.0; ng],
             last_status: None,
             last: None,
+            skip_enabled: true,
         }
+    }
+
+    /// Verification only: with `false` the solver runs even for a feasible nominal (the
+    /// result then equals the skip path's up to the solver tolerance).
+    pub fn set_skip_enabled(&mut self, on: bool) {
+        self.skip_enabled = on;
     }
 
     /// Number of inputs, barrier rows, bound rows.
@@ -278,7 +286,7 @@ impl QpEngine {
             let a = &rows_a[i * m..(i + 1) * m];
             rows_c[i] + dot(a, u_nom) >= 0.0
         }) && (0..ng).all(|k| dot(&g[k * m..(k + 1) * m], u_nom) <= g_max[k]);
-        if feasible {
+        if feasible && self.skip_enabled {
             u_out.copy_from_slice(u_nom);
             self.last_x.copy_from_slice(u_nom);
             let r = QpResult {
