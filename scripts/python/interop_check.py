@@ -1,0 +1,150 @@
+#!/usr/bin/env python3
+"""Python <-> Rust interop check, and a template for a Python nominal controller.
+
+Plays the nominal translational controller of the partition:
+1. joins run ``SC_RUN_ID`` (iceoryx2 global.prefix ``sc_<run id>_``);
+2. creates its ports: subscriber + listener on ``safe_capture/sim/state``,
+   publisher + notifier on ``safe_capture/nominal/translational``;
+3. announces itself on the handshake (event ``safe_capture/handshake/ready``,
+   id 8 + role) until the coordinator's ``go`` (event ``.../go``, id 3);
+4. for every SimState: f_H = -k * r_H  published as NominalTranslational, then
+   notify; stops after a SimState with ``phase == 0`` (sent by the Rust test).
+
+Usage: ``SC_RUN_ID=<id> scripts/.venv/bin/python scripts/python/interop_check.py``
+Exit code 0 on success. Needs ``pip install iceoryx2==0.10.0`` (same x.y.z as the
+Rust crate: the version is part of the shared-memory names).
+"""
+
+import os
+import sys
+import time
+
+import iceoryx2 as iox2
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import sc_icd  # noqa: E402
+
+GAIN = 0.5
+TIMEOUT_S = 20.0
+# Same service settings as sc_bus::ServiceSettings::lock_step() and the event
+# settings of sc_bus (whoever creates a service first fixes them).
+LOCK_STEP = dict(buffer=4, history=0, max_publishers=2, max_subscribers=8, max_nodes=16)
+
+
+def open_pubsub(node, name, ctype):
+    return (
+        node.service_builder(iox2.ServiceName.new(name))
+        .publish_subscribe(ctype)
+        .subscriber_max_buffer_size(LOCK_STEP["buffer"])
+        .history_size(LOCK_STEP["history"])
+        .max_publishers(LOCK_STEP["max_publishers"])
+        .max_subscribers(LOCK_STEP["max_subscribers"])
+        .max_nodes(LOCK_STEP["max_nodes"])
+        .enable_safe_overflow(False)
+        .subscriber_max_borrowed_samples(2)
+        .open_or_create()
+    )
+
+
+def open_event(node, name, max_ports, max_nodes, id_max):
+    return (
+        node.service_builder(iox2.ServiceName.new(name))
+        .event()
+        .max_notifiers(max_ports)
+        .max_listeners(max_ports)
+        .max_nodes(max_nodes)
+        .event_id_max_value(id_max)
+        .notifier_dead_event(iox2.EventId.new(sc_icd.EVENT_NOTIFIER_DEAD))
+        .notifier_dropped_event(iox2.EventId.new(sc_icd.EVENT_NOTIFIER_DROPPED))
+        .open_or_create()
+    )
+
+
+def data_event(node, name):
+    return open_event(
+        node, name, LOCK_STEP["max_publishers"] + LOCK_STEP["max_subscribers"], LOCK_STEP["max_nodes"], 7
+    )
+
+
+def handshake(node, role):
+    """Announce `role` until the coordinator says go (sc_bus::handshake)."""
+    ready_svc = open_event(node, sc_icd.SERVICE_HANDSHAKE + "/ready", 32, 40, 8 + 64)
+    go_svc = open_event(node, sc_icd.SERVICE_HANDSHAKE + "/go", 32, 40, 8 + 64)
+    go = go_svc.listener_builder().create()  # listener first: the go cannot be lost
+    ready = ready_svc.notifier_builder().default_event_id(iox2.EventId.new(sc_icd.HANDSHAKE_ID_OFFSET + role)).create()
+    deadline = time.monotonic() + TIMEOUT_S
+    try:
+        while time.monotonic() < deadline:
+            ready.notify()
+            for ev in go.timed_wait(iox2.Duration.from_millis(20)):
+                if ev.id.as_value == sc_icd.EVENT_GO:
+                    return True
+        return False
+    finally:
+        ready.delete()
+        go.delete()
+
+
+def main():
+    run_id = os.environ.get("SC_RUN_ID")
+    if not run_id:
+        print("interop_check: SC_RUN_ID not set", file=sys.stderr)
+        return 2
+    iox2.set_log_level_from_env_or(iox2.LogLevel.Warn)
+    cfg = iox2.config.default()
+    cfg.global_cfg.prefix = iox2.FileName.new(sc_icd.run_prefix(run_id))
+    node = iox2.NodeBuilder.new().name(iox2.NodeName.new("py_nominal_t")).config(cfg).create(iox2.ServiceType.Ipc)
+
+    state_svc = open_pubsub(node, sc_icd.SERVICE_SIM_STATE, sc_icd.SimState)
+    state_ev = data_event(node, sc_icd.SERVICE_SIM_STATE)
+    cmd_svc = open_pubsub(node, sc_icd.SERVICE_NOMINAL_TRANSLATIONAL, sc_icd.NominalTranslational)
+    cmd_ev = data_event(node, sc_icd.SERVICE_NOMINAL_TRANSLATIONAL)
+    sub = state_svc.subscriber_builder().create()
+    listener = state_ev.listener_builder().create()
+    pub = cmd_svc.publisher_builder().create()
+    notifier = cmd_ev.notifier_builder().default_event_id(iox2.EventId.new(sc_icd.EVENT_SAMPLE)).create()
+    ports = [sub, listener, pub, notifier]
+
+    rc = 1
+    try:
+        if not handshake(node, sc_icd.ROLE_NOMINAL_TRANSLATIONAL):
+            print("interop_check: handshake timed out", file=sys.stderr)
+            return 1
+        handled = 0
+        deadline = time.monotonic() + TIMEOUT_S
+        while time.monotonic() < deadline:
+            listener.timed_wait(iox2.Duration.from_millis(100))  # sleep on the event
+            while True:
+                sample = sub.receive()
+                if sample is None:
+                    break
+                s = sample.payload().contents
+                step, phase, r_h, t = s.step, s.phase, list(s.r_h), s.t
+                sample.delete()
+                if phase == 0:
+                    print(f"interop_check: handled {handled} states")
+                    rc = 0
+                    return rc
+                recv_ns = time.monotonic_ns()
+                cmd = sc_icd.NominalTranslational(
+                    tick=step, t=t, valid=1, recv_ns=recv_ns, publish_ns=time.monotonic_ns()
+                )
+                for i in range(3):
+                    cmd.f_h[i] = -GAIN * r_h[i]
+                pub.loan_uninit().write_payload(cmd).send()
+                if os.environ.get("SC_DEBUG"):
+                    print(f"interop_check: answered step {step}", file=sys.stderr)
+                notifier.notify()
+                handled += 1
+        print("interop_check: timed out waiting for states", file=sys.stderr)
+        return 1
+    finally:
+        # Delete ports, then the node: otherwise a dead node is left behind.
+        for p in ports:
+            p.delete()
+        del state_svc, state_ev, cmd_svc, cmd_ev
+        del node
+
+
+if __name__ == "__main__":
+    sys.exit(main())
