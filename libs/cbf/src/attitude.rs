@@ -251,7 +251,7 @@ pub struct AttitudeFilter {
 
 impl AttitudeFilter {
     pub fn new(params: AttitudeParams) -> Self {
-        let qp = QpEngine::new(3, N, 6, &params.solver);
+        let qp = QpEngine::new(3, N, 6, params.torque_max, &params.solver);
         Self { params, qp }
     }
 

@@ -8,8 +8,9 @@
 //! solved with Clarabel. Clarabel's standard form is `min ½xᵀPx + qᵀx` s.t.
 //! `Ax + s = b, s ≥ 0`, so `P = 2I`, `q = −2u_nom`; a barrier row becomes
 //! `−σ_i a_i·u + s = σ_i c_i` and a bound row `G_k u + s = g_k`. Each barrier row is
-//! scaled by `σ_i = 1/max(‖a_i‖, 10⁻⁸|c_i|, 10⁻³⁰⁰)` (an exactly equivalent row; the
-//! constraints of one filter have very different units) because Clarabel's own
+//! scaled by `σ_i = 1/‖a_i‖` (an exactly equivalent row; the constraints of one
+//! filter have very different units), rows that cannot bind inside the box are neutralised
+//! (see [`QpEngine::solve`]) because Clarabel's own
 //! equilibration is switched off: its scaling would be computed once from the set-up data
 //! and silently reused by every data update.
 //!
@@ -109,7 +110,10 @@ pub struct QpDump {
     /// Slack of the relaxed problem (0 otherwise).
     pub slack: f64,
     pub outcome: Option<QpOutcome>,
+    /// Clarabel status of the last solver call (the relaxed one if it ran).
     pub solver_status: String,
+    /// Clarabel status of the hard QP of the last solve ("" when skipped).
+    pub hard_status: String,
     pub iterations: u32,
 }
 
@@ -157,6 +161,9 @@ pub struct QpEngine {
     a_r: Vec<f64>,
     b_r: Vec<f64>,
     scale: Vec<f64>,
+    neutral: Vec<bool>,
+    /// Bound on ‖u‖∞ over the input box.
+    u_inf: f64,
     // last problem (unscaled, row-major) for the dump
     last_u_nom: Vec<f64>,
     last_rows_a: Vec<f64>,
@@ -167,6 +174,7 @@ pub struct QpEngine {
     last_row_duals: Vec<f64>,
     last_bound_duals: Vec<f64>,
     last_status: Option<SolverStatus>,
+    last_hard_status: Option<SolverStatus>,
     last: Option<QpResult>,
     skip_enabled: bool,
 }
@@ -174,7 +182,8 @@ pub struct QpEngine {
 impl QpEngine {
     /// Builds both Clarabel solvers once. A solver that cannot be built is `None`, and
     /// every solve then reports [`QpOutcome::Failed`] (the filter falls back).
-    pub fn new(m: usize, nb: usize, ng: usize, params: &SolverParams) -> Self {
+    /// `u_inf` bounds `‖u‖∞` on the input box (used to condition the rows).
+    pub fn new(m: usize, nb: usize, ng: usize, u_inf: f64, params: &SolverParams) -> Self {
         let rows_h = nb + ng;
         let rows_r = nb + ng + 1;
         let cones_h = [SupportedConeT::NonnegativeConeT(rows_h)];
@@ -218,6 +227,8 @@ impl QpEngine {
             a_r: vec![0.0; rows_r * (m + 1)],
             b_r: vec![0.0; rows_r],
             scale: vec![1.0; nb],
+            neutral: vec![false; nb],
+            u_inf,
             last_u_nom: vec![0.0; m],
             last_rows_a: vec![0.0; nb * m],
             last_rows_c: vec![0.0; nb],
@@ -227,6 +238,7 @@ impl QpEngine {
             last_row_duals: vec![0.0; nb],
             last_bound_duals: vec![0.0; ng],
             last_status: None,
+            last_hard_status: None,
             last: None,
             skip_enabled: true,
         }
@@ -264,6 +276,7 @@ impl QpEngine {
             && g_max.len() == ng
             && u_out.len() == m;
         self.last_status = None;
+        self.last_hard_status = None;
         self.last_row_duals.iter_mut().for_each(|x| *x = 0.0);
         self.last_bound_duals.iter_mut().for_each(|x| *x = 0.0);
         if !dims_ok {
@@ -298,11 +311,29 @@ impl QpEngine {
             return r;
         }
 
-        // Row scaling σ_i.
+        // Row conditioning. With ‖u‖∞ ≤ U on the box, |a·u| ≤ ‖a‖₁U =: reach. A row with
+        // c ≥ reach can never bind inside the box and is replaced by the neutral row
+        // 0·u ≥ −1 (its multiplier is 0); a row with c < −reach cannot be met anywhere in
+        // the box, so the hard QP is infeasible and only the relaxed one is solved (that
+        // row scaled to unit violation). Every other row is scaled by σ = 1/‖a‖, so all
+        // right-hand sides stay of the order of U (Clarabel stalls on rows like
+        // 0·u ≥ −10⁸ that a near-zero ‖a‖ would otherwise produce).
+        let mut hard_infeasible = false;
         for i in 0..nb {
             let a = &rows_a[i * m..(i + 1) * m];
-            let na = dot(a, a).sqrt();
-            self.scale[i] = 1.0 / na.max(1e-8 * rows_c[i].abs()).max(1e-300);
+            let c = rows_c[i];
+            let reach = a.iter().map(|x| x.abs()).sum::<f64>() * self.u_inf;
+            if c >= reach {
+                self.scale[i] = 0.0;
+                self.neutral[i] = true;
+            } else if c < -reach {
+                hard_infeasible = true;
+                self.neutral[i] = false;
+                self.scale[i] = 1.0 / (-c).max(1e-300);
+            } else {
+                self.neutral[i] = false;
+                self.scale[i] = 1.0 / dot(a, a).sqrt();
+            }
         }
 
         // ---- hard problem
@@ -317,11 +348,15 @@ impl QpEngine {
             }
         }
         for i in 0..nb {
-            self.b_h[i] = self.scale[i] * rows_c[i];
+            self.b_h[i] = if self.neutral[i] {
+                1.0
+            } else {
+                self.scale[i] * rows_c[i]
+            };
         }
         self.b_h[nb..].copy_from_slice(g_max);
         let mut iterations = 0;
-        if let Some(s) = self.hard.as_mut() {
+        if let Some(s) = self.hard.as_mut().filter(|_| !hard_infeasible) {
             let upd = s.update_q(&self.q_h).is_ok()
                 && s.update_A(&self.a_h).is_ok()
                 && s.update_b(&self.b_h).is_ok();
@@ -330,6 +365,7 @@ impl QpEngine {
                 let sol = &s.solution;
                 iterations += sol.iterations;
                 self.last_status = Some(sol.status);
+                self.last_hard_status = Some(sol.status);
                 if accepted(sol.status) && sol.x.iter().all(|x| x.is_finite()) {
                     u_out.copy_from_slice(&sol.x);
                     self.last_x.copy_from_slice(&sol.x);
@@ -360,8 +396,9 @@ impl QpEngine {
         self.q_r[m] = 0.0;
         let sc = m * rows_r;
         for i in 0..rows_r {
-            // slack column: −s on barrier rows, 0 on bounds, −s ≤ 0 on the last row
-            self.a_r[sc + i] = if i < nb || i == rows_h { -1.0 } else { 0.0 };
+            // slack column: −s on (non-neutral) barrier rows, 0 on bounds, −s ≤ 0 last
+            let on = (i < nb && !self.neutral[i]) || i == rows_h;
+            self.a_r[sc + i] = if on { -1.0 } else { 0.0 };
         }
         self.b_r[..rows_h].copy_from_slice(&self.b_h);
         self.b_r[rows_h] = 0.0;
@@ -420,6 +457,10 @@ impl QpEngine {
             outcome: self.last.map(|r| r.outcome),
             solver_status: self
                 .last_status
+                .map(|s| format!("{s:?}"))
+                .unwrap_or_default(),
+            hard_status: self
+                .last_hard_status
                 .map(|s| format!("{s:?}"))
                 .unwrap_or_default(),
             iterations: self.last.map(|r| r.iterations).unwrap_or(0),

@@ -258,7 +258,7 @@ fn finite_in<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>, max: f64) -
 
 impl RoboticFilter {
     pub fn new(params: RoboticParams) -> Self {
-        let qp = QpEngine::new(NJ, N, 2 * NJ, &params.solver);
+        let qp = QpEngine::new(NJ, N, 2 * NJ, params.torque_max, &params.solver);
         Self { params, qp }
     }
 

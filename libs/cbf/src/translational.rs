@@ -207,7 +207,7 @@ pub struct TranslationalFilter {
 
 impl TranslationalFilter {
     pub fn new(params: TranslationalParams) -> Self {
-        let qp = QpEngine::new(3, N, 6, &params.solver);
+        let qp = QpEngine::new(3, N, 6, 3f64.sqrt() * params.force_max, &params.solver);
         Self { params, qp }
     }
 

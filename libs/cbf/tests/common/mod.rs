@@ -31,19 +31,29 @@ pub fn mean_motion(s: &Scenario) -> f64 {
 
 /// Translational input with the servicer at `r_r` (F_R) moving at `v_r` (F_R components
 /// of the Hill-frame rate), attitude `q_rb`.
-pub fn tr_input(s: &Scenario, r_r: Vector3<f64>, v_r: Vector3<f64>, q_rb: quat::Quat) -> TranslationalInput {
+pub fn tr_input(
+    s: &Scenario,
+    r_r: Vector3<f64>,
+    v_r: Vector3<f64>,
+    q_rb: quat::Quat,
+) -> TranslationalInput {
     let q_hr = s.reference_frame.attitude_in_hill;
     let r_hr = quat::to_matrix(&q_hr);
     TranslationalInput::circular(r_hr * r_r, r_hr * v_r, q_hr, mean_motion(s), q_rb)
 }
 
 pub fn inertia() -> Matrix3<f64> {
-    Matrix3::new(420.0, 12.0, -8.0, 12.0, 510.0, 5.0, -8.0, 5.0, 460.0)
+    Matrix3::new(55.2, 1.2, -0.8, 1.2, 46.0, 0.5, -0.8, 0.5, 50.8)
 }
 
 /// Attitude input: servicer at `r_r`, attitude `q_rb`, rate `w`; target tumbling about
 /// -x_R at 0.08 rad/s, grasping point at angle `phase`.
-pub fn att_input(r_r: Vector3<f64>, q_rb: quat::Quat, w: Vector3<f64>, phase: f64) -> AttitudeInput {
+pub fn att_input(
+    r_r: Vector3<f64>,
+    q_rb: quat::Quat,
+    w: Vector3<f64>,
+    phase: f64,
+) -> AttitudeInput {
     let wt = Vector3::new(-0.08, 0.0, 0.0);
     let p_t = Vector3::new(-0.55, 0.12, 0.0);
     let r_rt = quat::to_matrix(&quat::from_axis_angle(&wt, wt.norm() * phase));
@@ -85,7 +95,10 @@ pub fn theta0(s: &Scenario) -> Vector7 {
 pub struct Lcg(pub u64);
 impl Lcg {
     pub fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
     }
     pub fn v3(&mut self, s: f64) -> Vector3<f64> {
