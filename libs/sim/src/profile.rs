@@ -1,0 +1,230 @@
+//! Open-loop command profiles: the CSV read by `safe-capture simulate --commands`.
+//!
+//! Format: a header line with exactly [`PROFILE_COLUMNS`], then one row per change of
+//! command. Row `k` holds from its time `t_s` until the next row's time (zero-order
+//! hold); the command applied over the control period starting at `t` is the last row
+//! with `t_s ≤ t` (zero before the first row). Forces/torques in the servicer base
+//! frame [N, N m], joint torques [N m].
+
+use crate::state::Command;
+use nalgebra::Vector3;
+use sc_multibody::Vector7;
+
+/// Header of a command profile.
+pub const PROFILE_COLUMNS: [&str; 14] = [
+    "t_s",
+    "f_b_x_n",
+    "f_b_y_n",
+    "f_b_z_n",
+    "tau_b_x_nm",
+    "tau_b_y_nm",
+    "tau_b_z_nm",
+    "tau_m_1_nm",
+    "tau_m_2_nm",
+    "tau_m_3_nm",
+    "tau_m_4_nm",
+    "tau_m_5_nm",
+    "tau_m_6_nm",
+    "tau_m_7_nm",
+];
+
+/// Why a profile was rejected; every message names the line (and column) at fault.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ProfileError {
+    #[error("command profile is empty (expected the header `{}`)", PROFILE_COLUMNS.join(","))]
+    Empty,
+    #[error("line 1: header column {index} is `{found}`, expected `{expected}`")]
+    Header {
+        index: usize,
+        found: String,
+        expected: String,
+    },
+    #[error("line {line}: expected {expected} columns, found {found}")]
+    Columns {
+        line: usize,
+        expected: usize,
+        found: usize,
+    },
+    #[error("line {line}, column `{column}`: `{value}` is not a number")]
+    NotANumber {
+        line: usize,
+        column: String,
+        value: String,
+    },
+    #[error("line {line}, column `{column}`: value {value} is not finite")]
+    NotFinite {
+        line: usize,
+        column: String,
+        value: f64,
+    },
+    #[error("line {line}: time {t} s does not increase (previous row at {prev} s)")]
+    TimeOrder { line: usize, t: f64, prev: f64 },
+}
+
+/// A parsed, validated command profile.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CommandProfile {
+    rows: Vec<(f64, Command)>,
+}
+
+impl CommandProfile {
+    /// Parses the CSV text of a profile.
+    pub fn parse(text: &str) -> Result<Self, ProfileError> {
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+        let (_, header) = lines.next().ok_or(ProfileError::Empty)?;
+        let names: Vec<&str> = header.split(',').map(str::trim).collect();
+        for (i, expected) in PROFILE_COLUMNS.iter().enumerate() {
+            let found = names.get(i).copied().unwrap_or("");
+            if found != *expected {
+                return Err(ProfileError::Header {
+                    index: i + 1,
+                    found: found.into(),
+                    expected: (*expected).into(),
+                });
+            }
+        }
+        if names.len() != PROFILE_COLUMNS.len() {
+            return Err(ProfileError::Columns {
+                line: 1,
+                expected: PROFILE_COLUMNS.len(),
+                found: names.len(),
+            });
+        }
+        let mut rows: Vec<(f64, Command)> = Vec::new();
+        for (i, line) in lines {
+            let line_no = i + 1;
+            let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+            if cells.len() != PROFILE_COLUMNS.len() {
+                return Err(ProfileError::Columns {
+                    line: line_no,
+                    expected: PROFILE_COLUMNS.len(),
+                    found: cells.len(),
+                });
+            }
+            let mut v = [0.0; 14];
+            for (k, cell) in cells.iter().enumerate() {
+                let x: f64 = cell.parse().map_err(|_| ProfileError::NotANumber {
+                    line: line_no,
+                    column: PROFILE_COLUMNS[k].into(),
+                    value: (*cell).into(),
+                })?;
+                if !x.is_finite() {
+                    return Err(ProfileError::NotFinite {
+                        line: line_no,
+                        column: PROFILE_COLUMNS[k].into(),
+                        value: x,
+                    });
+                }
+                v[k] = x;
+            }
+            if let Some((prev, _)) = rows.last() {
+                if v[0] <= *prev {
+                    return Err(ProfileError::TimeOrder {
+                        line: line_no,
+                        t: v[0],
+                        prev: *prev,
+                    });
+                }
+            }
+            let cmd = Command {
+                force_b: Vector3::new(v[1], v[2], v[3]),
+                torque_b: Vector3::new(v[4], v[5], v[6]),
+                tau: Vector7::from_column_slice(&v[7..14]),
+            };
+            rows.push((v[0], cmd));
+        }
+        Ok(Self { rows })
+    }
+
+    /// The command that holds at time `t` [s] (zero before the first row).
+    pub fn at(&self, t: f64) -> Command {
+        let idx = self.rows.partition_point(|(ti, _)| *ti <= t + 1e-9);
+        if idx == 0 {
+            Command::zero()
+        } else {
+            self.rows[idx - 1].1
+        }
+    }
+
+    /// Number of rows.
+    pub fn len(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// True if the profile has no rows.
+    pub fn is_empty(&self) -> bool {
+        self.rows.is_empty()
+    }
+
+    /// Writes a profile as CSV text (inverse of [`Self::parse`]).
+    pub fn to_csv(rows: &[(f64, Command)]) -> String {
+        let mut s = PROFILE_COLUMNS.join(",");
+        s.push('\n');
+        for (t, c) in rows {
+            let vals: Vec<String> = std::iter::once(*t)
+                .chain(c.force_b.iter().copied())
+                .chain(c.torque_b.iter().copied())
+                .chain(c.tau.iter().copied())
+                .map(|x| format!("{x}"))
+                .collect();
+            s.push_str(&vals.join(","));
+            s.push('\n');
+        }
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn header() -> String {
+        PROFILE_COLUMNS.join(",")
+    }
+
+    #[test]
+    fn zero_order_hold_lookup() {
+        let text = format!(
+            "{}\n0,1,0,0,0,0,0,0,0,0,0,0,0,0\n10,2,0,0,0,0,0,0,0,0,0,0,0,0.5\n",
+            header()
+        );
+        let p = CommandProfile::parse(&text).unwrap();
+        assert_eq!(p.at(-1.0), Command::zero());
+        assert_eq!(p.at(0.0).force_b.x, 1.0);
+        assert_eq!(p.at(9.95).force_b.x, 1.0);
+        assert_eq!(p.at(10.0).force_b.x, 2.0);
+        assert_eq!(p.at(100.0).tau[6], 0.5);
+        let again = CommandProfile::parse(&CommandProfile::to_csv(&p.rows)).unwrap();
+        assert_eq!(again, p);
+    }
+
+    #[test]
+    fn errors_name_line_and_column() {
+        let e = CommandProfile::parse(&format!("{}\n0,1,0,0,0,0,0,0,0,0,0,0,0,NaN\n", header()))
+            .unwrap_err();
+        assert!(
+            e.to_string().contains("line 2") && e.to_string().contains("tau_m_7_nm"),
+            "{e}"
+        );
+        let e = CommandProfile::parse(&format!("{}\n0,1,0,x,0,0,0,0,0,0,0,0,0,0\n", header()))
+            .unwrap_err();
+        assert!(
+            e.to_string().contains("f_b_z_n") && e.to_string().contains("not a number"),
+            "{e}"
+        );
+        let e = CommandProfile::parse(&format!("{}\n0,1,0\n", header())).unwrap_err();
+        assert!(matches!(e, ProfileError::Columns { line: 2, .. }), "{e}");
+        let e = CommandProfile::parse("t_s,fx\n").unwrap_err();
+        assert!(matches!(e, ProfileError::Header { index: 2, .. }), "{e}");
+        let e = CommandProfile::parse(&format!(
+            "{}\n5,0,0,0,0,0,0,0,0,0,0,0,0,0\n5,0,0,0,0,0,0,0,0,0,0,0,0,0\n",
+            header()
+        ))
+        .unwrap_err();
+        assert!(matches!(e, ProfileError::TimeOrder { line: 3, .. }), "{e}");
+        assert_eq!(CommandProfile::parse("").unwrap_err(), ProfileError::Empty);
+    }
+}
