@@ -347,11 +347,11 @@ impl QpEngine {
                 self.a_h[j * rows_h + nb + k] = g[k * m + j];
             }
         }
-        for i in 0..nb {
+        for (i, &c) in rows_c.iter().enumerate() {
             self.b_h[i] = if self.neutral[i] {
                 1.0
             } else {
-                self.scale[i] * rows_c[i]
+                self.scale[i] * c
             };
         }
         self.b_h[nb..].copy_from_slice(g_max);

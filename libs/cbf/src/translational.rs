@@ -225,7 +225,8 @@ impl TranslationalFilter {
     fn prepare(&self, x: &TranslationalInput) -> Option<Prepared> {
         let p = &self.params;
         let rn = x.r_h.norm();
-        if !(in_range3(&x.r_h, MAX_RANGE_M) && rn >= MIN_RANGE_M)
+        if !in_range3(&x.r_h, MAX_RANGE_M)
+            || rn < MIN_RANGE_M
             || !in_range3(&x.v_h, MAX_SPEED_M_S)
             || !in_range3(&x.omega_h, MAX_FRAME_RATE)
             || !in_range3(&x.omega_dot_h, MAX_FRAME_RATE)

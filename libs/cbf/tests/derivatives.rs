@@ -26,6 +26,7 @@ fn fd(h: impl Fn(f64) -> f64, dt: f64) -> (f64, f64) {
 // ---------------------------------------------------------------- translational
 
 /// CW + rotating corridor axis, RK4 with `steps` sub-steps to time `t`.
+#[allow(clippy::too_many_arguments)]
 fn tr_traj(
     n: f64,
     m: f64,

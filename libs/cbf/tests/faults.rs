@@ -23,7 +23,7 @@ fn wild(scale: f64) -> impl Strategy<Value = f64> {
     ]
 }
 fn v3(scale: f64) -> impl Strategy<Value = Vector3<f64>> {
-    [wild(scale), wild(scale), wild(scale)].prop_map(|a| Vector3::from(a))
+    [wild(scale), wild(scale), wild(scale)].prop_map(Vector3::from)
 }
 fn v7(scale: f64) -> impl Strategy<Value = Vector7> {
     proptest::collection::vec(wild(scale), 7).prop_map(|v| Vector7::from_column_slice(&v))
