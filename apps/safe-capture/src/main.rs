@@ -1,2 +1,52 @@
-//! The safe-capture command-line tool.
-fn main() {}
+//! `safe-capture`: the command-line front door of the safety layer.
+
+mod cmd_model;
+mod cmd_run;
+mod cmd_simulate;
+
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Safety layer for a free-flying robotic servicer capturing a tumbling target:
+/// three coupling-aware CBF safety filters (translational → attitude → robotic) over a
+/// high-fidelity simulator.
+#[derive(Parser)]
+#[command(name = "safe-capture", version, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run the whole mission in one process (simulator + nominal controllers + filters).
+    Run(cmd_run::Args),
+    /// Open-loop simulation of a command profile.
+    Simulate(cmd_simulate::Args),
+    /// Evaluate the servicer model at a state (JSON in, JSON out) for cross-checks.
+    Model(cmd_model::Args),
+}
+
+/// Default scenario path (relative to the working directory).
+pub fn default_scenario() -> PathBuf {
+    PathBuf::from(sc_scenario::DEFAULT_SCENARIO)
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Run(a) => cmd_run::run(a),
+        Command::Simulate(a) => cmd_simulate::run(a),
+        Command::Model(a) => cmd_model::run(a),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            // one line naming the problem
+            let chain: Vec<String> = e.chain().map(|c| c.to_string()).collect();
+            eprintln!("error: {}", chain.join(": ").replace('\n', " "));
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,1 +1,26 @@
-//! The mission in one process: phases, telemetry, summary.
+//! The mission in one process: simulator, nominal controllers and the three safety
+//! filters in causal order (translational → attitude → robotic), one control step at a
+//! time; plus the telemetry record of every step and the run's summary.
+//!
+//! The partition (one process per module) calls the very same stage functions of
+//! [`stages`], so its results are bit-for-bit those of [`Mission`].
+
+pub mod mission;
+pub mod record;
+pub mod setup;
+pub mod stages;
+pub mod summary;
+
+pub use mission::{Mission, MissionEnd, RunOptions};
+pub use record::{StepRecord, TelemetryWriter, telemetry_columns, timing_columns};
+pub use setup::{Setup, SetupError};
+pub use summary::{Summary, summarize};
+
+/// Names of all 51 constraints in telemetry order (translational, attitude, robotic).
+pub fn constraint_names() -> Vec<&'static str> {
+    let mut v: Vec<&'static str> = Vec::new();
+    v.extend(sc_cbf::names::TRANSLATIONAL.iter());
+    v.extend(sc_cbf::names::ATTITUDE.iter());
+    v.extend(sc_cbf::names::ROBOTIC.iter());
+    v
+}

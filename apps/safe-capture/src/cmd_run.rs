@@ -1,0 +1,147 @@
+//! `safe-capture run`: the whole mission in one process.
+
+use anyhow::Context;
+use sc_mission::{Mission, MissionEnd, RunOptions, Setup, StepRecord, TelemetryWriter, summarize};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Runs the three-phase mission (final approach, rate synchronisation, capture) in one
+/// process: simulator, nominal controllers and the three safety filters in causal order.
+///
+/// Writes to OUT: telemetry.csv (deterministic, one row per control step: time, phase,
+/// states, nominal and safe commands, every barrier value h, filter status and faults),
+/// timing.csv (filter solve times), summary.json (captured, capture_time_s, constraints,
+/// interventions, solve_time_us, faults). Exit code 0 when the run was safe (every barrier
+/// ≥ 0, no fault) and captured, 1 otherwise.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Scenario file.
+    #[arg(long, value_name = "FILE", default_value_os_t = crate::default_scenario())]
+    scenario: PathBuf,
+    /// Output directory (created if missing).
+    #[arg(long, value_name = "DIR", default_value = "out/run")]
+    out: PathBuf,
+    /// Apply the nominal commands alone (saturated to the actuator bounds); the filters
+    /// still evaluate every barrier so the summary shows what the nominal violates.
+    #[arg(long)]
+    no_filter: bool,
+    /// Write every QP (P, q, A, b, bounds, solution) as JSON lines to FILE.
+    #[arg(long, value_name = "FILE")]
+    dump_qp: Option<PathBuf>,
+    /// Print nothing but the final line.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+/// Runs one mission, writing telemetry into `out`; returns the records and how it ended.
+pub fn run_mission(
+    setup: Setup,
+    options: RunOptions,
+    out: &Path,
+    dump_qp: Option<&Path>,
+    quiet: bool,
+) -> anyhow::Result<(Vec<StepRecord>, MissionEnd)> {
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    let open = |name: &str| -> anyhow::Result<std::io::BufWriter<std::fs::File>> {
+        let p = out.join(name);
+        Ok(std::io::BufWriter::new(
+            std::fs::File::create(&p).with_context(|| format!("cannot create {}", p.display()))?,
+        ))
+    };
+    let mut writer = TelemetryWriter::new(open("telemetry.csv")?, open("timing.csv")?)?;
+    let mut qp_file = match dump_qp {
+        Some(p) => Some(std::io::BufWriter::new(
+            std::fs::File::create(p).with_context(|| format!("cannot create {}", p.display()))?,
+        )),
+        None => None,
+    };
+    let duration = setup.scenario.mission.duration_s;
+    let mut mission = Mission::new(setup, options)?;
+    let mut records = Vec::new();
+    let mut io_err: Option<std::io::Error> = None;
+    let mut last_print = 0.0;
+    let end = mission.run(|m, r| {
+        if let Err(e) = writer.write(r) {
+            io_err.get_or_insert(e);
+        }
+        if let Some(f) = qp_file.as_mut() {
+            let q = m.last_qps();
+            for (name, d) in [
+                ("translational", &q.translational),
+                ("attitude", &q.attitude),
+                ("robotic", &q.robotic),
+            ] {
+                let line = serde_json::json!({"step": r.step, "t_s": r.t, "filter": name, "qp": d});
+                if let Err(e) = writeln!(f, "{line}") {
+                    io_err.get_or_insert(e);
+                }
+            }
+        }
+        if !quiet && r.t - last_print >= 10.0 {
+            last_print = r.t;
+            eprint!(
+                "\r  t = {:6.1} / {duration:.0} s  phase {}  grasp distance {:7.3} m",
+                r.t,
+                r.phase + 1,
+                r.obs.grasp_distance()
+            );
+        }
+        records.push(*r);
+    });
+    if !quiet {
+        eprintln!();
+    }
+    if let Some(e) = io_err {
+        return Err(e).context("writing telemetry");
+    }
+    writer.flush()?;
+    if let Some(mut f) = qp_file {
+        f.flush()?;
+    }
+    Ok((records, end))
+}
+
+pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    let setup = Setup::load(&a.scenario)?;
+    let phase_names: Vec<String> = setup
+        .scenario
+        .mission
+        .phases
+        .iter()
+        .map(|p| p.name.clone())
+        .collect();
+    let options = RunOptions {
+        no_filter: a.no_filter,
+    };
+    let started = std::time::Instant::now();
+    let (records, end) = run_mission(setup, options, &a.out, a.dump_qp.as_deref(), a.quiet)?;
+    let summary = summarize(&records, &end, &phase_names, !a.no_filter);
+    let path = a.out.join("summary.json");
+    std::fs::write(&path, serde_json::to_string_pretty(&summary)? + "\n")
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    let safe = summary.violated_constraints.is_empty() && summary.fault_count == 0;
+    println!(
+        "{}: {} at t = {:.1} s; min margin {} = {:.3e}; violated: [{}]; faults: {}; total solve time geomean {:.1} us, max {:.1} us; wall {:.2} s -> {}",
+        if a.no_filter {
+            "nominal only"
+        } else {
+            "filtered"
+        },
+        summary.end,
+        summary.final_time_s,
+        summary.min_margin.0,
+        summary.min_margin.1,
+        summary.violated_constraints.join(", "),
+        summary.fault_count,
+        summary.solve_time_us["total"].geomean,
+        summary.solve_time_us["total"].max,
+        started.elapsed().as_secs_f64(),
+        a.out.display()
+    );
+    Ok(if safe && summary.captured {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}

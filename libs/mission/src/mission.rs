@@ -1,0 +1,195 @@
+//! The whole mission in one process.
+
+use crate::record::StepRecord;
+use crate::setup::{Setup, SetupError};
+use crate::stages;
+use nalgebra::Vector3;
+use sc_cbf::{QpDump, SafetyLayer};
+use sc_nominal::NominalControllers;
+use sc_sim::{Command, Simulator};
+
+/// Options of a run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct RunOptions {
+    /// Apply the nominal commands (saturated to the actuator bounds) instead of the safe
+    /// ones. The filters still run, so that every barrier value is reported.
+    pub no_filter: bool,
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum MissionEnd {
+    /// The end-effector reached the grasping point within tolerance at `t` [s].
+    Captured { t: f64 },
+    /// The configured duration elapsed without capture.
+    Timeout { t: f64 },
+    /// The simulator failed (non-finite state).
+    SimulatorFailed { t: f64, message: String },
+}
+
+/// Simulator + nominal controllers + safety layer, stepped at the control period.
+pub struct Mission {
+    pub setup: Setup,
+    pub sim: Simulator,
+    pub nominal: NominalControllers,
+    pub safety: SafetyLayer,
+    pub options: RunOptions,
+    end: Option<MissionEnd>,
+}
+
+/// The three QPs of one step, for `--dump-qp`.
+pub struct StepQps {
+    pub translational: QpDump,
+    pub attitude: QpDump,
+    pub robotic: QpDump,
+}
+
+impl Mission {
+    /// Builds a mission from a setup.
+    pub fn new(setup: Setup, options: RunOptions) -> Result<Self, SetupError> {
+        let sim = Simulator::new(&setup.scenario, setup.robot.clone())
+            .map_err(|e| SetupError::Other(e.to_string()))?;
+        let nominal = NominalControllers::new(&setup.scenario, (*setup.robot).clone())
+            .map_err(|e| SetupError::Other(e.to_string()))?;
+        let safety = SafetyLayer::from_scenario(&setup.scenario, setup.mass());
+        Ok(Self {
+            setup,
+            sim,
+            nominal,
+            safety,
+            options,
+            end: None,
+        })
+    }
+
+    /// How the run ended, once it has.
+    pub fn end(&self) -> Option<&MissionEnd> {
+        self.end.as_ref()
+    }
+
+    /// Computes the commands of the current step (nominal → translational → attitude →
+    /// robotic filter), without advancing the simulator.
+    pub fn compute(&mut self) -> StepRecord {
+        let o = self.sim.observe();
+        let robot = self.setup.robot.clone();
+        let limits = &self.setup.scenario.limits;
+        let nom = self.nominal.command(&stages::nominal_input(&o));
+        let tr = self
+            .safety
+            .translational
+            .filter(&stages::translational_input(&o), &nom.f_h);
+        // what acts on the base: the safe force, or the saturated nominal without filters
+        let f_b = if self.options.no_filter {
+            stages::saturate(&stages::hill_to_body(&o, &nom.f_h), limits.force_max_n)
+        } else {
+            tr.actuated
+        };
+        let at = self
+            .safety
+            .attitude
+            .filter(&stages::attitude_input(&o, &robot, &f_b), &nom.tau_b);
+        let tau_b = if self.options.no_filter {
+            stages::saturate(&nom.tau_b, limits.torque_max_nm)
+        } else {
+            at.u
+        };
+        let rob_in = stages::robotic_input(&o, &robot, &f_b, &tau_b);
+        let rb = match rob_in {
+            Some(x) => self.safety.robotic.filter(&x, &nom.tau_m),
+            None => stages::robotic_invalid_state(),
+        };
+        let tau_m = if self.options.no_filter {
+            stages::saturate(&nom.tau_m, limits.joint_torque_max_nm)
+        } else {
+            rb.u
+        };
+        StepRecord {
+            step: o.step,
+            t: o.t,
+            phase: nom.phase,
+            obs: o,
+            f_h_nom: nom.f_h,
+            tau_b_nom: nom.tau_b,
+            tau_m_nom: nom.tau_m,
+            translational: tr,
+            attitude: at,
+            robotic: rb,
+            applied: Command {
+                force_b: f_b,
+                torque_b: tau_b,
+                tau: tau_m,
+            },
+        }
+    }
+
+    /// The QPs of the last [`Self::compute`].
+    pub fn last_qps(&self) -> StepQps {
+        StepQps {
+            translational: self.safety.translational.dump_qp(),
+            attitude: self.safety.attitude.dump_qp(),
+            robotic: self.safety.robotic.dump_qp(),
+        }
+    }
+
+    /// True if the record shows a capture: grasping phase, end-effector on the grasping
+    /// point within the configured distance and relative-speed tolerances.
+    pub fn is_capture(&self, r: &StepRecord) -> bool {
+        let m = &self.setup.scenario.mission;
+        let grasping = self
+            .setup
+            .scenario
+            .mission
+            .phases
+            .get(r.phase)
+            .map(|p| p.robotic)
+            == Some(sc_scenario::RoboticMode::Grasp);
+        grasping
+            && r.obs.grasp_distance() <= m.capture_tolerance_m
+            && r.obs.grasp_speed() <= m.capture_speed_tolerance_m_s
+    }
+
+    /// One control step: compute, then advance the simulator under the applied command.
+    /// Returns the record, or `None` once the mission has ended.
+    pub fn step(&mut self) -> Option<StepRecord> {
+        if self.end.is_some() {
+            return None;
+        }
+        let r = self.compute();
+        self.advance(&r);
+        Some(r)
+    }
+
+    /// Ends the mission on capture or timeout, or advances the simulator by one period.
+    pub fn advance(&mut self, r: &StepRecord) {
+        let m = &self.setup.scenario.mission;
+        if self.is_capture(r) {
+            self.end = Some(MissionEnd::Captured { t: r.t });
+            return;
+        }
+        if r.t + 0.5 * m.control_period_s >= m.duration_s {
+            self.end = Some(MissionEnd::Timeout { t: r.t });
+            return;
+        }
+        if let Err(e) = self.sim.step(&r.applied) {
+            self.end = Some(MissionEnd::SimulatorFailed {
+                t: r.t,
+                message: e.to_string(),
+            });
+        }
+    }
+
+    /// Runs to the end, handing every record to `sink`.
+    pub fn run(&mut self, mut sink: impl FnMut(&Mission, &StepRecord)) -> MissionEnd {
+        while self.end.is_none() {
+            let r = self.compute();
+            sink(self, &r);
+            self.advance(&r);
+        }
+        self.end.clone().unwrap_or(MissionEnd::Timeout { t: 0.0 })
+    }
+}
+
+/// Zero vector helper for callers building records by hand.
+pub fn zero3() -> Vector3<f64> {
+    Vector3::zeros()
+}

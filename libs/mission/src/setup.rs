@@ -1,0 +1,87 @@
+//! Loading a scenario and its servicer model, with the cross-checks between the two.
+
+use sc_multibody::Robot;
+use sc_scenario::{Scenario, ScenarioError};
+use std::path::Path;
+use std::sync::Arc;
+
+/// Why a mission could not be set up. One line each, naming the problem.
+#[derive(Debug, thiserror::Error)]
+pub enum SetupError {
+    #[error("{0}")]
+    Scenario(#[from] ScenarioError),
+    #[error("{path}: {message}")]
+    Urdf { path: String, message: String },
+    #[error("`{key}` = {value}: {rule}")]
+    Inconsistent {
+        key: String,
+        value: String,
+        rule: String,
+    },
+    #[error("{0}")]
+    Other(String),
+}
+
+/// A validated scenario with its servicer model.
+#[derive(Debug, Clone)]
+pub struct Setup {
+    pub scenario: Scenario,
+    pub robot: Arc<Robot>,
+}
+
+impl Setup {
+    /// Loads `path` and the URDF it names.
+    pub fn load(path: &Path) -> Result<Self, SetupError> {
+        Self::from_scenario(Scenario::load(path)?)
+    }
+
+    /// Loads the URDF of an already parsed scenario and cross-checks the two.
+    pub fn from_scenario(scenario: Scenario) -> Result<Self, SetupError> {
+        let urdf = scenario.urdf_path();
+        let robot = Robot::from_urdf_file(&urdf).map_err(|e| SetupError::Urdf {
+            path: urdf.display().to_string(),
+            message: e.to_string(),
+        })?;
+        let rb = &scenario.safety.robotic;
+        let (lower, upper, velocity, effort) = robot.joint_limit_arrays();
+        for i in 0..sc_multibody::NJ {
+            if rb.theta_min_rad[i] < lower[i] || rb.theta_max_rad[i] > upper[i] {
+                return Err(SetupError::Inconsistent {
+                    key: format!("safety.robotic.theta_min_rad/theta_max_rad[{i}]"),
+                    value: format!("[{}, {}]", rb.theta_min_rad[i], rb.theta_max_rad[i]),
+                    rule: format!(
+                        "must lie inside the URDF joint limits [{}, {}]",
+                        lower[i], upper[i]
+                    ),
+                });
+            }
+            if rb.theta_dot_max_rad_s[i] > velocity[i] {
+                return Err(SetupError::Inconsistent {
+                    key: format!("safety.robotic.theta_dot_max_rad_s[{i}]"),
+                    value: rb.theta_dot_max_rad_s[i].to_string(),
+                    rule: format!("must not exceed the URDF velocity limit {}", velocity[i]),
+                });
+            }
+            if scenario.limits.joint_torque_max_nm > effort[i] {
+                return Err(SetupError::Inconsistent {
+                    key: "limits.joint_torque_max_nm".into(),
+                    value: scenario.limits.joint_torque_max_nm.to_string(),
+                    rule: format!(
+                        "must not exceed the URDF effort limit {} of joint {}",
+                        effort[i],
+                        i + 1
+                    ),
+                });
+            }
+        }
+        Ok(Self {
+            scenario,
+            robot: Arc::new(robot),
+        })
+    }
+
+    /// Total servicer mass [kg] (base + arm), the `m` of the CW model.
+    pub fn mass(&self) -> f64 {
+        self.robot.total_mass()
+    }
+}

@@ -1,0 +1,108 @@
+//! The stages of one control step as pure functions of their inputs. The in-process
+//! [`crate::Mission`] and every process of the partition call exactly these, in the
+//! causal order translational → attitude → robotic.
+
+use nalgebra::Vector3;
+use sc_cbf::{AttitudeInput, RoboticInput, TranslationalInput, attitude::tidal_acceleration};
+use sc_models::quat;
+use sc_multibody::{Robot, Vector7};
+use sc_nominal::NominalInput;
+use sc_sim::Observation;
+
+/// Input of the nominal controllers from an observation.
+pub fn nominal_input(o: &Observation) -> NominalInput {
+    NominalInput {
+        t: o.t,
+        q_hr: o.q_hr,
+        omega_h: o.omega_h,
+        r_r: o.r_r,
+        v_r: o.v_r,
+        q_rb: o.q_rb,
+        omega_b: o.omega_b,
+        q_rt: o.q_rt,
+        omega_t: o.omega_t,
+        theta: o.theta,
+        theta_dot: o.theta_dot,
+    }
+}
+
+/// Input of the translational filter (ξ_tr = 0: it runs first).
+pub fn translational_input(o: &Observation) -> TranslationalInput {
+    TranslationalInput {
+        r_h: o.r_h,
+        v_h: o.v_h,
+        q_hr: o.q_hr,
+        omega_h: o.omega_h,
+        omega_dot_h: o.omega_dot_h,
+        q_rb: o.q_rb,
+    }
+}
+
+/// Input of the attitude filter; `f_b_sf` is the upstream safe (actuated) force in F_B,
+/// which enters the line-of-sight barrier as ξ_att.
+pub fn attitude_input(o: &Observation, robot: &Robot, f_b_sf: &Vector3<f64>) -> AttitudeInput {
+    let mass = robot.total_mass();
+    let r_rh = quat::to_matrix(&quat::conj(&o.q_hr));
+    let radial_r = r_rh * Vector3::x();
+    let r_bt = quat::to_matrix(&quat::mul(&quat::conj(&o.q_rb), &o.q_rt));
+    AttitudeInput {
+        q_rb: o.q_rb,
+        omega_b: o.omega_b,
+        inertia: robot.system_inertia_com(&o.theta),
+        r_r: o.r_r,
+        v_r: o.v_r,
+        a_drift_r: tidal_acceleration(o.mean_motion, &radial_r, &o.r_r),
+        grasp_r: o.grasp_r,
+        grasp_vel_r: o.grasp_v_r,
+        grasp_acc_r: o.grasp_a_r,
+        xi_r: sc_cbf::attitude::xi_att_from_force(f_b_sf, &o.q_rb, mass),
+        omega_target_b: r_bt * o.omega_t,
+    }
+}
+
+/// Input of the robotic filter; the upstream safe force and torque (F_B) enter as ξ_rob.
+/// `None` when the model cannot be evaluated (non-finite state): the filter's fallback applies.
+pub fn robotic_input(
+    o: &Observation,
+    robot: &Robot,
+    f_b_sf: &Vector3<f64>,
+    tau_b_sf: &Vector3<f64>,
+) -> Option<RoboticInput> {
+    sc_cbf::robotic_input_from_model(robot, &o.theta, &o.theta_dot, &o.omega_b, f_b_sf, tau_b_sf)
+}
+
+/// Saturates a nominal command to the actuator bounds (what the hardware does when no
+/// filter is in the loop); non-finite components become zero.
+pub fn saturate<const M: usize>(
+    u: &nalgebra::SVector<f64, M>,
+    limit: f64,
+) -> nalgebra::SVector<f64, M> {
+    u.map(|x| {
+        if x.is_finite() {
+            x.clamp(-limit, limit)
+        } else {
+            0.0
+        }
+    })
+}
+
+/// `f_B = R_BH f_H` for a force given in the Hill frame.
+pub fn hill_to_body(o: &Observation, f_h: &Vector3<f64>) -> Vector3<f64> {
+    let r_hb = quat::to_matrix(&quat::mul(&o.q_hr, &o.q_rb));
+    r_hb.transpose() * f_h
+}
+
+/// Joint torques as a plain vector type (re-export convenience).
+pub type JointTorques = Vector7;
+
+/// The robotic filter's defined output when its model cannot even be evaluated (a
+/// non-finite state): zero joint torque, status `Fallback`, flag `INVALID_STATE`.
+pub fn robotic_invalid_state() -> sc_cbf::RoboticOutput {
+    let mut report = sc_cbf::FilterReport::default();
+    report.faults |= sc_cbf::faults::INVALID_STATE;
+    sc_cbf::FilterOutput {
+        u: Vector7::zeros(),
+        actuated: Vector7::zeros(),
+        report,
+    }
+}

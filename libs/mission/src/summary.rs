@@ -1,0 +1,266 @@
+//! `summary.json`: the stable, script-readable result of a run.
+
+use crate::mission::MissionEnd;
+use crate::record::StepRecord;
+use sc_cbf::faults;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// Statistics of a set of solve times [µs].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+pub struct TimeStats {
+    pub geomean: f64,
+    pub p50: f64,
+    pub p99: f64,
+    pub max: f64,
+    pub samples: usize,
+}
+
+impl TimeStats {
+    /// Geometric mean, nearest-rank percentiles and maximum of `v` (µs; zeros are
+    /// counted as 1 ns so that the geometric mean stays defined).
+    pub fn of(v: &[f64]) -> Self {
+        if v.is_empty() {
+            return Self::default();
+        }
+        let mut s: Vec<f64> = v.iter().map(|x| x.max(1e-3)).collect();
+        s.sort_by(f64::total_cmp);
+        let pct = |p: f64| s[((p / 100.0 * s.len() as f64).ceil() as usize).clamp(1, s.len()) - 1];
+        let geomean = (s.iter().map(|x| x.ln()).sum::<f64>() / s.len() as f64).exp();
+        Self {
+            geomean,
+            p50: pct(50.0),
+            p99: pct(99.0),
+            max: s[s.len() - 1],
+            samples: s.len(),
+        }
+    }
+}
+
+/// Minimum of one barrier over the run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ConstraintSummary {
+    /// Smallest h over the run (NaN samples excluded; see `nan_samples`).
+    pub min_h: f64,
+    /// True if any sample was < 0 (or NaN).
+    pub violated: bool,
+    pub t_of_min_s: f64,
+    pub nan_samples: usize,
+    /// Smallest h per mission phase (by phase name).
+    pub min_h_per_phase: BTreeMap<String, f64>,
+}
+
+/// One reported fault.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FaultEvent {
+    pub step: u64,
+    pub t_s: f64,
+    pub filter: String,
+    pub flags: Vec<String>,
+}
+
+/// Interventions of one filter.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+pub struct Interventions {
+    /// Steps in which the safe command differed from the nominal one.
+    pub steps: usize,
+    pub fraction: f64,
+}
+
+/// The summary of a run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    pub filtered: bool,
+    pub captured: bool,
+    pub capture_time_s: Option<f64>,
+    /// "captured", "timeout" or "simulator_failed".
+    pub end: String,
+    pub final_time_s: f64,
+    pub steps: usize,
+    /// The constraint with the smallest h over the run, and that h (the safety margin).
+    pub min_margin: (String, f64),
+    pub violated_constraints: Vec<String>,
+    pub constraints: BTreeMap<String, ConstraintSummary>,
+    pub interventions: BTreeMap<String, Interventions>,
+    pub solve_time_us: BTreeMap<String, TimeStats>,
+    /// Peak ‖ω_B − R_BT ω_T‖ per phase [rad/s].
+    pub sync_error_peak_rad_s: BTreeMap<String, f64>,
+    /// Peak ‖τ_M‖₂ applied in each phase [N m].
+    pub joint_torque_norm_peak_nm: BTreeMap<String, f64>,
+    pub fault_count: usize,
+    /// Fault events (the first 1000).
+    pub faults: Vec<FaultEvent>,
+}
+
+fn flag_names(bits: u32) -> Vec<String> {
+    faults::NAMES
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| bits & (1 << i) != 0)
+        .map(|(_, n)| n.to_string())
+        .collect()
+}
+
+/// Builds the summary of a run from its records.
+pub fn summarize(
+    records: &[StepRecord],
+    end: &MissionEnd,
+    phase_names: &[String],
+    filtered: bool,
+) -> Summary {
+    let names = crate::constraint_names();
+    let phase_name = |p: usize| {
+        phase_names
+            .get(p)
+            .cloned()
+            .unwrap_or_else(|| format!("phase_{p}"))
+    };
+    let mut constraints: BTreeMap<String, ConstraintSummary> = BTreeMap::new();
+    for n in &names {
+        constraints.insert(
+            n.to_string(),
+            ConstraintSummary {
+                min_h: f64::INFINITY,
+                violated: false,
+                t_of_min_s: 0.0,
+                nan_samples: 0,
+                min_h_per_phase: BTreeMap::new(),
+            },
+        );
+    }
+    let mut solve: [Vec<f64>; 4] = Default::default();
+    let mut inter = [0usize; 3];
+    let mut sync_peak: BTreeMap<String, f64> = BTreeMap::new();
+    let mut torque_peak: BTreeMap<String, f64> = BTreeMap::new();
+    let mut fault_events = Vec::new();
+    let mut fault_count = 0;
+    for r in records {
+        let pn = phase_name(r.phase);
+        for (n, h) in names.iter().zip(r.h()) {
+            let c = constraints.get_mut(*n).expect("constraint present");
+            if h.is_nan() {
+                c.nan_samples += 1;
+                c.violated = true;
+                continue;
+            }
+            if h < c.min_h {
+                c.min_h = h;
+                c.t_of_min_s = r.t;
+            }
+            if h < 0.0 {
+                c.violated = true;
+            }
+            let e = c.min_h_per_phase.entry(pn.clone()).or_insert(f64::INFINITY);
+            *e = e.min(h);
+        }
+        let t = r.solve_time_us();
+        for i in 0..4 {
+            solve[i].push(t[i]);
+        }
+        let changed = [
+            (r.translational.u - r.f_h_nom).amax() > 1e-9,
+            (r.attitude.u - r.tau_b_nom).amax() > 1e-9,
+            (r.robotic.u - r.tau_m_nom).amax() > 1e-9,
+        ];
+        for i in 0..3 {
+            inter[i] += changed[i] as usize;
+        }
+        let s = sync_peak.entry(pn.clone()).or_insert(0.0);
+        *s = s.max(r.obs.sync_error().norm());
+        let tq = torque_peak.entry(pn.clone()).or_insert(0.0);
+        *tq = tq.max(r.applied.tau.norm());
+        for (name, f) in [
+            ("translational", r.translational.report.faults),
+            ("attitude", r.attitude.report.faults),
+            ("robotic", r.robotic.report.faults),
+        ] {
+            if f != 0 {
+                fault_count += 1;
+                if fault_events.len() < 1000 {
+                    fault_events.push(FaultEvent {
+                        step: r.step,
+                        t_s: r.t,
+                        filter: name.into(),
+                        flags: flag_names(f),
+                    });
+                }
+            }
+        }
+    }
+    let mut min_margin = (String::new(), f64::INFINITY);
+    for (n, c) in &constraints {
+        if c.min_h < min_margin.1 {
+            min_margin = (n.clone(), c.min_h);
+        }
+    }
+    let violated_constraints = constraints
+        .iter()
+        .filter(|(_, c)| c.violated)
+        .map(|(n, _)| n.clone())
+        .collect();
+    let steps = records.len();
+    let fraction = |k: usize| {
+        if steps == 0 {
+            0.0
+        } else {
+            k as f64 / steps as f64
+        }
+    };
+    let interventions = ["translational", "attitude", "robotic"]
+        .iter()
+        .zip(inter)
+        .map(|(n, k)| {
+            (
+                n.to_string(),
+                Interventions {
+                    steps: k,
+                    fraction: fraction(k),
+                },
+            )
+        })
+        .collect();
+    let solve_time_us = ["translational", "attitude", "robotic", "total"]
+        .iter()
+        .zip(solve.iter())
+        .map(|(n, v)| (n.to_string(), TimeStats::of(v)))
+        .collect();
+    let (captured, capture_time_s, end_name, final_time_s) = match end {
+        MissionEnd::Captured { t } => (true, Some(*t), "captured", *t),
+        MissionEnd::Timeout { t } => (false, None, "timeout", *t),
+        MissionEnd::SimulatorFailed { t, .. } => (false, None, "simulator_failed", *t),
+    };
+    Summary {
+        filtered,
+        captured,
+        capture_time_s,
+        end: end_name.into(),
+        final_time_s,
+        steps,
+        min_margin,
+        violated_constraints,
+        constraints,
+        interventions,
+        solve_time_us,
+        sync_error_peak_rad_s: sync_peak,
+        joint_torque_norm_peak_nm: torque_peak,
+        fault_count,
+        faults: fault_events,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn time_stats_nearest_rank() {
+        let v: Vec<f64> = (1..=100).map(|x| x as f64).collect();
+        let s = TimeStats::of(&v);
+        assert_eq!(s.p50, 50.0);
+        assert_eq!(s.p99, 99.0);
+        assert_eq!(s.max, 100.0);
+        let g = TimeStats::of(&[1.0, 100.0]).geomean;
+        assert!((g - 10.0).abs() < 1e-12);
+        assert_eq!(TimeStats::of(&[]).samples, 0);
+    }
+}
