@@ -1,0 +1,1 @@
+//! Monte Carlo campaigns: dispersions, parallel runs, shards, merge, report.
