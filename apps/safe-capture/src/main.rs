@@ -1,5 +1,9 @@
 //! `safe-capture`: the command-line front door of the safety layer.
 
+// One module per subcommand; add a subcommand with one `mod` line, one enum variant
+// and one match arm.
+mod cmd_bench;
+mod cmd_bench_filters;
 mod cmd_model;
 mod cmd_run;
 mod cmd_simulate;
@@ -26,6 +30,8 @@ enum Command {
     Simulate(cmd_simulate::Args),
     /// Evaluate the servicer model at a state (JSON in, JSON out) for cross-checks.
     Model(cmd_model::Args),
+    /// Benchmarks: simulator speed, safety-layer solve times, partition latency.
+    Bench(cmd_bench::Args),
 }
 
 /// Default scenario path (relative to the working directory).
@@ -39,6 +45,7 @@ fn main() -> ExitCode {
         Command::Run(a) => cmd_run::run(a),
         Command::Simulate(a) => cmd_simulate::run(a),
         Command::Model(a) => cmd_model::run(a),
+        Command::Bench(a) => cmd_bench::run(a),
     };
     match result {
         Ok(code) => code,

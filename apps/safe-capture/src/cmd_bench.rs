@@ -1,0 +1,23 @@
+//! `safe-capture bench`: speed and latency measurements, reported as percentiles.
+
+use clap::Subcommand;
+use std::process::ExitCode;
+
+/// Benchmarks (run them on an otherwise idle machine; build with --release).
+#[derive(clap::Args)]
+pub struct Args {
+    #[command(subcommand)]
+    what: What,
+}
+
+#[derive(Subcommand)]
+enum What {
+    /// Safety-layer solve time per filter and in total over whole missions.
+    Filters(crate::cmd_bench_filters::Args),
+}
+
+pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    match a.what {
+        What::Filters(x) => crate::cmd_bench_filters::run(x),
+    }
+}
