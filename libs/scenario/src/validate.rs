@@ -240,13 +240,6 @@ impl Scenario {
                     "phases must start in strictly increasing order",
                 ));
             }
-            if p.start_s >= m.duration_s {
-                return Err(invalid(
-                    &key,
-                    p.start_s,
-                    format!("must start before mission.duration_s = {}", m.duration_s),
-                ));
-            }
         }
 
         let l = &self.limits;
@@ -336,9 +329,18 @@ impl Scenario {
         }
         positive("safety.solver.slack_weight", so.slack_weight)?;
         let fb = &sf.fallback;
-        positive("safety.fallback.translational_brake_time_s", fb.translational_brake_time_s)?;
-        positive("safety.fallback.attitude_brake_time_s", fb.attitude_brake_time_s)?;
-        positive("safety.fallback.robotic_brake_time_s", fb.robotic_brake_time_s)?;
+        positive(
+            "safety.fallback.translational_brake_time_s",
+            fb.translational_brake_time_s,
+        )?;
+        positive(
+            "safety.fallback.attitude_brake_time_s",
+            fb.attitude_brake_time_s,
+        )?;
+        positive(
+            "safety.fallback.robotic_brake_time_s",
+            fb.robotic_brake_time_s,
+        )?;
 
         let nt = &self.nominal.translational;
         if nt.horizon_steps == 0 {

@@ -1,0 +1,385 @@
+//! The CLI as a user meets it: documented commands work, bad input gives a one-line error
+//! naming the problem and a non-zero exit (never a panic), and the default mission is safe
+//! with the filters and unsafe without.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn bin() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_safe-capture"));
+    c.current_dir(root());
+    c
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("sc-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Asserts a clean failure: non-zero exit, no panic, one `error:` line containing `needle`.
+fn assert_one_line_error(out: &Output, needle: &str) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "expected failure, stderr: {err}");
+    assert!(!err.contains("panicked"), "panicked: {err}");
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "expected one line, got: {err}");
+    assert!(
+        lines[0].starts_with("error: ") && lines[0].contains(needle),
+        "{err}"
+    );
+}
+
+fn scenario_with(dir: &Path, from: &str, to: &str) -> PathBuf {
+    let text = std::fs::read_to_string(root().join("config/scenario.toml")).unwrap();
+    assert!(text.contains(from), "{from} not in the default scenario");
+    let text = text.replacen(from, to, 1).replace(
+        "urdf = \"servicer.urdf\"",
+        &format!(
+            "urdf = \"{}\"",
+            root().join("config/servicer.urdf").display()
+        ),
+    );
+    let p = dir.join("scenario.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+const HEADER: &str = "t_s,f_b_x_n,f_b_y_n,f_b_z_n,tau_b_x_nm,tau_b_y_nm,tau_b_z_nm,tau_m_1_nm,tau_m_2_nm,tau_m_3_nm,tau_m_4_nm,tau_m_5_nm,tau_m_6_nm,tau_m_7_nm";
+
+#[test]
+fn help_on_every_subcommand() {
+    for sub in [
+        &["--help"][..],
+        &["run", "--help"],
+        &["simulate", "--help"],
+        &["model", "--help"],
+        &["bench", "--help"],
+        &["bench", "filters", "--help"],
+    ] {
+        let out = bin().args(sub).output().unwrap();
+        assert!(out.status.success(), "{sub:?}");
+        assert!(
+            String::from_utf8_lossy(&out.stdout).contains("Usage"),
+            "{sub:?}"
+        );
+    }
+}
+
+#[test]
+fn simulate_writes_the_documented_trajectory() {
+    let d = tmp("simulate");
+    let profile = d.join("profile.csv");
+    std::fs::write(
+        &profile,
+        format!("{HEADER}\n0,1,0,0,0,0,0.01,0,0,0,0,0,0,0\n5,0,0,0,0,0,0,0,0,0,0,0,0,0\n"),
+    )
+    .unwrap();
+    let traj = d.join("traj.csv");
+    let out = bin()
+        .args(["simulate", "--commands"])
+        .arg(&profile)
+        .arg("--out")
+        .arg(&traj)
+        .args(["--duration", "10"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&traj).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(header, sc_sim::TRAJECTORY_COLUMNS.to_vec());
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 101);
+    assert_eq!(rows[100][0], 10.0);
+    assert!(
+        rows.iter()
+            .all(|r| r.len() == header.len() && r.iter().all(|x| x.is_finite()))
+    );
+    // 1 N along body x for 5 s moves the servicer measurably (≈ 1/269 m/s² · 12.5 s² ≈ 0.05 m)
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let moved = ((0..3)
+        .map(|i| rows[100][col("r_h_x_m") + i] - rows[0][col("r_h_x_m") + i])
+        .map(|x| x * x)
+        .sum::<f64>())
+    .sqrt();
+    assert!(moved > 0.01, "moved {moved}");
+}
+
+#[test]
+fn bad_inputs_give_one_line_errors() {
+    let d = tmp("bad");
+    // NaN in a profile
+    let nan = d.join("nan.csv");
+    std::fs::write(&nan, format!("{HEADER}\n0,1,0,0,0,0,0,0,0,0,0,NaN,0,0\n")).unwrap();
+    let out = bin()
+        .args(["simulate", "--commands"])
+        .arg(&nan)
+        .args(["--out"])
+        .arg(d.join("t.csv"))
+        .output()
+        .unwrap();
+    assert_one_line_error(&out, "tau_m_5_nm");
+    // malformed CSV
+    let bad = d.join("bad.csv");
+    std::fs::write(&bad, format!("{HEADER}\n0,1,2\n")).unwrap();
+    let out = bin()
+        .args(["simulate", "--commands"])
+        .arg(&bad)
+        .args(["--out"])
+        .arg(d.join("t.csv"))
+        .output()
+        .unwrap();
+    assert_one_line_error(&out, "line 2");
+    // missing profile
+    let out = bin()
+        .args(["simulate", "--commands", "/nonexistent.csv", "--out"])
+        .arg(d.join("t.csv"))
+        .output()
+        .unwrap();
+    assert_one_line_error(&out, "/nonexistent.csv");
+    // bad config value
+    let s = scenario_with(&d, "mass_kg = 800.0", "mass_kg = -800.0");
+    let out = bin()
+        .args(["run", "--scenario"])
+        .arg(&s)
+        .args(["--out"])
+        .arg(d.join("o"))
+        .output()
+        .unwrap();
+    assert_one_line_error(&out, "target.mass_kg");
+    // bad URDF path
+    let s = scenario_with(&d, "mass_kg = 800.0", "mass_kg = 800.0");
+    let text = std::fs::read_to_string(&s).unwrap();
+    let text = text.replace(
+        &root().join("config/servicer.urdf").display().to_string(),
+        "/nonexistent/arm.urdf",
+    );
+    std::fs::write(&s, text).unwrap();
+    let out = bin()
+        .args(["run", "--scenario"])
+        .arg(&s)
+        .args(["--out"])
+        .arg(d.join("o"))
+        .output()
+        .unwrap();
+    assert_one_line_error(&out, "servicer.urdf");
+    // model: malformed state and non-unit quaternion
+    let st = d.join("state.json");
+    std::fs::write(&st, "{\"position\": [0,0,0]}").unwrap();
+    let out = bin().args(["model", "--state"]).arg(&st).output().unwrap();
+    assert_one_line_error(&out, "state");
+    std::fs::write(
+        &st,
+        r#"{"position":[0,0,0],"quaternion":[2,0,0,0],"velocity":[0,0,0],"omega":[0,0,0],"theta":[0,0,0,0,0,0,0],"theta_dot":[0,0,0,0,0,0,0]}"#,
+    )
+    .unwrap();
+    let out = bin().args(["model", "--state"]).arg(&st).output().unwrap();
+    assert_one_line_error(&out, "quaternion");
+}
+
+fn close(what: &str, got: f64, want: f64) {
+    assert!(
+        (got - want).abs() <= 1e-9 * want.abs().max(1.0),
+        "{what}: {got} vs Pinocchio {want}"
+    );
+}
+
+/// `safe-capture model` against the Pinocchio reference (generated by
+/// scripts/pinocchio_reference.py, see scripts/test.sh), through the documented JSON
+/// conventions: inertial velocity in, base-frame ν out.
+#[test]
+fn model_command_matches_pinocchio() {
+    let path = root().join("tests/reference/pinocchio_reference.generated.json");
+    if !path.exists() {
+        if std::env::var("SC_SKIP_PINOCCHIO").as_deref() == Ok("1") {
+            eprintln!(
+                "SKIPPED: {} missing and SC_SKIP_PINOCCHIO=1",
+                path.display()
+            );
+            return;
+        }
+        panic!(
+            "{} is missing: run scripts/test.sh (or scripts/pinocchio_reference.py)",
+            path.display()
+        );
+    }
+    let reference: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let d = tmp("model");
+    let f = |v: &Value| -> Vec<f64> {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    };
+    for (k, s) in reference["states"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .take(8)
+        .enumerate()
+    {
+        let q = f(&s["q"]);
+        let v = f(&s["v"]);
+        let u = f(&s["u"]);
+        let quat = [q[6], q[3], q[4], q[5]];
+        let r = sc_models::quat::to_matrix(&quat);
+        let v_i = r * nalgebra::Vector3::new(v[0], v[1], v[2]);
+        let state = serde_json::json!({
+            "position": &q[0..3], "quaternion": quat, "velocity": [v_i.x, v_i.y, v_i.z],
+            "omega": &v[3..6], "theta": &q[7..14], "theta_dot": &v[6..13],
+            "force_b": &u[0..3], "torque_b": &u[3..6], "tau": &u[6..13],
+        });
+        let p = d.join(format!("state{k}.json"));
+        std::fs::write(&p, state.to_string()).unwrap();
+        let out = bin().args(["model", "--state"]).arg(&p).output().unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let m: Value = serde_json::from_slice(&out.stdout).unwrap();
+        for i in 0..13 {
+            close(
+                "bias",
+                m["bias"][i].as_f64().unwrap(),
+                s["bias"][i].as_f64().unwrap(),
+            );
+            close(
+                "nu_dot",
+                m["nu_dot"][i].as_f64().unwrap(),
+                s["aba"][i].as_f64().unwrap(),
+            );
+            for j in 0..13 {
+                close(
+                    "mass_matrix",
+                    m["mass_matrix"][i][j].as_f64().unwrap(),
+                    s["mass_matrix"][i][j].as_f64().unwrap(),
+                );
+            }
+        }
+        for i in 0..3 {
+            close(
+                "ee",
+                m["end_effector"]["position_b"][i].as_f64().unwrap(),
+                s["ee_position"][i].as_f64().unwrap(),
+            );
+        }
+        let spheres = m["collision_spheres"].as_array().unwrap();
+        let ref_spheres = s["spheres"].as_array().unwrap();
+        assert_eq!(spheres.len(), ref_spheres.len());
+        for (a, b) in spheres.iter().zip(ref_spheres) {
+            for i in 0..3 {
+                close(
+                    "sphere",
+                    a["position_b"][i].as_f64().unwrap(),
+                    b["center"][i].as_f64().unwrap(),
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn default_mission_is_safe_with_filters_and_unsafe_without() {
+    let d = tmp("mission");
+    let out = bin()
+        .args(["run", "--quiet", "--out"])
+        .arg(d.join("f"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let s: Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("f/summary.json")).unwrap()).unwrap();
+    assert_eq!(s["captured"], true);
+    assert_eq!(s["violated_constraints"].as_array().unwrap().len(), 0);
+    assert_eq!(s["fault_count"], 0);
+    for (name, c) in s["constraints"].as_object().unwrap() {
+        assert!(
+            c["min_h"].as_f64().unwrap() >= 0.0,
+            "{name}: {}",
+            c["min_h"]
+        );
+    }
+    for key in ["translational", "attitude", "robotic", "total"] {
+        for stat in ["geomean", "p50", "p99", "max"] {
+            assert!(s["solve_time_us"][key][stat].as_f64().unwrap() > 0.0);
+        }
+    }
+    // telemetry has one row per step and every barrier column
+    let tel = std::fs::read_to_string(d.join("f/telemetry.csv")).unwrap();
+    let header = tel.lines().next().unwrap();
+    assert!(header.contains("h_approach_corridor") && header.contains("h_link_base_7_3"));
+    assert_eq!(
+        tel.lines().count() - 1,
+        s["steps"].as_u64().unwrap() as usize
+    );
+
+    let out = bin()
+        .args(["run", "--quiet", "--no-filter", "--out"])
+        .arg(d.join("n"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success(), "an unsafe run must exit non-zero");
+    let s: Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("n/summary.json")).unwrap()).unwrap();
+    let violated: Vec<&str> = s["violated_constraints"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap())
+        .collect();
+    assert!(
+        violated.contains(&"approach_corridor") || violated.contains(&"line_of_sight"),
+        "{violated:?}"
+    );
+}
+
+#[test]
+fn dump_qp_writes_every_filter_every_step() {
+    let d = tmp("dump");
+    let s = scenario_with(&d, "duration_s = 240.0", "duration_s = 3.0");
+    let out = bin()
+        .args(["run", "--quiet", "--scenario"])
+        .arg(&s)
+        .arg("--out")
+        .arg(d.join("o"))
+        .arg("--dump-qp")
+        .arg(d.join("qp.jsonl"))
+        .output()
+        .unwrap();
+    // a 3 s mission ends by timeout (exit 1) but must write everything
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+    let text = std::fs::read_to_string(d.join("qp.jsonl")).unwrap();
+    let lines: Vec<Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    // steps at t = 0, 0.1, …, 3.0 s: 31 steps, three filters each
+    assert_eq!(lines.len(), 3 * 31);
+    for l in &lines {
+        assert!(
+            l["qp"]["u_nom"].is_array()
+                && l["qp"]["rows_a"].is_array()
+                && l["qp"]["solution"].is_array()
+        );
+    }
+}
