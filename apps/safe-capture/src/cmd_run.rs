@@ -12,7 +12,10 @@ use std::process::ExitCode;
 /// Writes to OUT: telemetry.csv (deterministic, one row per control step: time, phase,
 /// states, nominal and safe commands, every barrier value h, filter status and faults),
 /// timing.csv (filter solve times), summary.json (captured, capture_time_s, constraints,
-/// interventions, solve_time_us, faults). Exit code 0 when the run was safe (every barrier
+/// interventions, solve_time_us, faults), and the figures into OUT/figures (SVG): approach
+/// trajectory with corridor and sphere, every barrier over time, range rate, sync error,
+/// joint torques, line of sight. The figures compare with a nominal-only run (dashed),
+/// which is run too and written to OUT/nominal (skip with --no-compare). Exit code 0 when the run was safe (every barrier
 /// ≥ 0, no fault) and captured, 1 otherwise.
 #[derive(clap::Args)]
 pub struct Args {
@@ -32,6 +35,12 @@ pub struct Args {
     /// Print nothing but the final line.
     #[arg(long, short)]
     quiet: bool,
+    /// Do not run the nominal-only comparison (figures then show the run alone).
+    #[arg(long)]
+    no_compare: bool,
+    /// Write no figures.
+    #[arg(long)]
+    no_figures: bool,
 }
 
 /// Runs one mission, writing telemetry into `out`; returns the records and how it ended.
@@ -115,11 +124,22 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         no_filter: a.no_filter,
     };
     let started = std::time::Instant::now();
+    let scenario = setup.scenario.clone();
+    let compare_setup = setup.clone();
     let (records, end) = run_mission(setup, options, &a.out, a.dump_qp.as_deref(), a.quiet)?;
     let summary = summarize(&records, &end, &phase_names, !a.no_filter);
     let path = a.out.join("summary.json");
     std::fs::write(&path, serde_json::to_string_pretty(&summary)? + "\n")
         .with_context(|| format!("cannot write {}", path.display()))?;
+    if !a.no_figures {
+        write_figures(
+            &a.out,
+            &scenario,
+            &records,
+            compare_setup,
+            a.no_filter || a.no_compare,
+        )?;
+    }
     let safe = summary.violated_constraints.is_empty() && summary.fault_count == 0;
     println!(
         "{}: {} at t = {:.1} s; min margin {} = {:.3e}; violated: [{}]; faults: {}; total solve time geomean {:.1} us, max {:.1} us; wall {:.2} s -> {}",
@@ -144,4 +164,34 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     } else {
         ExitCode::from(1)
     })
+}
+
+/// Writes the run's figures into `out/figures`; unless `alone`, first runs the nominal
+/// controllers alone into `out/nominal` and draws that run dashed.
+fn write_figures(
+    out: &Path,
+    scenario: &sc_scenario::Scenario,
+    records: &[StepRecord],
+    setup: Setup,
+    alone: bool,
+) -> anyhow::Result<()> {
+    let nominal = if alone {
+        None
+    } else {
+        let dir = out.join("nominal");
+        let phase_names: Vec<String> = scenario
+            .mission
+            .phases
+            .iter()
+            .map(|p| p.name.clone())
+            .collect();
+        let (recs, end) = run_mission(setup, RunOptions { no_filter: true }, &dir, None, true)?;
+        let summary = summarize(&recs, &end, &phase_names, false);
+        let path = dir.join("summary.json");
+        std::fs::write(&path, serde_json::to_string_pretty(&summary)? + "\n")
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        Some(recs)
+    };
+    sc_plots::run_figures(&out.join("figures"), scenario, records, nominal.as_deref())?;
+    Ok(())
 }
