@@ -8,7 +8,7 @@ Plays the nominal translational controller of the partition:
 3. announces itself on the handshake (event ``safe_capture/handshake/ready``,
    id 8 + role) until the coordinator's ``go`` (event ``.../go``, id 3);
 4. for every SimState: f_H = -k * r_H  published as NominalTranslational, then
-   notify; stops after a SimState with ``phase == 0`` (sent by the Rust test).
+   notify; stops after a SimState with ``due_mask == 0`` (sent by the Rust test).
 
 Usage: ``SC_RUN_ID=<id> scripts/.venv/bin/python scripts/python/interop_check.py``
 Exit code 0 on success. Needs ``pip install iceoryx2==0.10.0`` (same x.y.z as the
@@ -119,9 +119,9 @@ def main():
                 if sample is None:
                     break
                 s = sample.payload().contents
-                step, phase, r_h, t = s.step, s.phase, list(s.r_h), s.t
+                step, due, r_h, t = s.tick, s.due_mask, list(s.r_h), s.t
                 sample.delete()
-                if phase == 0:
+                if due == 0:
                     print(f"interop_check: handled {handled} states")
                     rc = 0
                     return rc

@@ -42,6 +42,7 @@ SERVICE_NOMINAL_ROBOTIC = "safe_capture/nominal/robotic"
 SERVICE_SAFE_TRANSLATIONAL = "safe_capture/safe/translational"
 SERVICE_SAFE_ATTITUDE = "safe_capture/safe/attitude"
 SERVICE_SAFE_ROBOTIC = "safe_capture/safe/robotic"
+SERVICE_STEP_RESULT = "safe_capture/sim/step_result"
 SERVICE_HEALTH = "safe_capture/health"
 SERVICE_HANDSHAKE = "safe_capture/handshake"  # events <base>/ready and <base>/go
 
@@ -70,61 +71,77 @@ def run_prefix(run_id):
     return "sc_" + clean + "_"
 
 
+TICK_STEP = 0  # Tick.command
+TICK_STOP = 1
+DUE_TRANSLATIONAL = 1  # due_mask bits
+DUE_ATTITUDE = 2
+DUE_ROBOTIC = 4
+
+
 class Tick(ctypes.Structure):
-    """Scheduler -> all: start one control step."""
+    """Scheduler -> simulator (step), every process (stop)."""
 
     _fields_ = [
         ("tick", c_u64),  # tick index [-]
-        ("rate_group", c_u32),  # rate-group id [-]
+        ("due_mask", c_u32),  # subsystems due: 1 translational, 2 attitude, 4 robotic
         ("clock_mode", c_u32),  # 0 lock-step, 1 real time, 2 scaled [-]
         ("t", c_f64),  # simulation time [s]
         ("send_ns", c_u64),  # scheduler send stamp, CLOCK_MONOTONIC [ns]
+        ("command", c_u32),  # 0 step, 1 stop
+        ("_pad0", c_u32),
     ]
 
     @staticmethod
     def type_name():
-        return "safe_capture::v1::Tick"
+        return "safe_capture::v2::Tick"
 
 
 class SimState(ctypes.Structure):
-    """Simulator -> all: true state at the start of the step."""
+    """Simulator -> all: the observation at the start of the step (sc_sim::Observation)."""
 
     _fields_ = [
-        ("step", c_u64),  # [-]
+        ("tick", c_u64),  # [-]
         ("t", c_f64),  # [s]
-        ("phase", c_u32),  # 1 approach, 2 synchronisation, 3 capture
+        ("due_mask", c_u32),  # subsystems due in this tick
         ("_pad0", c_u32),
+        ("tick_send_ns", c_u64),  # [ns]
+        ("recv_ns", c_u64),  # [ns]
+        ("publish_ns", c_u64),  # [ns]
+        ("step", c_u64),  # simulator step counter [-]
         ("r_h", _vec(3)),  # F_H [m]
         ("v_h", _vec(3)),  # F_H [m/s]
         ("r_r", _vec(3)),  # F_R [m]
         ("v_r", _vec(3)),  # F_R [m/s]
+        ("q_hr", _vec(4)),  # scalar-first, F_R -> F_H
+        ("omega_h", _vec(3)),  # F_H [rad/s]
+        ("omega_dot_h", _vec(3)),  # F_H [rad/s^2]
+        ("mean_motion", c_f64),  # [rad/s]
         ("q_rb", _vec(4)),  # scalar-first, F_B -> F_R
-        ("w_b", _vec(3)),  # F_B [rad/s]
+        ("omega_b", _vec(3)),  # F_B [rad/s]
         ("theta", _vec(N_JOINTS)),  # [rad]
         ("theta_dot", _vec(N_JOINTS)),  # [rad/s]
         ("q_rt", _vec(4)),  # scalar-first, F_T -> F_R
-        ("w_t", _vec(3)),  # F_T [rad/s]
-        ("q_hr", _vec(4)),  # scalar-first, F_R -> F_H
-        ("w_h", _vec(3)),  # F_H [rad/s]
-        ("dw_h", _vec(3)),  # F_H [rad/s^2]
-        ("n", c_f64),  # mean motion [rad/s]
-        ("p_g_r", _vec(3)),  # grasping point, F_R [m]
-        ("v_g_r", _vec(3)),  # F_R [m/s]
-        ("a_g_r", _vec(3)),  # F_R [m/s^2]
-        ("p_ee_b", _vec(3)),  # end effector, F_B [m]
-        ("publish_ns", c_u64),  # [ns]
+        ("omega_t", _vec(3)),  # F_T [rad/s]
+        ("omega_dot_t", _vec(3)),  # F_T [rad/s^2]
+        ("grasp_r", _vec(3)),  # F_R [m]
+        ("grasp_v_r", _vec(3)),  # F_R [m/s]
+        ("grasp_a_r", _vec(3)),  # F_R [m/s^2]
+        ("grasp_b", _vec(3)),  # F_B [m]
+        ("ee_b", _vec(3)),  # F_B [m]
+        ("ee_r", _vec(3)),  # F_R [m]
+        ("ee_v_r", _vec(3)),  # F_R [m/s]
     ]
 
     @staticmethod
     def type_name():
-        return "safe_capture::v1::SimState"
+        return "safe_capture::v2::SimState"
 
 
 _NOMINAL_HEAD = [
     ("tick", c_u64),  # tick answered [-]
     ("t", c_f64),  # sim time of the state used [s]
     ("valid", c_u32),  # 1 valid, 0 not
-    ("_pad0", c_u32),
+    ("phase", c_u32),  # mission phase index, 0-based
     ("recv_ns", c_u64),  # state received [ns]
     ("publish_ns", c_u64),  # [ns]
 ]
@@ -137,7 +154,7 @@ class NominalTranslational(ctypes.Structure):
 
     @staticmethod
     def type_name():
-        return "safe_capture::v1::NominalTranslational"
+        return "safe_capture::v2::NominalTranslational"
 
 
 class NominalAttitude(ctypes.Structure):
@@ -147,7 +164,7 @@ class NominalAttitude(ctypes.Structure):
 
     @staticmethod
     def type_name():
-        return "safe_capture::v1::NominalAttitude"
+        return "safe_capture::v2::NominalAttitude"
 
 
 class NominalRobotic(ctypes.Structure):
@@ -157,10 +174,10 @@ class NominalRobotic(ctypes.Structure):
 
     @staticmethod
     def type_name():
-        return "safe_capture::v1::NominalRobotic"
+        return "safe_capture::v2::NominalRobotic"
 
 
-def _safe_head(n):
+def _safe(n, m):
     return [
         ("tick", c_u64),
         ("t", c_f64),  # [s]
@@ -168,46 +185,70 @@ def _safe_head(n):
         ("publish_ns", c_u64),  # [ns]
         ("active_mask", c_u64),  # bit i = constraint i active
         ("solve_ns", c_u64),  # [ns]
-        ("solver_status", c_u32),  # 0 solved
+        ("solver_status", c_u32),  # 0 skipped, 1 solved, 2 relaxed, 3 fallback
         ("iterations", c_u32),
-        ("fault_flags", c_u32),  # sc_icd::fault bits
+        ("fault_flags", c_u32),  # sc_cbf::faults bits
         ("n_constraints", c_u32),
+        ("phase", c_u32),
+        ("_pad0", c_u32),
+        ("slack", c_f64),
         ("h", _vec(n)),  # barrier values
-        ("phi", _vec(n)),  # CBF residuals
+        ("phi", _vec(n)),  # CBF conditions
+        ("u", _vec(m)),  # safe command
+        ("actuated", _vec(m)),  # actuated command
     ]
 
 
 class SafeTranslational(ctypes.Structure):
-    """Translational safety filter output; constraints AC, CAZ."""
+    """Translational safety filter -> attitude/robotic filters, simulator, recorder."""
 
-    _fields_ = _safe_head(N_CONSTRAINTS_TRANSLATIONAL) + [
-        ("f_h", _vec(3)),  # F_H [N]
-        ("f_b", _vec(3)),  # F_B [N]
+    _fields_ = _safe(N_CONSTRAINTS_TRANSLATIONAL, 3)  # u = f_H [N], actuated = f_B [N]
+
+    @staticmethod
+    def type_name():
+        return "safe_capture::v2::SafeTranslational"
+
+
+class SafeAttitude(ctypes.Structure):
+    """Attitude safety filter -> robotic filter, simulator, recorder."""
+
+    _fields_ = _safe(N_CONSTRAINTS_ATTITUDE, 3)  # tau_B, F_B [N m]
+
+    @staticmethod
+    def type_name():
+        return "safe_capture::v2::SafeAttitude"
+
+
+class SafeRobotic(ctypes.Structure):
+    """Robotic safety filter -> simulator, recorder."""
+
+    _fields_ = _safe(N_CONSTRAINTS_ROBOTIC, N_JOINTS)  # tau_M [N m]
+
+    @staticmethod
+    def type_name():
+        return "safe_capture::v2::SafeRobotic"
+
+
+class StepResult(ctypes.Structure):
+    """Simulator -> scheduler, recorder: applied command and end of the step."""
+
+    _fields_ = [
+        ("tick", c_u64),
+        ("t", c_f64),  # [s]
+        ("end", c_u32),  # 0 running, 1 captured, 2 timeout, 3 simulator failed
+        ("fallback_mask", c_u32),
+        ("held_mask", c_u32),
+        ("fault_flags", c_u32),
+        ("safe_recv_ns", c_u64),  # [ns]
+        ("publish_ns", c_u64),  # [ns]
+        ("force_b", _vec(3)),  # F_B [N]
+        ("torque_b", _vec(3)),  # F_B [N m]
+        ("tau", _vec(N_JOINTS)),  # [N m]
     ]
 
     @staticmethod
     def type_name():
-        return "safe_capture::v1::SafeTranslational"
-
-
-class SafeAttitude(ctypes.Structure):
-    """Attitude safety filter output; constraints ATT, w1..3 upper, w1..3 lower."""
-
-    _fields_ = _safe_head(N_CONSTRAINTS_ATTITUDE) + [("tau_b", _vec(3))]  # F_B [N m]
-
-    @staticmethod
-    def type_name():
-        return "safe_capture::v1::SafeAttitude"
-
-
-class SafeRobotic(ctypes.Structure):
-    """Robotic safety filter output; 42 constraints (theta 7, dtheta up 7, dtheta low 7, link-base 21)."""
-
-    _fields_ = _safe_head(N_CONSTRAINTS_ROBOTIC) + [("tau_m", _vec(N_JOINTS))]  # [N m]
-
-    @staticmethod
-    def type_name():
-        return "safe_capture::v1::SafeRobotic"
+        return "safe_capture::v1::StepResult"
 
 
 class Health(ctypes.Structure):
@@ -239,6 +280,7 @@ ALL_TYPES = [
     SafeTranslational,
     SafeAttitude,
     SafeRobotic,
+    StepResult,
     Health,
 ]
 

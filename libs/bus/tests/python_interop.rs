@@ -54,9 +54,10 @@ fn python_controller_answers_rust_states() {
 
         for i in 0..50u64 {
             let mut s = SimState {
+                tick: i,
                 step: i,
                 t: i as f64 * 0.1,
-                phase: 1,
+                due_mask: sc_icd::due::ALL,
                 ..Default::default()
             };
             s.r_h = [10.0 + i as f64, -2.0, 0.5];
@@ -69,7 +70,7 @@ fn python_controller_answers_rust_states() {
             assert_eq!(cmd.valid, 1);
             assert_eq!(cmd.f_h, [-0.5 * (10.0 + i as f64), 1.0, -0.25]);
         }
-        // phase 0 = stop.
+        // due_mask 0 = stop.
         state_tx.send(&SimState::default()).unwrap();
         let status = child.wait().unwrap();
         assert!(status.success(), "python exited with {status}");

@@ -148,48 +148,102 @@ pub mod fault {
     pub const PEER_DEAD: u32 = 1 << 7;
 }
 
-/// Scheduler → all: start one control step.
+/// Values of [`Tick::command`].
+pub mod tick_command {
+    /// Run one control step.
+    pub const STEP: u32 = 0;
+    /// The run is over: every process finishes its outputs and exits.
+    pub const STOP: u32 = 1;
+}
+
+/// Bits of the `due_mask` fields: which subsystems' rate groups run in a tick.
+pub mod due {
+    /// Translational nominal controller and safety filter.
+    pub const TRANSLATIONAL: u32 = 1 << 0;
+    /// Attitude nominal controller and safety filter.
+    pub const ATTITUDE: u32 = 1 << 1;
+    /// Robotic nominal controller and safety filter.
+    pub const ROBOTIC: u32 = 1 << 2;
+    /// All three.
+    pub const ALL: u32 = 7;
+}
+
+/// Values of [`StepResult::end`].
+pub mod end {
+    /// The mission goes on.
+    pub const RUNNING: u32 = 0;
+    /// Captured: end-effector on the grasping point within tolerance.
+    pub const CAPTURED: u32 = 1;
+    /// The configured duration elapsed.
+    pub const TIMEOUT: u32 = 2;
+    /// The simulator failed (non-finite state or command).
+    pub const SIMULATOR_FAILED: u32 = 3;
+}
+
+/// Scheduler → simulator, every other process (stop), recorder: start one control step.
 #[derive(Debug, Clone, Copy, ZeroCopySend, PartialEq)]
 #[repr(C)]
-#[type_name("safe_capture::v1::Tick")]
+#[type_name("safe_capture::v2::Tick")]
 pub struct Tick {
-    /// Tick index, starts at 0, +1 per tick of this rate group [-].
+    /// Tick index, starts at 0, +1 per tick of the fastest rate group [-].
     pub tick: u64,
-    /// Rate-group id (0 = the main control rate) [-].
-    pub rate_group: u32,
+    /// Subsystems due in this tick, bits of [`due`] [-].
+    pub due_mask: u32,
     /// Clock mode, one of [`clock_mode`] [-].
     pub clock_mode: u32,
     /// Simulation time at which this step starts [s].
     pub t: f64,
     /// Scheduler send stamp, monotonic clock [ns].
     pub send_ns: u64,
-}
-
-/// Simulator → all: the true state at the start of the step.
-#[derive(Debug, Clone, Copy, ZeroCopySend, PartialEq)]
-#[repr(C)]
-#[type_name("safe_capture::v1::SimState")]
-pub struct SimState {
-    /// Simulation step counter (equals the tick index it answers) [-].
-    pub step: u64,
-    /// Simulation time [s].
-    pub t: f64,
-    /// Mission phase 1..=3, see [`phase`] [-].
-    pub phase: u32,
+    /// One of [`tick_command`] [-].
+    pub command: u32,
     /// Always 0.
     pub _pad0: u32,
-    /// Servicer position relative to the target, Hill frame F_H [m].
+}
+
+/// Simulator → nominal controllers, safety filters, recorder: the observation at
+/// the start of the step. Every field of `sc_sim::Observation`, copied as f64, so
+/// that the stages compute exactly what they compute in one process.
+#[derive(Debug, Clone, Copy, ZeroCopySend, PartialEq)]
+#[repr(C)]
+#[type_name("safe_capture::v2::SimState")]
+pub struct SimState {
+    /// Tick index this state answers (= simulator step count at the base rate) [-].
+    pub tick: u64,
+    /// Simulation time [s].
+    pub t: f64,
+    /// Subsystems due in this tick, bits of [`due`] [-].
+    pub due_mask: u32,
+    /// Always 0.
+    pub _pad0: u32,
+    /// Send stamp of the tick this state answers, monotonic clock [ns].
+    pub tick_send_ns: u64,
+    /// Stamp at which the simulator received the tick, monotonic clock [ns].
+    pub recv_ns: u64,
+    /// Publish stamp, monotonic clock [ns].
+    pub publish_ns: u64,
+    /// Simulator step counter [-].
+    pub step: u64,
+    /// Servicer base origin relative to the target CoM, Hill frame F_H [m].
     pub r_h: [f64; 3],
-    /// Servicer velocity relative to the target, Hill frame F_H [m/s].
+    /// Its derivative in the rotating Hill frame F_H [m/s].
     pub v_h: [f64; 3],
-    /// Servicer position relative to the target, reference frame F_R [m].
+    /// Servicer base origin relative to the target CoM, reference frame F_R [m].
     pub r_r: [f64; 3],
-    /// Servicer velocity relative to the target, reference frame F_R [m/s].
+    /// Inertial derivative of `r_r`, in F_R [m/s].
     pub v_r: [f64; 3],
+    /// q_HR, scalar-first, rotates F_R vectors into F_H [-].
+    pub q_hr: [f64; 4],
+    /// Angular velocity of F_H w.r.t. inertial, in F_H [rad/s].
+    pub omega_h: [f64; 3],
+    /// Angular acceleration of F_H w.r.t. inertial, in F_H [rad/s²].
+    pub omega_dot_h: [f64; 3],
+    /// Mean motion of the target orbit |ω_H| [rad/s].
+    pub mean_motion: f64,
     /// Servicer attitude q_RB, scalar-first, rotates F_B vectors into F_R [-].
     pub q_rb: [f64; 4],
     /// Servicer body rate ω_B w.r.t. inertial, in F_B [rad/s].
-    pub w_b: [f64; 3],
+    pub omega_b: [f64; 3],
     /// Joint angles θ [rad].
     pub theta: [f64; N_JOINTS],
     /// Joint rates θ̇ [rad/s].
@@ -197,195 +251,163 @@ pub struct SimState {
     /// Target attitude q_RT, scalar-first, rotates F_T vectors into F_R [-].
     pub q_rt: [f64; 4],
     /// Target body rate ω_T w.r.t. inertial, in F_T [rad/s].
-    pub w_t: [f64; 3],
-    /// q_HR, scalar-first, rotates F_R vectors into F_H [-].
-    pub q_hr: [f64; 4],
-    /// Angular velocity of F_H w.r.t. inertial, in F_H [rad/s].
-    pub w_h: [f64; 3],
-    /// Angular acceleration of F_H w.r.t. inertial, in F_H [rad/s²].
-    pub dw_h: [f64; 3],
-    /// Mean motion n of the target orbit [rad/s].
-    pub n: f64,
-    /// Grasping point position relative to the target centre, F_R [m].
-    pub p_g_r: [f64; 3],
-    /// Grasping point velocity, F_R [m/s].
-    pub v_g_r: [f64; 3],
-    /// Grasping point acceleration, F_R [m/s²].
-    pub a_g_r: [f64; 3],
-    /// End-effector position relative to the servicer base, F_B [m].
-    pub p_ee_b: [f64; 3],
-    /// Publish stamp, monotonic clock [ns].
-    pub publish_ns: u64,
+    pub omega_t: [f64; 3],
+    /// Its derivative, in F_T [rad/s²].
+    pub omega_dot_t: [f64; 3],
+    /// Grasping point relative to the target CoM, F_R [m].
+    pub grasp_r: [f64; 3],
+    /// Grasping point inertial velocity, F_R [m/s].
+    pub grasp_v_r: [f64; 3],
+    /// Grasping point inertial acceleration, F_R [m/s²].
+    pub grasp_a_r: [f64; 3],
+    /// Grasping point relative to the base origin, F_B [m].
+    pub grasp_b: [f64; 3],
+    /// End-effector position relative to the base origin, F_B [m].
+    pub ee_b: [f64; 3],
+    /// End-effector position relative to the target CoM, F_R [m].
+    pub ee_r: [f64; 3],
+    /// End-effector inertial velocity, F_R [m/s].
+    pub ee_v_r: [f64; 3],
 }
 
-/// Nominal translational controller → translational safety filter.
-#[derive(Debug, Clone, Copy, ZeroCopySend, PartialEq)]
-#[repr(C)]
-#[type_name("safe_capture::v1::NominalTranslational")]
-pub struct NominalTranslational {
-    /// Tick index this command answers [-].
-    pub tick: u64,
-    /// Simulation time of the state used [s].
-    pub t: f64,
-    /// 1 if the command is valid, 0 otherwise [-].
-    pub valid: u32,
-    /// Always 0.
-    pub _pad0: u32,
-    /// Stamp at which the state was received, monotonic clock [ns].
-    pub recv_ns: u64,
-    /// Publish stamp, monotonic clock [ns].
-    pub publish_ns: u64,
-    /// Commanded force f_H, Hill frame F_H [N].
-    pub f_h: [f64; 3],
+macro_rules! nominal_msg {
+    ($(#[$m:meta])* $name:ident, $tn:literal, $field:ident, $n:expr, $doc:literal) => {
+        $(#[$m])*
+        #[derive(Debug, Clone, Copy, ZeroCopySend, PartialEq)]
+        #[repr(C)]
+        #[type_name($tn)]
+        pub struct $name {
+            /// Tick index this command answers [-].
+            pub tick: u64,
+            /// Simulation time of the state used [s].
+            pub t: f64,
+            /// 1 if the controller ran on valid inputs, 0 otherwise [-].
+            pub valid: u32,
+            /// Index of the mission phase (0-based, scenario order) [-].
+            pub phase: u32,
+            /// Stamp at which the state was received, monotonic clock [ns].
+            pub recv_ns: u64,
+            /// Publish stamp, monotonic clock [ns].
+            pub publish_ns: u64,
+            #[doc = $doc]
+            pub $field: [f64; $n],
+        }
+    };
 }
 
-/// Nominal attitude controller → attitude safety filter.
-#[derive(Debug, Clone, Copy, ZeroCopySend, PartialEq)]
-#[repr(C)]
-#[type_name("safe_capture::v1::NominalAttitude")]
-pub struct NominalAttitude {
-    /// Tick index this command answers [-].
-    pub tick: u64,
-    /// Simulation time of the state used [s].
-    pub t: f64,
-    /// 1 if the command is valid, 0 otherwise [-].
-    pub valid: u32,
-    /// Always 0.
-    pub _pad0: u32,
-    /// Stamp at which the state was received, monotonic clock [ns].
-    pub recv_ns: u64,
-    /// Publish stamp, monotonic clock [ns].
-    pub publish_ns: u64,
-    /// Commanded torque τ_B, base frame F_B [N·m].
-    pub tau_b: [f64; 3],
+nominal_msg!(
+    /// Nominal translational controller → translational safety filter, recorder.
+    NominalTranslational, "safe_capture::v2::NominalTranslational", f_h, 3,
+    "Commanded force f_H, Hill frame F_H, unsaturated [N]."
+);
+nominal_msg!(
+    /// Nominal attitude controller → attitude safety filter, recorder.
+    NominalAttitude, "safe_capture::v2::NominalAttitude", tau_b, 3,
+    "Commanded torque τ_B, base frame F_B, unsaturated [N·m]."
+);
+nominal_msg!(
+    /// Nominal robotic controller → robotic safety filter, recorder.
+    NominalRobotic, "safe_capture::v2::NominalRobotic", tau_m, N_JOINTS,
+    "Commanded joint torques τ_M, unsaturated [N·m]."
+);
+
+macro_rules! safe_msg {
+    ($(#[$m:meta])* $name:ident, $tn:literal, $nc:expr, $nu:expr, $udoc:literal, $adoc:literal) => {
+        $(#[$m])*
+        #[derive(Debug, Clone, Copy, ZeroCopySend, PartialEq)]
+        #[repr(C)]
+        #[type_name($tn)]
+        pub struct $name {
+            /// Tick index this command answers [-].
+            pub tick: u64,
+            /// Simulation time of the state used [s].
+            pub t: f64,
+            /// Stamp at which the last input of this tick arrived, monotonic clock [ns].
+            pub recv_ns: u64,
+            /// Publish stamp, monotonic clock [ns].
+            pub publish_ns: u64,
+            /// Bit i set = constraint i active (Φ_i ≈ 0) [-].
+            pub active_mask: u64,
+            /// Wall time of the filter call [ns].
+            pub solve_ns: u64,
+            /// `sc_cbf::FilterStatus`: 0 skipped, 1 solved, 2 relaxed, 3 fallback [-].
+            pub solver_status: u32,
+            /// Interior-point iterations [-].
+            pub iterations: u32,
+            /// `sc_cbf::faults` bits (UPSTREAM_MISSING = 1<<5 when an input was missing) [-].
+            pub fault_flags: u32,
+            /// Number of constraints in `h`/`phi` [-].
+            pub n_constraints: u32,
+            /// Mission phase of the nominal command filtered (0-based) [-].
+            pub phase: u32,
+            /// Always 0.
+            pub _pad0: u32,
+            /// Slack of the relaxed QP (0 otherwise), normalised rows [-].
+            pub slack: f64,
+            /// Barrier values h_i (NaN when not evaluated) [see docs/ICD.md].
+            pub h: [f64; $nc],
+            /// CBF conditions Φ_i at the safe command [units of h per s].
+            pub phi: [f64; $nc],
+            #[doc = $udoc]
+            pub u: [f64; $nu],
+            #[doc = $adoc]
+            pub actuated: [f64; $nu],
+        }
+    };
 }
 
-/// Nominal robotic controller → robotic safety filter.
-#[derive(Debug, Clone, Copy, ZeroCopySend, PartialEq)]
-#[repr(C)]
-#[type_name("safe_capture::v1::NominalRobotic")]
-pub struct NominalRobotic {
-    /// Tick index this command answers [-].
-    pub tick: u64,
-    /// Simulation time of the state used [s].
-    pub t: f64,
-    /// 1 if the command is valid, 0 otherwise [-].
-    pub valid: u32,
-    /// Always 0.
-    pub _pad0: u32,
-    /// Stamp at which the state was received, monotonic clock [ns].
-    pub recv_ns: u64,
-    /// Publish stamp, monotonic clock [ns].
-    pub publish_ns: u64,
-    /// Commanded joint torques τ_M [N·m].
-    pub tau_m: [f64; N_JOINTS],
-}
+safe_msg!(
+    /// Translational safety filter → attitude and robotic filters, simulator, recorder.
+    /// Constraint order: AC, CAZ.
+    SafeTranslational, "safe_capture::v2::SafeTranslational", N_CONSTRAINTS_TRANSLATIONAL, 3,
+    "Safe force f_H, Hill frame F_H [N].",
+    "Safe force f_B = R_BH f_H, base frame F_B (what the thrusters apply) [N]."
+);
+safe_msg!(
+    /// Attitude safety filter → robotic filter, simulator, recorder.
+    /// Constraint order: ATT, ω1..3 upper, ω1..3 lower.
+    SafeAttitude, "safe_capture::v2::SafeAttitude", N_CONSTRAINTS_ATTITUDE, 3,
+    "Safe torque τ_B, base frame F_B [N·m].",
+    "Actuated torque τ_B, base frame F_B (equals `u`) [N·m]."
+);
+safe_msg!(
+    /// Robotic safety filter → simulator, recorder.
+    /// Constraint order: θ limits 0..7, θ̇ upper 7..14, θ̇ lower 14..21, link-base 21..42.
+    SafeRobotic, "safe_capture::v2::SafeRobotic", N_CONSTRAINTS_ROBOTIC, N_JOINTS,
+    "Safe joint torques τ_M [N·m].",
+    "Actuated joint torques τ_M (equals `u`) [N·m]."
+);
 
-/// Translational safety filter → attitude filter, simulator, recorder.
-///
-/// The filter report (`h`, `phi`, ...) uses the constraint order AC, CAZ.
+/// Simulator → scheduler, recorder: the command applied over the step and how the
+/// step ended. Sent once all due safe commands of the tick are in (or their
+/// deadline passed and the simulator used the filter's fallback).
 #[derive(Debug, Clone, Copy, ZeroCopySend, PartialEq)]
 #[repr(C)]
-#[type_name("safe_capture::v1::SafeTranslational")]
-pub struct SafeTranslational {
-    /// Tick index this command answers [-].
+#[type_name("safe_capture::v1::StepResult")]
+pub struct StepResult {
+    /// Tick index [-].
     pub tick: u64,
-    /// Simulation time of the state used [s].
+    /// Simulation time at the start of the step [s].
     pub t: f64,
-    /// Stamp at which the last input arrived, monotonic clock [ns].
-    pub recv_ns: u64,
-    /// Publish stamp, monotonic clock [ns].
-    pub publish_ns: u64,
-    /// Bit i set = constraint i active (h_i ≈ 0 or QP multiplier > 0) [-].
-    pub active_mask: u64,
-    /// QP solve wall time [ns].
-    pub solve_ns: u64,
-    /// Solver status (0 = solved, solver-specific codes otherwise) [-].
-    pub solver_status: u32,
-    /// Solver iterations [-].
-    pub iterations: u32,
-    /// Fault flags, bits of [`fault`] [-].
+    /// One of [`end`] [-].
+    pub end: u32,
+    /// Subsystems ([`due`] bits) whose command is the filter fallback computed by the
+    /// simulator because the safe command was missing at the deadline [-].
+    pub fallback_mask: u32,
+    /// Subsystems ([`due`] bits) whose command was held from an earlier tick (slower rate group) [-].
+    pub held_mask: u32,
+    /// Partition fault flags, bits of [`fault`] [-].
     pub fault_flags: u32,
-    /// Number of constraints N in `h`/`phi` (= 2) [-].
-    pub n_constraints: u32,
-    /// Barrier values h_i, order AC, CAZ [m or m², see CBF design].
-    pub h: [f64; N_CONSTRAINTS_TRANSLATIONAL],
-    /// CBF condition residuals Φ_i = ḣ_i + α(h_i) at the safe command [units of h per s].
-    pub phi: [f64; N_CONSTRAINTS_TRANSLATIONAL],
-    /// Safe force f_H, Hill frame F_H [N].
-    pub f_h: [f64; 3],
-    /// Safe force f_B, base frame F_B [N].
-    pub f_b: [f64; 3],
-}
-
-/// Attitude safety filter → robotic filter, simulator, recorder.
-///
-/// Constraint order: ATT, ω1 upper, ω2 upper, ω3 upper, ω1 lower, ω2 lower, ω3 lower.
-#[derive(Debug, Clone, Copy, ZeroCopySend, PartialEq)]
-#[repr(C)]
-#[type_name("safe_capture::v1::SafeAttitude")]
-pub struct SafeAttitude {
-    /// Tick index this command answers [-].
-    pub tick: u64,
-    /// Simulation time of the state used [s].
-    pub t: f64,
-    /// Stamp at which the last input arrived, monotonic clock [ns].
-    pub recv_ns: u64,
+    /// Stamp at which the robotic safe command (the tick's last) was delivered, monotonic [ns].
+    pub safe_recv_ns: u64,
     /// Publish stamp, monotonic clock [ns].
     pub publish_ns: u64,
-    /// Bit i set = constraint i active [-].
-    pub active_mask: u64,
-    /// QP solve wall time [ns].
-    pub solve_ns: u64,
-    /// Solver status (0 = solved) [-].
-    pub solver_status: u32,
-    /// Solver iterations [-].
-    pub iterations: u32,
-    /// Fault flags, bits of [`fault`] [-].
-    pub fault_flags: u32,
-    /// Number of constraints N in `h`/`phi` (= 7) [-].
-    pub n_constraints: u32,
-    /// Barrier values h_i [rad-based, see CBF design].
-    pub h: [f64; N_CONSTRAINTS_ATTITUDE],
-    /// CBF condition residuals Φ_i [units of h per s].
-    pub phi: [f64; N_CONSTRAINTS_ATTITUDE],
-    /// Safe torque τ_B, base frame F_B [N·m].
-    pub tau_b: [f64; 3],
-}
-
-/// Robotic safety filter → simulator, recorder.
-///
-/// Constraint order: θ limits 0..7, θ̇ upper 7..14, θ̇ lower 14..21, link-base 21..42.
-#[derive(Debug, Clone, Copy, ZeroCopySend, PartialEq)]
-#[repr(C)]
-#[type_name("safe_capture::v1::SafeRobotic")]
-pub struct SafeRobotic {
-    /// Tick index this command answers [-].
-    pub tick: u64,
-    /// Simulation time of the state used [s].
-    pub t: f64,
-    /// Stamp at which the last input arrived, monotonic clock [ns].
-    pub recv_ns: u64,
-    /// Publish stamp, monotonic clock [ns].
-    pub publish_ns: u64,
-    /// Bit i set = constraint i active (42 constraints fit in 64 bits) [-].
-    pub active_mask: u64,
-    /// QP solve wall time [ns].
-    pub solve_ns: u64,
-    /// Solver status (0 = solved) [-].
-    pub solver_status: u32,
-    /// Solver iterations [-].
-    pub iterations: u32,
-    /// Fault flags, bits of [`fault`] [-].
-    pub fault_flags: u32,
-    /// Number of constraints N in `h`/`phi` (= 42) [-].
-    pub n_constraints: u32,
-    /// Barrier values h_i [rad, rad/s or m, see CBF design].
-    pub h: [f64; N_CONSTRAINTS_ROBOTIC],
-    /// CBF condition residuals Φ_i [units of h per s].
-    pub phi: [f64; N_CONSTRAINTS_ROBOTIC],
-    /// Safe joint torques τ_M [N·m].
-    pub tau_m: [f64; N_JOINTS],
+    /// Applied base force f_B, F_B [N].
+    pub force_b: [f64; 3],
+    /// Applied base torque τ_B, F_B [N·m].
+    pub torque_b: [f64; 3],
+    /// Applied joint torques τ_M [N·m].
+    pub tau: [f64; N_JOINTS],
 }
 
 /// Every process → scheduler, recorder: health and counters.
@@ -413,6 +435,7 @@ pub struct Health {
     pub publish_ns: u64,
 }
 
+
 zeroed!(
     Tick,
     SimState,
@@ -422,6 +445,7 @@ zeroed!(
     SafeTranslational,
     SafeAttitude,
     SafeRobotic,
+    StepResult,
     Health
 );
 
@@ -433,14 +457,15 @@ pub fn type_name_of<T: ZeroCopySend>() -> &'static str {
 }
 
 // Size guards: change them only together with scripts/python/sc_icd.py and docs/ICD.md.
-const _: () = assert!(core::mem::size_of::<Tick>() == 32);
-const _: () = assert!(core::mem::size_of::<SimState>() == 536);
+const _: () = assert!(core::mem::size_of::<Tick>() == 40);
+const _: () = assert!(core::mem::size_of::<SimState>() == 656);
 const _: () = assert!(core::mem::size_of::<NominalTranslational>() == 64);
 const _: () = assert!(core::mem::size_of::<NominalAttitude>() == 64);
 const _: () = assert!(core::mem::size_of::<NominalRobotic>() == 96);
-const _: () = assert!(core::mem::size_of::<SafeTranslational>() == 144);
-const _: () = assert!(core::mem::size_of::<SafeAttitude>() == 200);
-const _: () = assert!(core::mem::size_of::<SafeRobotic>() == 792);
+const _: () = assert!(core::mem::size_of::<SafeTranslational>() == 160);
+const _: () = assert!(core::mem::size_of::<SafeAttitude>() == 240);
+const _: () = assert!(core::mem::size_of::<SafeRobotic>() == 864);
+const _: () = assert!(core::mem::size_of::<StepResult>() == 152);
 const _: () = assert!(core::mem::size_of::<Health>() == 56);
 const _: () = assert!(core::mem::align_of::<SimState>() == 8);
 const _: () = assert!(core::mem::align_of::<Health>() == 8);
@@ -452,10 +477,10 @@ mod tests {
 
     #[test]
     fn type_names_are_versioned() {
-        assert_eq!(type_name_of::<Tick>(), "safe_capture::v1::Tick");
+        assert_eq!(type_name_of::<Tick>(), "safe_capture::v2::Tick");
         assert_eq!(
             type_name_of::<SafeRobotic>(),
-            "safe_capture::v1::SafeRobotic"
+            "safe_capture::v2::SafeRobotic"
         );
     }
 

@@ -44,6 +44,8 @@ pub const SAFE_ATTITUDE: ServiceName = ServiceName("safe_capture/safe/attitude")
 /// [`crate::SafeRobotic`]. Publisher: robotic safety filter.
 /// Subscribers: simulator (closes the step), scheduler, recorder.
 pub const SAFE_ROBOTIC: ServiceName = ServiceName("safe_capture/safe/robotic");
+/// [`crate::StepResult`]. Publisher: simulator. Subscribers: scheduler (step completion), recorder.
+pub const STEP_RESULT: ServiceName = ServiceName("safe_capture/sim/step_result");
 /// [`crate::Health`]. Publishers: every process (up to 16). Subscribers: scheduler, recorder.
 pub const HEALTH: ServiceName = ServiceName("safe_capture/health");
 /// Start-up handshake (event services `<HANDSHAKE>/ready` and `<HANDSHAKE>/go`, no payload).
@@ -53,16 +55,17 @@ pub const HANDSHAKE: ServiceName = ServiceName("safe_capture/handshake");
 
 /// All pub/sub services with their iceoryx2 type names, for tools and docs.
 pub const ALL: &[(ServiceName, &str)] = &[
-    (TICK, "safe_capture::v1::Tick"),
-    (SIM_STATE, "safe_capture::v1::SimState"),
+    (TICK, "safe_capture::v2::Tick"),
+    (SIM_STATE, "safe_capture::v2::SimState"),
     (
         NOMINAL_TRANSLATIONAL,
-        "safe_capture::v1::NominalTranslational",
+        "safe_capture::v2::NominalTranslational",
     ),
-    (NOMINAL_ATTITUDE, "safe_capture::v1::NominalAttitude"),
-    (NOMINAL_ROBOTIC, "safe_capture::v1::NominalRobotic"),
-    (SAFE_TRANSLATIONAL, "safe_capture::v1::SafeTranslational"),
-    (SAFE_ATTITUDE, "safe_capture::v1::SafeAttitude"),
-    (SAFE_ROBOTIC, "safe_capture::v1::SafeRobotic"),
+    (NOMINAL_ATTITUDE, "safe_capture::v2::NominalAttitude"),
+    (NOMINAL_ROBOTIC, "safe_capture::v2::NominalRobotic"),
+    (SAFE_TRANSLATIONAL, "safe_capture::v2::SafeTranslational"),
+    (SAFE_ATTITUDE, "safe_capture::v2::SafeAttitude"),
+    (SAFE_ROBOTIC, "safe_capture::v2::SafeRobotic"),
+    (STEP_RESULT, "safe_capture::v1::StepResult"),
     (HEALTH, "safe_capture::v1::Health"),
 ];
