@@ -5,6 +5,7 @@
 mod cmd_bench;
 mod cmd_bench_filters;
 mod cmd_model;
+mod cmd_montecarlo;
 mod cmd_run;
 mod cmd_simulate;
 
@@ -32,6 +33,8 @@ enum Command {
     Model(cmd_model::Args),
     /// Benchmarks: simulator speed, safety-layer solve times, partition latency.
     Bench(cmd_bench::Args),
+    /// Monte Carlo campaigns: dispersed runs in parallel, shards, merge, rerun.
+    Montecarlo(cmd_montecarlo::Args),
 }
 
 /// Default scenario path (relative to the working directory).
@@ -46,6 +49,7 @@ fn main() -> ExitCode {
         Command::Simulate(a) => cmd_simulate::run(a),
         Command::Model(a) => cmd_model::run(a),
         Command::Bench(a) => cmd_bench::run(a),
+        Command::Montecarlo(a) => cmd_montecarlo::run(a),
     };
     match result {
         Ok(code) => code,

@@ -1,1 +1,24 @@
 //! Monte Carlo campaigns: dispersions, parallel runs, shards, merge, report.
+//!
+//! * [`config`] — `config/montecarlo.toml`, the dispersions (default: the paper's).
+//! * [`sample`] — per-run seeds derived from (campaign seed, run index) and the sampled
+//!   initial position (inside the approach corridor) and target tumbling rate.
+//! * [`run`] — one run: dispersed scenario → mission → metrics, trace, timing; failures
+//!   and panics become failed results.
+//! * [`campaign`] — run a campaign or a shard in parallel (rayon, `--jobs` threads, an
+//!   indicatif progress bar), aggregate, merge shards, rerun one run.
+//! * [`report`] — the Markdown report beside the paper's numbers.
+
+pub mod campaign;
+pub mod config;
+pub mod hist;
+pub mod report;
+pub mod run;
+pub mod sample;
+
+pub use campaign::{
+    CampaignInfo, CampaignOptions, CampaignSummary, McError, WALL_CLOCK_FILES, WALL_CLOCK_KEYS,
+    aggregate, merge, parse_shard, rerun, run_campaign, shard_runs,
+};
+pub use config::{ConfigError, DEFAULT_CONFIG, MonteCarloConfig};
+pub use run::RunResult;

@@ -1,0 +1,242 @@
+//! `safe-capture montecarlo`: dispersed campaigns, in parallel, sharded, merged, rerun.
+
+use anyhow::Context;
+use sc_mission::{RunOptions, TelemetryWriter, summarize};
+use sc_montecarlo::{CampaignOptions, CampaignSummary, MonteCarloConfig};
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Monte Carlo campaign over dispersed initial positions (inside the approach corridor)
+/// and target tumbling rates (config/montecarlo.toml). Runs in parallel in one process;
+/// every run's seed derives from (--seed, run index), so shards and reruns reproduce
+/// exactly.
+///
+/// Writes to OUT: runs/K/ (scenario.toml, result.json, trace.csv, timing.json per run),
+/// runs.csv, runs_timing.csv, summary.json, report.md, figures/*.svg. Exit code 0 when
+/// every run completed safe and captured, 1 otherwise, 2 on errors.
+#[derive(clap::Args)]
+#[command(args_conflicts_with_subcommands = true)]
+pub struct Args {
+    #[command(subcommand)]
+    action: Option<Action>,
+    #[command(flatten)]
+    run: RunArgs,
+}
+
+#[derive(clap::Subcommand)]
+enum Action {
+    /// Rerun one run of a campaign from its saved scenario and check that it reproduces
+    /// the saved result exactly; writes its telemetry, summary and figures.
+    Rerun(RerunArgs),
+    /// Merge shard directories into one campaign (same outputs as an unsharded run).
+    Merge(MergeArgs),
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Mode {
+    /// Simulator, nominal controllers and filters in one process.
+    InProcess,
+    /// Through the process partition (not available yet).
+    Partition,
+}
+
+#[derive(clap::Args)]
+struct RunArgs {
+    /// Runs in the whole campaign.
+    #[arg(long, default_value_t = 100)]
+    runs: usize,
+    /// Campaign seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Worker threads (default: all cores).
+    #[arg(long, short)]
+    jobs: Option<usize>,
+    /// Output directory.
+    #[arg(long, value_name = "DIR", default_value = "out/montecarlo")]
+    out: PathBuf,
+    /// Run only shard i of N (0-based): runs k with k mod N = i.
+    #[arg(long, value_name = "i/N")]
+    shard: Option<String>,
+    /// Base scenario to disperse.
+    #[arg(long, value_name = "FILE", default_value_os_t = crate::default_scenario())]
+    scenario: PathBuf,
+    /// Dispersion configuration.
+    #[arg(long, value_name = "FILE", default_value = sc_montecarlo::DEFAULT_CONFIG)]
+    config: PathBuf,
+    /// Where the runs execute.
+    #[arg(long, value_enum, default_value_t = Mode::InProcess)]
+    mode: Mode,
+    /// No progress bar.
+    #[arg(long, short)]
+    quiet: bool,
+    /// Test hook: make these runs panic (also SC_MONTECARLO_INJECT_PANIC=K,K,...).
+    #[arg(long, value_name = "K", value_delimiter = ',', hide = true)]
+    inject_panic: Vec<usize>,
+}
+
+#[derive(clap::Args)]
+struct RerunArgs {
+    /// Campaign directory.
+    dir: PathBuf,
+    /// Run index.
+    #[arg(long)]
+    run: usize,
+    /// Output directory for telemetry, summary and figures (default DIR/runs/K/rerun).
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+    /// Write no figures.
+    #[arg(long)]
+    no_figures: bool,
+}
+
+#[derive(clap::Args)]
+struct MergeArgs {
+    /// Shard directories.
+    #[arg(required = true)]
+    dirs: Vec<PathBuf>,
+    /// Output directory.
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+}
+
+pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    match a.action {
+        Some(Action::Rerun(r)) => rerun(r),
+        Some(Action::Merge(m)) => {
+            let s = sc_montecarlo::merge(&m.dirs, &m.out)?;
+            Ok(report(&s, &m.out))
+        }
+        None => campaign(a.run),
+    }
+}
+
+fn campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
+    if a.mode == Mode::Partition {
+        anyhow::bail!(
+            "--mode partition is not available yet: the process partition (sc-partition) exposes no run function; use --mode in-process"
+        );
+    }
+    let config = MonteCarloConfig::load(&a.config)?;
+    let shard = a
+        .shard
+        .as_deref()
+        .map(sc_montecarlo::parse_shard)
+        .transpose()
+        .map_err(anyhow::Error::msg)?;
+    let mut inject = a.inject_panic.clone();
+    if let Ok(v) = std::env::var("SC_MONTECARLO_INJECT_PANIC") {
+        for k in v.split(',').filter(|s| !s.trim().is_empty()) {
+            inject.push(
+                k.trim()
+                    .parse()
+                    .with_context(|| format!("SC_MONTECARLO_INJECT_PANIC: `{k}` is not a run index"))?,
+            );
+        }
+    }
+    if !inject.is_empty() {
+        // keep the injected panics' messages off the progress bar; they are recorded
+        std::panic::set_hook(Box::new(|_| {}));
+    }
+    let jobs = a
+        .jobs
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let opts = CampaignOptions {
+        scenario: a.scenario,
+        config,
+        runs: a.runs,
+        seed: a.seed,
+        jobs,
+        shard,
+        out: a.out.clone(),
+        inject_panic: inject,
+        progress: !a.quiet,
+    };
+    let s = sc_montecarlo::run_campaign(&opts)?;
+    Ok(report(&s, &a.out))
+}
+
+fn report(s: &CampaignSummary, out: &std::path::Path) -> ExitCode {
+    let worst = s
+        .worst
+        .iter()
+        .filter_map(|(n, w)| w.min_h.map(|h| (n, h, w.run)))
+        .min_by(|a, b| a.1.total_cmp(&b.1));
+    let t = s.solve_time_us.get("total").copied().unwrap_or_default();
+    println!(
+        "montecarlo: {} runs{} (seed {}): {} safe, {} captured, {} failed; worst margin {}; total solve time geomean {:.1} us, max {:.1} us; wall {:.1} s -> {}",
+        s.runs,
+        s.shard.map(|[i, n]| format!(" of shard {i}/{n}")).unwrap_or_default(),
+        s.seed,
+        s.safe_runs,
+        s.captured_runs,
+        s.failed_runs,
+        worst
+            .map(|(n, h, r)| format!("{n} = {h:.3e} (run {})", r.map_or("-".into(), |r| r.to_string())))
+            .unwrap_or_else(|| "-".into()),
+        t.geomean,
+        t.max,
+        s.wall_time_s,
+        out.display()
+    );
+    for f in &s.failed {
+        println!("  run {} failed: {}", f.run, f.error);
+    }
+    if !s.unsafe_runs.is_empty() {
+        println!("  unsafe runs: {:?}", s.unsafe_runs);
+    }
+    if !s.not_captured_runs.is_empty() {
+        println!("  runs without capture: {:?}", s.not_captured_runs);
+    }
+    if s.failed_runs == 0 && s.safe_runs == s.runs && s.captured_runs == s.runs {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    }
+}
+
+fn rerun(a: RerunArgs) -> anyhow::Result<ExitCode> {
+    let r = sc_montecarlo::rerun(&a.dir, a.run)?;
+    let out = a
+        .out
+        .clone()
+        .unwrap_or_else(|| a.dir.join("runs").join(a.run.to_string()).join("rerun"));
+    std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
+    let open = |name: &str| -> anyhow::Result<std::io::BufWriter<std::fs::File>> {
+        let p = out.join(name);
+        Ok(std::io::BufWriter::new(
+            std::fs::File::create(&p).with_context(|| format!("cannot create {}", p.display()))?,
+        ))
+    };
+    let mut w = TelemetryWriter::new(open("telemetry.csv")?, open("timing.csv")?)?;
+    for rec in &r.records {
+        w.write(rec)?;
+    }
+    w.flush()?;
+    let phases: Vec<String> = r.scenario.mission.phases.iter().map(|p| p.name.clone()).collect();
+    let summary = summarize(&r.records, &r.end, &phases, !RunOptions::default().no_filter);
+    std::fs::write(out.join("summary.json"), serde_json::to_string_pretty(&summary)? + "\n")?;
+    let mut f = std::fs::File::create(out.join("result.json"))?;
+    writeln!(f, "{}", serde_json::to_string_pretty(&r.result)?)?;
+    if !a.no_figures {
+        sc_plots::run_figures(&out.join("figures"), &r.scenario, &r.records, None)?;
+    }
+    let m = r.result.metrics.as_ref();
+    println!(
+        "rerun of run {}: {} at t = {:.1} s, safe: {}, -> {}",
+        a.run,
+        m.map_or("-", |m| m.end.as_str()),
+        m.map_or(0.0, |m| m.final_time_s),
+        m.is_some_and(|m| m.safe),
+        out.display()
+    );
+    if r.differences.is_empty() {
+        println!("reproduced exactly: seed, dispersion, scenario and result match the saved run");
+        Ok(ExitCode::SUCCESS)
+    } else {
+        for d in &r.differences {
+            println!("  differs: {d}");
+        }
+        Ok(ExitCode::from(1))
+    }
+}

@@ -1,0 +1,843 @@
+//! Campaigns: run (all or a shard), aggregate a directory of runs, merge shards, rerun.
+//!
+//! Layout of a campaign directory:
+//!
+//! ```text
+//! campaign.json        seed, number of runs, shard, dispersion config   (deterministic)
+//! base_scenario.toml   the scenario that was dispersed                   (deterministic)
+//! montecarlo.toml      the dispersion config                             (deterministic)
+//! <urdf>               copy of the servicer URDF the scenarios name
+//! runs/K/scenario.toml the dispersed scenario of run K                   (deterministic)
+//! runs/K/result.json   seed, dispersion, metrics or failure of run K     (deterministic)
+//! runs/K/trace.csv     decimated trajectory for the figures              (deterministic)
+//! runs/K/timing.json   solve-time statistics and histograms             (wall clock)
+//! runs.csv             one row per run                                   (deterministic)
+//! runs_timing.csv      per-run solve-time geomean and max per filter     (wall clock)
+//! summary.json         counts, worst barriers, ranges; solve_time_us and wall_time_s are wall clock
+//! report.md            our numbers beside the paper's                    (wall clock)
+//! figures/*.svg        campaign figures; runtime.svg is wall clock
+//! ```
+//!
+//! Everything is (re)built from the files by [`aggregate`], so an unsharded campaign and
+//! the merge of its shards produce byte-identical deterministic files.
+
+use crate::config::MonteCarloConfig;
+use crate::hist::LogHistogram;
+use crate::run::{self, CampaignBase, RunResult, RunTiming, TIMERS};
+use crate::sample::{run_seed, sample};
+use rayon::prelude::*;
+use sc_mission::summary::TimeStats;
+use sc_mission::{MissionEnd, Setup, StepRecord};
+use sc_plots::{BarrierMinima, CampaignFigures, Geometry, RunPoint, RuntimeBar, TracePoint};
+use sc_scenario::Scenario;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Why a campaign could not run. One line each.
+#[derive(Debug, thiserror::Error)]
+pub enum McError {
+    #[error("{0}")]
+    Config(#[from] crate::config::ConfigError),
+    #[error("{0}")]
+    Setup(String),
+    #[error("{path}: {message}")]
+    Io { path: String, message: String },
+    #[error("{0}")]
+    Invalid(String),
+}
+
+fn io(path: &Path) -> impl Fn(std::io::Error) -> McError + '_ {
+    move |e| McError::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    }
+}
+
+fn read(path: &Path) -> Result<String, McError> {
+    std::fs::read_to_string(path).map_err(io(path))
+}
+
+fn write(path: &Path, text: impl AsRef<[u8]>) -> Result<(), McError> {
+    std::fs::write(path, text).map_err(io(path))
+}
+
+fn json<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<T, McError> {
+    serde_json::from_str(&read(path)?).map_err(|e| McError::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })
+}
+
+/// `campaign.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CampaignInfo {
+    pub seed: u64,
+    /// Runs of the whole campaign.
+    pub runs: usize,
+    /// `[i, n]` for shard i of n (0-based), absent for a whole or merged campaign.
+    pub shard: Option<[usize; 2]>,
+    /// File name of the URDF copy.
+    pub urdf: String,
+    pub config: MonteCarloConfig,
+}
+
+/// How a campaign is run.
+#[derive(Debug, Clone)]
+pub struct CampaignOptions {
+    pub scenario: PathBuf,
+    pub config: MonteCarloConfig,
+    pub runs: usize,
+    pub seed: u64,
+    /// Worker threads (≥ 1).
+    pub jobs: usize,
+    pub shard: Option<(usize, usize)>,
+    pub out: PathBuf,
+    /// Runs that panic on purpose (failure-handling tests).
+    pub inject_panic: Vec<usize>,
+    /// Show the progress bar on stderr.
+    pub progress: bool,
+}
+
+/// Parses `i/N` (0 ≤ i < N).
+pub fn parse_shard(s: &str) -> Result<(usize, usize), String> {
+    let (i, n) = s
+        .split_once('/')
+        .ok_or_else(|| format!("shard `{s}`: expected i/N, e.g. 0/4"))?;
+    let i: usize = i.trim().parse().map_err(|_| format!("shard `{s}`: `{i}` is not a number"))?;
+    let n: usize = n.trim().parse().map_err(|_| format!("shard `{s}`: `{n}` is not a number"))?;
+    if n == 0 || i >= n {
+        return Err(format!("shard `{s}`: needs 0 <= i < N"));
+    }
+    Ok((i, n))
+}
+
+/// The run indices of shard `(i, n)` of a campaign of `runs`: every n-th from i.
+pub fn shard_runs(runs: usize, shard: Option<(usize, usize)>) -> Vec<usize> {
+    match shard {
+        None => (0..runs).collect(),
+        Some((i, n)) => (0..runs).filter(|k| k % n == i).collect(),
+    }
+}
+
+/// Min and max of a quantity over the runs, with the runs they come from.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Spread {
+    pub min: f64,
+    pub min_run: usize,
+    pub max: f64,
+    pub max_run: usize,
+}
+
+#[derive(Default)]
+struct SpreadAcc(Option<Spread>);
+
+impl SpreadAcc {
+    fn add(&mut self, v: Option<f64>, run: usize) {
+        let Some(v) = v.filter(|v| v.is_finite()) else { return };
+        match &mut self.0 {
+            None => {
+                self.0 = Some(Spread {
+                    min: v,
+                    min_run: run,
+                    max: v,
+                    max_run: run,
+                })
+            }
+            Some(s) => {
+                if v < s.min {
+                    s.min = v;
+                    s.min_run = run;
+                }
+                if v > s.max {
+                    s.max = v;
+                    s.max_run = run;
+                }
+            }
+        }
+    }
+}
+
+/// The worst (smallest) minimum of one barrier over the runs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Worst {
+    pub min_h: Option<f64>,
+    pub run: Option<usize>,
+}
+
+/// A failed run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Failure {
+    pub run: usize,
+    pub error: String,
+}
+
+/// `summary.json` of a campaign.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CampaignSummary {
+    /// Runs in this directory.
+    pub runs: usize,
+    /// Runs of the whole campaign and the shard, if this is one.
+    pub campaign_runs: usize,
+    pub shard: Option<[usize; 2]>,
+    pub seed: u64,
+    /// Completed with every barrier ≥ 0.
+    pub safe_runs: usize,
+    pub captured_runs: usize,
+    pub failed_runs: usize,
+    /// Completed runs with at least one filter fault flag.
+    pub faulted_runs: usize,
+    pub unsafe_runs: Vec<usize>,
+    pub not_captured_runs: Vec<usize>,
+    pub failed: Vec<Failure>,
+    /// Constraint → worst min_h over the runs and its run.
+    pub worst: BTreeMap<String, Worst>,
+    pub capture_time_s: Option<Spread>,
+    /// Phase → spread of the per-run peak sync error [rad/s].
+    pub sync_error_peak_rad_s: BTreeMap<String, Spread>,
+    /// Phase → spread of the per-run peak joint-torque norm [N m].
+    pub joint_torque_norm_peak_nm: BTreeMap<String, Spread>,
+    pub joint_torque_norm_rms_grasp_nm: Option<Spread>,
+    /// Wall clock: filter → statistics over every step of every run [µs].
+    pub solve_time_us: BTreeMap<String, TimeStats>,
+    /// Wall clock: the campaign's wall time (merged: sum over the shards) [s].
+    pub wall_time_s: f64,
+}
+
+/// Keys of [`CampaignSummary`] that depend on the wall clock.
+pub const WALL_CLOCK_KEYS: [&str; 2] = ["solve_time_us", "wall_time_s"];
+
+/// Files of a campaign directory that depend on the wall clock (everything else is
+/// byte-identical between a campaign and the merge of its shards; in `summary.json` only
+/// [`WALL_CLOCK_KEYS`] differ).
+pub const WALL_CLOCK_FILES: [&str; 3] = ["runs_timing.csv", "report.md", "figures/runtime.svg"];
+
+/// Loads the base scenario and checks the config against it.
+fn load_base(scenario: &Path, config: &MonteCarloConfig) -> Result<Setup, McError> {
+    let setup = Setup::load(scenario).map_err(|e| McError::Setup(e.to_string()))?;
+    config.check_against(&setup.scenario)?;
+    Ok(setup)
+}
+
+/// Creates `out` for a new campaign: refuses a non-empty directory that is not a campaign,
+/// clears the runs and figures of an old one.
+fn prepare_out(out: &Path) -> Result<(), McError> {
+    if out.exists() {
+        let empty = std::fs::read_dir(out).map_err(io(out))?.next().is_none();
+        if !empty && !out.join("campaign.json").is_file() {
+            return Err(McError::Invalid(format!(
+                "{} is not empty and holds no campaign.json; choose another --out",
+                out.display()
+            )));
+        }
+        for sub in ["runs", "figures"] {
+            let p = out.join(sub);
+            if p.exists() {
+                std::fs::remove_dir_all(&p).map_err(io(&p))?;
+            }
+        }
+    }
+    std::fs::create_dir_all(out.join("runs")).map_err(io(out))
+}
+
+/// Writes the campaign's base files into `out` and returns the base every run shares.
+fn write_base(out: &Path, setup: &Setup, info: &CampaignInfo) -> Result<CampaignBase, McError> {
+    let urdf = setup.scenario.urdf_path();
+    let urdf_bytes = std::fs::read(&urdf).map_err(io(&urdf))?;
+    write(&out.join(&info.urdf), urdf_bytes)?;
+    let mut base = setup.scenario.clone();
+    base.servicer.urdf = PathBuf::from(&info.urdf);
+    let text = base.to_toml_string();
+    write(&out.join("base_scenario.toml"), &text)?;
+    let cfg = toml::to_string(&info.config).map_err(|e| McError::Invalid(e.to_string()))?;
+    write(&out.join("montecarlo.toml"), cfg)?;
+    let info_json = serde_json::to_string_pretty(info).map_err(|e| McError::Invalid(e.to_string()))?;
+    write(&out.join("campaign.json"), info_json + "\n")?;
+    load_campaign_base(out)
+}
+
+/// Reads the base of the campaign in `dir` (campaign.json, base_scenario.toml, URDF).
+pub fn load_campaign_base(dir: &Path) -> Result<CampaignBase, McError> {
+    let info: CampaignInfo = json(&dir.join("campaign.json"))?;
+    info.config.validate()?;
+    let text = read(&dir.join("base_scenario.toml"))?;
+    let scenario = Scenario::from_toml_str(&text, dir)
+        .map_err(|e| McError::Setup(format!("{}: {e}", dir.join("base_scenario.toml").display())))?;
+    let setup = Setup::from_scenario(scenario.clone()).map_err(|e| McError::Setup(e.to_string()))?;
+    Ok(CampaignBase {
+        scenario,
+        setup,
+        config: info.config,
+        seed: info.seed,
+        urdf_name: info.urdf,
+    })
+}
+
+fn run_dir(dir: &Path, k: usize) -> PathBuf {
+    dir.join("runs").join(k.to_string())
+}
+
+/// Runs a campaign (or one shard) into `opts.out` and aggregates it.
+pub fn run_campaign(opts: &CampaignOptions) -> Result<CampaignSummary, McError> {
+    let started = std::time::Instant::now();
+    let setup = load_base(&opts.scenario, &opts.config)?;
+    if opts.jobs == 0 {
+        return Err(McError::Invalid("--jobs 0: need at least one thread".into()));
+    }
+    prepare_out(&opts.out)?;
+    let urdf = setup
+        .scenario
+        .urdf_path()
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "servicer.urdf".into());
+    let info = CampaignInfo {
+        seed: opts.seed,
+        runs: opts.runs,
+        shard: opts.shard.map(|(i, n)| [i, n]),
+        urdf,
+        config: opts.config.clone(),
+    };
+    let base = write_base(&opts.out, &setup, &info)?;
+    let indices = shard_runs(opts.runs, opts.shard);
+    let bar = if opts.progress {
+        indicatif::ProgressBar::new(indices.len() as u64)
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:30}] {pos}/{len} runs, {msg}, ETA {eta}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+        .progress_chars("=> "),
+    );
+    bar.set_message("0 failed");
+    let failed = AtomicUsize::new(0);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.jobs)
+        .build()
+        .map_err(|e| McError::Invalid(format!("cannot start {} threads: {e}", opts.jobs)))?;
+    let save_errors: Vec<McError> = pool.install(|| {
+        indices
+            .par_iter()
+            .filter_map(|&k| {
+                let dir = run_dir(&opts.out, k);
+                let out = run::execute(&base, k, &dir, opts.inject_panic.contains(&k));
+                if out.result.failed() {
+                    failed.fetch_add(1, Ordering::Relaxed);
+                }
+                let saved = run::save(&out, &dir).map_err(io(&dir)).err();
+                bar.inc(1);
+                bar.set_message(format!("{} failed", failed.load(Ordering::Relaxed)));
+                saved
+            })
+            .collect()
+    });
+    bar.finish_and_clear();
+    if let Some(e) = save_errors.into_iter().next() {
+        return Err(e);
+    }
+    aggregate(&opts.out, started.elapsed().as_secs_f64())
+}
+
+/// One run as read back from its directory.
+struct Loaded {
+    result: RunResult,
+    trace: Vec<TracePoint>,
+    timing: Option<RunTiming>,
+}
+
+fn load_runs(dir: &Path) -> Result<Vec<Loaded>, McError> {
+    let runs = dir.join("runs");
+    let mut ks: Vec<usize> = Vec::new();
+    for e in std::fs::read_dir(&runs).map_err(io(&runs))? {
+        let e = e.map_err(io(&runs))?;
+        if let Some(k) = e.file_name().to_str().and_then(|n| n.parse::<usize>().ok()) {
+            ks.push(k);
+        }
+    }
+    ks.sort_unstable();
+    let mut out = Vec::with_capacity(ks.len());
+    for k in ks {
+        let d = run_dir(dir, k);
+        let result: RunResult = json(&d.join("result.json"))?;
+        if result.run != k {
+            return Err(McError::Invalid(format!(
+                "{}: holds run {} instead of {k}",
+                d.join("result.json").display(),
+                result.run
+            )));
+        }
+        let tp = d.join("trace.csv");
+        let trace = if tp.is_file() {
+            run::parse_trace(&read(&tp)?).map_err(|m| McError::Io {
+                path: tp.display().to_string(),
+                message: m,
+            })?
+        } else {
+            Vec::new()
+        };
+        let tj = d.join("timing.json");
+        let timing = if tj.is_file() { Some(json(&tj)?) } else { None };
+        out.push(Loaded {
+            result,
+            trace,
+            timing,
+        });
+    }
+    Ok(out)
+}
+
+fn num(x: Option<f64>) -> String {
+    x.map(|v| v.to_string()).unwrap_or_default()
+}
+
+fn quote(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\"").replace('\n', " "))
+    } else {
+        s.to_string()
+    }
+}
+
+/// `runs.csv` header and rows (deterministic).
+fn runs_csv(loaded: &[Loaded], phases: &[String], grasp: Option<&str>) -> String {
+    let names = sc_mission::constraint_names();
+    let mut cols: Vec<String> = [
+        "run",
+        "seed",
+        "status",
+        "distance_m",
+        "off_axis_deg",
+        "azimuth_deg",
+        "x0_r_m",
+        "y0_r_m",
+        "z0_r_m",
+        "initial_los_deg",
+        "tumble_rate_rad_s",
+        "end",
+        "captured",
+        "capture_time_s",
+        "safe",
+        "min_margin_constraint",
+        "min_margin",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    for p in phases {
+        cols.push(format!("sync_error_peak_{p}_rad_s"));
+    }
+    for p in phases {
+        cols.push(format!("joint_torque_norm_peak_{p}_nm"));
+    }
+    cols.push("joint_torque_norm_rms_grasp_nm".into());
+    cols.push("fault_count".into());
+    cols.push("faults".into());
+    for n in &names {
+        cols.push(format!("min_h_{n}"));
+    }
+    cols.push("error".into());
+    let mut s = cols.join(",") + "\n";
+    let _ = grasp;
+    for l in loaded {
+        let r = &l.result;
+        let mut v: Vec<String> = vec![r.run.to_string(), r.seed.to_string(), r.status.clone()];
+        match &r.dispersion {
+            Some(d) => v.extend([
+                d.distance_m.to_string(),
+                d.off_axis_deg.to_string(),
+                d.azimuth_deg.to_string(),
+                d.position_r_m[0].to_string(),
+                d.position_r_m[1].to_string(),
+                d.position_r_m[2].to_string(),
+                d.initial_los_deg.to_string(),
+                d.tumble_rate_rad_s.to_string(),
+            ]),
+            None => v.extend(std::iter::repeat_n(String::new(), 8)),
+        }
+        match &r.metrics {
+            Some(m) => {
+                let (mc, mv) = names
+                    .iter()
+                    .filter_map(|n| m.min_h.get(*n).copied().flatten().map(|h| (n, h)))
+                    .fold((String::new(), None::<f64>), |acc, (n, h)| match acc.1 {
+                        Some(b) if b <= h => acc,
+                        _ => (n.to_string(), Some(h)),
+                    });
+                v.extend([
+                    m.end.clone(),
+                    m.captured.to_string(),
+                    num(m.capture_time_s),
+                    m.safe.to_string(),
+                    mc,
+                    num(mv),
+                ]);
+                for p in phases {
+                    v.push(num(m.sync_error_peak_rad_s.get(p).copied().flatten()));
+                }
+                for p in phases {
+                    v.push(num(m.joint_torque_norm_peak_nm.get(p).copied().flatten()));
+                }
+                v.push(num(m.joint_torque_norm_rms_grasp_nm));
+                v.push(m.fault_count.to_string());
+                v.push(m.fault_flags.join(";"));
+                for n in &names {
+                    v.push(num(m.min_h.get(*n).copied().flatten()));
+                }
+            }
+            None => v.extend(std::iter::repeat_n(String::new(), 6 + 2 * phases.len() + 3 + names.len())),
+        }
+        v.push(quote(r.error.as_deref().unwrap_or("")));
+        s += &(v.join(",") + "\n");
+    }
+    s
+}
+
+fn runs_timing_csv(loaded: &[Loaded]) -> String {
+    let mut cols = vec!["run".to_string()];
+    for t in TIMERS {
+        cols.push(format!("{t}_geomean_us"));
+        cols.push(format!("{t}_max_us"));
+    }
+    let mut s = cols.join(",") + "\n";
+    for l in loaded {
+        let Some(t) = &l.timing else { continue };
+        let mut v = vec![l.result.run.to_string()];
+        for n in TIMERS {
+            let st = t.stats.get(n).copied().unwrap_or_default();
+            v.push(format!("{:.3}", st.geomean));
+            v.push(format!("{:.3}", st.max));
+        }
+        s += &(v.join(",") + "\n");
+    }
+    s
+}
+
+/// (Re)builds runs.csv, runs_timing.csv, summary.json, report.md and the figures of the
+/// campaign directory `dir` from its run directories.
+pub fn aggregate(dir: &Path, wall_time_s: f64) -> Result<CampaignSummary, McError> {
+    let info: CampaignInfo = json(&dir.join("campaign.json"))?;
+    let base = read(&dir.join("base_scenario.toml"))?;
+    let scenario = Scenario::from_toml_str(&base, dir)
+        .map_err(|e| McError::Setup(format!("{}: {e}", dir.join("base_scenario.toml").display())))?;
+    let phases: Vec<String> = scenario.mission.phases.iter().map(|p| p.name.clone()).collect();
+    let grasp = run::grasp_phase(&scenario);
+    let loaded = load_runs(dir)?;
+    write(&dir.join("runs.csv"), runs_csv(&loaded, &phases, grasp.as_deref()))?;
+    write(&dir.join("runs_timing.csv"), runs_timing_csv(&loaded))?;
+
+    let names = sc_mission::constraint_names();
+    let mut worst: BTreeMap<String, Worst> = names
+        .iter()
+        .map(|n| (n.to_string(), Worst { min_h: None, run: None }))
+        .collect();
+    let mut minima: Vec<BarrierMinima> = names
+        .iter()
+        .map(|n| BarrierMinima {
+            name: n.to_string(),
+            values: Vec::new(),
+        })
+        .collect();
+    let mut sync: BTreeMap<String, SpreadAcc> = BTreeMap::new();
+    let mut torque: BTreeMap<String, SpreadAcc> = BTreeMap::new();
+    let mut rms = SpreadAcc::default();
+    let mut capture = SpreadAcc::default();
+    let mut hist: BTreeMap<String, LogHistogram> = BTreeMap::new();
+    let mut s = CampaignSummary {
+        runs: loaded.len(),
+        campaign_runs: info.runs,
+        shard: info.shard,
+        seed: info.seed,
+        safe_runs: 0,
+        captured_runs: 0,
+        failed_runs: 0,
+        faulted_runs: 0,
+        unsafe_runs: Vec::new(),
+        not_captured_runs: Vec::new(),
+        failed: Vec::new(),
+        worst: BTreeMap::new(),
+        capture_time_s: None,
+        sync_error_peak_rad_s: BTreeMap::new(),
+        joint_torque_norm_peak_nm: BTreeMap::new(),
+        joint_torque_norm_rms_grasp_nm: None,
+        solve_time_us: BTreeMap::new(),
+        wall_time_s,
+    };
+    let mut traces = Vec::new();
+    let mut points = Vec::new();
+    for l in &loaded {
+        let r = &l.result;
+        if let Some(t) = &l.timing {
+            for (n, h) in &t.histograms {
+                hist.entry(n.clone()).or_default().merge(h);
+            }
+        }
+        let Some(m) = &r.metrics else {
+            s.failed_runs += 1;
+            s.failed.push(Failure {
+                run: r.run,
+                error: r.error.clone().unwrap_or_default(),
+            });
+            continue;
+        };
+        if m.safe {
+            s.safe_runs += 1;
+        } else {
+            s.unsafe_runs.push(r.run);
+        }
+        if m.captured {
+            s.captured_runs += 1;
+        } else {
+            s.not_captured_runs.push(r.run);
+        }
+        if m.fault_count > 0 {
+            s.faulted_runs += 1;
+        }
+        capture.add(m.capture_time_s, r.run);
+        for (i, n) in names.iter().enumerate() {
+            if let Some(h) = m.min_h.get(*n).copied().flatten() {
+                minima[i].values.push(h);
+                let w = worst.get_mut(*n).expect("constraint present");
+                if w.min_h.is_none_or(|b| h < b) {
+                    w.min_h = Some(h);
+                    w.run = Some(r.run);
+                }
+            }
+        }
+        for (p, v) in &m.sync_error_peak_rad_s {
+            sync.entry(p.clone()).or_default().add(*v, r.run);
+        }
+        for (p, v) in &m.joint_torque_norm_peak_nm {
+            torque.entry(p.clone()).or_default().add(*v, r.run);
+        }
+        rms.add(m.joint_torque_norm_rms_grasp_nm, r.run);
+        if !l.trace.is_empty() {
+            traces.push((r.run, l.trace.clone()));
+        }
+        if let (Some(d), Some(g)) = (&r.dispersion, &grasp) {
+            let peak = m.sync_error_peak_rad_s.get(g).copied().flatten();
+            if let (Some(peak), Some(tq)) = (peak, m.joint_torque_norm_rms_grasp_nm) {
+                points.push(RunPoint {
+                    run: r.run,
+                    tumble_rate: d.tumble_rate_rad_s,
+                    peak_sync_grasp: peak,
+                    torque_norm_grasp: tq,
+                });
+            }
+        }
+    }
+    s.worst = worst;
+    s.capture_time_s = capture.0;
+    s.sync_error_peak_rad_s = sync.into_iter().filter_map(|(k, v)| v.0.map(|x| (k, x))).collect();
+    s.joint_torque_norm_peak_nm = torque.into_iter().filter_map(|(k, v)| v.0.map(|x| (k, x))).collect();
+    s.joint_torque_norm_rms_grasp_nm = rms.0;
+    s.solve_time_us = TIMERS
+        .iter()
+        .map(|n| (n.to_string(), hist.get(*n).map(|h| h.stats()).unwrap_or_default()))
+        .collect();
+    let text = serde_json::to_string_pretty(&s).map_err(|e| McError::Invalid(e.to_string()))?;
+    write(&dir.join("summary.json"), text + "\n")?;
+    write(&dir.join("report.md"), crate::report::report(&s, &loaded_results(&loaded), grasp.as_deref(), &phases))?;
+
+    let runtime: Vec<RuntimeBar> = ["total", "translational", "attitude", "robotic"]
+        .iter()
+        .map(|n| {
+            let st = s.solve_time_us.get(*n).copied().unwrap_or_default();
+            RuntimeBar {
+                name: n.to_string(),
+                geomean_us: st.geomean,
+                max_us: st.max,
+            }
+        })
+        .collect();
+    let figs = CampaignFigures {
+        geometry: Geometry::from_scenario(&scenario),
+        traces: &traces,
+        points: &points,
+        runtime: &runtime,
+        runtime_reference: Some(("paper (CasADi + OSQP)".into(), 1590.0, 3750.0)),
+        minima: &minima,
+    };
+    sc_plots::campaign_figures(&dir.join("figures"), &figs).map_err(|e| McError::Invalid(e.to_string()))?;
+    Ok(s)
+}
+
+fn loaded_results(l: &[Loaded]) -> Vec<RunResult> {
+    l.iter().map(|x| x.result.clone()).collect()
+}
+
+fn copy_dir(from: &Path, to: &Path) -> Result<(), McError> {
+    std::fs::create_dir_all(to).map_err(io(to))?;
+    for e in std::fs::read_dir(from).map_err(io(from))? {
+        let e = e.map_err(io(from))?;
+        let p = e.path();
+        if p.is_file() {
+            std::fs::copy(&p, to.join(e.file_name())).map_err(io(&p))?;
+        }
+    }
+    Ok(())
+}
+
+/// Merges shard directories into `out`: checks that they belong to the same campaign and
+/// cover every run exactly once, copies the runs and aggregates. `wall_time_s` of the
+/// result is the sum of the shards'.
+pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<CampaignSummary, McError> {
+    let first = dirs
+        .first()
+        .ok_or_else(|| McError::Invalid("merge: no shard directories given".into()))?;
+    let info0: CampaignInfo = json(&first.join("campaign.json"))?;
+    let base0 = read(&first.join("base_scenario.toml"))?;
+    let urdf0 = std::fs::read(first.join(&info0.urdf)).map_err(io(&first.join(&info0.urdf)))?;
+    let out_abs = std::path::absolute(out).unwrap_or(out.to_path_buf());
+    for d in dirs {
+        if std::path::absolute(d).unwrap_or(d.clone()) == out_abs {
+            return Err(McError::Invalid(format!("merge: --out {} is one of the inputs", out.display())));
+        }
+        let info: CampaignInfo = json(&d.join("campaign.json"))?;
+        let same = info.seed == info0.seed
+            && info.runs == info0.runs
+            && info.config == info0.config
+            && info.urdf == info0.urdf
+            && read(&d.join("base_scenario.toml"))? == base0
+            && std::fs::read(d.join(&info.urdf)).map_err(io(&d.join(&info.urdf)))? == urdf0;
+        if !same {
+            return Err(McError::Invalid(format!(
+                "merge: {} belongs to a different campaign than {} (seed, runs, config or scenario differ)",
+                d.display(),
+                first.display()
+            )));
+        }
+    }
+    prepare_out(out)?;
+    let info = CampaignInfo {
+        shard: None,
+        ..info0.clone()
+    };
+    write(&out.join(&info.urdf), &urdf0)?;
+    write(&out.join("base_scenario.toml"), &base0)?;
+    let cfg = toml::to_string(&info.config).map_err(|e| McError::Invalid(e.to_string()))?;
+    write(&out.join("montecarlo.toml"), cfg)?;
+    let text = serde_json::to_string_pretty(&info).map_err(|e| McError::Invalid(e.to_string()))?;
+    write(&out.join("campaign.json"), text + "\n")?;
+    let mut seen: BTreeMap<usize, PathBuf> = BTreeMap::new();
+    let mut wall = 0.0;
+    for d in dirs {
+        let runs = d.join("runs");
+        for e in std::fs::read_dir(&runs).map_err(io(&runs))? {
+            let e = e.map_err(io(&runs))?;
+            let Some(k) = e.file_name().to_str().and_then(|n| n.parse::<usize>().ok()) else {
+                continue;
+            };
+            if let Some(prev) = seen.get(&k) {
+                return Err(McError::Invalid(format!(
+                    "merge: run {k} is in both {} and {}",
+                    prev.display(),
+                    d.display()
+                )));
+            }
+            if k >= info.runs {
+                return Err(McError::Invalid(format!(
+                    "merge: {} holds run {k} outside the campaign's {} runs",
+                    d.display(),
+                    info.runs
+                )));
+            }
+            copy_dir(&e.path(), &run_dir(out, k))?;
+            seen.insert(k, d.clone());
+        }
+        if let Ok(sum) = json::<serde_json::Value>(&d.join("summary.json")) {
+            wall += sum.get("wall_time_s").and_then(|v| v.as_f64()).unwrap_or(0.0);
+        }
+    }
+    let missing: Vec<String> = (0..info.runs)
+        .filter(|k| !seen.contains_key(k))
+        .map(|k| k.to_string())
+        .collect();
+    if !missing.is_empty() {
+        let shown: Vec<String> = missing.iter().take(10).cloned().collect();
+        return Err(McError::Invalid(format!(
+            "merge: {} of {} runs missing (e.g. {}); merge every shard",
+            missing.len(),
+            info.runs,
+            shown.join(", ")
+        )));
+    }
+    aggregate(out, wall)
+}
+
+/// A rerun of one run and how it compares with the saved one.
+pub struct Rerun {
+    pub scenario: Scenario,
+    pub records: Vec<StepRecord>,
+    pub end: MissionEnd,
+    pub result: RunResult,
+    pub timing: RunTiming,
+    /// Empty when the rerun reproduced the saved dispersion, scenario and result exactly.
+    pub differences: Vec<String>,
+}
+
+/// Reruns run `k` of the campaign in `dir` from its saved scenario and compares the
+/// re-derived seed and dispersion, the scenario text and the result with the saved ones.
+pub fn rerun(dir: &Path, k: usize) -> Result<Rerun, McError> {
+    let base = load_campaign_base(dir)?;
+    let info: CampaignInfo = json(&dir.join("campaign.json"))?;
+    if k >= info.runs {
+        return Err(McError::Invalid(format!("--run {k}: the campaign has runs 0..{}", info.runs)));
+    }
+    let rd = run_dir(dir, k);
+    let saved_path = rd.join("result.json");
+    if !saved_path.is_file() {
+        return Err(McError::Invalid(format!(
+            "run {k} is not in {} (another shard?)",
+            dir.display()
+        )));
+    }
+    let saved_text = read(&saved_path)?;
+    let saved: RunResult = json(&saved_path)?;
+    let mut differences = Vec::new();
+    let seed = run_seed(base.seed, k);
+    if seed != saved.seed {
+        differences.push(format!("seed: saved {}, derived {seed}", saved.seed));
+    }
+    let d = sample(&base.config, &base.scenario, seed).map_err(McError::Invalid)?;
+    let text = run::run_scenario(&base, &d).to_toml_string();
+    let saved_scenario = read(&rd.join("scenario.toml"))?;
+    if text != saved_scenario {
+        differences.push("scenario.toml: re-derived dispersed scenario differs from the saved one".into());
+    }
+    let scenario = Scenario::from_toml_str(&saved_scenario, &rd)
+        .map_err(|e| McError::Setup(format!("{}: {e}", rd.join("scenario.toml").display())))?;
+    let setup = Setup::from_scenario(scenario.clone()).map_err(|e| McError::Setup(e.to_string()))?;
+    let (records, end) = run::simulate(setup, false).map_err(McError::Invalid)?;
+    let (metrics, _trace, timing) = run::measure(&scenario, &records, &end, base.config.output.trace_every_steps);
+    let result = RunResult {
+        run: k,
+        seed,
+        status: "ok".into(),
+        error: None,
+        dispersion: Some(d),
+        metrics: Some(metrics),
+    };
+    let new_text = serde_json::to_string_pretty(&result).map_err(|e| McError::Invalid(e.to_string()))? + "\n";
+    if new_text != saved_text {
+        if saved.failed() {
+            differences.push(format!(
+                "result: the saved run failed ({}), the rerun completed",
+                saved.error.as_deref().unwrap_or("")
+            ));
+        } else {
+            differences.push("result.json: rerun result differs from the saved one".into());
+        }
+    }
+    Ok(Rerun {
+        scenario,
+        records,
+        end,
+        result,
+        timing,
+        differences,
+    })
+}

@@ -1,0 +1,159 @@
+//! `report.md`: the campaign's numbers beside the paper's.
+
+use crate::campaign::{CampaignSummary, Spread};
+use crate::run::RunResult;
+use std::fmt::Write;
+
+/// The paper's Monte Carlo numbers (Meinert et al., Sec. "Monte Carlo Simulation").
+pub const PAPER_TOTAL_GEOMEAN_MS: f64 = 1.59;
+pub const PAPER_TOTAL_MAX_MS: f64 = 3.75;
+pub const PAPER_COMPONENT_MAX_MS: f64 = 2.3;
+pub const PAPER_SYNC_GRASP_RAD_S: (f64, f64) = (0.0432, 0.0457);
+pub const PAPER_SYNC_SYNC_RAD_S: f64 = 0.3;
+
+fn spread(s: Option<&Spread>, digits: usize) -> String {
+    match s {
+        Some(s) => format!(
+            "{:.d$}–{:.d$} (runs {} / {})",
+            s.min,
+            s.max,
+            s.min_run,
+            s.max_run,
+            d = digits
+        ),
+        None => "–".into(),
+    }
+}
+
+/// The Markdown report.
+pub fn report(s: &CampaignSummary, results: &[RunResult], grasp: Option<&str>, phases: &[String]) -> String {
+    let mut o = String::new();
+    let _ = writeln!(o, "# Monte Carlo campaign\n");
+    let shard = s
+        .shard
+        .map(|[i, n]| format!(", shard {i}/{n}"))
+        .unwrap_or_default();
+    let _ = writeln!(
+        o,
+        "{} runs (campaign of {}{shard}, seed {}), wall time {:.1} s.\n",
+        s.runs, s.campaign_runs, s.seed, s.wall_time_s
+    );
+    let _ = writeln!(o, "| | runs |\n|---|---|");
+    let _ = writeln!(o, "| safe (every barrier ≥ 0) | {} / {} |", s.safe_runs, s.runs);
+    let _ = writeln!(o, "| captured | {} / {} |", s.captured_runs, s.runs);
+    let _ = writeln!(o, "| failed (error or panic) | {} |", s.failed_runs);
+    let _ = writeln!(o, "| with filter faults | {} |\n", s.faulted_runs);
+
+    let sync_phase = grasp
+        .and_then(|g| phases.iter().position(|p| p == g))
+        .and_then(|i| i.checked_sub(1))
+        .and_then(|i| phases.get(i));
+    let t = |n: &str| s.solve_time_us.get(n).copied().unwrap_or_default();
+    let _ = writeln!(o, "## Beside the paper\n");
+    let _ = writeln!(o, "| quantity | this campaign | paper (CasADi + OSQP, 100 runs) |\n|---|---|---|");
+    let _ = writeln!(
+        o,
+        "| total solve time per step, geometric mean | {:.1} µs | {PAPER_TOTAL_GEOMEAN_MS} ms |",
+        t("total").geomean
+    );
+    let _ = writeln!(
+        o,
+        "| total solve time per step, maximum | {:.1} µs | {PAPER_TOTAL_MAX_MS} ms |",
+        t("total").max
+    );
+    for f in ["translational", "attitude", "robotic"] {
+        let _ = writeln!(
+            o,
+            "| {f} QP, geomean / max | {:.1} / {:.1} µs | max < {PAPER_COMPONENT_MAX_MS} ms (all filters) |",
+            t(f).geomean,
+            t(f).max
+        );
+    }
+    if let Some(g) = grasp {
+        let _ = writeln!(
+            o,
+            "| peak sync error in grasping (III), range over runs | {} rad/s | {}–{} rad/s |",
+            spread(s.sync_error_peak_rad_s.get(g), 4),
+            PAPER_SYNC_GRASP_RAD_S.0,
+            PAPER_SYNC_GRASP_RAD_S.1
+        );
+    }
+    if let Some(p) = sync_phase {
+        let _ = writeln!(
+            o,
+            "| peak sync error in synchronisation (II), range over runs | {} rad/s | up to {PAPER_SYNC_SYNC_RAD_S} rad/s |",
+            spread(s.sync_error_peak_rad_s.get(p), 4)
+        );
+    }
+    let _ = writeln!(
+        o,
+        "| RMS joint-torque norm in grasping, range | {} N m | (figure only) |",
+        spread(s.joint_torque_norm_rms_grasp_nm.as_ref(), 3)
+    );
+    let _ = writeln!(
+        o,
+        "| capture time, range | {} s | – |\n",
+        spread(s.capture_time_s.as_ref(), 1)
+    );
+    let _ = writeln!(
+        o,
+        "Solve times are wall-clock measurements on this machine (percentiles from a log histogram, ±0.05 %).\n"
+    );
+
+    let _ = writeln!(o, "## Worst barrier margins\n\n| constraint | worst min h | run |\n|---|---|---|");
+    let mut worst: Vec<(&String, f64, Option<usize>)> = s
+        .worst
+        .iter()
+        .filter_map(|(n, w)| w.min_h.map(|h| (n, h, w.run)))
+        .collect();
+    worst.sort_by(|a, b| a.1.total_cmp(&b.1));
+    for (n, h, r) in worst.iter().take(10) {
+        let _ = writeln!(o, "| {n} | {h:.4e} | {} |", r.map(|x| x.to_string()).unwrap_or_default());
+    }
+    let _ = writeln!(o);
+
+    let bad: Vec<&RunResult> = results
+        .iter()
+        .filter(|r| r.failed() || !r.safe() || !r.captured())
+        .collect();
+    if bad.is_empty() {
+        let _ = writeln!(o, "Every run completed safe and captured.");
+    } else {
+        let _ = writeln!(
+            o,
+            "## Runs that failed, were unsafe or did not capture\n\n| run | seed | distance [m] | off-axis [deg] | azimuth [deg] | tumble rate [rad/s] | outcome |\n|---|---|---|---|---|---|---|"
+        );
+        for r in bad {
+            let (dist, off, az, w) = r
+                .dispersion
+                .map(|d| {
+                    (
+                        format!("{:.3}", d.distance_m),
+                        format!("{:.3}", d.off_axis_deg),
+                        format!("{:.1}", d.azimuth_deg),
+                        format!("{:.4}", d.tumble_rate_rad_s),
+                    )
+                })
+                .unwrap_or_default();
+            let outcome = match &r.metrics {
+                None => format!("failed: {}", r.error.as_deref().unwrap_or("")),
+                Some(m) => {
+                    let mut v = Vec::new();
+                    if !m.safe {
+                        v.push(format!("violated {}", m.violated.join(", ")));
+                    }
+                    if !m.captured {
+                        v.push(format!("not captured ({})", m.end));
+                    }
+                    v.join("; ")
+                }
+            };
+            let _ = writeln!(o, "| {} | {} | {dist} | {off} | {az} | {w} | {outcome} |", r.run, r.seed);
+        }
+    }
+    let _ = writeln!(
+        o,
+        "\nFigures: figures/runtime.svg, figures/trajectories_xy.svg, figures/attitude_los.svg, figures/torque_vs_sync.svg, figures/barrier_minima.svg."
+    );
+    o
+}

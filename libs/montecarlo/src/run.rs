@@ -1,0 +1,330 @@
+//! One run of a campaign: dispersed scenario → mission → metrics, trace and timing.
+
+use crate::config::MonteCarloConfig;
+use crate::hist::LogHistogram;
+use crate::sample::{Dispersion, apply, run_seed, sample};
+use sc_mission::summary::TimeStats;
+use sc_mission::{Mission, MissionEnd, RunOptions, Setup, StepRecord, summarize};
+use sc_plots::TracePoint;
+use sc_scenario::{RoboticMode, Scenario};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Filter names of the timing statistics, in order.
+pub const TIMERS: [&str; 4] = ["translational", "attitude", "robotic", "total"];
+
+/// Deterministic result of one run (`runs/K/result.json`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunResult {
+    pub run: usize,
+    pub seed: u64,
+    /// "ok" or "failed" (sampling, set-up or simulation error, or a panic).
+    pub status: String,
+    pub error: Option<String>,
+    pub dispersion: Option<Dispersion>,
+    pub metrics: Option<RunMetrics>,
+}
+
+impl RunResult {
+    pub fn failed(&self) -> bool {
+        self.status != "ok"
+    }
+    /// Completed with every barrier ≥ 0 (no NaN).
+    pub fn safe(&self) -> bool {
+        self.metrics.as_ref().is_some_and(|m| m.safe)
+    }
+    pub fn captured(&self) -> bool {
+        self.metrics.as_ref().is_some_and(|m| m.captured)
+    }
+}
+
+/// What a completed run measured.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunMetrics {
+    /// "captured", "timeout" or "simulator_failed".
+    pub end: String,
+    pub captured: bool,
+    pub capture_time_s: Option<f64>,
+    pub final_time_s: f64,
+    pub steps: usize,
+    /// Every barrier ≥ 0 over the whole run.
+    pub safe: bool,
+    pub violated: Vec<String>,
+    /// Minimum of every barrier (None if it had no finite sample).
+    pub min_h: BTreeMap<String, Option<f64>>,
+    /// Peak ‖ω_B − R_BT ω_T‖ per phase [rad/s].
+    pub sync_error_peak_rad_s: BTreeMap<String, Option<f64>>,
+    /// Peak ‖τ_M‖₂ per phase [N m].
+    pub joint_torque_norm_peak_nm: BTreeMap<String, Option<f64>>,
+    /// RMS of ‖τ_M‖₂ over the grasping phase [N m] (None if it was not reached).
+    pub joint_torque_norm_rms_grasp_nm: Option<f64>,
+    pub fault_count: usize,
+    /// Distinct fault flags, sorted.
+    pub fault_flags: Vec<String>,
+}
+
+/// Wall-clock solve times of one run (`runs/K/timing.json`), not reproducible.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct RunTiming {
+    pub stats: BTreeMap<String, TimeStats>,
+    pub histograms: BTreeMap<String, LogHistogram>,
+}
+
+/// Everything a run produced.
+#[derive(Debug, Clone)]
+pub struct RunOutput {
+    pub result: RunResult,
+    pub trace: Vec<TracePoint>,
+    pub timing: Option<RunTiming>,
+}
+
+/// Name of the phase whose robotic mode is grasp (phase III), if any.
+pub fn grasp_phase(s: &Scenario) -> Option<String> {
+    s.mission
+        .phases
+        .iter()
+        .find(|p| p.robotic == RoboticMode::Grasp)
+        .map(|p| p.name.clone())
+}
+
+/// Everything a run needs that is shared by all runs of a campaign.
+pub struct CampaignBase {
+    pub scenario: Scenario,
+    pub setup: Setup,
+    pub config: MonteCarloConfig,
+    pub seed: u64,
+    /// File name of the URDF copy in the campaign directory.
+    pub urdf_name: String,
+}
+
+/// The dispersed scenario of run `k` as saved in `runs/K/scenario.toml` (URDF path
+/// relative to that directory).
+pub fn run_scenario(base: &CampaignBase, d: &Dispersion) -> Scenario {
+    let mut s = apply(&base.scenario, d);
+    s.servicer.urdf = PathBuf::from("../..").join(&base.urdf_name);
+    s
+}
+
+fn panic_message(p: Box<dyn std::any::Any + Send>) -> String {
+    if let Some(s) = p.downcast_ref::<&str>() {
+        s.to_string()
+    } else if let Some(s) = p.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "unknown panic payload".into()
+    }
+}
+
+/// Runs a mission to its end, collecting every record. `inject_panic` panics at step 10
+/// (to test failure handling). Panics are caught and returned as errors.
+pub fn simulate(setup: Setup, inject_panic: bool) -> Result<(Vec<StepRecord>, MissionEnd), String> {
+    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(move || {
+        let mut mission = Mission::new(setup, RunOptions::default()).map_err(|e| e.to_string())?;
+        let mut records = Vec::with_capacity(mission.setup.scenario.control_steps() + 1);
+        let end = mission.run(|_, r| {
+            if inject_panic && r.step == 10 {
+                panic!("injected failure");
+            }
+            records.push(*r);
+        });
+        Ok::<_, String>((records, end))
+    }));
+    match outcome {
+        Ok(r) => r,
+        Err(p) => Err(format!("panicked: {}", panic_message(p))),
+    }
+}
+
+fn finite(x: Option<f64>) -> Option<f64> {
+    x.filter(|v| v.is_finite())
+}
+
+fn finite_map(m: &BTreeMap<String, f64>) -> BTreeMap<String, Option<f64>> {
+    m.iter().map(|(k, v)| (k.clone(), finite(Some(*v)))).collect()
+}
+
+/// Metrics, trace and timing of a finished run.
+pub fn measure(
+    s: &Scenario,
+    records: &[StepRecord],
+    end: &MissionEnd,
+    trace_every: u32,
+) -> (RunMetrics, Vec<TracePoint>, RunTiming) {
+    let phase_names: Vec<String> = s.mission.phases.iter().map(|p| p.name.clone()).collect();
+    let sum = summarize(records, end, &phase_names, true);
+    let min_h = sum
+        .constraints
+        .iter()
+        .map(|(n, c)| (n.clone(), c.min_h.is_finite().then_some(c.min_h)))
+        .collect();
+    let grasp = grasp_phase(s);
+    let mut sq = 0.0;
+    let mut n = 0usize;
+    let mut flags = std::collections::BTreeSet::new();
+    for f in &sum.faults {
+        flags.extend(f.flags.iter().cloned());
+    }
+    for r in records {
+        if grasp.as_deref() == phase_names.get(r.phase).map(|x| x.as_str()) {
+            sq += r.applied.tau.norm_squared();
+            n += 1;
+        }
+    }
+    let metrics = RunMetrics {
+        end: sum.end.clone(),
+        captured: sum.captured,
+        capture_time_s: finite(sum.capture_time_s),
+        final_time_s: sum.final_time_s,
+        steps: sum.steps,
+        safe: sum.violated_constraints.is_empty(),
+        violated: sum.violated_constraints.clone(),
+        min_h,
+        sync_error_peak_rad_s: finite_map(&sum.sync_error_peak_rad_s),
+        joint_torque_norm_peak_nm: finite_map(&sum.joint_torque_norm_peak_nm),
+        joint_torque_norm_rms_grasp_nm: finite((n > 0).then(|| (sq / n as f64).sqrt())),
+        fault_count: sum.fault_count,
+        fault_flags: flags.into_iter().collect(),
+    };
+    let d_b = nalgebra::Vector3::from(s.servicer.boresight_body);
+    let every = trace_every.max(1) as u64;
+    let trace = records
+        .iter()
+        .filter(|r| r.step % every == 0)
+        .map(|r| TracePoint {
+            t: r.t,
+            phase: r.phase,
+            r_r: r.obs.r_r.into(),
+            speed: r.obs.v_r.norm(),
+            los_deg: sc_plots::los_angles_deg(&r.obs.grasp_b, &d_b).unwrap_or([f64::NAN; 2]),
+            sync_error: r.obs.sync_error().norm(),
+        })
+        .collect();
+    let mut timing = RunTiming::default();
+    let mut h: [LogHistogram; 4] = Default::default();
+    let mut v: [Vec<f64>; 4] = Default::default();
+    for r in records {
+        for (i, x) in r.solve_time_us().iter().enumerate() {
+            h[i].add(*x);
+            v[i].push(*x);
+        }
+    }
+    for (i, name) in TIMERS.iter().enumerate() {
+        timing.stats.insert(name.to_string(), TimeStats::of(&v[i]));
+        timing.histograms.insert(name.to_string(), std::mem::take(&mut h[i]));
+    }
+    (metrics, trace, timing)
+}
+
+/// Samples, saves and runs run `k` of the campaign (files under `run_dir`); never panics,
+/// never fails: every problem ends up in the result as a failure.
+pub fn execute(base: &CampaignBase, k: usize, run_dir: &Path, inject_panic: bool) -> RunOutput {
+    let seed = run_seed(base.seed, k);
+    let mut result = RunResult {
+        run: k,
+        seed,
+        status: "failed".into(),
+        error: None,
+        dispersion: None,
+        metrics: None,
+    };
+    let fail = |mut result: RunResult, e: String| {
+        result.error = Some(e.replace('\n', " "));
+        RunOutput {
+            result,
+            trace: Vec::new(),
+            timing: None,
+        }
+    };
+    let d = match sample(&base.config, &base.scenario, seed) {
+        Ok(d) => d,
+        Err(e) => return fail(result, e),
+    };
+    result.dispersion = Some(d);
+    let text = run_scenario(base, &d).to_toml_string();
+    if let Err(e) = std::fs::create_dir_all(run_dir)
+        .and_then(|_| std::fs::write(run_dir.join("scenario.toml"), &text))
+    {
+        return fail(result, format!("cannot write {}: {e}", run_dir.display()));
+    }
+    // run exactly what was saved
+    let scenario = match Scenario::from_toml_str(&text, run_dir) {
+        Ok(s) => s,
+        Err(e) => return fail(result, format!("dispersed scenario rejected: {e}")),
+    };
+    let setup = Setup {
+        scenario: scenario.clone(),
+        robot: base.setup.robot.clone(),
+    };
+    let (records, end) = match simulate(setup, inject_panic) {
+        Ok(x) => x,
+        Err(e) => return fail(result, e),
+    };
+    let (metrics, trace, timing) =
+        measure(&scenario, &records, &end, base.config.output.trace_every_steps);
+    result.status = "ok".into();
+    result.metrics = Some(metrics);
+    RunOutput {
+        result,
+        trace,
+        timing: Some(timing),
+    }
+}
+
+/// Columns of `runs/K/trace.csv`.
+pub const TRACE_COLUMNS: &str =
+    "t_s,phase,x_r_m,y_r_m,z_r_m,speed_m_s,los_e1_deg,los_e2_deg,sync_error_rad_s";
+
+/// The trace as CSV text (floats in shortest round-trip form).
+pub fn trace_csv(trace: &[TracePoint]) -> String {
+    let mut s = String::from(TRACE_COLUMNS);
+    s.push('\n');
+    for p in trace {
+        s.push_str(&format!(
+            "{},{},{},{},{},{},{},{},{}\n",
+            p.t, p.phase, p.r_r[0], p.r_r[1], p.r_r[2], p.speed, p.los_deg[0], p.los_deg[1], p.sync_error
+        ));
+    }
+    s
+}
+
+/// Parses [`trace_csv`] output.
+pub fn parse_trace(text: &str) -> Result<Vec<TracePoint>, String> {
+    let mut out = Vec::new();
+    for (i, line) in text.lines().enumerate().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        if f.len() != 9 {
+            return Err(format!("line {}: expected 9 fields, found {}", i + 1, f.len()));
+        }
+        let num = |j: usize| {
+            f[j].parse::<f64>()
+                .map_err(|_| format!("line {}: `{}` is not a number", i + 1, f[j]))
+        };
+        out.push(TracePoint {
+            t: num(0)?,
+            phase: f[1]
+                .parse()
+                .map_err(|_| format!("line {}: `{}` is not a phase index", i + 1, f[1]))?,
+            r_r: [num(2)?, num(3)?, num(4)?],
+            speed: num(5)?,
+            los_deg: [num(6)?, num(7)?],
+            sync_error: num(8)?,
+        });
+    }
+    Ok(out)
+}
+
+/// Writes a run's `result.json`, `trace.csv` and `timing.json` into `run_dir`.
+pub fn save(out: &RunOutput, run_dir: &Path) -> std::io::Result<()> {
+    std::fs::create_dir_all(run_dir)?;
+    let json = serde_json::to_string_pretty(&out.result).map_err(std::io::Error::other)? + "\n";
+    std::fs::write(run_dir.join("result.json"), json)?;
+    if !out.trace.is_empty() {
+        std::fs::write(run_dir.join("trace.csv"), trace_csv(&out.trace))?;
+    }
+    if let Some(t) = &out.timing {
+        let json = serde_json::to_string(t).map_err(std::io::Error::other)? + "\n";
+        std::fs::write(run_dir.join("timing.json"), json)?;
+    }
+    Ok(())
+}
