@@ -127,11 +127,9 @@ fn campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
     let mut inject = a.inject_panic.clone();
     if let Ok(v) = std::env::var("SC_MONTECARLO_INJECT_PANIC") {
         for k in v.split(',').filter(|s| !s.trim().is_empty()) {
-            inject.push(
-                k.trim()
-                    .parse()
-                    .with_context(|| format!("SC_MONTECARLO_INJECT_PANIC: `{k}` is not a run index"))?,
-            );
+            inject.push(k.trim().parse().with_context(|| {
+                format!("SC_MONTECARLO_INJECT_PANIC: `{k}` is not a run index")
+            })?);
         }
     }
     if !inject.is_empty() {
@@ -166,13 +164,18 @@ fn report(s: &CampaignSummary, out: &std::path::Path) -> ExitCode {
     println!(
         "montecarlo: {} runs{} (seed {}): {} safe, {} captured, {} failed; worst margin {}; total solve time geomean {:.1} us, max {:.1} us; wall {:.1} s -> {}",
         s.runs,
-        s.shard.map(|[i, n]| format!(" of shard {i}/{n}")).unwrap_or_default(),
+        s.shard
+            .map(|[i, n]| format!(" of shard {i}/{n}"))
+            .unwrap_or_default(),
         s.seed,
         s.safe_runs,
         s.captured_runs,
         s.failed_runs,
         worst
-            .map(|(n, h, r)| format!("{n} = {h:.3e} (run {})", r.map_or("-".into(), |r| r.to_string())))
+            .map(|(n, h, r)| format!(
+                "{n} = {h:.3e} (run {})",
+                r.map_or("-".into(), |r| r.to_string())
+            ))
             .unwrap_or_else(|| "-".into()),
         t.geomean,
         t.max,
@@ -213,9 +216,23 @@ fn rerun(a: RerunArgs) -> anyhow::Result<ExitCode> {
         w.write(rec)?;
     }
     w.flush()?;
-    let phases: Vec<String> = r.scenario.mission.phases.iter().map(|p| p.name.clone()).collect();
-    let summary = summarize(&r.records, &r.end, &phases, !RunOptions::default().no_filter);
-    std::fs::write(out.join("summary.json"), serde_json::to_string_pretty(&summary)? + "\n")?;
+    let phases: Vec<String> = r
+        .scenario
+        .mission
+        .phases
+        .iter()
+        .map(|p| p.name.clone())
+        .collect();
+    let summary = summarize(
+        &r.records,
+        &r.end,
+        &phases,
+        !RunOptions::default().no_filter,
+    );
+    std::fs::write(
+        out.join("summary.json"),
+        serde_json::to_string_pretty(&summary)? + "\n",
+    )?;
     let mut f = std::fs::File::create(out.join("result.json"))?;
     writeln!(f, "{}", serde_json::to_string_pretty(&r.result)?)?;
     if !a.no_figures {

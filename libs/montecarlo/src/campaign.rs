@@ -105,8 +105,14 @@ pub fn parse_shard(s: &str) -> Result<(usize, usize), String> {
     let (i, n) = s
         .split_once('/')
         .ok_or_else(|| format!("shard `{s}`: expected i/N, e.g. 0/4"))?;
-    let i: usize = i.trim().parse().map_err(|_| format!("shard `{s}`: `{i}` is not a number"))?;
-    let n: usize = n.trim().parse().map_err(|_| format!("shard `{s}`: `{n}` is not a number"))?;
+    let i: usize = i
+        .trim()
+        .parse()
+        .map_err(|_| format!("shard `{s}`: `{i}` is not a number"))?;
+    let n: usize = n
+        .trim()
+        .parse()
+        .map_err(|_| format!("shard `{s}`: `{n}` is not a number"))?;
     if n == 0 || i >= n {
         return Err(format!("shard `{s}`: needs 0 <= i < N"));
     }
@@ -135,7 +141,9 @@ struct SpreadAcc(Option<Spread>);
 
 impl SpreadAcc {
     fn add(&mut self, v: Option<f64>, run: usize) {
-        let Some(v) = v.filter(|v| v.is_finite()) else { return };
+        let Some(v) = v.filter(|v| v.is_finite()) else {
+            return;
+        };
         match &mut self.0 {
             None => {
                 self.0 = Some(Spread {
@@ -252,7 +260,8 @@ fn write_base(out: &Path, setup: &Setup, info: &CampaignInfo) -> Result<Campaign
     write(&out.join("base_scenario.toml"), &text)?;
     let cfg = toml::to_string(&info.config).map_err(|e| McError::Invalid(e.to_string()))?;
     write(&out.join("montecarlo.toml"), cfg)?;
-    let info_json = serde_json::to_string_pretty(info).map_err(|e| McError::Invalid(e.to_string()))?;
+    let info_json =
+        serde_json::to_string_pretty(info).map_err(|e| McError::Invalid(e.to_string()))?;
     write(&out.join("campaign.json"), info_json + "\n")?;
     load_campaign_base(out)
 }
@@ -262,9 +271,11 @@ pub fn load_campaign_base(dir: &Path) -> Result<CampaignBase, McError> {
     let info: CampaignInfo = json(&dir.join("campaign.json"))?;
     info.config.validate()?;
     let text = read(&dir.join("base_scenario.toml"))?;
-    let scenario = Scenario::from_toml_str(&text, dir)
-        .map_err(|e| McError::Setup(format!("{}: {e}", dir.join("base_scenario.toml").display())))?;
-    let setup = Setup::from_scenario(scenario.clone()).map_err(|e| McError::Setup(e.to_string()))?;
+    let scenario = Scenario::from_toml_str(&text, dir).map_err(|e| {
+        McError::Setup(format!("{}: {e}", dir.join("base_scenario.toml").display()))
+    })?;
+    let setup =
+        Setup::from_scenario(scenario.clone()).map_err(|e| McError::Setup(e.to_string()))?;
     Ok(CampaignBase {
         scenario,
         setup,
@@ -283,7 +294,9 @@ pub fn run_campaign(opts: &CampaignOptions) -> Result<CampaignSummary, McError> 
     let started = std::time::Instant::now();
     let setup = load_base(&opts.scenario, &opts.config)?;
     if opts.jobs == 0 {
-        return Err(McError::Invalid("--jobs 0: need at least one thread".into()));
+        return Err(McError::Invalid(
+            "--jobs 0: need at least one thread".into(),
+        ));
     }
     prepare_out(&opts.out)?;
     let urdf = setup
@@ -488,7 +501,10 @@ fn runs_csv(loaded: &[Loaded], phases: &[String], grasp: Option<&str>) -> String
                     v.push(num(m.min_h.get(*n).copied().flatten()));
                 }
             }
-            None => v.extend(std::iter::repeat_n(String::new(), 6 + 2 * phases.len() + 3 + names.len())),
+            None => v.extend(std::iter::repeat_n(
+                String::new(),
+                6 + 2 * phases.len() + 3 + names.len(),
+            )),
         }
         v.push(quote(r.error.as_deref().unwrap_or("")));
         s += &(v.join(",") + "\n");
@@ -521,18 +537,35 @@ fn runs_timing_csv(loaded: &[Loaded]) -> String {
 pub fn aggregate(dir: &Path, wall_time_s: f64) -> Result<CampaignSummary, McError> {
     let info: CampaignInfo = json(&dir.join("campaign.json"))?;
     let base = read(&dir.join("base_scenario.toml"))?;
-    let scenario = Scenario::from_toml_str(&base, dir)
-        .map_err(|e| McError::Setup(format!("{}: {e}", dir.join("base_scenario.toml").display())))?;
-    let phases: Vec<String> = scenario.mission.phases.iter().map(|p| p.name.clone()).collect();
+    let scenario = Scenario::from_toml_str(&base, dir).map_err(|e| {
+        McError::Setup(format!("{}: {e}", dir.join("base_scenario.toml").display()))
+    })?;
+    let phases: Vec<String> = scenario
+        .mission
+        .phases
+        .iter()
+        .map(|p| p.name.clone())
+        .collect();
     let grasp = run::grasp_phase(&scenario);
     let loaded = load_runs(dir)?;
-    write(&dir.join("runs.csv"), runs_csv(&loaded, &phases, grasp.as_deref()))?;
+    write(
+        &dir.join("runs.csv"),
+        runs_csv(&loaded, &phases, grasp.as_deref()),
+    )?;
     write(&dir.join("runs_timing.csv"), runs_timing_csv(&loaded))?;
 
     let names = sc_mission::constraint_names();
     let mut worst: BTreeMap<String, Worst> = names
         .iter()
-        .map(|n| (n.to_string(), Worst { min_h: None, run: None }))
+        .map(|n| {
+            (
+                n.to_string(),
+                Worst {
+                    min_h: None,
+                    run: None,
+                },
+            )
+        })
         .collect();
     let mut minima: Vec<BarrierMinima> = names
         .iter()
@@ -631,16 +664,30 @@ pub fn aggregate(dir: &Path, wall_time_s: f64) -> Result<CampaignSummary, McErro
     }
     s.worst = worst;
     s.capture_time_s = capture.0;
-    s.sync_error_peak_rad_s = sync.into_iter().filter_map(|(k, v)| v.0.map(|x| (k, x))).collect();
-    s.joint_torque_norm_peak_nm = torque.into_iter().filter_map(|(k, v)| v.0.map(|x| (k, x))).collect();
+    s.sync_error_peak_rad_s = sync
+        .into_iter()
+        .filter_map(|(k, v)| v.0.map(|x| (k, x)))
+        .collect();
+    s.joint_torque_norm_peak_nm = torque
+        .into_iter()
+        .filter_map(|(k, v)| v.0.map(|x| (k, x)))
+        .collect();
     s.joint_torque_norm_rms_grasp_nm = rms.0;
     s.solve_time_us = TIMERS
         .iter()
-        .map(|n| (n.to_string(), hist.get(*n).map(|h| h.stats()).unwrap_or_default()))
+        .map(|n| {
+            (
+                n.to_string(),
+                hist.get(*n).map(|h| h.stats()).unwrap_or_default(),
+            )
+        })
         .collect();
     let text = serde_json::to_string_pretty(&s).map_err(|e| McError::Invalid(e.to_string()))?;
     write(&dir.join("summary.json"), text + "\n")?;
-    write(&dir.join("report.md"), crate::report::report(&s, &loaded_results(&loaded), grasp.as_deref(), &phases))?;
+    write(
+        &dir.join("report.md"),
+        crate::report::report(&s, &loaded_results(&loaded), grasp.as_deref(), &phases),
+    )?;
 
     let runtime: Vec<RuntimeBar> = ["total", "translational", "attitude", "robotic"]
         .iter()
@@ -661,7 +708,8 @@ pub fn aggregate(dir: &Path, wall_time_s: f64) -> Result<CampaignSummary, McErro
         runtime_reference: Some(("paper (CasADi + OSQP)".into(), 1590.0, 3750.0)),
         minima: &minima,
     };
-    sc_plots::campaign_figures(&dir.join("figures"), &figs).map_err(|e| McError::Invalid(e.to_string()))?;
+    sc_plots::campaign_figures(&dir.join("figures"), &figs)
+        .map_err(|e| McError::Invalid(e.to_string()))?;
     Ok(s)
 }
 
@@ -694,7 +742,10 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<CampaignSummary, McError> {
     let out_abs = std::path::absolute(out).unwrap_or(out.to_path_buf());
     for d in dirs {
         if std::path::absolute(d).unwrap_or(d.clone()) == out_abs {
-            return Err(McError::Invalid(format!("merge: --out {} is one of the inputs", out.display())));
+            return Err(McError::Invalid(format!(
+                "merge: --out {} is one of the inputs",
+                out.display()
+            )));
         }
         let info: CampaignInfo = json(&d.join("campaign.json"))?;
         let same = info.seed == info0.seed
@@ -749,7 +800,10 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<CampaignSummary, McError> {
             seen.insert(k, d.clone());
         }
         if let Ok(sum) = json::<serde_json::Value>(&d.join("summary.json")) {
-            wall += sum.get("wall_time_s").and_then(|v| v.as_f64()).unwrap_or(0.0);
+            wall += sum
+                .get("wall_time_s")
+                .and_then(|v| v.as_f64())
+                .unwrap_or(0.0);
         }
     }
     let missing: Vec<String> = (0..info.runs)
@@ -785,7 +839,10 @@ pub fn rerun(dir: &Path, k: usize) -> Result<Rerun, McError> {
     let base = load_campaign_base(dir)?;
     let info: CampaignInfo = json(&dir.join("campaign.json"))?;
     if k >= info.runs {
-        return Err(McError::Invalid(format!("--run {k}: the campaign has runs 0..{}", info.runs)));
+        return Err(McError::Invalid(format!(
+            "--run {k}: the campaign has runs 0..{}",
+            info.runs
+        )));
     }
     let rd = run_dir(dir, k);
     let saved_path = rd.join("result.json");
@@ -806,13 +863,20 @@ pub fn rerun(dir: &Path, k: usize) -> Result<Rerun, McError> {
     let text = run::run_scenario(&base, &d).to_toml_string();
     let saved_scenario = read(&rd.join("scenario.toml"))?;
     if text != saved_scenario {
-        differences.push("scenario.toml: re-derived dispersed scenario differs from the saved one".into());
+        differences
+            .push("scenario.toml: re-derived dispersed scenario differs from the saved one".into());
     }
     let scenario = Scenario::from_toml_str(&saved_scenario, &rd)
         .map_err(|e| McError::Setup(format!("{}: {e}", rd.join("scenario.toml").display())))?;
-    let setup = Setup::from_scenario(scenario.clone()).map_err(|e| McError::Setup(e.to_string()))?;
+    let setup =
+        Setup::from_scenario(scenario.clone()).map_err(|e| McError::Setup(e.to_string()))?;
     let (records, end) = run::simulate(setup, false).map_err(McError::Invalid)?;
-    let (metrics, _trace, timing) = run::measure(&scenario, &records, &end, base.config.output.trace_every_steps);
+    let (metrics, _trace, timing) = run::measure(
+        &scenario,
+        &records,
+        &end,
+        base.config.output.trace_every_steps,
+    );
     let result = RunResult {
         run: k,
         seed,
@@ -821,7 +885,8 @@ pub fn rerun(dir: &Path, k: usize) -> Result<Rerun, McError> {
         dispersion: Some(d),
         metrics: Some(metrics),
     };
-    let new_text = serde_json::to_string_pretty(&result).map_err(|e| McError::Invalid(e.to_string()))? + "\n";
+    let new_text =
+        serde_json::to_string_pretty(&result).map_err(|e| McError::Invalid(e.to_string()))? + "\n";
     if new_text != saved_text {
         if saved.failed() {
             differences.push(format!(

@@ -129,7 +129,10 @@ impl MonteCarloConfig {
                 "must be >= initial_position.distance_min_m",
             ));
         }
-        finite_nonneg("initial_position.corridor_margin_deg", p.corridor_margin_deg)?;
+        finite_nonneg(
+            "initial_position.corridor_margin_deg",
+            p.corridor_margin_deg,
+        )?;
         finite_nonneg("initial_position.los_margin_deg", p.los_margin_deg)?;
         let r = &self.target_rate;
         finite_nonneg("target_rate.rate_min_rad_s", r.rate_min_rad_s)?;
@@ -142,11 +145,19 @@ impl MonteCarloConfig {
             ));
         }
         if r.rate_max_rad_s > 1.0 {
-            return Err(invalid("target_rate.rate_max_rad_s", r.rate_max_rad_s, "must be <= 1 rad/s"));
+            return Err(invalid(
+                "target_rate.rate_max_rad_s",
+                r.rate_max_rad_s,
+                "must be <= 1 rad/s",
+            ));
         }
         let n = r.axis_t.iter().map(|x| x * x).sum::<f64>().sqrt();
         if !n.is_finite() || (n - 1.0).abs() > 1e-6 {
-            return Err(invalid("target_rate.axis_t", r.axis_t, "must be a unit vector"));
+            return Err(invalid(
+                "target_rate.axis_t",
+                r.axis_t,
+                "must be a unit vector",
+            ));
         }
         if self.output.trace_every_steps == 0 {
             return Err(invalid("output.trace_every_steps", 0, "must be >= 1"));

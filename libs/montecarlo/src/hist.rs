@@ -21,7 +21,9 @@ pub struct LogHistogram {
 
 impl LogHistogram {
     fn bin(x: f64) -> u32 {
-        ((x / FLOOR_US).ln() / RATIO.ln()).floor().clamp(0.0, u32::MAX as f64) as u32
+        ((x / FLOOR_US).ln() / RATIO.ln())
+            .floor()
+            .clamp(0.0, u32::MAX as f64) as u32
     }
 
     /// Adds one sample [µs] (non-finite samples are ignored).

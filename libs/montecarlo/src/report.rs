@@ -26,7 +26,12 @@ fn spread(s: Option<&Spread>, digits: usize) -> String {
 }
 
 /// The Markdown report.
-pub fn report(s: &CampaignSummary, results: &[RunResult], grasp: Option<&str>, phases: &[String]) -> String {
+pub fn report(
+    s: &CampaignSummary,
+    results: &[RunResult],
+    grasp: Option<&str>,
+    phases: &[String],
+) -> String {
     let mut o = String::new();
     let _ = writeln!(o, "# Monte Carlo campaign\n");
     let shard = s
@@ -39,7 +44,11 @@ pub fn report(s: &CampaignSummary, results: &[RunResult], grasp: Option<&str>, p
         s.runs, s.campaign_runs, s.seed, s.wall_time_s
     );
     let _ = writeln!(o, "| | runs |\n|---|---|");
-    let _ = writeln!(o, "| safe (every barrier ≥ 0) | {} / {} |", s.safe_runs, s.runs);
+    let _ = writeln!(
+        o,
+        "| safe (every barrier ≥ 0) | {} / {} |",
+        s.safe_runs, s.runs
+    );
     let _ = writeln!(o, "| captured | {} / {} |", s.captured_runs, s.runs);
     let _ = writeln!(o, "| failed (error or panic) | {} |", s.failed_runs);
     let _ = writeln!(o, "| with filter faults | {} |\n", s.faulted_runs);
@@ -50,7 +59,10 @@ pub fn report(s: &CampaignSummary, results: &[RunResult], grasp: Option<&str>, p
         .and_then(|i| phases.get(i));
     let t = |n: &str| s.solve_time_us.get(n).copied().unwrap_or_default();
     let _ = writeln!(o, "## Beside the paper\n");
-    let _ = writeln!(o, "| quantity | this campaign | paper (CasADi + OSQP, 100 runs) |\n|---|---|---|");
+    let _ = writeln!(
+        o,
+        "| quantity | this campaign | paper (CasADi + OSQP, 100 runs) |\n|---|---|---|"
+    );
     let _ = writeln!(
         o,
         "| total solve time per step, geometric mean | {:.1} µs | {PAPER_TOTAL_GEOMEAN_MS} ms |",
@@ -100,7 +112,10 @@ pub fn report(s: &CampaignSummary, results: &[RunResult], grasp: Option<&str>, p
         "Solve times are wall-clock measurements on this machine (percentiles from a log histogram, ±0.05 %).\n"
     );
 
-    let _ = writeln!(o, "## Worst barrier margins\n\n| constraint | worst min h | run |\n|---|---|---|");
+    let _ = writeln!(
+        o,
+        "## Worst barrier margins\n\n| constraint | worst min h | run |\n|---|---|---|"
+    );
     let mut worst: Vec<(&String, f64, Option<usize>)> = s
         .worst
         .iter()
@@ -108,7 +123,11 @@ pub fn report(s: &CampaignSummary, results: &[RunResult], grasp: Option<&str>, p
         .collect();
     worst.sort_by(|a, b| a.1.total_cmp(&b.1));
     for (n, h, r) in worst.iter().take(10) {
-        let _ = writeln!(o, "| {n} | {h:.4e} | {} |", r.map(|x| x.to_string()).unwrap_or_default());
+        let _ = writeln!(
+            o,
+            "| {n} | {h:.4e} | {} |",
+            r.map(|x| x.to_string()).unwrap_or_default()
+        );
     }
     let _ = writeln!(o);
 
@@ -148,7 +167,11 @@ pub fn report(s: &CampaignSummary, results: &[RunResult], grasp: Option<&str>, p
                     v.join("; ")
                 }
             };
-            let _ = writeln!(o, "| {} | {} | {dist} | {off} | {az} | {w} | {outcome} |", r.run, r.seed);
+            let _ = writeln!(
+                o,
+                "| {} | {} | {dist} | {off} | {az} | {w} | {outcome} |",
+                r.run, r.seed
+            );
         }
     }
     let _ = writeln!(

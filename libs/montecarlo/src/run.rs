@@ -141,7 +141,9 @@ fn finite(x: Option<f64>) -> Option<f64> {
 }
 
 fn finite_map(m: &BTreeMap<String, f64>) -> BTreeMap<String, Option<f64>> {
-    m.iter().map(|(k, v)| (k.clone(), finite(Some(*v)))).collect()
+    m.iter()
+        .map(|(k, v)| (k.clone(), finite(Some(*v))))
+        .collect()
 }
 
 /// Metrics, trace and timing of a finished run.
@@ -211,7 +213,9 @@ pub fn measure(
     }
     for (i, name) in TIMERS.iter().enumerate() {
         timing.stats.insert(name.to_string(), TimeStats::of(&v[i]));
-        timing.histograms.insert(name.to_string(), std::mem::take(&mut h[i]));
+        timing
+            .histograms
+            .insert(name.to_string(), std::mem::take(&mut h[i]));
     }
     (metrics, trace, timing)
 }
@@ -260,8 +264,12 @@ pub fn execute(base: &CampaignBase, k: usize, run_dir: &Path, inject_panic: bool
         Ok(x) => x,
         Err(e) => return fail(result, e),
     };
-    let (metrics, trace, timing) =
-        measure(&scenario, &records, &end, base.config.output.trace_every_steps);
+    let (metrics, trace, timing) = measure(
+        &scenario,
+        &records,
+        &end,
+        base.config.output.trace_every_steps,
+    );
     result.status = "ok".into();
     result.metrics = Some(metrics);
     RunOutput {
@@ -282,7 +290,15 @@ pub fn trace_csv(trace: &[TracePoint]) -> String {
     for p in trace {
         s.push_str(&format!(
             "{},{},{},{},{},{},{},{},{}\n",
-            p.t, p.phase, p.r_r[0], p.r_r[1], p.r_r[2], p.speed, p.los_deg[0], p.los_deg[1], p.sync_error
+            p.t,
+            p.phase,
+            p.r_r[0],
+            p.r_r[1],
+            p.r_r[2],
+            p.speed,
+            p.los_deg[0],
+            p.los_deg[1],
+            p.sync_error
         ));
     }
     s
@@ -294,7 +310,11 @@ pub fn parse_trace(text: &str) -> Result<Vec<TracePoint>, String> {
     for (i, line) in text.lines().enumerate().skip(1) {
         let f: Vec<&str> = line.split(',').collect();
         if f.len() != 9 {
-            return Err(format!("line {}: expected 9 fields, found {}", i + 1, f.len()));
+            return Err(format!(
+                "line {}: expected 9 fields, found {}",
+                i + 1,
+                f.len()
+            ));
         }
         let num = |j: usize| {
             f[j].parse::<f64>()

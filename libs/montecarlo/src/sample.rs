@@ -43,7 +43,11 @@ pub struct Dispersion {
 
 /// Two unit vectors completing `d` to an orthonormal basis.
 fn basis(d: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
-    let pick = if d.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
+    let pick = if d.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
     let e1 = (pick - d * d.dot(&pick)).normalize();
     (e1, d.cross(&e1))
 }
@@ -61,7 +65,11 @@ pub fn initial_los_deg(s: &sc_scenario::Scenario, r_r: &Vector3<f64>) -> f64 {
 
 /// Samples run `seed`'s dispersion for scenario `s`. Errors when no draw in
 /// [`MAX_DRAWS`] satisfies the line-of-sight margin.
-pub fn sample(cfg: &MonteCarloConfig, s: &sc_scenario::Scenario, seed: u64) -> Result<Dispersion, String> {
+pub fn sample(
+    cfg: &MonteCarloConfig,
+    s: &sc_scenario::Scenario,
+    seed: u64,
+) -> Result<Dispersion, String> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let p = &cfg.initial_position;
     let axis = Vector3::from(s.safety.translational.corridor_axis);

@@ -189,8 +189,8 @@ fn attitude(area: &Area, f: &CampaignFigures) -> DrawResult {
         .map_err(e)?;
     chart
         .configure_mesh()
-        .x_desc("LOS angle about e1 [deg]")
-        .y_desc("LOS angle about e2 [deg]")
+        .x_desc("LOS angle towards e1 (y_B for d_B = x_B) [deg]")
+        .y_desc("LOS angle towards e2 (z_B for d_B = x_B) [deg]")
         .light_line_style(WHITE.mix(0.0))
         .draw()
         .map_err(e)?;
@@ -235,7 +235,7 @@ fn scatter(area: &Area, f: &CampaignFigures) -> DrawResult {
     chart
         .configure_mesh()
         .x_desc("peak sync error in grasping [rad/s]")
-        .y_desc("peak joint-torque norm ‖τ_M‖ in grasping [N m]")
+        .y_desc("RMS joint-torque norm ‖τ_M‖ in grasping [N m]")
         .draw()
         .map_err(e)?;
     let t = |v: f64| {
@@ -288,7 +288,7 @@ fn runtime(area: &Area, f: &CampaignFigures) -> DrawResult {
     let lo = vals.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = vals.iter().copied().fold(0.0, f64::max);
     let (lo, hi) = if lo.is_finite() && hi > 0.0 {
-        (lo / 3.0, hi * 3.0)
+        (lo / 3.0, hi * 40.0)
     } else {
         (0.1, 10.0)
     };

@@ -239,6 +239,8 @@ pub fn colour_bar(area: &Area, label: &str, lo: f64, hi: f64) -> DrawResult {
         .disable_x_axis()
         .y_desc(label)
         .y_labels(6)
+        .y_label_style(("sans-serif", 12))
+        .axis_desc_style(("sans-serif", 13))
         .draw()
         .map_err(e)?;
     let n = 64;

@@ -1,0 +1,333 @@
+//! Campaigns: config rules, seeds and dispersions, shard/merge byte-identity, rerun,
+//! injected failures. Short missions (a few seconds) keep them fast.
+
+use sc_montecarlo::campaign::{WALL_CLOCK_FILES, WALL_CLOCK_KEYS};
+use sc_montecarlo::sample::{initial_los_deg, run_seed, sample};
+use sc_montecarlo::{
+    CampaignOptions, MonteCarloConfig, merge, parse_shard, rerun, run_campaign, shard_runs,
+};
+use sc_scenario::Scenario;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("sc-mc-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn config() -> MonteCarloConfig {
+    MonteCarloConfig::load(&root().join("config/montecarlo.toml")).unwrap()
+}
+
+fn scenario() -> Scenario {
+    Scenario::load(&root().join("config/scenario.toml")).unwrap()
+}
+
+/// The default scenario with a short duration, written to `dir/scenario.toml`.
+fn short_scenario(dir: &Path, duration: f64) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let mut s = scenario();
+    s.mission.duration_s = duration;
+    s.servicer.urdf = std::path::absolute(s.urdf_path()).unwrap();
+    let p = dir.join("scenario.toml");
+    std::fs::write(&p, s.to_toml_string()).unwrap();
+    p
+}
+
+fn options(scenario: PathBuf, out: PathBuf, runs: usize) -> CampaignOptions {
+    CampaignOptions {
+        scenario,
+        config: config(),
+        runs,
+        seed: 7,
+        jobs: 2,
+        shard: None,
+        out,
+        inject_panic: Vec::new(),
+        progress: false,
+    }
+}
+
+/// Every file under `dir`, relative path → bytes.
+fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                let rel = p
+                    .strip_prefix(dir)
+                    .unwrap()
+                    .to_string_lossy()
+                    .replace('\\', "/");
+                out.insert(rel, std::fs::read(&p).unwrap());
+            }
+        }
+    }
+    out
+}
+
+fn deterministic(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    let mut f = files(dir);
+    f.retain(|k, _| !WALL_CLOCK_FILES.contains(&k.as_str()) && !k.ends_with("timing.json"));
+    let mut summary: serde_json::Value = serde_json::from_slice(&f["summary.json"]).unwrap();
+    for k in WALL_CLOCK_KEYS {
+        summary.as_object_mut().unwrap().remove(k);
+    }
+    f.insert("summary.json".into(), serde_json::to_vec(&summary).unwrap());
+    f
+}
+
+#[test]
+fn default_config_is_the_papers() {
+    let c = config();
+    assert_eq!(c.target_rate.rate_min_rad_s, 0.0);
+    assert_eq!(c.target_rate.rate_max_rad_s, 0.15);
+    assert_eq!(c.target_rate.axis_t, [-1.0, 0.0, 0.0]);
+    c.check_against(&scenario()).unwrap();
+}
+
+#[test]
+fn bad_configs_are_rejected_in_one_line() {
+    let good = std::fs::read_to_string(root().join("config/montecarlo.toml")).unwrap();
+    let cases = [
+        (
+            "distance_max_m = 11.0",
+            "distance_max_m = 3.0",
+            "initial_position.distance_max_m",
+        ),
+        (
+            "rate_max_rad_s = 0.15",
+            "rate_max_rad_s = nan",
+            "target_rate.rate_max_rad_s",
+        ),
+        (
+            "axis_t = [-1.0, 0.0, 0.0]",
+            "axis_t = [-1.0, 1.0, 0.0]",
+            "target_rate.axis_t",
+        ),
+        (
+            "trace_every_steps = 5",
+            "trace_every_steps = 0",
+            "output.trace_every_steps",
+        ),
+        (
+            "trace_every_steps = 5",
+            "trace_every_steps = 5\nextra = 1",
+            "extra",
+        ),
+        (
+            "los_margin_deg = 0.5",
+            "los_margin_deg = -1.0",
+            "initial_position.los_margin_deg",
+        ),
+    ];
+    for (from, to, key) in cases {
+        assert!(good.contains(from), "{from}");
+        let e = MonteCarloConfig::from_toml_str(&good.replace(from, to)).unwrap_err();
+        let m = e.to_string();
+        assert!(m.contains(key) && !m.contains('\n'), "{to}: {m}");
+    }
+    let mut c = config();
+    c.initial_position.corridor_margin_deg = 5.0;
+    let m = c.check_against(&scenario()).unwrap_err().to_string();
+    assert!(m.contains("corridor_margin_deg") && m.contains("5"), "{m}");
+    c = config();
+    c.initial_position.distance_min_m = 1.0;
+    assert!(c.check_against(&scenario()).is_err());
+    let e = MonteCarloConfig::load(Path::new("/nonexistent/mc.toml")).unwrap_err();
+    assert!(e.to_string().contains("/nonexistent/mc.toml"));
+}
+
+#[test]
+fn seeds_are_deterministic_and_distinct() {
+    assert_eq!(run_seed(7, 3), run_seed(7, 3));
+    let seeds: std::collections::BTreeSet<u64> = (0..1000).map(|k| run_seed(7, k)).collect();
+    assert_eq!(seeds.len(), 1000);
+    assert_ne!(run_seed(7, 0), run_seed(8, 0));
+}
+
+#[test]
+fn dispersions_stay_inside_the_corridor_and_the_rate_range() {
+    let c = config();
+    let s = scenario();
+    let psi = s.safety.translational.corridor_half_angle_deg;
+    let beta = s.safety.attitude.los_half_angle_deg;
+    let axis = nalgebra::Vector3::from(s.safety.translational.corridor_axis);
+    let mut rates = Vec::new();
+    for k in 0..500 {
+        let d = sample(&c, &s, run_seed(1, k)).unwrap();
+        assert_eq!(d, sample(&c, &s, run_seed(1, k)).unwrap());
+        let p = nalgebra::Vector3::from(d.position_r_m);
+        let ang = (p.dot(&axis) / p.norm()).acos().to_degrees();
+        assert!(
+            ang <= psi - c.initial_position.corridor_margin_deg + 1e-9,
+            "{ang}"
+        );
+        assert!((ang - d.off_axis_deg).abs() < 1e-6);
+        assert!((p.norm() - d.distance_m).abs() < 1e-9);
+        assert!(d.distance_m >= c.initial_position.distance_min_m);
+        assert!(d.distance_m <= c.initial_position.distance_max_m);
+        assert!(initial_los_deg(&s, &p) <= beta - c.initial_position.los_margin_deg);
+        assert!((0.0..=0.15).contains(&d.tumble_rate_rad_s));
+        assert_eq!(d.omega_t_rad_s, [-d.tumble_rate_rad_s, 0.0, 0.0]);
+        rates.push(d.tumble_rate_rad_s);
+    }
+    let mean = rates.iter().sum::<f64>() / rates.len() as f64;
+    assert!((mean - 0.075).abs() < 0.01, "mean rate {mean}");
+}
+
+#[test]
+fn an_unsatisfiable_los_margin_is_an_error() {
+    let mut c = config();
+    c.initial_position.los_margin_deg = 4.999;
+    c.initial_position.distance_min_m = 2.0;
+    c.initial_position.distance_max_m = 2.0;
+    let e = sample(&c, &scenario(), 1).unwrap_err();
+    assert!(e.contains("los_margin_deg"), "{e}");
+}
+
+#[test]
+fn shards_partition_the_campaign() {
+    assert_eq!(parse_shard("1/4").unwrap(), (1, 4));
+    for bad in ["4/4", "1", "a/2", "0/0", "-1/2"] {
+        let e = parse_shard(bad).unwrap_err();
+        assert!(e.contains(bad), "{e}");
+    }
+    let mut all: Vec<usize> = (0..3).flat_map(|i| shard_runs(10, Some((i, 3)))).collect();
+    all.sort_unstable();
+    assert_eq!(all, (0..10).collect::<Vec<_>>());
+    assert_eq!(shard_runs(5, None), vec![0, 1, 2, 3, 4]);
+}
+
+#[test]
+fn merged_shards_equal_the_whole_campaign_and_reruns_reproduce() {
+    let base = tmp("merge");
+    let sc = short_scenario(&base, 2.0);
+    let whole = base.join("whole");
+    let s = run_campaign(&options(sc.clone(), whole.clone(), 5)).unwrap();
+    assert_eq!(s.runs, 5);
+    assert_eq!(s.failed_runs, 0);
+    assert_eq!(s.safe_runs, 5, "{s:?}");
+    assert!(s.solve_time_us["total"].samples > 0);
+    let mut shards = Vec::new();
+    for i in 0..2 {
+        let mut o = options(sc.clone(), base.join(format!("shard{i}")), 5);
+        o.shard = Some((i, 2));
+        o.jobs = 1;
+        let s = run_campaign(&o).unwrap();
+        assert_eq!(s.runs, if i == 0 { 3 } else { 2 });
+        shards.push(o.out);
+    }
+    let merged = base.join("merged");
+    // shards in either order give the same result
+    shards.reverse();
+    let m = merge(&shards, &merged).unwrap();
+    assert_eq!(m.runs, 5);
+    let (a, b) = (deterministic(&whole), deterministic(&merged));
+    assert_eq!(
+        a.keys().collect::<Vec<_>>(),
+        b.keys().collect::<Vec<_>>(),
+        "file sets differ"
+    );
+    for (k, v) in &a {
+        assert!(
+            v == &b[k],
+            "{k} differs between the whole campaign and the merged shards"
+        );
+    }
+    assert!(a.contains_key("runs.csv") && a.contains_key("figures/trajectories_xy.svg"));
+    assert!(a.contains_key("runs/4/scenario.toml") && a.contains_key("runs/4/trace.csv"));
+
+    // rerun reproduces exactly, from the whole campaign and from the merge
+    for dir in [&whole, &merged] {
+        let r = rerun(dir, 3).unwrap();
+        assert!(r.differences.is_empty(), "{:?}", r.differences);
+        assert_eq!(r.result.run, 3);
+    }
+    assert!(rerun(&whole, 99).is_err());
+
+    // merging an incomplete set or mixing campaigns is refused
+    let e = merge(&shards[..1], &base.join("partial"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("missing"), "{e}");
+    let mut other = options(sc.clone(), base.join("other"), 5);
+    other.seed = 8;
+    other.shard = Some((0, 2));
+    run_campaign(&other).unwrap();
+    let e = merge(&[shards[0].clone(), other.out.clone()], &base.join("mixed"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("different campaign"), "{e}");
+    let e = merge(&[shards[0].clone(), shards[0].clone()], &base.join("dup"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("in both"), "{e}");
+    let _ = std::fs::remove_dir_all(&base);
+}
+
+#[test]
+fn a_panicking_run_is_recorded_and_the_campaign_completes() {
+    let base = tmp("panic");
+    let sc = short_scenario(&base, 2.0);
+    let mut o = options(sc, base.join("c"), 4);
+    o.inject_panic = vec![2];
+    let s = run_campaign(&o).unwrap();
+    assert_eq!(s.runs, 4);
+    assert_eq!(s.failed_runs, 1);
+    assert_eq!(s.failed[0].run, 2);
+    assert!(
+        s.failed[0].error.contains("injected failure"),
+        "{:?}",
+        s.failed
+    );
+    assert_eq!(s.safe_runs, 3);
+    let csv = std::fs::read_to_string(o.out.join("runs.csv")).unwrap();
+    let row = csv.lines().find(|l| l.starts_with("2,")).unwrap();
+    assert!(
+        row.contains(",failed,") && row.contains("injected failure"),
+        "{row}"
+    );
+    let header = csv.lines().next().unwrap().split(',').count();
+    assert!(csv.lines().all(|l| l.split(',').count() == header));
+    let report = std::fs::read_to_string(o.out.join("report.md")).unwrap();
+    assert!(
+        report.contains("failed: panicked: injected failure"),
+        "{report}"
+    );
+    // its rerun completes and says that it differs from the saved failure
+    let r = rerun(&o.out, 2).unwrap();
+    assert_eq!(r.differences.len(), 1, "{:?}", r.differences);
+    let _ = std::fs::remove_dir_all(&base);
+}
+
+#[test]
+fn bad_campaign_inputs_are_one_line_errors() {
+    let base = tmp("bad");
+    let sc = short_scenario(&base, 1.0);
+    let mut o = options(sc.clone(), base.join("c"), 2);
+    o.jobs = 0;
+    assert!(run_campaign(&o).unwrap_err().to_string().contains("--jobs"));
+    let o = options(base.join("missing.toml"), base.join("c2"), 2);
+    let m = run_campaign(&o).unwrap_err().to_string();
+    assert!(m.contains("missing.toml") && !m.contains('\n'), "{m}");
+    // a non-empty directory that is no campaign is not overwritten
+    let foreign = base.join("foreign");
+    std::fs::create_dir_all(&foreign).unwrap();
+    std::fs::write(foreign.join("precious.txt"), "x").unwrap();
+    let m = run_campaign(&options(sc, foreign.clone(), 1))
+        .unwrap_err()
+        .to_string();
+    assert!(m.contains("campaign.json"), "{m}");
+    assert!(foreign.join("precious.txt").is_file());
+    let _ = std::fs::remove_dir_all(&base);
+}
