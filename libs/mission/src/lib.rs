@@ -11,7 +11,7 @@ pub mod setup;
 pub mod stages;
 pub mod summary;
 
-pub use mission::{Mission, MissionEnd, RunOptions};
+pub use mission::{Mission, MissionEnd, RunOptions, capture_check, timeout_check};
 pub use record::{StepRecord, TelemetryWriter, telemetry_columns, timing_columns};
 pub use setup::{Setup, SetupError};
 pub use summary::{Summary, summarize};

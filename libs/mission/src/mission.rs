@@ -134,18 +134,7 @@ impl Mission {
     /// True if the record shows a capture: grasping phase, end-effector on the grasping
     /// point within the configured distance and relative-speed tolerances.
     pub fn is_capture(&self, r: &StepRecord) -> bool {
-        let m = &self.setup.scenario.mission;
-        let grasping = self
-            .setup
-            .scenario
-            .mission
-            .phases
-            .get(r.phase)
-            .map(|p| p.robotic)
-            == Some(sc_scenario::RoboticMode::Grasp);
-        grasping
-            && r.obs.grasp_distance() <= m.capture_tolerance_m
-            && r.obs.grasp_speed() <= m.capture_speed_tolerance_m_s
+        capture_check(&self.setup.scenario, r.phase, &r.obs)
     }
 
     /// One control step: compute, then advance the simulator under the applied command.
@@ -161,12 +150,11 @@ impl Mission {
 
     /// Ends the mission on capture or timeout, or advances the simulator by one period.
     pub fn advance(&mut self, r: &StepRecord) {
-        let m = &self.setup.scenario.mission;
         if self.is_capture(r) {
             self.end = Some(MissionEnd::Captured { t: r.t });
             return;
         }
-        if r.t + 0.5 * m.control_period_s >= m.duration_s {
+        if timeout_check(&self.setup.scenario, r.t) {
             self.end = Some(MissionEnd::Timeout { t: r.t });
             return;
         }
@@ -187,6 +175,27 @@ impl Mission {
         }
         self.end.clone().unwrap_or(MissionEnd::Timeout { t: 0.0 })
     }
+}
+
+/// True if phase `phase` grasps and the observation shows the end-effector on the
+/// grasping point within the scenario's distance and relative-speed tolerances.
+/// Shared by [`Mission`] and the partition's simulator process.
+pub fn capture_check(
+    scenario: &sc_scenario::Scenario,
+    phase: usize,
+    o: &sc_sim::Observation,
+) -> bool {
+    let m = &scenario.mission;
+    let grasping = m.phases.get(phase).map(|p| p.robotic) == Some(sc_scenario::RoboticMode::Grasp);
+    grasping
+        && o.grasp_distance() <= m.capture_tolerance_m
+        && o.grasp_speed() <= m.capture_speed_tolerance_m_s
+}
+
+/// True if the step starting at `t` is the last one of the configured duration.
+pub fn timeout_check(scenario: &sc_scenario::Scenario, t: f64) -> bool {
+    let m = &scenario.mission;
+    t + 0.5 * m.control_period_s >= m.duration_s
 }
 
 /// Zero vector helper for callers building records by hand.

@@ -115,6 +115,41 @@ pub struct NominalOutput {
     pub ik: Option<IkSolution>,
 }
 
+/// Which subsystems [`NominalControllers::command_subsystems`] computes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Subsystems {
+    pub translational: bool,
+    pub attitude: bool,
+    pub robotic: bool,
+}
+
+impl Subsystems {
+    /// All three.
+    pub const ALL: Self = Self {
+        translational: true,
+        attitude: true,
+        robotic: true,
+    };
+    /// Only the translational controller.
+    pub const TRANSLATIONAL: Self = Self {
+        translational: true,
+        attitude: false,
+        robotic: false,
+    };
+    /// Only the attitude controller.
+    pub const ATTITUDE: Self = Self {
+        translational: false,
+        attitude: true,
+        robotic: false,
+    };
+    /// Only the robotic controller.
+    pub const ROBOTIC: Self = Self {
+        translational: false,
+        attitude: false,
+        robotic: true,
+    };
+}
+
 /// Modes of one mission phase.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PhaseModes {
@@ -279,6 +314,14 @@ impl NominalControllers {
     /// [`SubsystemStatus`] for the handling of bad inputs. A non-finite `t` makes
     /// every subsystem `InvalidInput`.
     pub fn command(&self, x: &NominalInput) -> NominalOutput {
+        self.command_subsystems(x, Subsystems::ALL)
+    }
+
+    /// Like [`Self::command`] but computes only the selected subsystems (the others
+    /// stay `Off` with a zero command). Each selected subsystem's command is exactly
+    /// what [`Self::command`] returns for it: one process per controller gives the
+    /// same results as all three in one process.
+    pub fn command_subsystems(&self, x: &NominalInput, which: Subsystems) -> NominalOutput {
         let phase = self.phase_at(x.t);
         let modes = self.phases[phase];
         let mut out = NominalOutput {
@@ -309,7 +352,7 @@ impl NominalControllers {
             }
         };
 
-        if modes.translational == TranslationalMode::Approach {
+        if which.translational && modes.translational == TranslationalMode::Approach {
             let valid = match quat::normalized(&x.q_hr) {
                 Some(q_hr) => {
                     let r_hr = quat::to_matrix(&q_hr);
@@ -333,7 +376,7 @@ impl NominalControllers {
             AttitudeMode::PointAndSync => Some(AttitudeTask::PointAndSync),
             AttitudeMode::Off => None,
         };
-        if let Some(task) = task {
+        if let Some(task) = task.filter(|_| which.attitude) {
             let valid = match grasp {
                 Some((p_g, v_g)) => {
                     let inertia_b = if theta_ok {
@@ -365,7 +408,12 @@ impl NominalControllers {
             out.attitude = status(valid);
         }
 
-        match modes.robotic {
+        let robotic_mode = if which.robotic {
+            modes.robotic
+        } else {
+            RoboticMode::Off
+        };
+        match robotic_mode {
             RoboticMode::Off => {}
             RoboticMode::Hold => {
                 let c = self.robotic.computed_torque(
