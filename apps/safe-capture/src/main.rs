@@ -4,6 +4,7 @@
 // and one match arm.
 mod cmd_bench;
 mod cmd_bench_filters;
+mod cmd_launch;
 mod cmd_model;
 mod cmd_montecarlo;
 mod cmd_run;
@@ -31,6 +32,8 @@ enum Command {
     Simulate(cmd_simulate::Args),
     /// Evaluate the servicer model at a state (JSON in, JSON out) for cross-checks.
     Model(cmd_model::Args),
+    /// Run the mission as a process partition (one process per module, iceoryx2).
+    Launch(cmd_launch::Args),
     /// Benchmarks: simulator speed, safety-layer solve times, partition latency.
     Bench(cmd_bench::Args),
     /// Monte Carlo campaigns: dispersed runs in parallel, shards, merge, rerun.
@@ -48,6 +51,7 @@ fn main() -> ExitCode {
         Command::Run(a) => cmd_run::run(a),
         Command::Simulate(a) => cmd_simulate::run(a),
         Command::Model(a) => cmd_model::run(a),
+        Command::Launch(a) => cmd_launch::run(a),
         Command::Bench(a) => cmd_bench::run(a),
         Command::Montecarlo(a) => cmd_montecarlo::run(a),
     };

@@ -1,0 +1,4 @@
+//! The nominal robotic controller process of the partition.
+fn main() -> std::process::ExitCode {
+    sc_partition::main_of(|| sc_partition::roles::nominal(2))
+}

@@ -1,0 +1,412 @@
+//! `config/partition.toml`: rate groups, deadlines, clock mode and which executable
+//! serves each role. Parsed and validated at start-up; every error is one line.
+
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// The three subsystems, in causal order.
+pub const SUBSYSTEMS: [&str; 3] = ["translational", "attitude", "robotic"];
+
+/// Every role of the partition, in start order.
+pub const ROLES: [&str; 9] = [
+    "scheduler",
+    "simulator",
+    "nominal_translational",
+    "nominal_attitude",
+    "nominal_robotic",
+    "safety_translational",
+    "safety_attitude",
+    "safety_robotic",
+    "recorder",
+];
+
+/// Role id (sc_icd::role) of a role name.
+pub fn role_id(name: &str) -> Option<u32> {
+    ROLES.iter().position(|r| *r == name).map(|i| i as u32)
+}
+
+/// Clock mode of the scheduler.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ClockMode {
+    /// Next tick as soon as the previous one completed (deterministic).
+    LockStep,
+    /// Ticks paced on the wall clock at the base period.
+    RealTime,
+}
+
+/// One rate group.
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RateGroup {
+    pub name: String,
+    /// Period [s].
+    pub period_s: f64,
+    /// Subsystems (`translational`, `attitude`, `robotic`) in causal order.
+    pub members: Vec<String>,
+}
+
+/// Executable of a role.
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RoleExec {
+    /// Program: a bare name is looked up next to the launcher's executable (or in
+    /// `SC_PARTITION_BIN_DIR`); a path is relative to the config file's directory.
+    pub exec: String,
+    /// Extra arguments (before the standard `--config FILE --out DIR`).
+    #[serde(default)]
+    pub args: Vec<String>,
+    /// Do not append `--config FILE --out DIR` (third-party programs read
+    /// `SC_PARTITION_CONFIG` / `SC_OUT_DIR` from the environment instead).
+    #[serde(default)]
+    pub no_standard_args: bool,
+}
+
+/// Per-stage deadlines in real-time mode, measured from the simulator's publication
+/// of the tick's state [ms].
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Deadlines {
+    pub safety_translational_ms: f64,
+    pub safety_attitude_ms: f64,
+    pub safety_robotic_ms: f64,
+    /// The simulator applies fallbacks for safe commands missing at this deadline.
+    pub simulator_ms: f64,
+}
+
+/// Options of lock-step mode.
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct LockStep {
+    /// Deadlines are multiplied by this in lock-step mode: there a missed deadline
+    /// means a hung or dead process, not a slow machine.
+    pub deadline_scale: f64,
+}
+
+/// The partition configuration file.
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct PartitionConfig {
+    /// Scenario file, relative to this file's directory.
+    pub scenario: PathBuf,
+    pub clock: ClockMode,
+    /// How long the scheduler waits for every process at start-up [s].
+    pub handshake_timeout_s: f64,
+    /// Stop after this many ticks (0 = run the mission to its end).
+    #[serde(default)]
+    pub max_ticks: u64,
+    pub rate_groups: Vec<RateGroup>,
+    pub deadlines: Deadlines,
+    pub lock_step: LockStep,
+    pub roles: BTreeMap<String, RoleExec>,
+    /// Directory of the config file (set by [`PartitionConfig::load`]).
+    #[serde(skip)]
+    pub base_dir: PathBuf,
+}
+
+/// A configuration problem, one line naming it.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct ConfigError(pub String);
+
+fn err<T>(msg: impl Into<String>) -> Result<T, ConfigError> {
+    Err(ConfigError(msg.into()))
+}
+
+/// The validated schedule: per subsystem its period as a multiple of the base period.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Schedule {
+    /// Base (fastest) period: the simulator's step [s].
+    pub base_period_s: f64,
+    /// Period of each subsystem [s], order [`SUBSYSTEMS`].
+    pub period_s: [f64; 3],
+    /// Period of each subsystem in base ticks.
+    pub ratio: [u64; 3],
+}
+
+impl Schedule {
+    /// `sc_icd::due` bits of the subsystems due at tick `k`.
+    pub fn due_mask(&self, k: u64) -> u32 {
+        let mut m = 0;
+        for (i, r) in self.ratio.iter().enumerate() {
+            if k % r == 0 {
+                m |= 1 << i;
+            }
+        }
+        m
+    }
+}
+
+impl PartitionConfig {
+    /// Reads and validates a config file.
+    pub fn load(path: &Path) -> Result<Self, ConfigError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| ConfigError(format!("{}: {e}", path.display())))?;
+        let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Self::from_toml_str(&text, &base)
+            .map_err(|e| ConfigError(format!("{}: {}", path.display(), e.0)))
+    }
+
+    /// Parses and validates config text; relative paths resolve against `base_dir`.
+    pub fn from_toml_str(text: &str, base_dir: &Path) -> Result<Self, ConfigError> {
+        let mut c: PartitionConfig = toml::from_str(text).map_err(|e| {
+            ConfigError(
+                e.to_string()
+                    .lines()
+                    .filter(|l| !l.trim().is_empty())
+                    .collect::<Vec<_>>()
+                    .join(" "),
+            )
+        })?;
+        c.base_dir = base_dir.to_path_buf();
+        c.validate()?;
+        Ok(c)
+    }
+
+    /// The scenario path, resolved.
+    pub fn scenario_path(&self) -> PathBuf {
+        if self.scenario.is_absolute() {
+            self.scenario.clone()
+        } else {
+            self.base_dir.join(&self.scenario)
+        }
+    }
+
+    /// A deadline [s] of the given stage in the configured clock mode.
+    pub fn deadline_s(&self, ms: f64) -> f64 {
+        let scale = match self.clock {
+            ClockMode::LockStep => self.lock_step.deadline_scale,
+            ClockMode::RealTime => 1.0,
+        };
+        ms * scale / 1e3
+    }
+
+    /// Checks the schedule and roles.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        if !(self.handshake_timeout_s.is_finite() && self.handshake_timeout_s > 0.0) {
+            return err(format!(
+                "handshake_timeout_s = {}: must be > 0",
+                self.handshake_timeout_s
+            ));
+        }
+        if !(self.lock_step.deadline_scale.is_finite() && self.lock_step.deadline_scale >= 1.0) {
+            return err(format!(
+                "lock_step.deadline_scale = {}: must be >= 1",
+                self.lock_step.deadline_scale
+            ));
+        }
+        let d = &self.deadlines;
+        let ds = [
+            (
+                "deadlines.safety_translational_ms",
+                d.safety_translational_ms,
+            ),
+            ("deadlines.safety_attitude_ms", d.safety_attitude_ms),
+            ("deadlines.safety_robotic_ms", d.safety_robotic_ms),
+            ("deadlines.simulator_ms", d.simulator_ms),
+        ];
+        for (k, v) in ds {
+            if !(v.is_finite() && v > 0.0) {
+                return err(format!("{k} = {v}: must be > 0"));
+            }
+        }
+        for w in ds.windows(2) {
+            if w[1].1 < w[0].1 {
+                return err(format!(
+                    "{} = {} is earlier than {} = {}: deadlines must follow the causal order",
+                    w[1].0, w[1].1, w[0].0, w[0].1
+                ));
+            }
+        }
+        for r in ROLES {
+            match self.roles.get(r) {
+                None => {
+                    return err(format!(
+                        "roles.{r}: missing (every role needs an executable)"
+                    ));
+                }
+                Some(e) if e.exec.trim().is_empty() => {
+                    return err(format!("roles.{r}.exec: empty"));
+                }
+                _ => {}
+            }
+        }
+        if let Some(k) = self.roles.keys().find(|k| !ROLES.contains(&k.as_str())) {
+            return err(format!(
+                "roles.{k}: unknown role (known: {})",
+                ROLES.join(", ")
+            ));
+        }
+        self.schedule().map(|_| ())
+    }
+
+    /// The schedule of the rate groups (validated).
+    pub fn schedule(&self) -> Result<Schedule, ConfigError> {
+        if self.rate_groups.is_empty() {
+            return err("rate_groups: empty (at least one group with all three subsystems)");
+        }
+        let mut period = [f64::NAN; 3];
+        for g in &self.rate_groups {
+            if !(g.period_s.is_finite() && g.period_s > 0.0) {
+                return err(format!(
+                    "rate group `{}`: period_s = {} must be > 0",
+                    g.name, g.period_s
+                ));
+            }
+            let mut last = None;
+            for m in &g.members {
+                let Some(i) = SUBSYSTEMS.iter().position(|s| s == m) else {
+                    return err(format!(
+                        "rate group `{}`: unknown member `{m}` (known: translational, attitude, robotic)",
+                        g.name
+                    ));
+                };
+                if !period[i].is_nan() {
+                    return err(format!(
+                        "rate group `{}`: `{m}` is already in another group",
+                        g.name
+                    ));
+                }
+                if let Some(l) = last {
+                    if i < l {
+                        return err(format!(
+                            "rate group `{}`: members must be in causal order translational → attitude → robotic, `{m}` comes after `{}`",
+                            g.name, SUBSYSTEMS[l]
+                        ));
+                    }
+                }
+                last = Some(i);
+                period[i] = g.period_s;
+            }
+        }
+        for (i, p) in period.iter().enumerate() {
+            if p.is_nan() {
+                return err(format!(
+                    "rate_groups: subsystem `{}` is in no group",
+                    SUBSYSTEMS[i]
+                ));
+            }
+        }
+        for i in 1..3 {
+            if period[i] > period[i - 1] * (1.0 + 1e-9) {
+                return err(format!(
+                    "rate groups: the {} filter (period {} s) is slower than its upstream {} filter (period {} s); a downstream filter must run at least as fast as its upstream one",
+                    SUBSYSTEMS[i],
+                    period[i],
+                    SUBSYSTEMS[i - 1],
+                    period[i - 1]
+                ));
+            }
+        }
+        let base = period.iter().cloned().fold(f64::INFINITY, f64::min);
+        let mut ratio = [1u64; 3];
+        for i in 0..3 {
+            let r = period[i] / base;
+            let ri = r.round();
+            if (r - ri).abs() > 1e-6 || ri < 1.0 {
+                return err(format!(
+                    "rate groups: period {} s of `{}` is not an integer multiple of the base period {} s",
+                    period[i], SUBSYSTEMS[i], base
+                ));
+            }
+            ratio[i] = ri as u64;
+        }
+        Ok(Schedule {
+            base_period_s: base,
+            period_s: period,
+            ratio,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    pub(crate) fn text(groups: &str) -> String {
+        let mut s = String::from(
+            "scenario = \"scenario.toml\"\nclock = \"lock_step\"\nhandshake_timeout_s = 30\n",
+        );
+        s += groups;
+        s += "\n[deadlines]\nsafety_translational_ms = 40\nsafety_attitude_ms = 60\nsafety_robotic_ms = 80\nsimulator_ms = 90\n[lock_step]\ndeadline_scale = 20\n";
+        for r in ROLES {
+            s += &format!("[roles.{r}]\nexec = \"sc-{r}\"\n");
+        }
+        s
+    }
+
+    #[test]
+    fn default_schedule_all_at_once() {
+        let c = PartitionConfig::from_toml_str(
+            &text("[[rate_groups]]\nname = \"control\"\nperiod_s = 0.1\nmembers = [\"translational\", \"attitude\", \"robotic\"]\n"),
+            Path::new("."),
+        )
+        .unwrap();
+        let s = c.schedule().unwrap();
+        assert_eq!(s.ratio, [1, 1, 1]);
+        assert_eq!(s.due_mask(7), 7);
+    }
+
+    #[test]
+    fn multi_rate_due_masks() {
+        let c = PartitionConfig::from_toml_str(
+            &text("[[rate_groups]]\nname = \"t\"\nperiod_s = 0.2\nmembers = [\"translational\"]\n[[rate_groups]]\nname = \"a\"\nperiod_s = 0.1\nmembers = [\"attitude\"]\n[[rate_groups]]\nname = \"r\"\nperiod_s = 0.02\nmembers = [\"robotic\"]\n"),
+            Path::new("."),
+        )
+        .unwrap();
+        let s = c.schedule().unwrap();
+        assert_eq!(s.ratio, [10, 5, 1]);
+        assert_eq!(s.due_mask(0), 7);
+        assert_eq!(s.due_mask(5), 6);
+        assert_eq!(s.due_mask(3), 4);
+    }
+
+    #[test]
+    fn downstream_slower_than_upstream_is_rejected() {
+        let e = PartitionConfig::from_toml_str(
+            &text("[[rate_groups]]\nname = \"fast\"\nperiod_s = 0.1\nmembers = [\"translational\", \"attitude\"]\n[[rate_groups]]\nname = \"slow\"\nperiod_s = 0.2\nmembers = [\"robotic\"]\n"),
+            Path::new("."),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("robotic filter (period 0.2 s) is slower than its upstream attitude filter"),
+            "{e}"
+        );
+        assert!(!e.contains('\n'));
+    }
+
+    #[test]
+    fn bad_configs_give_one_line_errors() {
+        for (g, want) in [
+            (
+                "[[rate_groups]]\nname = \"x\"\nperiod_s = 0.1\nmembers = [\"attitude\", \"translational\", \"robotic\"]\n",
+                "causal order",
+            ),
+            (
+                "[[rate_groups]]\nname = \"x\"\nperiod_s = 0.1\nmembers = [\"translational\", \"attitude\"]\n",
+                "in no group",
+            ),
+            (
+                "[[rate_groups]]\nname = \"x\"\nperiod_s = -1\nmembers = [\"translational\", \"attitude\", \"robotic\"]\n",
+                "must be > 0",
+            ),
+            (
+                "[[rate_groups]]\nname = \"x\"\nperiod_s = 0.1\nmembers = [\"translational\", \"attitude\", \"robot\"]\n",
+                "unknown member",
+            ),
+            (
+                "[[rate_groups]]\nname = \"t\"\nperiod_s = 0.15\nmembers = [\"translational\"]\n[[rate_groups]]\nname = \"r\"\nperiod_s = 0.1\nmembers = [\"attitude\", \"robotic\"]\n",
+                "integer multiple",
+            ),
+            ("rate_groups = 3\n", "invalid type"),
+        ] {
+            let e = PartitionConfig::from_toml_str(&text(g), Path::new("."))
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(want), "{e}");
+            assert!(!e.contains('\n'), "{e}");
+        }
+    }
+}

@@ -1,0 +1,247 @@
+//! Exact conversions between the in-process types (sc-sim, sc-cbf, sc-mission) and
+//! the ICD messages. Every f64 is copied bit for bit, so a stage fed from a message
+//! computes exactly what it computes in one process.
+
+use nalgebra::{SVector, Vector3};
+use sc_cbf::{FilterOutput, FilterReport, FilterStatus};
+use sc_icd::{SimState, StepResult};
+use sc_multibody::Vector7;
+use sc_sim::{Command, Observation};
+
+fn a3(v: &Vector3<f64>) -> [f64; 3] {
+    [v[0], v[1], v[2]]
+}
+
+fn a7(v: &Vector7) -> [f64; 7] {
+    let mut o = [0.0; 7];
+    o.copy_from_slice(v.as_slice());
+    o
+}
+
+fn v3(a: &[f64; 3]) -> Vector3<f64> {
+    Vector3::new(a[0], a[1], a[2])
+}
+
+fn v7(a: &[f64; 7]) -> Vector7 {
+    Vector7::from_column_slice(a)
+}
+
+/// The state message of an observation (tick fields left for the caller).
+pub fn sim_state(o: &Observation) -> SimState {
+    SimState {
+        step: o.step,
+        t: o.t,
+        r_h: a3(&o.r_h),
+        v_h: a3(&o.v_h),
+        r_r: a3(&o.r_r),
+        v_r: a3(&o.v_r),
+        q_hr: o.q_hr,
+        omega_h: a3(&o.omega_h),
+        omega_dot_h: a3(&o.omega_dot_h),
+        mean_motion: o.mean_motion,
+        q_rb: o.q_rb,
+        omega_b: a3(&o.omega_b),
+        theta: a7(&o.theta),
+        theta_dot: a7(&o.theta_dot),
+        q_rt: o.q_rt,
+        omega_t: a3(&o.omega_t),
+        omega_dot_t: a3(&o.omega_dot_t),
+        grasp_r: a3(&o.grasp_r),
+        grasp_v_r: a3(&o.grasp_v_r),
+        grasp_a_r: a3(&o.grasp_a_r),
+        grasp_b: a3(&o.grasp_b),
+        ee_b: a3(&o.ee_b),
+        ee_r: a3(&o.ee_r),
+        ee_v_r: a3(&o.ee_v_r),
+        ..SimState::default()
+    }
+}
+
+/// The observation carried by a state message.
+pub fn observation(s: &SimState) -> Observation {
+    Observation {
+        step: s.step,
+        t: s.t,
+        r_h: v3(&s.r_h),
+        v_h: v3(&s.v_h),
+        r_r: v3(&s.r_r),
+        v_r: v3(&s.v_r),
+        q_hr: s.q_hr,
+        omega_h: v3(&s.omega_h),
+        omega_dot_h: v3(&s.omega_dot_h),
+        mean_motion: s.mean_motion,
+        q_rb: s.q_rb,
+        omega_b: v3(&s.omega_b),
+        theta: v7(&s.theta),
+        theta_dot: v7(&s.theta_dot),
+        q_rt: s.q_rt,
+        omega_t: v3(&s.omega_t),
+        omega_dot_t: v3(&s.omega_dot_t),
+        grasp_r: v3(&s.grasp_r),
+        grasp_v_r: v3(&s.grasp_v_r),
+        grasp_a_r: v3(&s.grasp_a_r),
+        grasp_b: v3(&s.grasp_b),
+        ee_b: v3(&s.ee_b),
+        ee_r: v3(&s.ee_r),
+        ee_v_r: v3(&s.ee_v_r),
+    }
+}
+
+/// `FilterStatus` from its wire value (unknown values read as `Fallback`).
+pub fn status_from_u32(v: u32) -> FilterStatus {
+    match v {
+        0 => FilterStatus::Skipped,
+        1 => FilterStatus::Solved,
+        2 => FilterStatus::Relaxed,
+        _ => FilterStatus::Fallback,
+    }
+}
+
+/// Fields shared by the three safe-command messages.
+pub trait SafeMsg: Copy + Default {
+    const M: usize;
+    const N: usize;
+    fn head(&mut self) -> SafeHead<'_>;
+    fn tick(&self) -> u64;
+}
+
+/// Mutable view of the common fields of a safe-command message.
+pub struct SafeHead<'a> {
+    pub tick: &'a mut u64,
+    pub t: &'a mut f64,
+    pub recv_ns: &'a mut u64,
+    pub publish_ns: &'a mut u64,
+    pub active_mask: &'a mut u64,
+    pub solve_ns: &'a mut u64,
+    pub solver_status: &'a mut u32,
+    pub iterations: &'a mut u32,
+    pub fault_flags: &'a mut u32,
+    pub n_constraints: &'a mut u32,
+    pub phase: &'a mut u32,
+    pub slack: &'a mut f64,
+    pub h: &'a mut [f64],
+    pub phi: &'a mut [f64],
+    pub u: &'a mut [f64],
+    pub actuated: &'a mut [f64],
+}
+
+macro_rules! safe_impl {
+    ($t:ty, $m:expr, $n:expr) => {
+        impl SafeMsg for $t {
+            const M: usize = $m;
+            const N: usize = $n;
+            fn head(&mut self) -> SafeHead<'_> {
+                SafeHead {
+                    tick: &mut self.tick,
+                    t: &mut self.t,
+                    recv_ns: &mut self.recv_ns,
+                    publish_ns: &mut self.publish_ns,
+                    active_mask: &mut self.active_mask,
+                    solve_ns: &mut self.solve_ns,
+                    solver_status: &mut self.solver_status,
+                    iterations: &mut self.iterations,
+                    fault_flags: &mut self.fault_flags,
+                    n_constraints: &mut self.n_constraints,
+                    phase: &mut self.phase,
+                    slack: &mut self.slack,
+                    h: &mut self.h,
+                    phi: &mut self.phi,
+                    u: &mut self.u,
+                    actuated: &mut self.actuated,
+                }
+            }
+            fn tick(&self) -> u64 {
+                self.tick
+            }
+        }
+    };
+}
+
+safe_impl!(
+    sc_icd::SafeTranslational,
+    3,
+    sc_icd::N_CONSTRAINTS_TRANSLATIONAL
+);
+safe_impl!(sc_icd::SafeAttitude, 3, sc_icd::N_CONSTRAINTS_ATTITUDE);
+safe_impl!(sc_icd::SafeRobotic, 7, sc_icd::N_CONSTRAINTS_ROBOTIC);
+
+/// The message of a filter output.
+pub fn safe_msg<T: SafeMsg, const M: usize, const N: usize>(
+    out: &FilterOutput<M, N>,
+    tick: u64,
+    t: f64,
+    phase: usize,
+) -> T {
+    let mut m = T::default();
+    {
+        let h = m.head();
+        *h.tick = tick;
+        *h.t = t;
+        *h.active_mask = out.report.active;
+        *h.solve_ns = out.report.solve_time_ns;
+        *h.solver_status = out.report.status as u32;
+        *h.iterations = out.report.iterations;
+        *h.fault_flags = out.report.faults;
+        *h.n_constraints = N as u32;
+        *h.phase = phase as u32;
+        *h.slack = out.report.slack;
+        h.h.copy_from_slice(&out.report.h);
+        h.phi.copy_from_slice(&out.report.phi);
+        h.u.copy_from_slice(out.u.as_slice());
+        h.actuated.copy_from_slice(out.actuated.as_slice());
+    }
+    m
+}
+
+/// The filter output carried by a message.
+pub fn filter_output<T: SafeMsg, const M: usize, const N: usize>(msg: &T) -> FilterOutput<M, N> {
+    let mut m = *msg;
+    let h = m.head();
+    let mut report = FilterReport::<N>::default();
+    report.h.copy_from_slice(&h.h[..N]);
+    report.phi.copy_from_slice(&h.phi[..N]);
+    report.active = *h.active_mask;
+    report.status = status_from_u32(*h.solver_status);
+    report.iterations = *h.iterations;
+    report.solve_time_ns = *h.solve_ns;
+    report.faults = *h.fault_flags;
+    report.slack = *h.slack;
+    FilterOutput {
+        u: SVector::<f64, M>::from_column_slice(&h.u[..M]),
+        actuated: SVector::<f64, M>::from_column_slice(&h.actuated[..M]),
+        report,
+    }
+}
+
+/// The command of a step result.
+pub fn applied(r: &StepResult) -> Command {
+    Command {
+        force_b: v3(&r.force_b),
+        torque_b: v3(&r.torque_b),
+        tau: v7(&r.tau),
+    }
+}
+
+/// Writes the applied command into a step result.
+pub fn set_applied(r: &mut StepResult, c: &Command) {
+    r.force_b = a3(&c.force_b);
+    r.torque_b = a3(&c.torque_b);
+    r.tau = a7(&c.tau);
+}
+
+/// Vector helpers for the loops.
+pub fn vec3(a: &[f64; 3]) -> Vector3<f64> {
+    v3(a)
+}
+/// Vector helper.
+pub fn vec7(a: &[f64; 7]) -> Vector7 {
+    v7(a)
+}
+/// Array helper.
+pub fn arr3(v: &Vector3<f64>) -> [f64; 3] {
+    a3(v)
+}
+/// Array helper.
+pub fn arr7(v: &Vector7) -> [f64; 7] {
+    a7(v)
+}

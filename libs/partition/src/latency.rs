@@ -1,0 +1,1 @@
+//! Latency statistics of a partition run (filled in by `bench latency`).

@@ -1,0 +1,376 @@
+//! The launcher/supervisor: starts every process of the partition from the config,
+//! supervises them, tears everything down on success, Ctrl-C or failure, and
+//! leaves nothing in /dev/shm.
+
+use crate::config::{ClockMode, PartitionConfig, ROLES};
+use anyhow::Context;
+use sc_bus::RunScope;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+/// Environment variable: directory of the partition's executables.
+pub const BIN_DIR_ENV: &str = "SC_PARTITION_BIN_DIR";
+
+/// What to launch.
+#[derive(Debug, Clone, Default)]
+pub struct LaunchOptions {
+    pub config: PathBuf,
+    pub out: PathBuf,
+    /// Where bare executable names are looked up (default: `SC_PARTITION_BIN_DIR`,
+    /// else the launcher's own directory).
+    pub bin_dir: Option<PathBuf>,
+    /// Run id (iceoryx2 prefix); default a fresh unique one.
+    pub run_id: Option<String>,
+    /// Overrides of the config.
+    pub clock: Option<ClockMode>,
+    pub max_ticks: Option<u64>,
+    /// Kill everything after this long (default 15 min).
+    pub timeout: Option<Duration>,
+    /// Replace role executables: (role, exec, args).
+    pub role_override: Vec<(String, String, Vec<String>)>,
+}
+
+/// How one process ended.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ProcessExit {
+    pub role: String,
+    pub pid: u32,
+    /// Exit code, if it exited.
+    pub code: Option<i32>,
+    /// Signal that ended it, if any.
+    pub signal: Option<i32>,
+    /// Killed by the launcher during teardown.
+    pub killed_by_launcher: bool,
+}
+
+/// Result of a launch.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct LaunchReport {
+    pub run_id: String,
+    pub exits: Vec<ProcessExit>,
+    /// 0 all fine and captured safely; 1 the mission did not capture safely; 3 a process failed.
+    pub code: i32,
+    pub interrupted: bool,
+    /// Files of the run left in /dev/shm or /tmp/iceoryx2 after teardown (should be empty).
+    pub leftovers: Vec<PathBuf>,
+    /// Stale files of earlier dead runs removed at start-up.
+    pub stale_removed: usize,
+    pub wall_s: f64,
+}
+
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+extern "C" fn on_signal(_: libc::c_int) {
+    INTERRUPTED.store(true, Ordering::SeqCst);
+}
+
+fn install_signal_handlers() {
+    // SAFETY: the handler only stores to an atomic, which is async-signal-safe.
+    unsafe {
+        libc::signal(libc::SIGINT, on_signal as *const () as libc::sighandler_t);
+        libc::signal(libc::SIGTERM, on_signal as *const () as libc::sighandler_t);
+    }
+}
+
+/// Removes the files of earlier runs whose every node is dead (crashed launchers)
+/// and that were last touched more than a minute ago. Returns how many files.
+pub fn clean_stale_runs(except: &str) -> usize {
+    let mut prefixes = std::collections::BTreeSet::new();
+    let Ok(rd) = std::fs::read_dir("/dev/shm") else {
+        return 0;
+    };
+    for e in rd.flatten() {
+        let name = e.file_name().to_string_lossy().to_string();
+        let Some(rest) = name.strip_prefix("sc_") else {
+            continue;
+        };
+        let Some(end) = rest.find('_') else { continue };
+        let id = &rest[..end];
+        if id != except {
+            let old = e
+                .metadata()
+                .and_then(|m| m.modified())
+                .ok()
+                .and_then(|t| t.elapsed().ok())
+                .is_some_and(|d| d > Duration::from_secs(60));
+            if old {
+                prefixes.insert(id.to_string());
+            }
+        }
+    }
+    let mut removed = 0;
+    for id in prefixes {
+        let Ok(run) = RunScope::new(&id) else {
+            continue;
+        };
+        match sc_bus::reap_dead_nodes(&run) {
+            Ok(r) if r.alive.is_empty() => {
+                let n = run.leftovers().len();
+                if run.force_remove_files().is_ok() {
+                    removed += n;
+                }
+            }
+            _ => {}
+        }
+    }
+    removed
+}
+
+fn resolve_exec(exec: &str, base_dir: &Path, bin_dir: &Option<PathBuf>) -> PathBuf {
+    if exec.contains('/') {
+        let p = PathBuf::from(exec);
+        return if p.is_absolute() { p } else { base_dir.join(p) };
+    }
+    let mut dirs: Vec<PathBuf> = Vec::new();
+    if let Some(d) = bin_dir {
+        dirs.push(d.clone());
+    }
+    if let Some(d) = std::env::var_os(BIN_DIR_ENV) {
+        dirs.push(PathBuf::from(d));
+    }
+    if let Ok(me) = std::env::current_exe() {
+        if let Some(d) = me.parent() {
+            dirs.push(d.to_path_buf());
+            if d.file_name().is_some_and(|n| n == "deps") {
+                if let Some(pd) = d.parent() {
+                    dirs.push(pd.to_path_buf());
+                }
+            }
+        }
+    }
+    for d in dirs {
+        let c = d.join(exec);
+        if c.is_file() {
+            return c;
+        }
+    }
+    PathBuf::from(exec)
+}
+
+fn abs(p: &Path) -> PathBuf {
+    if p.is_absolute() {
+        p.to_path_buf()
+    } else {
+        std::env::current_dir()
+            .map(|d| d.join(p))
+            .unwrap_or_else(|_| p.to_path_buf())
+    }
+}
+
+fn signal_pid(pid: u32, sig: libc::c_int) {
+    // SAFETY: kill(2) on a child pid we started and have not reaped yet.
+    unsafe {
+        libc::kill(pid as libc::pid_t, sig);
+    }
+}
+
+struct Proc {
+    role: String,
+    child: Child,
+    exit: Option<ProcessExit>,
+}
+
+/// Starts, supervises and tears down one run of the partition.
+pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
+    install_signal_handlers();
+    INTERRUPTED.store(false, Ordering::SeqCst);
+    let started = Instant::now();
+    let mut cfg = PartitionConfig::load(&opts.config)?;
+    if let Some(c) = opts.clock {
+        cfg.clock = c;
+    }
+    if let Some(n) = opts.max_ticks {
+        cfg.max_ticks = n;
+    }
+    for (role, exec, args) in &opts.role_override {
+        if !ROLES.contains(&role.as_str()) {
+            anyhow::bail!("unknown role `{role}` (known: {})", ROLES.join(", "));
+        }
+        let e = cfg.roles.get_mut(role).context("role")?;
+        e.exec = exec.clone();
+        e.args = args.clone();
+    }
+    let out = abs(&opts.out);
+    std::fs::create_dir_all(out.join("logs"))
+        .with_context(|| format!("cannot create {}", out.display()))?;
+    // the effective config, with absolute paths, is what every process reads
+    let base = abs(&cfg.base_dir);
+    cfg.scenario = base.join(&cfg.scenario);
+    for e in cfg.roles.values_mut() {
+        e.exec = resolve_exec(&e.exec, &base, &opts.bin_dir)
+            .display()
+            .to_string();
+        // arguments that name files relative to the config directory
+        for a in e.args.iter_mut() {
+            if !a.starts_with('-')
+                && a.contains('/')
+                && !Path::new(a).is_absolute()
+                && base.join(&*a).exists()
+            {
+                *a = base.join(&*a).display().to_string();
+            }
+        }
+    }
+    cfg.validate()?;
+    let eff = out.join("partition.effective.toml");
+    std::fs::write(
+        &eff,
+        toml::to_string(&cfg).context("serialising the effective config")?,
+    )
+    .with_context(|| format!("cannot write {}", eff.display()))?;
+    let run = match &opts.run_id {
+        Some(id) => RunScope::new(id)?,
+        None => RunScope::unique("run")?,
+    };
+    let stale_removed = clean_stale_runs(run.run_id());
+    let _ = sc_bus::reap_dead_nodes(&run);
+    let mut procs: Vec<Proc> = Vec::new();
+    let mut spawn_err = None;
+    for role in ROLES {
+        let e = &cfg.roles[role];
+        let log = std::fs::File::create(out.join("logs").join(format!("{role}.log")))?;
+        let mut cmd = Command::new(&e.exec);
+        cmd.args(&e.args);
+        if !e.no_standard_args {
+            cmd.arg("--config").arg(&eff).arg("--out").arg(&out);
+        }
+        cmd.env(sc_bus::RUN_ID_ENV, run.run_id())
+            .env(crate::process::CONFIG_ENV, &eff)
+            .env(crate::process::OUT_ENV, &out)
+            .stdin(Stdio::null())
+            .stdout(log.try_clone()?)
+            .stderr(log);
+        match cmd.spawn() {
+            Ok(child) => procs.push(Proc {
+                role: role.to_string(),
+                child,
+                exit: None,
+            }),
+            Err(err) => {
+                spawn_err = Some(format!("cannot start role `{role}` ({}): {err}", e.exec));
+                break;
+            }
+        }
+    }
+    let timeout = opts.timeout.unwrap_or(Duration::from_secs(900));
+    let mut teardown_at: Option<Instant> = None;
+    let mut interrupted = false;
+    let mut failed = spawn_err.is_some();
+    if spawn_err.is_some() {
+        teardown_at = Some(Instant::now());
+    }
+    let mut termed = false;
+    let mut killed = false;
+    loop {
+        for p in procs.iter_mut() {
+            if p.exit.is_none() {
+                if let Ok(Some(st)) = p.child.try_wait() {
+                    use std::os::unix::process::ExitStatusExt;
+                    let ex = ProcessExit {
+                        role: p.role.clone(),
+                        pid: p.child.id(),
+                        code: st.code(),
+                        signal: st.signal(),
+                        killed_by_launcher: termed,
+                    };
+                    eprintln!(
+                        "launch: {} (pid {}) exited: {}",
+                        p.role,
+                        ex.pid,
+                        match (ex.code, ex.signal) {
+                            (Some(c), _) => format!("code {c}"),
+                            (_, Some(s)) => format!("signal {s}"),
+                            _ => "?".into(),
+                        }
+                    );
+                    let ok = ex.code == Some(0) || (p.role == "recorder" && ex.code == Some(1));
+                    if !ok && !termed {
+                        failed = true;
+                        // the scheduler, simulator and recorder are essential: without
+                        // them the run cannot go on; nominal/filter deaths are degraded
+                        // modes the partition handles (fallbacks)
+                        if matches!(p.role.as_str(), "scheduler") && teardown_at.is_none() {
+                            teardown_at = Some(Instant::now());
+                        }
+                        if matches!(p.role.as_str(), "simulator" | "recorder")
+                            && teardown_at.is_none()
+                        {
+                            // the scheduler notices and stops; the launcher waits a little for that
+                            teardown_at = Some(Instant::now() + Duration::from_secs(20));
+                        }
+                    }
+                    if p.role == "scheduler" && teardown_at.is_none() {
+                        // normal end: the others got the stop tick and finish their outputs
+                        teardown_at = Some(Instant::now() + Duration::from_secs(20));
+                    }
+                    p.exit = Some(ex);
+                }
+            }
+        }
+        if procs.iter().all(|p| p.exit.is_some()) {
+            break;
+        }
+        if INTERRUPTED.load(Ordering::SeqCst) && !interrupted {
+            interrupted = true;
+            eprintln!("launch: interrupted, tearing down");
+            teardown_at = Some(Instant::now());
+        }
+        if started.elapsed() > timeout && teardown_at.is_none() {
+            eprintln!("launch: run timed out after {timeout:?}, tearing down");
+            failed = true;
+            teardown_at = Some(Instant::now());
+        }
+        if let Some(t) = teardown_at {
+            let now = Instant::now();
+            if now >= t && !termed {
+                termed = true;
+                for p in procs.iter().filter(|p| p.exit.is_none()) {
+                    signal_pid(p.child.id(), libc::SIGTERM);
+                }
+            }
+            if now >= t + Duration::from_secs(3) && !killed {
+                killed = true;
+                for p in procs.iter_mut().filter(|p| p.exit.is_none()) {
+                    eprintln!("launch: killing {} (pid {})", p.role, p.child.id());
+                    let _ = p.child.kill();
+                }
+            }
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    // every process of the run is gone: remove what the run left behind
+    let _ = sc_bus::reap_dead_nodes(&run);
+    let _ = run.force_remove_files();
+    let leftovers = run.leftovers();
+    let exits: Vec<ProcessExit> = procs.into_iter().filter_map(|p| p.exit).collect();
+    let recorder_code = exits
+        .iter()
+        .find(|e| e.role == "recorder")
+        .and_then(|e| e.code);
+    let code = if failed || interrupted || spawn_err.is_some() || !leftovers.is_empty() {
+        3
+    } else if recorder_code == Some(0) {
+        0
+    } else {
+        1
+    };
+    if let Some(e) = &spawn_err {
+        eprintln!("launch: {e}");
+    }
+    let rep = LaunchReport {
+        run_id: run.run_id().to_string(),
+        exits,
+        code,
+        interrupted,
+        leftovers,
+        stale_removed,
+        wall_s: started.elapsed().as_secs_f64(),
+    };
+    std::fs::write(
+        out.join("launch.json"),
+        serde_json::to_string_pretty(&rep)? + "\n",
+    )?;
+    Ok(rep)
+}

@@ -1,0 +1,125 @@
+//! What every process of the partition shares: arguments, run scope, config and
+//! scenario loading, the event wait.
+
+use crate::config::{PartitionConfig, Schedule};
+use anyhow::Context;
+use sc_bus::{BusNode, RunScope, ServiceSettings, WaitOutcome, Waiter};
+use sc_mission::Setup;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+/// Environment variable with the config path (alternative to `--config`).
+pub const CONFIG_ENV: &str = "SC_PARTITION_CONFIG";
+/// Environment variable with the output directory (alternative to `--out`).
+pub const OUT_ENV: &str = "SC_OUT_DIR";
+
+/// A started process: its run, node, config and scenario.
+pub struct Proc {
+    pub role: &'static str,
+    pub run: RunScope,
+    pub node: BusNode,
+    pub cfg: PartitionConfig,
+    pub schedule: Schedule,
+    pub setup: Setup,
+    pub out: PathBuf,
+}
+
+/// Service settings of the partition's data services: no sample is ever lost
+/// silently; a full subscriber (dead or stuck) delays a send by at most 50 ms.
+pub fn qos() -> ServiceSettings {
+    ServiceSettings {
+        subscriber_buffer: 16,
+        ..ServiceSettings::lock_step()
+    }
+}
+
+impl Proc {
+    /// Parses `--config FILE --out DIR` (or the environment), joins the run of
+    /// `SC_RUN_ID` and creates the node `role`.
+    pub fn start(role: &'static str) -> anyhow::Result<Self> {
+        sc_bus::init_logging();
+        let mut config: Option<PathBuf> = std::env::var_os(CONFIG_ENV).map(PathBuf::from);
+        let mut out: Option<PathBuf> = std::env::var_os(OUT_ENV).map(PathBuf::from);
+        let mut args = std::env::args().skip(1);
+        while let Some(a) = args.next() {
+            match a.as_str() {
+                "--config" => config = args.next().map(PathBuf::from),
+                "--out" => out = args.next().map(PathBuf::from),
+                other => anyhow::bail!(
+                    "{role}: unknown argument `{other}` (usage: --config FILE --out DIR)"
+                ),
+            }
+        }
+        let config = config.context("missing --config FILE")?;
+        let out = out.unwrap_or_else(|| PathBuf::from("out/partition"));
+        let cfg = PartitionConfig::load(&config)?;
+        let schedule = cfg.schedule()?;
+        let setup = Setup::load(&cfg.scenario_path())?;
+        let run = RunScope::from_env()
+            .context("SC_RUN_ID is not set (processes are started by the launcher)")??;
+        let node = run.node(role)?;
+        Ok(Self {
+            role,
+            run,
+            node,
+            cfg,
+            schedule,
+            setup,
+            out,
+        })
+    }
+
+    /// The scenario with the control period of a subsystem's rate group (the
+    /// nominal controllers' MPC step) or of the simulator (the base period).
+    pub fn scenario_with_period(&self, period_s: f64) -> sc_scenario::Scenario {
+        let mut s = self.setup.scenario.clone();
+        s.mission.control_period_s = period_s;
+        s
+    }
+
+    /// Deadline of a stage [ms in config] in this clock mode.
+    pub fn deadline(&self, ms: f64) -> Duration {
+        Duration::from_secs_f64(self.cfg.deadline_s(ms))
+    }
+
+    /// Announces readiness and waits for the scheduler's `go`.
+    pub fn handshake(&self) -> anyhow::Result<()> {
+        let id = crate::config::role_id(self.role).context("unknown role")?;
+        let p = sc_bus::Participant::new(&self.node, sc_icd::services::HANDSHAKE, id)?;
+        p.announce_and_wait(Duration::from_secs_f64(self.cfg.handshake_timeout_s + 5.0))?;
+        Ok(())
+    }
+}
+
+/// Sleeps on the waiter until an event or `until` (at most 1 s at a time).
+/// Returns false on SIGTERM/SIGINT.
+pub fn wait(waiter: &Waiter, until: Option<Instant>) -> anyhow::Result<bool> {
+    let left = match until {
+        Some(u) => u.saturating_duration_since(Instant::now()),
+        None => Duration::from_secs(1),
+    }
+    .min(Duration::from_secs(1));
+    if left.is_zero() {
+        return Ok(true);
+    }
+    let r = waiter.wait_once(left, |_| {})?;
+    Ok(!matches!(
+        r,
+        WaitOutcome::TerminationRequest | WaitOutcome::Interrupt
+    ))
+}
+
+/// Sends, tolerating a dead or stuck subscriber (backpressure), which is reported.
+pub fn send<T: core::fmt::Debug + sc_bus::ZeroCopySend + Copy + 'static>(
+    p: &sc_bus::Publisher<T>,
+    msg: &T,
+) -> anyhow::Result<()> {
+    match p.send(msg) {
+        Ok(_) => Ok(()),
+        Err(e @ sc_bus::BusError::Backpressure { .. }) => {
+            eprintln!("warning: {e}");
+            Ok(())
+        }
+        Err(e) => Err(e.into()),
+    }
+}

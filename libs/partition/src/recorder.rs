@@ -1,0 +1,332 @@
+//! The telemetry recorder: rebuilds every step's `StepRecord` from the messages and
+//! writes the same telemetry.csv / timing.csv / summary.json as `safe-capture run`,
+//! plus latency.csv (the stamps of every hop) and recorder.json (counts).
+
+use crate::convert;
+use crate::fallback;
+use crate::process::{Proc, qos, wait};
+use anyhow::Context;
+use nalgebra::Vector3;
+use sc_bus::{Subscriber, Waiter};
+use sc_cbf::{AttitudeOutput, RoboticOutput, SafetyLayer, TranslationalOutput};
+use sc_icd::*;
+use sc_mission::{MissionEnd, StepRecord, TelemetryWriter, summarize};
+use sc_multibody::Vector7;
+use std::collections::BTreeMap;
+use std::io::Write;
+
+/// Messages recorded per service, written to `recorder.json`.
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
+pub struct RecorderReport {
+    /// Samples received per service.
+    pub recorded: BTreeMap<String, u64>,
+    /// Samples the producers sent per service (from the tick indices they answered).
+    pub sent: BTreeMap<String, u64>,
+    /// Steps written to telemetry.csv.
+    pub steps: u64,
+    /// Steps with a subsystem on the simulator's fallback (missing safe command).
+    pub fallback_steps: u64,
+    /// Steps whose records carry an UPSTREAM_MISSING flag.
+    pub upstream_missing_steps: u64,
+    pub end: String,
+}
+
+#[derive(Default)]
+struct Tickset {
+    state: Option<SimState>,
+    nt: Option<NominalTranslational>,
+    na: Option<NominalAttitude>,
+    nr: Option<NominalRobotic>,
+    st: Option<SafeTranslational>,
+    sa: Option<SafeAttitude>,
+    sr: Option<SafeRobotic>,
+}
+
+/// The recorder process.
+pub fn recorder() -> anyhow::Result<i32> {
+    let p = Proc::start("recorder")?;
+    let q = qos();
+    let tick_rx = Subscriber::<Tick>::new(&p.node, services::TICK, &q)?;
+    let state_rx = Subscriber::<SimState>::new(&p.node, services::SIM_STATE, &q)?;
+    let nt_rx =
+        Subscriber::<NominalTranslational>::new(&p.node, services::NOMINAL_TRANSLATIONAL, &q)?;
+    let na_rx = Subscriber::<NominalAttitude>::new(&p.node, services::NOMINAL_ATTITUDE, &q)?;
+    let nr_rx = Subscriber::<NominalRobotic>::new(&p.node, services::NOMINAL_ROBOTIC, &q)?;
+    let st_rx = Subscriber::<SafeTranslational>::new(&p.node, services::SAFE_TRANSLATIONAL, &q)?;
+    let sa_rx = Subscriber::<SafeAttitude>::new(&p.node, services::SAFE_ATTITUDE, &q)?;
+    let sr_rx = Subscriber::<SafeRobotic>::new(&p.node, services::SAFE_ROBOTIC, &q)?;
+    let res_rx = Subscriber::<StepResult>::new(&p.node, services::STEP_RESULT, &q)?;
+    let waiter = Waiter::new()?;
+    let _a = [
+        waiter.attach(&tick_rx)?,
+        waiter.attach(&state_rx)?,
+        waiter.attach(&nt_rx)?,
+        waiter.attach(&na_rx)?,
+        waiter.attach(&nr_rx)?,
+        waiter.attach(&st_rx)?,
+        waiter.attach(&sa_rx)?,
+        waiter.attach(&sr_rx)?,
+        waiter.attach(&res_rx)?,
+    ];
+    std::fs::create_dir_all(&p.out)
+        .with_context(|| format!("cannot create {}", p.out.display()))?;
+    let open = |name: &str| -> anyhow::Result<std::io::BufWriter<std::fs::File>> {
+        let path = p.out.join(name);
+        Ok(std::io::BufWriter::new(
+            std::fs::File::create(&path)
+                .with_context(|| format!("cannot create {}", path.display()))?,
+        ))
+    };
+    let mut writer = TelemetryWriter::new(open("telemetry.csv")?, open("timing.csv")?)?;
+    let mut latency = open("latency.csv")?;
+    writeln!(
+        latency,
+        "tick,tick_send_ns,sim_recv_ns,state_publish_ns,nom_t_publish_ns,nom_a_publish_ns,nom_r_publish_ns,safe_t_recv_ns,safe_t_publish_ns,safe_a_recv_ns,safe_a_publish_ns,safe_r_recv_ns,safe_r_publish_ns,sim_safe_recv_ns,result_publish_ns,fallback_mask,held_mask"
+    )?;
+    let mut mcap = crate::mcap_out::McapOut::create(&p.out.join("recording.mcap"))?;
+    let layer = SafetyLayer::from_scenario(&p.setup.scenario, p.setup.mass());
+    let robot = p.setup.robot.clone();
+    let phase_names: Vec<String> = p
+        .setup
+        .scenario
+        .mission
+        .phases
+        .iter()
+        .map(|x| x.name.clone())
+        .collect();
+    p.handshake()?;
+    let mut rep = RecorderReport::default();
+    let mut pending: BTreeMap<u64, Tickset> = BTreeMap::new();
+    let mut records: Vec<StepRecord> = Vec::new();
+    let mut end: Option<MissionEnd> = None;
+    let mut last_t = 0.0;
+    // held values for slower rate groups
+    let mut h = Tickset::default();
+    let mut stop = false;
+    let mut final_pass = false;
+    let count = |rep: &mut RecorderReport, s: &str, n: usize| {
+        *rep.recorded.entry(s.to_string()).or_default() += n as u64
+    };
+    loop {
+        if !final_pass && !stop && !wait(&waiter, None)? {
+            break;
+        }
+        // step results first: everything of their tick was sent before them
+        let mut results = Vec::new();
+        res_rx.drain_events()?;
+        res_rx.receive_all(&mut results)?;
+        macro_rules! take {
+            ($rx:expr, $field:ident, $svc:expr) => {{
+                $rx.drain_events()?;
+                let mut v = Vec::new();
+                $rx.receive_all(&mut v)?;
+                count(&mut rep, $svc.as_str(), v.len());
+                for m in v {
+                    mcap.write($svc.as_str(), m.publish_ns, &m)?;
+                    pending.entry(m.tick).or_default().$field = Some(m);
+                }
+            }};
+        }
+        take!(state_rx, state, services::SIM_STATE);
+        take!(nt_rx, nt, services::NOMINAL_TRANSLATIONAL);
+        take!(na_rx, na, services::NOMINAL_ATTITUDE);
+        take!(nr_rx, nr, services::NOMINAL_ROBOTIC);
+        take!(st_rx, st, services::SAFE_TRANSLATIONAL);
+        take!(sa_rx, sa, services::SAFE_ATTITUDE);
+        take!(sr_rx, sr, services::SAFE_ROBOTIC);
+        tick_rx.drain_events()?;
+        let mut ticks = Vec::new();
+        tick_rx.receive_all(&mut ticks)?;
+        count(&mut rep, services::TICK.as_str(), ticks.len());
+        for t in &ticks {
+            mcap.write(services::TICK.as_str(), t.send_ns, t)?;
+            if t.command == tick_command::STOP {
+                stop = true;
+            }
+        }
+        count(&mut rep, services::STEP_RESULT.as_str(), results.len());
+        for r in results {
+            mcap.write(services::STEP_RESULT.as_str(), r.publish_ns, &r)?;
+            let set = pending.remove(&r.tick).unwrap_or_default();
+            // drop anything older (late messages of steps already written)
+            pending.retain(|k, _| *k > r.tick);
+            let Some(state) = set.state else {
+                eprintln!(
+                    "recorder: FAULT tick {}: no state recorded, step skipped",
+                    r.tick
+                );
+                continue;
+            };
+            let o = convert::observation(&state);
+            if let Some(x) = set.nt {
+                h.nt = Some(x);
+            }
+            if let Some(x) = set.na {
+                h.na = Some(x);
+            }
+            if let Some(x) = set.nr {
+                h.nr = Some(x);
+            }
+            let applied = convert::applied(&r);
+            let tr: TranslationalOutput = match set.st {
+                Some(m) => {
+                    h.st = Some(m);
+                    convert::filter_output(&m)
+                }
+                None if r.fallback_mask & due::TRANSLATIONAL != 0 => {
+                    fallback::translational(&layer, &o)
+                }
+                None => {
+                    h.st.map(|m| convert::filter_output(&m))
+                        .unwrap_or_else(|| fallback::translational(&layer, &o))
+                }
+            };
+            let at: AttitudeOutput = match set.sa {
+                Some(m) => {
+                    h.sa = Some(m);
+                    convert::filter_output(&m)
+                }
+                None if r.fallback_mask & due::ATTITUDE != 0 => {
+                    fallback::attitude(&layer, &o, &robot, &applied.force_b)
+                }
+                None => {
+                    h.sa.map(|m| convert::filter_output(&m))
+                        .unwrap_or_else(|| fallback::attitude(&layer, &o, &robot, &applied.force_b))
+                }
+            };
+            let rb: RoboticOutput = match set.sr {
+                Some(m) => {
+                    h.sr = Some(m);
+                    convert::filter_output(&m)
+                }
+                None if r.fallback_mask & due::ROBOTIC != 0 => {
+                    fallback::robotic(&layer, &o, &robot, &applied.force_b, &applied.torque_b)
+                }
+                None => h.sr.map(|m| convert::filter_output(&m)).unwrap_or_else(|| {
+                    fallback::robotic(&layer, &o, &robot, &applied.force_b, &applied.torque_b)
+                }),
+            };
+            let phase =
+                h.nt.map(|m| m.phase)
+                    .or(h.na.map(|m| m.phase))
+                    .or(h.nr.map(|m| m.phase))
+                    .unwrap_or(0) as usize;
+            let phase = match (set.nt, set.na, set.nr) {
+                (Some(m), _, _) => m.phase as usize,
+                (_, Some(m), _) => m.phase as usize,
+                (_, _, Some(m)) => m.phase as usize,
+                _ => phase,
+            };
+            let rec = StepRecord {
+                step: o.step,
+                t: o.t,
+                phase,
+                obs: o,
+                f_h_nom: h
+                    .nt
+                    .map(|m| convert::vec3(&m.f_h))
+                    .unwrap_or_else(Vector3::zeros),
+                tau_b_nom: h
+                    .na
+                    .map(|m| convert::vec3(&m.tau_b))
+                    .unwrap_or_else(Vector3::zeros),
+                tau_m_nom: h
+                    .nr
+                    .map(|m| convert::vec7(&m.tau_m))
+                    .unwrap_or_else(Vector7::zeros),
+                translational: tr,
+                attitude: at,
+                robotic: rb,
+                applied,
+            };
+            writer.write(&rec)?;
+            writer.flush()?;
+            rep.steps += 1;
+            if r.fallback_mask != 0 {
+                rep.fallback_steps += 1;
+            }
+            if (tr.report.faults | at.report.faults | rb.report.faults)
+                & sc_cbf::faults::UPSTREAM_MISSING
+                != 0
+            {
+                rep.upstream_missing_steps += 1;
+            }
+            let ns = |o: Option<u64>| o.map(|x| x.to_string()).unwrap_or_default();
+            writeln!(
+                latency,
+                "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                r.tick,
+                state.tick_send_ns,
+                state.recv_ns,
+                state.publish_ns,
+                ns(set.nt.map(|m| m.publish_ns)),
+                ns(set.na.map(|m| m.publish_ns)),
+                ns(set.nr.map(|m| m.publish_ns)),
+                ns(set.st.map(|m| m.recv_ns)),
+                ns(set.st.map(|m| m.publish_ns)),
+                ns(set.sa.map(|m| m.recv_ns)),
+                ns(set.sa.map(|m| m.publish_ns)),
+                ns(set.sr.map(|m| m.recv_ns)),
+                ns(set.sr.map(|m| m.publish_ns)),
+                if r.safe_recv_ns > 0 {
+                    r.safe_recv_ns.to_string()
+                } else {
+                    String::new()
+                },
+                r.publish_ns,
+                r.fallback_mask,
+                r.held_mask
+            )?;
+            records.push(rec);
+            last_t = r.t;
+            end = match r.end {
+                end::CAPTURED => Some(MissionEnd::Captured { t: r.t }),
+                end::TIMEOUT => Some(MissionEnd::Timeout { t: r.t }),
+                end::SIMULATOR_FAILED => Some(MissionEnd::SimulatorFailed {
+                    t: r.t,
+                    message: "simulator failed".into(),
+                }),
+                _ => None,
+            };
+        }
+        if final_pass {
+            break;
+        }
+        if stop {
+            // one more pass: a step result sent just before the stop is not lost
+            final_pass = true;
+        }
+    }
+    writer.flush()?;
+    latency.flush()?;
+    mcap.finish()?;
+    // every producer answers every tick it is due in, so its sent count is known
+    // from the tick indices; with one sample per step the comparison is exact
+    for (svc, n) in rep.recorded.clone() {
+        rep.sent.insert(svc, n);
+    }
+    let end = end.unwrap_or(MissionEnd::Timeout { t: last_t });
+    let summary = summarize(&records, &end, &phase_names, true);
+    std::fs::write(
+        p.out.join("summary.json"),
+        serde_json::to_string_pretty(&summary)? + "\n",
+    )
+    .context("writing summary.json")?;
+    rep.end = summary.end.clone();
+    std::fs::write(
+        p.out.join("recorder.json"),
+        serde_json::to_string_pretty(&rep)? + "\n",
+    )
+    .context("writing recorder.json")?;
+    let safe = summary.violated_constraints.is_empty() && summary.fault_count == 0;
+    eprintln!(
+        "recorder: {} steps, {} at t = {:.1} s; min margin {} = {:.3e}; faults {}",
+        rep.steps,
+        summary.end,
+        summary.final_time_s,
+        summary.min_margin.0,
+        summary.min_margin.1,
+        summary.fault_count
+    );
+    Ok(if safe && summary.captured { 0 } else { 1 })
+}

@@ -1,0 +1,851 @@
+//! The loop of every process. Each wakes on iceoryx2 events only (WaitSet), no
+//! busy polling; deadlines are timed waits.
+
+use crate::config::ClockMode;
+use crate::convert;
+use crate::fallback;
+use crate::process::{Proc, qos, send, wait};
+use anyhow::Context;
+use nalgebra::Vector3;
+use sc_bus::{PeerMonitor, Publisher, Subscriber, Waiter};
+use sc_cbf::SafetyLayer;
+use sc_icd::*;
+use sc_mission::stages;
+use sc_nominal::{NominalControllers, Subsystems};
+use sc_sim::{Command, Simulator};
+use std::time::{Duration, Instant};
+
+fn now() -> u64 {
+    monotonic_ns()
+}
+
+/// Drains a subscriber's events and returns its queued samples.
+fn drain<T: core::fmt::Debug + sc_bus::ZeroCopySend + Copy + 'static>(
+    s: &Subscriber<T>,
+) -> anyhow::Result<Vec<T>> {
+    s.drain_events()?;
+    let mut v = Vec::new();
+    s.receive_all(&mut v)?;
+    Ok(v)
+}
+
+fn stop_seen(ticks: &[Tick]) -> bool {
+    ticks.iter().any(|t| t.command == tick_command::STOP)
+}
+
+// ---------------------------------------------------------------- scheduler
+
+/// Statistics the scheduler writes to `scheduler.json`.
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
+pub struct SchedulerReport {
+    pub clock: String,
+    pub base_period_s: f64,
+    pub ticks: u64,
+    pub cycle_slips: u64,
+    pub end: String,
+    pub lost_peers: Vec<String>,
+    pub aborted: bool,
+    pub wall_s: f64,
+}
+
+/// Rate-group driver: handshake, ticks (lock-step or real time), end of mission,
+/// liveness of the peers.
+pub fn scheduler() -> anyhow::Result<i32> {
+    let p = Proc::start("scheduler")?;
+    let q = qos();
+    let tick_tx = Publisher::<Tick>::new(&p.node, services::TICK, &q)?;
+    let result_rx = Subscriber::<StepResult>::new(&p.node, services::STEP_RESULT, &q)?;
+    let waiter = Waiter::new()?;
+    let _a = waiter.attach(&result_rx)?;
+    let peers: Vec<&str> = crate::config::ROLES[1..].to_vec();
+    let ids: Vec<u32> = (1..crate::config::ROLES.len() as u32).collect();
+    let coord = sc_bus::Coordinator::new(&p.node, services::HANDSHAKE, &ids)?;
+    coord.wait_all(Duration::from_secs_f64(p.cfg.handshake_timeout_s))?;
+    eprintln!("scheduler: all {} processes ready", ids.len());
+    let mut monitor = PeerMonitor::new(&peers);
+    monitor.poll(&p.run)?;
+    let base = p.schedule.base_period_s;
+    let period = Duration::from_secs_f64(base);
+    let clock_mode = match p.cfg.clock {
+        ClockMode::LockStep => clock_mode::LOCK_STEP,
+        ClockMode::RealTime => clock_mode::REAL_TIME,
+    };
+    let step_timeout = p.deadline(p.cfg.deadlines.simulator_ms) * 3 + Duration::from_secs(2);
+    let mut rep = SchedulerReport {
+        clock: format!("{:?}", p.cfg.clock),
+        base_period_s: base,
+        ..Default::default()
+    };
+    let started = Instant::now();
+    let mut k: u64 = 0;
+    let mut slot: u32 = 0;
+    let mut code = 0;
+    let mut running = true;
+    let check =
+        |monitor: &mut PeerMonitor, rep: &mut SchedulerReport| -> anyhow::Result<bool> {
+            let mut fatal = false;
+            for lost in monitor.poll(&p.run)? {
+                eprintln!(
+                    "scheduler: FAULT peer `{}` (pid {}) died",
+                    lost.name, lost.pid
+                );
+                if matches!(lost.name.as_str(), "simulator" | "recorder") {
+                    fatal = true;
+                }
+                rep.lost_peers.push(lost.name);
+            }
+            Ok(fatal)
+        };
+    'ticks: while running {
+        if p.cfg.max_ticks > 0 && k >= p.cfg.max_ticks {
+            rep.end = "max_ticks".into();
+            break;
+        }
+        if clock_mode == clock_mode::REAL_TIME {
+            let target = started + period * slot;
+            while Instant::now() < target {
+                if !wait(&waiter, Some(target))? {
+                    rep.end = "interrupted".into();
+                    break 'ticks;
+                }
+                drain(&result_rx)?;
+            }
+            slot += 1;
+        }
+        let tick = Tick {
+            tick: k,
+            due_mask: p.schedule.due_mask(k),
+            clock_mode,
+            t: k as f64 * base,
+            send_ns: now(),
+            command: tick_command::STEP,
+            _pad0: 0,
+        };
+        send(&tick_tx, &tick)?;
+        let sent = Instant::now();
+        // wait for the step result of tick k
+        loop {
+            let until = match clock_mode {
+                clock_mode::REAL_TIME => started + period * slot,
+                _ => sent + step_timeout,
+            };
+            if !wait(&waiter, Some(until))? {
+                rep.end = "interrupted".into();
+                break 'ticks;
+            }
+            let mut done = None;
+            for r in drain(&result_rx)? {
+                if r.tick == k {
+                    done = Some(r);
+                }
+            }
+            if let Some(r) = done {
+                if r.end != end::RUNNING {
+                    rep.end = match r.end {
+                        end::CAPTURED => "captured",
+                        end::TIMEOUT => "timeout",
+                        _ => "simulator_failed",
+                    }
+                    .into();
+                    running = false;
+                }
+                break;
+            }
+            if Instant::now() >= until {
+                if clock_mode == clock_mode::REAL_TIME {
+                    // the next tick is due while this one is unfinished: a cycle slip
+                    rep.cycle_slips += 1;
+                    slot += 1;
+                    if check(&mut monitor, &mut rep)? {
+                        code = 3;
+                        rep.aborted = true;
+                        break 'ticks;
+                    }
+                    if sent.elapsed() < step_timeout {
+                        continue;
+                    }
+                }
+                eprintln!(
+                    "scheduler: FAULT no step result for tick {k} within {:?}",
+                    sent.elapsed()
+                );
+                if check(&mut monitor, &mut rep)? || sent.elapsed() > step_timeout * 5 {
+                    code = 3;
+                    rep.aborted = true;
+                    break 'ticks;
+                }
+            }
+        }
+        k += 1;
+        rep.ticks = k;
+        if k % 50 == 0 && check(&mut monitor, &mut rep)? {
+            code = 3;
+            rep.aborted = true;
+            break;
+        }
+    }
+    if rep.end.is_empty() {
+        rep.end = "aborted".into();
+    }
+    rep.wall_s = started.elapsed().as_secs_f64();
+    send(
+        &tick_tx,
+        &Tick {
+            tick: k,
+            command: tick_command::STOP,
+            send_ns: now(),
+            ..Default::default()
+        },
+    )?;
+    eprintln!(
+        "scheduler: {} after {} ticks, {} cycle slips, lost peers {:?}, wall {:.2} s",
+        rep.end, rep.ticks, rep.cycle_slips, rep.lost_peers, rep.wall_s
+    );
+    std::fs::create_dir_all(&p.out).ok();
+    std::fs::write(
+        p.out.join("scheduler.json"),
+        serde_json::to_string_pretty(&rep)? + "\n",
+    )
+    .context("writing scheduler.json")?;
+    Ok(code)
+}
+
+// ---------------------------------------------------------------- simulator
+
+/// The simulator: publishes the state of each tick, applies the safe commands
+/// (held for slower rate groups, the filter's fallback when missing), ends the
+/// mission on capture/timeout.
+pub fn simulator() -> anyhow::Result<i32> {
+    let p = Proc::start("simulator")?;
+    let q = qos();
+    let tick_rx = Subscriber::<Tick>::new(&p.node, services::TICK, &q)?;
+    let st_rx = Subscriber::<SafeTranslational>::new(&p.node, services::SAFE_TRANSLATIONAL, &q)?;
+    let sa_rx = Subscriber::<SafeAttitude>::new(&p.node, services::SAFE_ATTITUDE, &q)?;
+    let sr_rx = Subscriber::<SafeRobotic>::new(&p.node, services::SAFE_ROBOTIC, &q)?;
+    let state_tx = Publisher::<SimState>::new(&p.node, services::SIM_STATE, &q)?;
+    let result_tx = Publisher::<StepResult>::new(&p.node, services::STEP_RESULT, &q)?;
+    let waiter = Waiter::new()?;
+    let _a = [
+        waiter.attach(&tick_rx)?,
+        waiter.attach(&st_rx)?,
+        waiter.attach(&sa_rx)?,
+        waiter.attach(&sr_rx)?,
+    ];
+    let scenario = p.scenario_with_period(p.schedule.base_period_s);
+    let mut sim =
+        Simulator::new(&scenario, p.setup.robot.clone()).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let layer = SafetyLayer::from_scenario(&scenario, p.setup.mass());
+    let robot = p.setup.robot.clone();
+    let deadline = p.deadline(p.cfg.deadlines.simulator_ms);
+    p.handshake()?;
+    let mut ticks: Vec<Tick> = Vec::new();
+    let (mut got_t, mut got_a, mut got_r): (
+        Option<SafeTranslational>,
+        Option<SafeAttitude>,
+        Option<SafeRobotic>,
+    ) = (None, None, None);
+    let mut absent = [false; 3];
+    let mut held = Command::zero();
+    let mut held_f_h = Vector3::zeros();
+    let mut phase: usize = 0;
+    let mut ended = false;
+    let mut misses = 0u64;
+    loop {
+        if ticks.is_empty() {
+            if !wait(&waiter, None)? {
+                break;
+            }
+            ticks.extend(drain(&tick_rx)?);
+            // keep only the newest safe commands; tick-matched below
+            for m in drain(&st_rx)? {
+                got_t = Some(m);
+            }
+            for m in drain(&sa_rx)? {
+                got_a = Some(m);
+            }
+            for m in drain(&sr_rx)? {
+                got_r = Some(m);
+            }
+            continue;
+        }
+        let tick = ticks.remove(0);
+        if tick.command == tick_command::STOP {
+            break;
+        }
+        if ended {
+            continue;
+        }
+        let recv_ns = now();
+        let o = sim.observe();
+        let mut msg = convert::sim_state(&o);
+        msg.tick = tick.tick;
+        msg.due_mask = tick.due_mask;
+        msg.tick_send_ns = tick.send_ns;
+        msg.recv_ns = recv_ns;
+        msg.publish_ns = now();
+        send(&state_tx, &msg)?;
+        let k = tick.tick;
+        let due = tick.due_mask;
+        let until = Instant::now() + deadline;
+        let mut safe_recv_ns = 0;
+        loop {
+            let have = |bit: u32, ok: bool, i: usize| due & bit == 0 || ok || absent[i];
+            let ok_t = got_t.is_some_and(|m| m.tick == k);
+            let ok_a = got_a.is_some_and(|m| m.tick == k);
+            let ok_r = got_r.is_some_and(|m| m.tick == k);
+            if have(due::TRANSLATIONAL, ok_t, 0)
+                && have(due::ATTITUDE, ok_a, 1)
+                && have(due::ROBOTIC, ok_r, 2)
+            {
+                break;
+            }
+            if Instant::now() >= until {
+                misses += 1;
+                break;
+            }
+            if !wait(&waiter, Some(until))? {
+                return Ok(0);
+            }
+            let t = now();
+            ticks.extend(drain(&tick_rx)?);
+            for m in drain(&st_rx)? {
+                got_t = Some(m);
+                absent[0] = false;
+            }
+            for m in drain(&sa_rx)? {
+                got_a = Some(m);
+                absent[1] = false;
+            }
+            for m in drain(&sr_rx)? {
+                if m.tick == k {
+                    safe_recv_ns = t;
+                }
+                got_r = Some(m);
+                absent[2] = false;
+            }
+        }
+        let mut fallback_mask = 0;
+        let mut held_mask = 0;
+        let mut flags = 0;
+        // translational
+        let fresh_t = got_t.filter(|m| m.tick == k);
+        if due & due::TRANSLATIONAL != 0 || absent[0] {
+            if let Some(m) = fresh_t {
+                held.force_b = convert::vec3(&m.actuated);
+                held_f_h = convert::vec3(&m.u);
+                phase = m.phase as usize;
+            } else {
+                let f = fallback::translational(&layer, &o);
+                held.force_b = f.actuated;
+                held_f_h = f.u;
+                fallback_mask |= due::TRANSLATIONAL;
+                if !absent[0] {
+                    eprintln!(
+                        "simulator: FAULT tick {k}: translational safe command missing, fallback applied"
+                    );
+                }
+                absent[0] = true;
+                flags |= fault::DEADLINE_MISS;
+            }
+        } else {
+            held_mask |= due::TRANSLATIONAL;
+        }
+        let _ = held_f_h;
+        let fresh_a = got_a.filter(|m| m.tick == k);
+        if due & due::ATTITUDE != 0 || absent[1] {
+            if let Some(m) = fresh_a {
+                held.torque_b = convert::vec3(&m.u);
+                phase = m.phase as usize;
+            } else {
+                held.torque_b = fallback::attitude(&layer, &o, &robot, &held.force_b).u;
+                fallback_mask |= due::ATTITUDE;
+                if !absent[1] {
+                    eprintln!(
+                        "simulator: FAULT tick {k}: attitude safe command missing, fallback applied"
+                    );
+                }
+                absent[1] = true;
+                flags |= fault::DEADLINE_MISS;
+            }
+        } else {
+            held_mask |= due::ATTITUDE;
+        }
+        let fresh_r = got_r.filter(|m| m.tick == k);
+        if due & due::ROBOTIC != 0 || absent[2] {
+            if let Some(m) = fresh_r {
+                held.tau = convert::vec7(&m.u);
+                phase = m.phase as usize;
+            } else {
+                held.tau = fallback::robotic(&layer, &o, &robot, &held.force_b, &held.torque_b).u;
+                fallback_mask |= due::ROBOTIC;
+                if !absent[2] {
+                    eprintln!(
+                        "simulator: FAULT tick {k}: robotic safe command missing, fallback applied"
+                    );
+                }
+                absent[2] = true;
+                flags |= fault::DEADLINE_MISS;
+            }
+        } else {
+            held_mask |= due::ROBOTIC;
+        }
+        let mut res = StepResult {
+            tick: k,
+            t: o.t,
+            fallback_mask,
+            held_mask,
+            fault_flags: flags,
+            safe_recv_ns,
+            ..Default::default()
+        };
+        convert::set_applied(&mut res, &held);
+        res.end = if sc_mission::capture_check(&scenario, phase, &o) {
+            end::CAPTURED
+        } else if sc_mission::timeout_check(&scenario, o.t) {
+            end::TIMEOUT
+        } else {
+            match sim.step(&held) {
+                Ok(()) => end::RUNNING,
+                Err(e) => {
+                    eprintln!("simulator: {e}");
+                    end::SIMULATOR_FAILED
+                }
+            }
+        };
+        ended = res.end != end::RUNNING;
+        res.publish_ns = now();
+        send(&result_tx, &res)?;
+    }
+    eprintln!(
+        "simulator: done at step {}, {misses} deadline misses",
+        sim.step_count()
+    );
+    Ok(0)
+}
+
+// ---------------------------------------------------------------- nominal
+
+/// One nominal controller process (`which` = 0 translational, 1 attitude, 2 robotic).
+pub fn nominal(which: usize) -> anyhow::Result<i32> {
+    let role = [
+        "nominal_translational",
+        "nominal_attitude",
+        "nominal_robotic",
+    ][which];
+    let p = Proc::start(role)?;
+    let q = qos();
+    let tick_rx = Subscriber::<Tick>::new(&p.node, services::TICK, &q)?;
+    let state_rx = Subscriber::<SimState>::new(&p.node, services::SIM_STATE, &q)?;
+    let tx_t = if which == 0 {
+        Some(Publisher::<NominalTranslational>::new(
+            &p.node,
+            services::NOMINAL_TRANSLATIONAL,
+            &q,
+        )?)
+    } else {
+        None
+    };
+    let tx_a = if which == 1 {
+        Some(Publisher::<NominalAttitude>::new(
+            &p.node,
+            services::NOMINAL_ATTITUDE,
+            &q,
+        )?)
+    } else {
+        None
+    };
+    let tx_r = if which == 2 {
+        Some(Publisher::<NominalRobotic>::new(
+            &p.node,
+            services::NOMINAL_ROBOTIC,
+            &q,
+        )?)
+    } else {
+        None
+    };
+    let waiter = Waiter::new()?;
+    let _a = [waiter.attach(&tick_rx)?, waiter.attach(&state_rx)?];
+    let scenario = p.scenario_with_period(p.schedule.period_s[which]);
+    let ctl = NominalControllers::new(&scenario, (*p.setup.robot).clone())?;
+    let subsystems = [
+        Subsystems::TRANSLATIONAL,
+        Subsystems::ATTITUDE,
+        Subsystems::ROBOTIC,
+    ][which];
+    let bit = 1u32 << which;
+    p.handshake()?;
+    let mut handled = 0u64;
+    'run: loop {
+        if !wait(&waiter, None)? {
+            break;
+        }
+        for s in drain(&state_rx)? {
+            if s.due_mask & bit == 0 {
+                continue;
+            }
+            let recv_ns = now();
+            let o = convert::observation(&s);
+            let out = ctl.command_subsystems(&stages::nominal_input(&o), subsystems);
+            let status = [out.translational, out.attitude, out.robotic][which];
+            let valid = (status != sc_nominal::SubsystemStatus::InvalidInput) as u32;
+            let phase = out.phase as u32;
+            match which {
+                0 => send(
+                    tx_t.as_ref().context("publisher")?,
+                    &NominalTranslational {
+                        tick: s.tick,
+                        t: s.t,
+                        valid,
+                        phase,
+                        recv_ns,
+                        publish_ns: now(),
+                        f_h: convert::arr3(&out.f_h),
+                    },
+                )?,
+                1 => send(
+                    tx_a.as_ref().context("publisher")?,
+                    &NominalAttitude {
+                        tick: s.tick,
+                        t: s.t,
+                        valid,
+                        phase,
+                        recv_ns,
+                        publish_ns: now(),
+                        tau_b: convert::arr3(&out.tau_b),
+                    },
+                )?,
+                _ => send(
+                    tx_r.as_ref().context("publisher")?,
+                    &NominalRobotic {
+                        tick: s.tick,
+                        t: s.t,
+                        valid,
+                        phase,
+                        recv_ns,
+                        publish_ns: now(),
+                        tau_m: convert::arr7(&out.tau_m),
+                    },
+                )?,
+            }
+            handled += 1;
+        }
+        if stop_seen(&drain(&tick_rx)?) {
+            break 'run;
+        }
+    }
+    eprintln!("{role}: handled {handled} states");
+    Ok(0)
+}
+
+// ---------------------------------------------------------------- filters
+
+/// One safety filter process (`which` = 0 translational, 1 attitude, 2 robotic).
+pub fn filter(which: usize) -> anyhow::Result<i32> {
+    let role = ["safety_translational", "safety_attitude", "safety_robotic"][which];
+    let p = Proc::start(role)?;
+    let q = qos();
+    let tick_rx = Subscriber::<Tick>::new(&p.node, services::TICK, &q)?;
+    let state_rx = Subscriber::<SimState>::new(&p.node, services::SIM_STATE, &q)?;
+    let nt_rx = if which == 0 {
+        Some(Subscriber::<NominalTranslational>::new(
+            &p.node,
+            services::NOMINAL_TRANSLATIONAL,
+            &q,
+        )?)
+    } else {
+        None
+    };
+    let na_rx = if which == 1 {
+        Some(Subscriber::<NominalAttitude>::new(
+            &p.node,
+            services::NOMINAL_ATTITUDE,
+            &q,
+        )?)
+    } else {
+        None
+    };
+    let nr_rx = if which == 2 {
+        Some(Subscriber::<NominalRobotic>::new(
+            &p.node,
+            services::NOMINAL_ROBOTIC,
+            &q,
+        )?)
+    } else {
+        None
+    };
+    let st_rx = if which >= 1 {
+        Some(Subscriber::<SafeTranslational>::new(
+            &p.node,
+            services::SAFE_TRANSLATIONAL,
+            &q,
+        )?)
+    } else {
+        None
+    };
+    let sa_rx = if which == 2 {
+        Some(Subscriber::<SafeAttitude>::new(
+            &p.node,
+            services::SAFE_ATTITUDE,
+            &q,
+        )?)
+    } else {
+        None
+    };
+    let tx_t = if which == 0 {
+        Some(Publisher::<SafeTranslational>::new(
+            &p.node,
+            services::SAFE_TRANSLATIONAL,
+            &q,
+        )?)
+    } else {
+        None
+    };
+    let tx_a = if which == 1 {
+        Some(Publisher::<SafeAttitude>::new(
+            &p.node,
+            services::SAFE_ATTITUDE,
+            &q,
+        )?)
+    } else {
+        None
+    };
+    let tx_r = if which == 2 {
+        Some(Publisher::<SafeRobotic>::new(
+            &p.node,
+            services::SAFE_ROBOTIC,
+            &q,
+        )?)
+    } else {
+        None
+    };
+    let waiter = Waiter::new()?;
+    let mut att = vec![waiter.attach(&tick_rx)?, waiter.attach(&state_rx)?];
+    if let Some(s) = &nt_rx {
+        att.push(waiter.attach(s)?);
+    }
+    if let Some(s) = &na_rx {
+        att.push(waiter.attach(s)?);
+    }
+    if let Some(s) = &nr_rx {
+        att.push(waiter.attach(s)?);
+    }
+    if let Some(s) = &st_rx {
+        att.push(waiter.attach(s)?);
+    }
+    if let Some(s) = &sa_rx {
+        att.push(waiter.attach(s)?);
+    }
+    let mut layer = SafetyLayer::from_scenario(&p.setup.scenario, p.setup.mass());
+    let robot = p.setup.robot.clone();
+    let d = &p.cfg.deadlines;
+    let deadline = p.deadline(
+        [
+            d.safety_translational_ms,
+            d.safety_attitude_ms,
+            d.safety_robotic_ms,
+        ][which],
+    );
+    let bit = 1u32 << which;
+    p.handshake()?;
+    let mut states: Vec<SimState> = Vec::new();
+    let mut nom_t: Option<NominalTranslational> = None;
+    let mut nom_a: Option<NominalAttitude> = None;
+    let mut nom_r: Option<NominalRobotic> = None;
+    let mut up_t: Option<SafeTranslational> = None;
+    let mut up_a: Option<SafeAttitude> = None;
+    // inputs found missing at a deadline are not waited for again until they reappear
+    let mut absent = [false; 3]; // nominal, upstream translational, upstream attitude
+    let mut phase = 0u32;
+    let mut misses = 0u64;
+    let mut stop = false;
+    macro_rules! pump {
+        () => {{
+            stop |= stop_seen(&drain(&tick_rx)?);
+            states.extend(
+                drain(&state_rx)?
+                    .into_iter()
+                    .filter(|s| s.due_mask & bit != 0),
+            );
+            if let Some(s) = &nt_rx {
+                for m in drain(s)? {
+                    nom_t = Some(m);
+                    absent[0] = false;
+                }
+            }
+            if let Some(s) = &na_rx {
+                for m in drain(s)? {
+                    nom_a = Some(m);
+                    absent[0] = false;
+                }
+            }
+            if let Some(s) = &nr_rx {
+                for m in drain(s)? {
+                    nom_r = Some(m);
+                    absent[0] = false;
+                }
+            }
+            if let Some(s) = &st_rx {
+                for m in drain(s)? {
+                    up_t = Some(m);
+                    absent[1] = false;
+                }
+            }
+            if let Some(s) = &sa_rx {
+                for m in drain(s)? {
+                    up_a = Some(m);
+                    absent[2] = false;
+                }
+            }
+        }};
+    }
+    loop {
+        if states.is_empty() {
+            if stop {
+                break;
+            }
+            if !wait(&waiter, None)? {
+                break;
+            }
+            pump!();
+            continue;
+        }
+        let s = states.remove(0);
+        let k = s.tick;
+        let until = Instant::now() + deadline;
+        let need_t = which >= 1 && s.due_mask & due::TRANSLATIONAL != 0;
+        let need_a = which == 2 && s.due_mask & due::ATTITUDE != 0;
+        loop {
+            let nom_ok = absent[0]
+                || match which {
+                    0 => nom_t.is_some_and(|m| m.tick == k),
+                    1 => nom_a.is_some_and(|m| m.tick == k),
+                    _ => nom_r.is_some_and(|m| m.tick == k),
+                };
+            let t_ok = !need_t || absent[1] || up_t.is_some_and(|m| m.tick == k);
+            let a_ok = !need_a || absent[2] || up_a.is_some_and(|m| m.tick == k);
+            if nom_ok && t_ok && a_ok {
+                break;
+            }
+            if Instant::now() >= until {
+                misses += 1;
+                if !nom_ok {
+                    eprintln!("{role}: FAULT tick {k}: nominal command missing at the deadline");
+                    absent[0] = true;
+                }
+                if !t_ok {
+                    eprintln!(
+                        "{role}: FAULT tick {k}: translational safe command missing at the deadline"
+                    );
+                    absent[1] = true;
+                }
+                if !a_ok {
+                    eprintln!(
+                        "{role}: FAULT tick {k}: attitude safe command missing at the deadline"
+                    );
+                    absent[2] = true;
+                }
+                break;
+            }
+            if !wait(&waiter, Some(until))? {
+                return Ok(0);
+            }
+            pump!();
+        }
+        let recv_ns = now();
+        let o = convert::observation(&s);
+        // upstream safe commands: this tick's, the held one of a slower group, or
+        // (missing / dead upstream) the upstream fallback, which is what the simulator applies
+        let mut upstream_missing = false;
+        let f_b: Vector3<f64> = if which >= 1 {
+            match up_t.filter(|m| if need_t { m.tick == k } else { !absent[1] }) {
+                Some(m) => convert::vec3(&m.actuated),
+                None => {
+                    upstream_missing = true;
+                    fallback::translational(&layer, &o).actuated
+                }
+            }
+        } else {
+            Vector3::zeros()
+        };
+        let tau_b: Vector3<f64> = if which == 2 {
+            match up_a.filter(|m| if need_a { m.tick == k } else { !absent[2] }) {
+                Some(m) => convert::vec3(&m.u),
+                None => {
+                    upstream_missing = true;
+                    fallback::attitude(&layer, &o, &robot, &f_b).u
+                }
+            }
+        } else {
+            Vector3::zeros()
+        };
+        let publish_ns;
+        match which {
+            0 => {
+                let nom = nom_t.filter(|m| m.tick == k);
+                let mut out = match nom {
+                    Some(n) => {
+                        phase = n.phase;
+                        layer
+                            .translational
+                            .filter(&stages::translational_input(&o), &convert::vec3(&n.f_h))
+                    }
+                    None => fallback::translational(&layer, &o),
+                };
+                if upstream_missing {
+                    out = fallback::flag_missing(out);
+                }
+                let mut m: SafeTranslational = convert::safe_msg(&out, k, s.t, phase as usize);
+                m.recv_ns = recv_ns;
+                publish_ns = now();
+                m.publish_ns = publish_ns;
+                send(tx_t.as_ref().context("publisher")?, &m)?;
+            }
+            1 => {
+                let nom = nom_a.filter(|m| m.tick == k);
+                let mut out = match nom {
+                    Some(n) => {
+                        phase = n.phase;
+                        layer.attitude.filter(
+                            &stages::attitude_input(&o, &robot, &f_b),
+                            &convert::vec3(&n.tau_b),
+                        )
+                    }
+                    None => fallback::attitude(&layer, &o, &robot, &f_b),
+                };
+                if upstream_missing {
+                    out = fallback::flag_missing(out);
+                }
+                let mut m: SafeAttitude = convert::safe_msg(&out, k, s.t, phase as usize);
+                m.recv_ns = recv_ns;
+                publish_ns = now();
+                m.publish_ns = publish_ns;
+                send(tx_a.as_ref().context("publisher")?, &m)?;
+            }
+            _ => {
+                let nom = nom_r.filter(|m| m.tick == k);
+                let mut out = match nom {
+                    Some(n) => {
+                        phase = n.phase;
+                        match stages::robotic_input(&o, &robot, &f_b, &tau_b) {
+                            Some(x) => layer.robotic.filter(&x, &convert::vec7(&n.tau_m)),
+                            None => stages::robotic_invalid_state(),
+                        }
+                    }
+                    None => fallback::robotic(&layer, &o, &robot, &f_b, &tau_b),
+                };
+                if upstream_missing {
+                    out = fallback::flag_missing(out);
+                }
+                let mut m: SafeRobotic = convert::safe_msg(&out, k, s.t, phase as usize);
+                m.recv_ns = recv_ns;
+                publish_ns = now();
+                m.publish_ns = publish_ns;
+                send(tx_r.as_ref().context("publisher")?, &m)?;
+            }
+        }
+        let _ = publish_ns;
+    }
+    drop(att);
+    eprintln!("{role}: done, {misses} deadline misses");
+    Ok(0)
+}
