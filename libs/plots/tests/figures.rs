@@ -88,12 +88,14 @@ fn run_figures_report_an_unwritable_directory() {
     assert!(m.contains("sub") && !m.contains('\n'), "{m}");
 }
 
-fn campaign_data() -> (
+type CampaignData = (
     Vec<(usize, Vec<TracePoint>)>,
     Vec<RunPoint>,
     Vec<RuntimeBar>,
     Vec<BarrierMinima>,
-) {
+);
+
+fn campaign_data() -> CampaignData {
     let traces = (0..3)
         .map(|k| {
             let pts = (0..20)
