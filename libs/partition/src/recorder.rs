@@ -20,8 +20,12 @@ use std::io::Write;
 pub struct RecorderReport {
     /// Samples received per service.
     pub recorded: BTreeMap<String, u64>,
-    /// Samples the producers sent per service (from the tick indices they answered).
-    pub sent: BTreeMap<String, u64>,
+    /// Samples the schedule requires per service: one state and one step result per
+    /// step, one nominal and one safe command per step in which the subsystem is due.
+    pub expected: BTreeMap<String, u64>,
+    /// Required samples that never reached the recorder (lost or never sent, e.g.
+    /// a dead producer), per service.
+    pub missing: BTreeMap<String, u64>,
     /// Steps written to telemetry.csv.
     pub steps: u64,
     /// Steps with a subsystem on the simulator's fallback (missing safe command).
@@ -158,6 +162,32 @@ pub fn recorder() -> anyhow::Result<i32> {
                 continue;
             };
             let o = convert::observation(&state);
+            {
+                let due = state.due_mask;
+                let mut need = |svc: ServiceName, due_bit: u32, present: bool| {
+                    if due_bit == 0 || due & due_bit != 0 {
+                        *rep.expected.entry(svc.as_str().into()).or_default() += 1;
+                        let m = rep.missing.entry(svc.as_str().into()).or_default();
+                        *m += (!present) as u64;
+                    }
+                };
+                need(services::SIM_STATE, 0, true);
+                need(services::STEP_RESULT, 0, true);
+                need(
+                    services::NOMINAL_TRANSLATIONAL,
+                    due::TRANSLATIONAL,
+                    set.nt.is_some(),
+                );
+                need(services::NOMINAL_ATTITUDE, due::ATTITUDE, set.na.is_some());
+                need(services::NOMINAL_ROBOTIC, due::ROBOTIC, set.nr.is_some());
+                need(
+                    services::SAFE_TRANSLATIONAL,
+                    due::TRANSLATIONAL,
+                    set.st.is_some(),
+                );
+                need(services::SAFE_ATTITUDE, due::ATTITUDE, set.sa.is_some());
+                need(services::SAFE_ROBOTIC, due::ROBOTIC, set.sr.is_some());
+            }
             if let Some(x) = set.nt {
                 h.nt = Some(x);
             }
@@ -300,11 +330,6 @@ pub fn recorder() -> anyhow::Result<i32> {
     writer.flush()?;
     latency.flush()?;
     mcap.finish()?;
-    // every producer answers every tick it is due in, so its sent count is known
-    // from the tick indices; with one sample per step the comparison is exact
-    for (svc, n) in rep.recorded.clone() {
-        rep.sent.insert(svc, n);
-    }
     let end = end.unwrap_or(MissionEnd::Timeout { t: last_t });
     let summary = summarize(&records, &end, &phase_names, true);
     std::fs::write(
@@ -319,6 +344,11 @@ pub fn recorder() -> anyhow::Result<i32> {
     )
     .context("writing recorder.json")?;
     let safe = summary.violated_constraints.is_empty() && summary.fault_count == 0;
+    let missing: u64 = rep.missing.values().sum();
+    eprintln!(
+        "recorder: recorded per service {:?}; missing {missing} of the samples the schedule requires",
+        rep.recorded
+    );
     eprintln!(
         "recorder: {} steps, {} at t = {:.1} s; min margin {} = {:.3e}; faults {}",
         rep.steps,

@@ -81,21 +81,20 @@ pub fn scheduler() -> anyhow::Result<i32> {
     let mut slot: u32 = 0;
     let mut code = 0;
     let mut running = true;
-    let check =
-        |monitor: &mut PeerMonitor, rep: &mut SchedulerReport| -> anyhow::Result<bool> {
-            let mut fatal = false;
-            for lost in monitor.poll(&p.run)? {
-                eprintln!(
-                    "scheduler: FAULT peer `{}` (pid {}) died",
-                    lost.name, lost.pid
-                );
-                if matches!(lost.name.as_str(), "simulator" | "recorder") {
-                    fatal = true;
-                }
-                rep.lost_peers.push(lost.name);
+    let check = |monitor: &mut PeerMonitor, rep: &mut SchedulerReport| -> anyhow::Result<bool> {
+        let mut fatal = false;
+        for lost in monitor.poll(&p.run)? {
+            eprintln!(
+                "scheduler: FAULT peer `{}` (pid {}) died",
+                lost.name, lost.pid
+            );
+            if matches!(lost.name.as_str(), "simulator" | "recorder") {
+                fatal = true;
             }
-            Ok(fatal)
-        };
+            rep.lost_peers.push(lost.name);
+        }
+        Ok(fatal)
+    };
     'ticks: while running {
         if p.cfg.max_ticks > 0 && k >= p.cfg.max_ticks {
             rep.end = "max_ticks".into();
@@ -150,6 +149,12 @@ pub fn scheduler() -> anyhow::Result<i32> {
                     running = false;
                 }
                 break;
+            }
+            if sent.elapsed() > Duration::from_secs(1) && check(&mut monitor, &mut rep)? {
+                // the simulator or the recorder died: the run cannot go on
+                code = 3;
+                rep.aborted = true;
+                break 'ticks;
             }
             if Instant::now() >= until {
                 if clock_mode == clock_mode::REAL_TIME {

@@ -1,0 +1,158 @@
+//! Helpers of the partition's integration tests: unique run ids, temp configs with
+//! a shortened scenario, finding and killing one process of a run.
+#![allow(dead_code)]
+
+use sc_partition::{LaunchOptions, LaunchReport};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+pub fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+pub fn bin_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_BIN_EXE_sc-scheduler"))
+        .parent()
+        .unwrap()
+        .to_path_buf()
+}
+
+/// A fresh temp directory.
+pub fn tmp(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!(
+        "sc-part-{tag}-{}-{}",
+        std::process::id(),
+        sc_icd::monotonic_ns()
+    ));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Writes a scenario copy with `duration_s` (None = unchanged) and a partition config
+/// into `dir`; `groups` replaces the rate groups if given; returns the config path.
+pub fn write_config(
+    dir: &Path,
+    duration_s: Option<f64>,
+    groups: Option<&str>,
+    deadline_scale: f64,
+) -> PathBuf {
+    let cfg = repo().join("config");
+    let mut sc = std::fs::read_to_string(cfg.join("scenario.toml")).unwrap();
+    sc = sc.replace(
+        "urdf = \"servicer.urdf\"",
+        &format!("urdf = \"{}\"", cfg.join("servicer.urdf").display()),
+    );
+    if let Some(d) = duration_s {
+        let start = sc.find("duration_s = ").unwrap();
+        let end = start + sc[start..].find('\n').unwrap();
+        sc.replace_range(start..end, &format!("duration_s = {d}"));
+    }
+    std::fs::write(dir.join("scenario.toml"), sc).unwrap();
+    let mut p = std::fs::read_to_string(cfg.join("partition.toml")).unwrap();
+    if let Some(g) = groups {
+        let a = p.find("[[rate_groups]]").unwrap();
+        let b = p.find("# Per-stage deadlines").unwrap();
+        p.replace_range(a..b, g);
+    }
+    p = p.replace(
+        "deadline_scale = 20.0",
+        &format!("deadline_scale = {deadline_scale}"),
+    );
+    let path = dir.join("partition.toml");
+    std::fs::write(&path, p).unwrap();
+    path
+}
+
+pub fn options(config: &Path, out: &Path, tag: &str) -> LaunchOptions {
+    LaunchOptions {
+        config: config.to_path_buf(),
+        out: out.to_path_buf(),
+        bin_dir: Some(bin_dir()),
+        run_id: Some(format!(
+            "t{tag}-{}-{}",
+            std::process::id(),
+            sc_icd::monotonic_ns() % 1_000_000_000
+        )),
+        timeout: Some(Duration::from_secs(240)),
+        ..Default::default()
+    }
+}
+
+/// Pids of the processes whose command line contains `needle` and `out`.
+pub fn pids_of(needle: &str, out: &Path) -> Vec<i32> {
+    let out = out.display().to_string();
+    let mut v = Vec::new();
+    for e in std::fs::read_dir("/proc").unwrap().flatten() {
+        let Ok(pid) = e.file_name().to_string_lossy().parse::<i32>() else {
+            continue;
+        };
+        let Ok(cmd) = std::fs::read(e.path().join("cmdline")) else {
+            continue;
+        };
+        let cmd = String::from_utf8_lossy(&cmd).to_string();
+        let argv0 = cmd.split('\0').next().unwrap_or("");
+        let prog = argv0.rsplit('/').next().unwrap_or("");
+        if prog.starts_with(needle) && cmd.contains(&out) {
+            // skip zombies (exited, not yet reaped)
+            let st = std::fs::read_to_string(e.path().join("stat")).unwrap_or_default();
+            if !st.contains(") Z ") {
+                v.push(pid);
+            }
+        }
+    }
+    v
+}
+
+/// Rows in `out/telemetry.csv` (header excluded).
+pub fn rows(out: &Path) -> usize {
+    std::fs::read_to_string(out.join("telemetry.csv"))
+        .map(|s| s.lines().count().saturating_sub(1))
+        .unwrap_or(0)
+}
+
+/// Waits until telemetry has `n` rows, then SIGKILLs the process `exec` of the run.
+pub fn kill_when(out: &Path, exec: &str, n: usize) -> i32 {
+    let t0 = Instant::now();
+    while rows(out) < n {
+        assert!(
+            t0.elapsed() < Duration::from_secs(120),
+            "telemetry never reached {n} rows"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    let pids = pids_of(exec, out);
+    assert_eq!(pids.len(), 1, "one {exec} expected, found {pids:?}");
+    // SAFETY: kill(2) on a pid found above.
+    unsafe { libc::kill(pids[0], libc::SIGKILL) };
+    pids[0]
+}
+
+/// The common post-conditions: nothing of the run left running or in /dev/shm.
+pub fn assert_clean(rep: &LaunchReport, out: &Path) {
+    assert!(rep.leftovers.is_empty(), "leftovers {:?}", rep.leftovers);
+    let run = sc_bus::RunScope::new(&rep.run_id).unwrap();
+    assert!(
+        run.leftovers().is_empty(),
+        "leftovers {:?}",
+        run.leftovers()
+    );
+    let left: Vec<i32> = pids_of("sc-", out);
+    assert!(left.is_empty(), "processes left behind: {left:?}");
+    assert_eq!(rep.exits.len(), 9, "{:?}", rep.exits);
+}
+
+/// Telemetry steps are 0..n without gaps; returns n.
+pub fn contiguous_steps(out: &Path) -> usize {
+    let s = std::fs::read_to_string(out.join("telemetry.csv")).unwrap();
+    let mut n = 0;
+    for (i, line) in s.lines().skip(1).enumerate() {
+        let step: usize = line.split(',').next().unwrap().parse().unwrap();
+        assert_eq!(step, i, "telemetry row {i} has step {step}");
+        n += 1;
+    }
+    n
+}
+
+pub fn summary(out: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+}

@@ -1,0 +1,164 @@
+//! Faults: SIGKILL of each kind of process mid-mission. The partition reacts with
+//! the defined fallback and a recorded fault; telemetry up to that point is complete;
+//! no process is left behind and nothing is left in /dev/shm.
+
+mod common;
+use common::*;
+use std::path::Path;
+
+/// Steps in which `filter` reported upstream_missing (telemetry.csv `<filter>_faults`).
+fn flagged_steps(out: &Path, filter: &str) -> Vec<u64> {
+    let text = std::fs::read_to_string(out.join("telemetry.csv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = header
+        .iter()
+        .position(|c| *c == format!("{filter}_faults"))
+        .unwrap();
+    let upstream_missing = sc_cbf_upstream_missing();
+    lines
+        .filter_map(|l| {
+            let v: Vec<&str> = l.split(',').collect();
+            let flags: u32 = v[col].parse().unwrap();
+            (flags & upstream_missing != 0).then(|| v[0].parse().unwrap())
+        })
+        .collect()
+}
+
+/// `sc_cbf::faults::UPSTREAM_MISSING` (bit 5, documented in docs/ICD.md).
+fn sc_cbf_upstream_missing() -> u32 {
+    1 << 5
+}
+
+/// Runs a shortened mission (60 s, lock-step) and SIGKILLs `exec` after 100 steps.
+fn kill_run(
+    tag: &str,
+    exec: &str,
+) -> (
+    sc_partition::LaunchReport,
+    std::path::PathBuf,
+    std::path::PathBuf,
+) {
+    let dir = tmp(tag);
+    let out = dir.join("out");
+    let config = write_config(&dir, Some(60.0), None, 5.0);
+    let opts = options(&config, &out, tag);
+    let h = std::thread::spawn(move || sc_partition::launch(&opts).unwrap());
+    kill_when(&out, exec, 100);
+    let rep = h.join().unwrap();
+    assert_clean(&rep, &out);
+    assert_eq!(rep.code, 3, "a killed process is a failed run: {rep:?}");
+    let killed = rep
+        .exits
+        .iter()
+        .filter(|e| e.signal == Some(9) && !e.killed_by_launcher)
+        .count();
+    assert_eq!(killed, 1, "{:?}", rep.exits);
+    (rep, dir, out)
+}
+
+fn degraded(exec: &str, filter: &str) {
+    let (_, dir, out) = kill_run(exec, exec);
+    // the mission went on to its end, every step recorded
+    let n = contiguous_steps(&out);
+    assert_eq!(n, 601, "all steps 0..=600 of the 60 s mission recorded");
+    let s = summary(&out);
+    assert_eq!(s["end"], "timeout");
+    // from the kill on, the subsystem runs on its fallback, flagged
+    let f = flagged_steps(&out, filter);
+    let first = *f
+        .first()
+        .unwrap_or_else(|| panic!("{filter}: no step flagged upstream_missing"));
+    assert!(
+        first >= 100,
+        "{filter}: flagged before the kill (step {first})"
+    );
+    let expect: Vec<u64> = (first..=600).collect();
+    assert_eq!(
+        f, expect,
+        "{filter}: every step from the kill on is on the flagged fallback"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn killed_nominal_translational_gives_translational_fallback() {
+    degraded("sc-nominal-translational", "translational");
+}
+
+#[test]
+fn killed_nominal_robotic_gives_robotic_fallback() {
+    degraded("sc-nominal-robotic", "robotic");
+}
+
+#[test]
+fn killed_translational_filter_gives_fallback_applied_by_simulator() {
+    degraded("sc-safety-translational", "translational");
+    // (the attitude and robotic filters use the translational fallback as coupling)
+}
+
+#[test]
+fn killed_attitude_filter_gives_fallback_applied_by_simulator() {
+    degraded("sc-safety-attitude", "attitude");
+}
+
+#[test]
+fn killed_robotic_filter_gives_fallback_applied_by_simulator() {
+    degraded("sc-safety-robotic", "robotic");
+}
+
+fn aborted(exec: &str, peer: &str) {
+    let (_, dir, out) = kill_run(exec, exec);
+    let n = contiguous_steps(&out);
+    assert!(n >= 100 && n < 600, "{n} steps recorded up to the kill");
+    let sched: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("scheduler.json")).unwrap())
+            .unwrap();
+    if peer != "scheduler" {
+        assert_eq!(sched["aborted"], true, "{sched}");
+        assert!(
+            sched["lost_peers"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|p| p == peer),
+            "{sched}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn killed_simulator_aborts_the_run_with_complete_telemetry() {
+    aborted("sc-simulator", "simulator");
+}
+
+#[test]
+fn killed_scheduler_tears_the_run_down_with_complete_telemetry() {
+    let (_, dir, out) = kill_run("sc-scheduler", "sc-scheduler");
+    let n = contiguous_steps(&out);
+    assert!(n >= 100 && n < 600, "{n} steps");
+    assert!(
+        out.join("summary.json").exists(),
+        "recorder finished its outputs on SIGTERM"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn killed_recorder_aborts_the_run() {
+    let (_, dir, out) = kill_run("sc-recorder", "sc-recorder");
+    let sched: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("scheduler.json")).unwrap())
+            .unwrap();
+    assert_eq!(sched["aborted"], true, "{sched}");
+    assert!(
+        sched["lost_peers"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|p| p == "recorder"),
+        "{sched}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -1,0 +1,112 @@
+//! The partition in lock-step: bit-identical to the in-process run, multi-rate to
+//! capture, schedule validation.
+
+mod common;
+use common::*;
+use sc_mission::{Mission, RunOptions, Setup, TelemetryWriter, summarize};
+
+/// telemetry.csv and summary.json (except solve times) of the partition equal the
+/// in-process run's byte for byte (full default mission).
+#[test]
+fn lock_step_telemetry_is_identical_to_in_process_run() {
+    let dir = tmp("ident");
+    let out = dir.join("out");
+    let config = repo().join("config/partition.toml");
+    let rep = sc_partition::launch(&options(&config, &out, "ident")).unwrap();
+    assert_eq!(rep.code, 0, "{rep:?}");
+    assert_clean(&rep, &out);
+
+    let setup = Setup::load(&repo().join("config/scenario.toml")).unwrap();
+    let names: Vec<String> = setup
+        .scenario
+        .mission
+        .phases
+        .iter()
+        .map(|p| p.name.clone())
+        .collect();
+    let mut tel = Vec::new();
+    let mut tim = Vec::new();
+    let mut records = Vec::new();
+    let end = {
+        let mut w = TelemetryWriter::new(&mut tel, &mut tim).unwrap();
+        let mut m = Mission::new(setup, RunOptions::default()).unwrap();
+        let end = m.run(|_, r| {
+            w.write(r).unwrap();
+            records.push(*r);
+        });
+        w.flush().unwrap();
+        end
+    };
+    let part = std::fs::read(out.join("telemetry.csv")).unwrap();
+    assert!(part == tel, "telemetry.csv differs from the in-process run");
+    let mut a = serde_json::to_value(summarize(&records, &end, &names, true)).unwrap();
+    let mut b = summary(&out);
+    a.as_object_mut().unwrap().remove("solve_time_us");
+    b.as_object_mut().unwrap().remove("solve_time_us");
+    assert_eq!(a, b);
+    assert_eq!(b["end"], "captured");
+    // MCAP and counts
+    assert!(std::fs::metadata(out.join("recording.mcap")).unwrap().len() > 1000);
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("recorder.json")).unwrap()).unwrap();
+    assert_eq!(
+        r["missing"]
+            .as_object()
+            .unwrap()
+            .values()
+            .map(|v| v.as_u64().unwrap())
+            .sum::<u64>(),
+        0,
+        "{r}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+const MULTI_RATE: &str = "[[rate_groups]]\nname = \"translational\"\nperiod_s = 0.2\nmembers = [\"translational\"]\n\n[[rate_groups]]\nname = \"attitude\"\nperiod_s = 0.1\nmembers = [\"attitude\"]\n\n[[rate_groups]]\nname = \"robotic\"\nperiod_s = 0.02\nmembers = [\"robotic\"]\n\n";
+
+/// Robotic 0.02 s, attitude 0.1 s, translational 0.2 s: runs to capture.
+#[test]
+fn multi_rate_schedule_runs_to_capture() {
+    let dir = tmp("multi");
+    let out = dir.join("out");
+    let config = write_config(&dir, None, Some(MULTI_RATE), 20.0);
+    let rep = sc_partition::launch(&options(&config, &out, "multi")).unwrap();
+    assert_eq!(rep.code, 0, "{rep:?}");
+    assert_clean(&rep, &out);
+    let s = summary(&out);
+    assert_eq!(s["end"], "captured", "{s}");
+    assert!(
+        s["violated_constraints"].as_array().unwrap().is_empty(),
+        "{s}"
+    );
+    // base period 0.02 s: five simulator steps per attitude period
+    let n = contiguous_steps(&out);
+    assert!(n > 3000, "{n} steps");
+    let lat = std::fs::read_to_string(out.join("latency.csv")).unwrap();
+    let held = lat
+        .lines()
+        .skip(1)
+        .filter(|l| l.split(',').nth(16) != Some("0"))
+        .count();
+    assert!(
+        held > n / 2,
+        "slower groups' commands are held on most ticks ({held} of {n})"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A downstream filter slower than its upstream one is rejected at start-up with a
+/// clear one-line error, before any process starts.
+#[test]
+fn slower_downstream_filter_is_rejected() {
+    let dir = tmp("reject");
+    let groups = "[[rate_groups]]\nname = \"fast\"\nperiod_s = 0.1\nmembers = [\"translational\", \"attitude\"]\n\n[[rate_groups]]\nname = \"slow\"\nperiod_s = 0.2\nmembers = [\"robotic\"]\n\n";
+    let config = write_config(&dir, None, Some(groups), 20.0);
+    let e = sc_partition::launch(&options(&config, &dir.join("out"), "reject"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("robotic filter (period 0.2 s) is slower than its upstream attitude filter (period 0.1 s)"), "{e}");
+    assert!(!e.contains('\n'), "{e}");
+    assert!(!dir.join("out/logs").exists(), "nothing may start");
+    std::fs::remove_dir_all(&dir).ok();
+}
