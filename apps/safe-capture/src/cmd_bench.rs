@@ -14,10 +14,13 @@ pub struct Args {
 enum What {
     /// Safety-layer solve time per filter and in total over whole missions.
     Filters(crate::cmd_bench_filters::Args),
+    /// Partition latency in real time: per hop and whole tick, percentiles, HDR histogram.
+    Latency(crate::cmd_bench_latency::Args),
 }
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     match a.what {
         What::Filters(x) => crate::cmd_bench_filters::run(x),
+        What::Latency(x) => crate::cmd_bench_latency::run(x),
     }
 }

@@ -4,6 +4,7 @@
 // and one match arm.
 mod cmd_bench;
 mod cmd_bench_filters;
+mod cmd_bench_latency;
 mod cmd_launch;
 mod cmd_model;
 mod cmd_montecarlo;

@@ -1,1 +1,367 @@
-//! Latency statistics of a partition run (filled in by `bench latency`).
+//! Latency of the partition (`safe-capture bench latency`): per hop and for the whole
+//! tick (scheduler tick sent → robotic safe command delivered to the simulator), from
+//! the stamps every message carries (latency.csv written by the recorder).
+
+use crate::launcher::{LaunchOptions, launch};
+use anyhow::Context;
+use hdrhistogram::Histogram;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Percentiles of one hop [µs].
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct HopStats {
+    pub n: u64,
+    pub min_us: f64,
+    pub p50_us: f64,
+    pub p90_us: f64,
+    pub p99_us: f64,
+    pub p99_9_us: f64,
+    pub max_us: f64,
+}
+
+/// Facts of the machine the benchmark ran on.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Machine {
+    pub cores: usize,
+    pub kernel: String,
+    pub cpu: String,
+}
+
+/// The latency report.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct LatencyReport {
+    pub clock: String,
+    pub period_s: f64,
+    pub ticks_total: u64,
+    pub warmup_ticks: u64,
+    /// Whole tick: scheduler send → robotic safe command delivered to the simulator.
+    pub whole_tick: HopStats,
+    /// Per hop, in causal order.
+    pub hops: BTreeMap<String, HopStats>,
+    pub cycle_slips: u64,
+    /// Ticks (after warm-up) in which a stage missed its deadline (a fallback was used).
+    pub deadline_misses: u64,
+    pub machine: Machine,
+}
+
+/// Hops measured, (name, from column, to column) of latency.csv.
+pub const HOPS: [(&str, &str, &str); 9] = [
+    ("1 tick -> simulator", "tick_send_ns", "sim_recv_ns"),
+    (
+        "2 simulator observe+publish",
+        "sim_recv_ns",
+        "state_publish_ns",
+    ),
+    (
+        "3 state -> nominal translational out",
+        "state_publish_ns",
+        "nom_t_publish_ns",
+    ),
+    (
+        "4 state -> nominal attitude out",
+        "state_publish_ns",
+        "nom_a_publish_ns",
+    ),
+    (
+        "5 state -> nominal robotic out",
+        "state_publish_ns",
+        "nom_r_publish_ns",
+    ),
+    (
+        "6 state -> translational filter out",
+        "state_publish_ns",
+        "safe_t_publish_ns",
+    ),
+    (
+        "7 translational -> attitude filter out",
+        "safe_t_publish_ns",
+        "safe_a_publish_ns",
+    ),
+    (
+        "8 attitude -> robotic filter out",
+        "safe_a_publish_ns",
+        "safe_r_publish_ns",
+    ),
+    (
+        "9 robotic safe -> simulator",
+        "safe_r_publish_ns",
+        "sim_safe_recv_ns",
+    ),
+];
+
+fn hist() -> Histogram<u64> {
+    // 1 ns .. 100 s, 3 significant digits
+    Histogram::new_with_bounds(1, 100_000_000_000, 3)
+        .unwrap_or_else(|_| Histogram::new(3).expect("histogram"))
+}
+
+fn stats(h: &Histogram<u64>) -> HopStats {
+    let us = |v: u64| v as f64 / 1e3;
+    if h.is_empty() {
+        return HopStats {
+            n: 0,
+            min_us: 0.0,
+            p50_us: 0.0,
+            p90_us: 0.0,
+            p99_us: 0.0,
+            p99_9_us: 0.0,
+            max_us: 0.0,
+        };
+    }
+    HopStats {
+        n: h.len(),
+        min_us: us(h.min()),
+        p50_us: us(h.value_at_quantile(0.5)),
+        p90_us: us(h.value_at_quantile(0.9)),
+        p99_us: us(h.value_at_quantile(0.99)),
+        p99_9_us: us(h.value_at_quantile(0.999)),
+        max_us: us(h.max()),
+    }
+}
+
+/// The machine's cores, kernel and CPU model.
+pub fn machine() -> Machine {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown".into());
+    Machine {
+        cores: std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(0),
+        kernel: std::fs::read_to_string("/proc/sys/kernel/osrelease")
+            .map(|s| s.trim().to_string())
+            .unwrap_or_else(|_| "unknown".into()),
+        cpu,
+    }
+}
+
+/// Computes the report from a run's output directory, excluding the first `warmup` ticks;
+/// writes `latency_whole_tick.hgrm` (HDR percentile distribution) and
+/// `latency.svg` (log-scale percentile plot) next to it.
+pub fn analyse(out: &Path, warmup: u64) -> anyhow::Result<LatencyReport> {
+    let text = std::fs::read_to_string(out.join("latency.csv"))
+        .with_context(|| format!("reading {}", out.join("latency.csv").display()))?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines
+        .next()
+        .context("latency.csv is empty")?
+        .split(',')
+        .collect();
+    let col = |n: &str| {
+        header
+            .iter()
+            .position(|c| *c == n)
+            .with_context(|| format!("latency.csv: no column {n}"))
+    };
+    let mut whole = hist();
+    let mut hops: Vec<Histogram<u64>> = HOPS.iter().map(|_| hist()).collect();
+    let (c_tick, c_send, c_recv, c_fb) = (
+        col("tick")?,
+        col("tick_send_ns")?,
+        col("sim_safe_recv_ns")?,
+        col("fallback_mask")?,
+    );
+    let hop_cols: Vec<(usize, usize)> = HOPS
+        .iter()
+        .map(|(_, a, b)| Ok((col(a)?, col(b)?)))
+        .collect::<anyhow::Result<_>>()?;
+    let mut total = 0;
+    let mut misses = 0;
+    for l in lines {
+        let v: Vec<&str> = l.split(',').collect();
+        total += 1;
+        let tick: u64 = v[c_tick].parse().context("latency.csv: bad tick")?;
+        if tick < warmup {
+            continue;
+        }
+        if v[c_fb] != "0" {
+            misses += 1;
+        }
+        let num = |i: usize| v.get(i).and_then(|x| x.parse::<u64>().ok());
+        if let (Some(a), Some(b)) = (num(c_send), num(c_recv)) {
+            whole.saturating_record(b.saturating_sub(a).max(1));
+        }
+        for (h, (a, b)) in hops.iter_mut().zip(&hop_cols) {
+            if let (Some(a), Some(b)) = (num(*a), num(*b)) {
+                h.saturating_record(b.saturating_sub(a).max(1));
+            }
+        }
+    }
+    let sched: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(out.join("scheduler.json")).context("reading scheduler.json")?,
+    )?;
+    let rep = LatencyReport {
+        clock: sched["clock"].as_str().unwrap_or("").to_string(),
+        period_s: sched["base_period_s"].as_f64().unwrap_or(0.0),
+        ticks_total: total,
+        warmup_ticks: warmup,
+        whole_tick: stats(&whole),
+        hops: HOPS
+            .iter()
+            .zip(&hops)
+            .map(|((n, _, _), h)| (n.to_string(), stats(h)))
+            .collect(),
+        cycle_slips: sched["cycle_slips"].as_u64().unwrap_or(0),
+        deadline_misses: misses,
+        machine: machine(),
+    };
+    // HDR percentile distribution of the whole tick
+    let mut f =
+        std::io::BufWriter::new(std::fs::File::create(out.join("latency_whole_tick.hgrm"))?);
+    writeln!(
+        f,
+        "{:>12} {:>14} {:>10} {:>14}",
+        "Value(us)", "Percentile", "TotalCount", "1/(1-Percentile)"
+    )?;
+    let mut points = Vec::new();
+    for v in whole.iter_quantiles(4) {
+        let q = v.quantile_iterated_to();
+        let val = v.value_iterated_to() as f64 / 1e3;
+        let inv = if q < 1.0 {
+            1.0 / (1.0 - q)
+        } else {
+            f64::INFINITY
+        };
+        writeln!(
+            f,
+            "{:>12.3} {:>14.12} {:>10} {:>14.2}",
+            val,
+            q,
+            v.count_since_last_iteration(),
+            inv
+        )?;
+        if q < 1.0 {
+            points.push((inv, val));
+        }
+    }
+    writeln!(
+        f,
+        "#[Mean = {:.3}, StdDeviation = {:.3}]",
+        whole.mean() / 1e3,
+        whole.stdev() / 1e3
+    )?;
+    writeln!(
+        f,
+        "#[Max = {:.3}, Total count = {}]",
+        whole.max() as f64 / 1e3,
+        whole.len()
+    )?;
+    f.flush()?;
+    plot(&out.join("latency.svg"), &points, &rep)?;
+    Ok(rep)
+}
+
+fn plot(path: &Path, pts: &[(f64, f64)], rep: &LatencyReport) -> anyhow::Result<()> {
+    use plotters::prelude::*;
+    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
+    root.fill(&WHITE)
+        .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+    let xmax = pts.iter().map(|p| p.0).fold(10.0, f64::max) * 1.5;
+    let ymin = pts
+        .iter()
+        .map(|p| p.1)
+        .fold(f64::INFINITY, f64::min)
+        .max(0.1)
+        / 1.5;
+    let ymax = pts.iter().map(|p| p.1).fold(1.0, f64::max) * 1.5;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            format!(
+                "whole-tick latency, {} ticks at {} s ({} cores, kernel {})",
+                rep.whole_tick.n, rep.period_s, rep.machine.cores, rep.machine.kernel
+            ),
+            ("sans-serif", 18),
+        )
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(65)
+        .build_cartesian_2d(
+            (1.0..xmax).log_scale(),
+            (ymin.min(ymax / 2.0)..ymax).log_scale(),
+        )
+        .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+    chart
+        .configure_mesh()
+        .x_desc("percentile as 1/(1-p): 10 = p90, 100 = p99, 1000 = p99.9")
+        .y_desc("latency [us] (log)")
+        .draw()
+        .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+    chart
+        .draw_series(LineSeries::new(pts.iter().cloned(), &BLUE))
+        .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+    root.present().map_err(|e| anyhow::anyhow!("plot: {e}"))?;
+    Ok(())
+}
+
+/// Options of the benchmark.
+#[derive(Debug, Clone)]
+pub struct BenchOptions {
+    pub config: PathBuf,
+    pub out: PathBuf,
+    pub ticks: u64,
+    pub warmup: u64,
+    pub bin_dir: Option<PathBuf>,
+    pub run_id: Option<String>,
+}
+
+/// Runs the partition in real-time mode for `warmup + ticks` ticks and analyses it.
+pub fn bench(o: &BenchOptions) -> anyhow::Result<LatencyReport> {
+    let rep = launch(&LaunchOptions {
+        config: o.config.clone(),
+        out: o.out.clone(),
+        bin_dir: o.bin_dir.clone(),
+        run_id: o.run_id.clone(),
+        clock: Some(crate::ClockMode::RealTime),
+        max_ticks: Some(o.ticks + o.warmup),
+        ..Default::default()
+    })?;
+    if rep.code == 3 {
+        anyhow::bail!("the partition run failed (see {}/logs)", o.out.display());
+    }
+    let r = analyse(&o.out, o.warmup)?;
+    std::fs::write(
+        o.out.join("latency_report.json"),
+        serde_json::to_string_pretty(&r)? + "\n",
+    )?;
+    std::fs::write(o.out.join("latency_report.md"), markdown(&r))?;
+    Ok(r)
+}
+
+/// The report as a Markdown table.
+pub fn markdown(r: &LatencyReport) -> String {
+    let mut s = format!(
+        "Machine: {} cores, {}, kernel {}. Clock {} at {} s; {} ticks measured ({} warm-up excluded); cycle slips {}; deadline misses {}.\n\n| hop | N | min | p50 | p90 | p99 | p99.9 | max |\n|---|---|---|---|---|---|---|---|\n",
+        r.machine.cores,
+        r.machine.cpu,
+        r.machine.kernel,
+        r.clock,
+        r.period_s,
+        r.whole_tick.n,
+        r.warmup_ticks,
+        r.cycle_slips,
+        r.deadline_misses
+    );
+    let row = |n: &str, h: &HopStats| {
+        format!(
+            "| {n} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |\n",
+            h.n, h.min_us, h.p50_us, h.p90_us, h.p99_us, h.p99_9_us, h.max_us
+        )
+    };
+    for (n, h) in &r.hops {
+        s += &row(n, h);
+    }
+    s += &row(
+        "**whole tick** (tick -> robotic safe command at the simulator)",
+        &r.whole_tick,
+    );
+    s += "\nAll times in µs.\n";
+    s
+}

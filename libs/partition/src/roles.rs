@@ -311,7 +311,6 @@ pub fn simulator() -> anyhow::Result<i32> {
             if !wait(&waiter, Some(until))? {
                 return Ok(0);
             }
-            let t = now();
             ticks.extend(drain(&tick_rx)?);
             for m in drain(&st_rx)? {
                 got_t = Some(m);
@@ -323,7 +322,8 @@ pub fn simulator() -> anyhow::Result<i32> {
             }
             for m in drain(&sr_rx)? {
                 if m.tick == k {
-                    safe_recv_ns = t;
+                    // delivered: the simulator holds the tick's last safe command
+                    safe_recv_ns = now();
                 }
                 got_r = Some(m);
                 absent[2] = false;

@@ -1,0 +1,50 @@
+//! `bench latency` on a short real-time run: the report is consistent with the run
+//! (counts, ordering of percentiles, files). No timing assertions.
+
+mod common;
+use common::*;
+use sc_partition::latency::{BenchOptions, bench};
+
+#[test]
+fn latency_report_is_consistent() {
+    let dir = tmp("bench");
+    let out = dir.join("out");
+    let config = write_config(&dir, None, None, 20.0);
+    let r = bench(&BenchOptions {
+        config,
+        out: out.clone(),
+        ticks: 25,
+        warmup: 5,
+        bin_dir: Some(bin_dir()),
+        run_id: Some(format!("tbench-{}", std::process::id())),
+    })
+    .unwrap();
+    assert_eq!(r.clock, "RealTime");
+    assert_eq!(r.ticks_total, 30);
+    assert_eq!(r.warmup_ticks, 5);
+    assert_eq!(r.whole_tick.n, 25, "{r:?}");
+    assert_eq!(r.hops.len(), 9);
+    for (name, h) in r.hops.iter().chain([(&"whole".to_string(), &r.whole_tick)]) {
+        assert_eq!(h.n, 25, "{name}");
+        let v = [h.min_us, h.p50_us, h.p90_us, h.p99_us, h.p99_9_us, h.max_us];
+        assert!(v.windows(2).all(|w| w[0] <= w[1]), "{name}: {v:?}");
+        assert!(h.min_us > 0.0, "{name}");
+    }
+    // the whole tick contains the causal chain of hops 1, 2, 6, 7, 8, 9
+    assert!(r.whole_tick.max_us >= r.hops["8 attitude -> robotic filter out"].min_us);
+    assert!(r.machine.cores > 0 && !r.machine.kernel.is_empty());
+    for f in [
+        "latency_whole_tick.hgrm",
+        "latency.svg",
+        "latency_report.json",
+        "latency_report.md",
+    ] {
+        assert!(out.join(f).exists(), "{f}");
+    }
+    let hgrm = std::fs::read_to_string(out.join("latency_whole_tick.hgrm")).unwrap();
+    assert!(hgrm.contains("Total count = 25"), "{hgrm}");
+    let launch: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("launch.json")).unwrap()).unwrap();
+    assert!(launch["leftovers"].as_array().unwrap().is_empty());
+    std::fs::remove_dir_all(&dir).ok();
+}

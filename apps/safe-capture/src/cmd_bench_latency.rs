@@ -1,0 +1,40 @@
+//! `safe-capture bench latency`: the partition's latency in real time (logic in sc-partition).
+
+use sc_partition::latency::{BenchOptions, bench, markdown};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Runs the partition in real-time mode (paced ticks) and reports per-hop and
+/// whole-tick latency (scheduler tick → robotic safe command delivered to the
+/// simulator): N, min/p50/p90/p99/p99.9/max, cycle slips, deadline misses, an HDR
+/// histogram (latency_whole_tick.hgrm), a log-scale plot (latency.svg) and the
+/// machine's facts. Writes latency_report.{json,md} into OUT.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Measured ticks (after the warm-up).
+    #[arg(long, default_value_t = 3000)]
+    ticks: u64,
+    /// Warm-up ticks excluded from the statistics.
+    #[arg(long, default_value_t = 50)]
+    warmup: u64,
+    /// Partition config (its rate groups set the period).
+    #[arg(long, value_name = "FILE", default_value = "config/partition.toml")]
+    config: PathBuf,
+    /// Output directory.
+    #[arg(long, value_name = "DIR", default_value = "out/bench-latency")]
+    out: PathBuf,
+}
+
+pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    let r = bench(&BenchOptions {
+        config: a.config,
+        out: a.out.clone(),
+        ticks: a.ticks,
+        warmup: a.warmup,
+        bin_dir: None,
+        run_id: None,
+    })?;
+    print!("{}", markdown(&r));
+    println!("-> {}", a.out.display());
+    Ok(ExitCode::SUCCESS)
+}
