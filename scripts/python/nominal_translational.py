@@ -1,0 +1,209 @@
+#!/usr/bin/env python3
+"""A third-party nominal translational controller for the safe-capture partition,
+written in Python with the ``iceoryx2`` PyPI package (pin: iceoryx2==0.10.0, the
+same 0.10.x as the Rust crate — the version is part of the shared-memory names).
+
+It replaces the Rust role ``nominal_translational`` from config (see
+docs/PARTITION.md)::
+
+    [roles.nominal_translational]
+    exec = "../scripts/.venv/bin/python"
+    args = ["../scripts/python/nominal_translational.py"]
+
+What a partner's controller has to do (every step below is in this file):
+
+1. join the run: iceoryx2 ``global.prefix`` = ``sc_<SC_RUN_ID>_`` (set by the launcher);
+2. create its ports: subscriber + listener on ``safe_capture/sim/state`` (SimState),
+   subscriber + listener on ``safe_capture/scheduler/tick`` (Tick, for the stop),
+   publisher + notifier on ``safe_capture/nominal/translational`` (NominalTranslational);
+3. announce itself on the start-up handshake until the scheduler's ``go``;
+4. for every SimState whose ``due_mask`` has the translational bit: compute f_H and
+   publish it with the same ``tick``, then notify; the safety filter does the rest
+   (the command may be unsafe: the filter keeps the servicer safe);
+5. exit on a Tick with ``command == 1`` (stop), deleting ports before the node.
+
+The law here is deliberately simple: a PD towards the Go-for-Capture point on the
+corridor axis, f_H = m (-kp e - kd v_H), in the Hill frame, switched off in phases
+whose ``translational`` mode is "off". The scenario (mass, GfC point, phases) is
+read from the partition config given by ``--config`` / ``SC_PARTITION_CONFIG``.
+"""
+
+import math
+import os
+import sys
+import time
+import tomllib
+
+import iceoryx2 as iox2
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import sc_icd  # noqa: E402
+
+OMEGA = 0.06  # closed-loop natural frequency [rad/s]
+ZETA = 1.0  # damping ratio
+MASS_KG = 269.0  # servicer mass (bus + arm); only scales the gains
+TIMEOUT_S = 60.0
+# Same settings as sc_partition::process::qos() (whoever creates a service first fixes them).
+QOS = dict(buffer=16, history=0, max_publishers=2, max_subscribers=8, max_nodes=16)
+
+
+def arg(name, env):
+    argv = sys.argv[1:]
+    if name in argv and argv.index(name) + 1 < len(argv):
+        return argv[argv.index(name) + 1]
+    return os.environ.get(env)
+
+
+def load_scenario(config_path):
+    with open(config_path, "rb") as f:
+        cfg = tomllib.load(f)
+    sc_path = cfg["scenario"]
+    if not os.path.isabs(sc_path):
+        sc_path = os.path.join(os.path.dirname(os.path.abspath(config_path)), sc_path)
+    with open(sc_path, "rb") as f:
+        return tomllib.load(f)
+
+
+def rotate(q, v):
+    """Rotates v by the scalar-first unit quaternion q (q_AB: F_B -> F_A)."""
+    w, x, y, z = q
+    # v + 2 w (u x v) + 2 u x (u x v), u = (x, y, z)
+    ux = (y * v[2] - z * v[1], z * v[0] - x * v[2], x * v[1] - y * v[0])
+    uux = (y * ux[2] - z * ux[1], z * ux[0] - x * ux[2], x * ux[1] - y * ux[0])
+    return [v[i] + 2.0 * w * ux[i] + 2.0 * uux[i] for i in range(3)]
+
+
+def open_pubsub(node, name, ctype):
+    return (
+        node.service_builder(iox2.ServiceName.new(name))
+        .publish_subscribe(ctype)
+        .subscriber_max_buffer_size(QOS["buffer"])
+        .history_size(QOS["history"])
+        .max_publishers(QOS["max_publishers"])
+        .max_subscribers(QOS["max_subscribers"])
+        .max_nodes(QOS["max_nodes"])
+        .enable_safe_overflow(False)
+        .subscriber_max_borrowed_samples(2)
+        .open_or_create()
+    )
+
+
+def open_event(node, name, max_ports, max_nodes, id_max):
+    return (
+        node.service_builder(iox2.ServiceName.new(name))
+        .event()
+        .max_notifiers(max_ports)
+        .max_listeners(max_ports)
+        .max_nodes(max_nodes)
+        .event_id_max_value(id_max)
+        .notifier_dead_event(iox2.EventId.new(sc_icd.EVENT_NOTIFIER_DEAD))
+        .notifier_dropped_event(iox2.EventId.new(sc_icd.EVENT_NOTIFIER_DROPPED))
+        .open_or_create()
+    )
+
+
+def data_event(node, name):
+    return open_event(node, name, QOS["max_publishers"] + QOS["max_subscribers"], QOS["max_nodes"], 7)
+
+
+def handshake(node, role):
+    ready_svc = open_event(node, sc_icd.SERVICE_HANDSHAKE + "/ready", 32, 40, 8 + 64)
+    go_svc = open_event(node, sc_icd.SERVICE_HANDSHAKE + "/go", 32, 40, 8 + 64)
+    go = go_svc.listener_builder().create()  # listener first: the go cannot be lost
+    ready = ready_svc.notifier_builder().default_event_id(iox2.EventId.new(sc_icd.HANDSHAKE_ID_OFFSET + role)).create()
+    deadline = time.monotonic() + TIMEOUT_S
+    try:
+        while time.monotonic() < deadline:
+            ready.notify()
+            for ev in go.timed_wait(iox2.Duration.from_millis(20)):
+                if ev.id.as_value == sc_icd.EVENT_GO:
+                    return True
+        return False
+    finally:
+        ready.delete()
+        go.delete()
+
+
+def main():
+    run_id = os.environ.get("SC_RUN_ID")
+    config = arg("--config", "SC_PARTITION_CONFIG")
+    if not run_id or not config:
+        print("nominal_translational.py: SC_RUN_ID and --config are required", file=sys.stderr)
+        return 2
+    sc = load_scenario(config)
+    phases = sorted(sc["mission"]["phases"], key=lambda p: p["start_s"])
+    axis = sc["safety"]["translational"]["corridor_axis"]
+    norm = math.sqrt(sum(a * a for a in axis))
+    gfc_r = [a / norm * sc["nominal"]["translational"]["gfc_distance_m"] for a in axis]
+    kp, kd = OMEGA * OMEGA, 2.0 * ZETA * OMEGA
+
+    iox2.set_log_level_from_env_or(iox2.LogLevel.Warn)
+    cfg = iox2.config.default()
+    cfg.global_cfg.prefix = iox2.FileName.new(sc_icd.run_prefix(run_id))
+    node = iox2.NodeBuilder.new().name(iox2.NodeName.new("nominal_translational")).config(cfg).create(iox2.ServiceType.Ipc)
+    state_svc = open_pubsub(node, sc_icd.SERVICE_SIM_STATE, sc_icd.SimState)
+    state_ev = data_event(node, sc_icd.SERVICE_SIM_STATE)
+    tick_svc = open_pubsub(node, sc_icd.SERVICE_TICK, sc_icd.Tick)
+    tick_ev = data_event(node, sc_icd.SERVICE_TICK)
+    cmd_svc = open_pubsub(node, sc_icd.SERVICE_NOMINAL_TRANSLATIONAL, sc_icd.NominalTranslational)
+    cmd_ev = data_event(node, sc_icd.SERVICE_NOMINAL_TRANSLATIONAL)
+    state_sub = state_svc.subscriber_builder().create()
+    state_lis = state_ev.listener_builder().create()
+    tick_sub = tick_svc.subscriber_builder().create()
+    tick_lis = tick_ev.listener_builder().create()
+    pub = cmd_svc.publisher_builder().create()
+    notifier = cmd_ev.notifier_builder().default_event_id(iox2.EventId.new(sc_icd.EVENT_SAMPLE)).create()
+    ports = [state_sub, state_lis, tick_sub, tick_lis, pub, notifier]
+    handled = 0
+    try:
+        if not handshake(node, sc_icd.ROLE_NOMINAL_TRANSLATIONAL):
+            print("nominal_translational.py: handshake timed out", file=sys.stderr)
+            return 1
+        while True:
+            # sleep until a state arrives (event wake-up); the timeout only bounds
+            # how late the final stop tick (sent when no more states come) is seen
+            state_lis.timed_wait(iox2.Duration.from_millis(100))
+            tick_lis.try_wait()
+            while True:
+                sample = state_sub.receive()
+                if sample is None:
+                    break
+                s = sample.payload().contents
+                tick, t, due = s.tick, s.t, s.due_mask
+                r_h, v_h, q_hr = list(s.r_h), list(s.v_h), list(s.q_hr)
+                sample.delete()
+                if not due & sc_icd.DUE_TRANSLATIONAL:
+                    continue
+                recv_ns = time.monotonic_ns()
+                phase = max(i for i, p in enumerate(phases) if t + 1e-9 >= p["start_s"]) if t >= 0 else 0
+                gfc_h = rotate(q_hr, gfc_r)
+                f_h = [MASS_KG * (-kp * (r_h[i] - gfc_h[i]) - kd * v_h[i]) for i in range(3)]
+                if phases[phase]["translational"] == "off":
+                    f_h = [0.0, 0.0, 0.0]
+                valid = int(all(math.isfinite(x) for x in f_h))
+                cmd = sc_icd.NominalTranslational(tick=tick, t=t, valid=valid, phase=phase, recv_ns=recv_ns)
+                for i in range(3):
+                    cmd.f_h[i] = f_h[i] if valid else 0.0
+                cmd.publish_ns = time.monotonic_ns()
+                pub.loan_uninit().write_payload(cmd).send()
+                notifier.notify()
+                handled += 1
+            stop = False
+            while True:
+                sample = tick_sub.receive()
+                if sample is None:
+                    break
+                stop |= sample.payload().contents.command == sc_icd.TICK_STOP
+                sample.delete()
+            if stop:
+                print(f"nominal_translational.py: handled {handled} states", file=sys.stderr)
+                return 0
+    finally:
+        for p in ports:
+            p.delete()
+        del state_svc, state_ev, tick_svc, tick_ev, cmd_svc, cmd_ev
+        del node
+
+
+if __name__ == "__main__":
+    sys.exit(main())
