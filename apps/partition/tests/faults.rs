@@ -110,7 +110,7 @@ fn killed_robotic_filter_gives_fallback_applied_by_simulator() {
 fn aborted(exec: &str, peer: &str) {
     let (_, dir, out) = kill_run(exec, exec);
     let n = contiguous_steps(&out);
-    assert!(n >= 100 && n < 600, "{n} steps recorded up to the kill");
+    assert!((100..600).contains(&n), "{n} steps recorded up to the kill");
     let sched: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("scheduler.json")).unwrap())
             .unwrap();
@@ -137,7 +137,7 @@ fn killed_simulator_aborts_the_run_with_complete_telemetry() {
 fn killed_scheduler_tears_the_run_down_with_complete_telemetry() {
     let (_, dir, out) = kill_run("sc-scheduler", "sc-scheduler");
     let n = contiguous_steps(&out);
-    assert!(n >= 100 && n < 600, "{n} steps");
+    assert!((100..600).contains(&n), "{n} steps");
     assert!(
         out.join("summary.json").exists(),
         "recorder finished its outputs on SIGTERM"

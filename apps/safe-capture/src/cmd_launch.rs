@@ -45,8 +45,14 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         .and_then(|s| serde_json::from_str::<serde_json::Value>(&s).ok());
     println!(
         "partition: {} at t = {} s; {} processes, failed: [{}]; shm leftovers: {}; wall {:.2} s -> {}",
-        summary.as_ref().and_then(|s| s["end"].as_str().map(String::from)).unwrap_or_else(|| "no summary".into()),
-        summary.as_ref().map(|s| s["final_time_s"].to_string()).unwrap_or_default(),
+        summary
+            .as_ref()
+            .and_then(|s| s["end"].as_str().map(String::from))
+            .unwrap_or_else(|| "no summary".into()),
+        summary
+            .as_ref()
+            .map(|s| s["final_time_s"].to_string())
+            .unwrap_or_default(),
         rep.exits.len(),
         failed.join(", "),
         rep.leftovers.len(),

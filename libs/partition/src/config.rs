@@ -130,7 +130,7 @@ impl Schedule {
     pub fn due_mask(&self, k: u64) -> u32 {
         let mut m = 0;
         for (i, r) in self.ratio.iter().enumerate() {
-            if k % r == 0 {
+            if k.is_multiple_of(*r) {
                 m |= 1 << i;
             }
         }
@@ -268,13 +268,13 @@ impl PartitionConfig {
                         g.name
                     ));
                 }
-                if let Some(l) = last {
-                    if i < l {
-                        return err(format!(
-                            "rate group `{}`: members must be in causal order translational → attitude → robotic, `{m}` comes after `{}`",
-                            g.name, SUBSYSTEMS[l]
-                        ));
-                    }
+                if let Some(l) = last
+                    && i < l
+                {
+                    return err(format!(
+                        "rate group `{}`: members must be in causal order translational → attitude → robotic, `{m}` comes after `{}`",
+                        g.name, SUBSYSTEMS[l]
+                    ));
                 }
                 last = Some(i);
                 period[i] = g.period_s;

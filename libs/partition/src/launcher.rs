@@ -130,14 +130,14 @@ fn resolve_exec(exec: &str, base_dir: &Path, bin_dir: &Option<PathBuf>) -> PathB
     if let Some(d) = std::env::var_os(BIN_DIR_ENV) {
         dirs.push(PathBuf::from(d));
     }
-    if let Ok(me) = std::env::current_exe() {
-        if let Some(d) = me.parent() {
-            dirs.push(d.to_path_buf());
-            if d.file_name().is_some_and(|n| n == "deps") {
-                if let Some(pd) = d.parent() {
-                    dirs.push(pd.to_path_buf());
-                }
-            }
+    if let Ok(me) = std::env::current_exe()
+        && let Some(d) = me.parent()
+    {
+        dirs.push(d.to_path_buf());
+        if d.file_name().is_some_and(|n| n == "deps")
+            && let Some(pd) = d.parent()
+        {
+            dirs.push(pd.to_path_buf());
         }
     }
     for d in dirs {
@@ -265,48 +265,47 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
     let mut killed = false;
     loop {
         for p in procs.iter_mut() {
-            if p.exit.is_none() {
-                if let Ok(Some(st)) = p.child.try_wait() {
-                    use std::os::unix::process::ExitStatusExt;
-                    let ex = ProcessExit {
-                        role: p.role.clone(),
-                        pid: p.child.id(),
-                        code: st.code(),
-                        signal: st.signal(),
-                        killed_by_launcher: termed,
-                    };
-                    eprintln!(
-                        "launch: {} (pid {}) exited: {}",
-                        p.role,
-                        ex.pid,
-                        match (ex.code, ex.signal) {
-                            (Some(c), _) => format!("code {c}"),
-                            (_, Some(s)) => format!("signal {s}"),
-                            _ => "?".into(),
-                        }
-                    );
-                    let ok = ex.code == Some(0) || (p.role == "recorder" && ex.code == Some(1));
-                    if !ok && !termed {
-                        failed = true;
-                        // the scheduler, simulator and recorder are essential: without
-                        // them the run cannot go on; nominal/filter deaths are degraded
-                        // modes the partition handles (fallbacks)
-                        if matches!(p.role.as_str(), "scheduler") && teardown_at.is_none() {
-                            teardown_at = Some(Instant::now());
-                        }
-                        if matches!(p.role.as_str(), "simulator" | "recorder")
-                            && teardown_at.is_none()
-                        {
-                            // the scheduler notices and stops; the launcher waits a little for that
-                            teardown_at = Some(Instant::now() + Duration::from_secs(20));
-                        }
+            if p.exit.is_none()
+                && let Ok(Some(st)) = p.child.try_wait()
+            {
+                use std::os::unix::process::ExitStatusExt;
+                let ex = ProcessExit {
+                    role: p.role.clone(),
+                    pid: p.child.id(),
+                    code: st.code(),
+                    signal: st.signal(),
+                    killed_by_launcher: termed,
+                };
+                eprintln!(
+                    "launch: {} (pid {}) exited: {}",
+                    p.role,
+                    ex.pid,
+                    match (ex.code, ex.signal) {
+                        (Some(c), _) => format!("code {c}"),
+                        (_, Some(s)) => format!("signal {s}"),
+                        _ => "?".into(),
                     }
-                    if p.role == "scheduler" && teardown_at.is_none() {
-                        // normal end: the others got the stop tick and finish their outputs
+                );
+                let ok = ex.code == Some(0) || (p.role == "recorder" && ex.code == Some(1));
+                if !ok && !termed {
+                    failed = true;
+                    // the scheduler, simulator and recorder are essential: without
+                    // them the run cannot go on; nominal/filter deaths are degraded
+                    // modes the partition handles (fallbacks)
+                    if matches!(p.role.as_str(), "scheduler") && teardown_at.is_none() {
+                        teardown_at = Some(Instant::now());
+                    }
+                    if matches!(p.role.as_str(), "simulator" | "recorder") && teardown_at.is_none()
+                    {
+                        // the scheduler notices and stops; the launcher waits a little for that
                         teardown_at = Some(Instant::now() + Duration::from_secs(20));
                     }
-                    p.exit = Some(ex);
                 }
+                if p.role == "scheduler" && teardown_at.is_none() {
+                    // normal end: the others got the stop tick and finish their outputs
+                    teardown_at = Some(Instant::now() + Duration::from_secs(20));
+                }
+                p.exit = Some(ex);
             }
         }
         if procs.iter().all(|p| p.exit.is_some()) {

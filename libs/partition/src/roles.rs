@@ -183,7 +183,7 @@ pub fn scheduler() -> anyhow::Result<i32> {
         }
         k += 1;
         rep.ticks = k;
-        if k % 50 == 0 && check(&mut monitor, &mut rep)? {
+        if k.is_multiple_of(50) && check(&mut monitor, &mut rep)? {
             code = 3;
             rep.aborted = true;
             break;
