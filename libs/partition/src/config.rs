@@ -96,6 +96,10 @@ pub struct PartitionConfig {
     /// Stop after this many ticks (0 = run the mission to its end).
     #[serde(default)]
     pub max_ticks: u64,
+    /// SCHED_FIFO priority (1..=99) of every process in real-time mode; 0 = the
+    /// normal scheduler. Needs CAP_SYS_NICE (or root); refused → a warning.
+    #[serde(default)]
+    pub real_time_priority: u32,
     pub rate_groups: Vec<RateGroup>,
     pub deadlines: Deadlines,
     pub lock_step: LockStep,
@@ -194,6 +198,12 @@ impl PartitionConfig {
             return err(format!(
                 "lock_step.deadline_scale = {}: must be >= 1",
                 self.lock_step.deadline_scale
+            ));
+        }
+        if self.real_time_priority > 99 {
+            return err(format!(
+                "real_time_priority = {}: must be 0 (off) or 1..=99",
+                self.real_time_priority
             ));
         }
         let d = &self.deadlines;

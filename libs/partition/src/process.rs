@@ -57,6 +57,9 @@ impl Proc {
         let setup = Setup::load(&cfg.scenario_path())?;
         let run = RunScope::from_env()
             .context("SC_RUN_ID is not set (processes are started by the launcher)")??;
+        if cfg.clock == crate::ClockMode::RealTime && cfg.real_time_priority > 0 {
+            set_fifo(role, cfg.real_time_priority);
+        }
         let node = run.node(role)?;
         Ok(Self {
             role,
@@ -121,5 +124,20 @@ pub fn send<T: core::fmt::Debug + sc_bus::ZeroCopySend + Copy + 'static>(
             Ok(())
         }
         Err(e) => Err(e.into()),
+    }
+}
+
+/// Puts this process in the SCHED_FIFO class (real-time mode); a refusal is a warning.
+fn set_fifo(role: &str, prio: u32) {
+    let param = libc::sched_param {
+        sched_priority: prio as libc::c_int,
+    };
+    // SAFETY: sched_setscheduler on this process with a valid, initialised param.
+    let rc = unsafe { libc::sched_setscheduler(0, libc::SCHED_FIFO, &param) };
+    if rc != 0 {
+        eprintln!(
+            "warning: {role}: SCHED_FIFO priority {prio} refused ({}); normal scheduling",
+            std::io::Error::last_os_error()
+        );
     }
 }
