@@ -120,14 +120,14 @@ impl CommandProfile {
                 }
                 v[k] = x;
             }
-            if let Some((prev, _)) = rows.last() {
-                if v[0] <= *prev {
-                    return Err(ProfileError::TimeOrder {
-                        line: line_no,
-                        t: v[0],
-                        prev: *prev,
-                    });
-                }
+            if let Some((prev, _)) = rows.last()
+                && v[0] <= *prev
+            {
+                return Err(ProfileError::TimeOrder {
+                    line: line_no,
+                    t: v[0],
+                    prev: *prev,
+                });
             }
             let cmd = Command {
                 force_b: Vector3::new(v[1], v[2], v[3]),
