@@ -162,3 +162,32 @@ fn killed_recorder_aborts_the_run() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A hung (SIGSTOPped) robotic filter: its missed deadlines put the robotic
+/// subsystem on the fallback applied by the simulator; the launcher kills it at
+/// teardown; nothing is left behind.
+#[test]
+fn hung_robotic_filter_is_detected_by_deadlines() {
+    let dir = tmp("hung");
+    let out = dir.join("out");
+    let config = write_config(&dir, Some(60.0), None, 5.0);
+    let opts = options(&config, &out, "hung");
+    let h = std::thread::spawn(move || sc_partition::launch(&opts).unwrap());
+    let t0 = std::time::Instant::now();
+    while rows(&out) < 100 {
+        assert!(t0.elapsed() < std::time::Duration::from_secs(120));
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    let pids = pids_of("sc-safety-robotic", &out);
+    assert_eq!(pids.len(), 1);
+    // SAFETY: kill(2) on the pid found above.
+    unsafe { libc::kill(pids[0], libc::SIGSTOP) };
+    let rep = h.join().unwrap();
+    assert_clean(&rep, &out);
+    assert_eq!(rep.code, 3, "{rep:?}");
+    assert_eq!(contiguous_steps(&out), 601);
+    let f = flagged_steps(&out, "robotic");
+    let first = *f.first().expect("robotic steps flagged");
+    assert_eq!(f, (first..=600).collect::<Vec<u64>>());
+    std::fs::remove_dir_all(&dir).ok();
+}

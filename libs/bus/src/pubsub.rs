@@ -30,6 +30,8 @@ use iceoryx2::service::port_factory::event::PortFactory as EventFactory;
 use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSubFactory;
 use sc_icd::ServiceName as IcdServiceName;
 use std::fmt::Debug;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 /// Event id a publisher notifies with after each send.
@@ -176,6 +178,7 @@ fn open_pubsub<T: Debug + ZeroCopySend + Copy>(
 pub struct Publisher<T: Debug + ZeroCopySend + Copy + 'static> {
     name: String,
     timeout: Duration,
+    stuck: Arc<AtomicBool>,
     // Field order matters for drop order: ports before their factories.
     publisher: iceoryx2::port::publisher::Publisher<ipc::Service, T, ()>,
     notifier: Notifier<ipc::Service>,
@@ -200,15 +203,23 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Publisher<T> {
             EVENT_ID_MAX,
         )?;
         let timeout = settings.backpressure_timeout;
+        let stuck = Arc::new(AtomicBool::new(false));
         let mut builder = pubsub.publisher_builder().max_loaned_samples(2);
         if !settings.safe_overflow {
             // Retry while the subscriber may still drain; after `timeout` drop the
             // sample for that subscriber only and report it (never block forever).
+            // Once a subscriber stayed full for `timeout` (hung or dead), later sends
+            // give up on a full buffer at once instead of stalling every send by
+            // `timeout`; the first send that meets no full buffer re-arms the wait.
+            let stuck = stuck.clone();
             builder =
                 builder.set_backpressure_handler(move |info: &iceoryx2::port::BackpressureInfo| {
-                    if info.elapsed_time < timeout {
+                    if stuck.load(Ordering::Relaxed) {
+                        BackpressureAction::DiscardDataAndFail
+                    } else if info.elapsed_time < timeout {
                         BackpressureAction::Retry
                     } else {
+                        stuck.store(true, Ordering::Relaxed);
                         BackpressureAction::DiscardDataAndFail
                     }
                 });
@@ -230,6 +241,7 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Publisher<T> {
         Ok(Self {
             name: name.to_string(),
             timeout,
+            stuck,
             publisher,
             notifier,
             _pubsub: pubsub,
@@ -251,7 +263,10 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Publisher<T> {
         })?;
         let sample = sample.write_payload(*msg);
         let delivered = match sample.send() {
-            Ok(n) => n,
+            Ok(n) => {
+                self.stuck.store(false, Ordering::Relaxed);
+                n
+            }
             Err(iceoryx2::port::SendError::UnableToDeliver) => {
                 // Still wake the subscribers that did get it before reporting.
                 let _ = self.notifier.notify();

@@ -303,7 +303,7 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
                 }
                 if p.role == "scheduler" && teardown_at.is_none() {
                     // normal end: the others got the stop tick and finish their outputs
-                    teardown_at = Some(Instant::now() + Duration::from_secs(20));
+                    teardown_at = Some(Instant::now() + Duration::from_secs(8));
                 }
                 p.exit = Some(ex);
             }
@@ -332,6 +332,8 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
             if now >= t + Duration::from_secs(3) && !killed {
                 killed = true;
                 for p in procs.iter_mut().filter(|p| p.exit.is_none()) {
+                    // a process that ignores the stop tick and SIGTERM is hung: a failure
+                    failed = true;
                     eprintln!("launch: killing {} (pid {})", p.role, p.child.id());
                     let _ = p.child.kill();
                 }

@@ -14,6 +14,7 @@ use sc_mission::{MissionEnd, StepRecord, TelemetryWriter, summarize};
 use sc_multibody::Vector7;
 use std::collections::BTreeMap;
 use std::io::Write;
+use std::time::{Duration, Instant};
 
 /// Messages recorded per service, written to `recorder.json`.
 #[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
@@ -94,6 +95,8 @@ pub fn recorder() -> anyhow::Result<i32> {
     p.handshake()?;
     let mut rep = RecorderReport::default();
     let mut pending: BTreeMap<u64, Tickset> = BTreeMap::new();
+    let mut queued: Vec<StepResult> = Vec::new();
+    let mut queued_since: Option<Instant> = None;
     let mut records: Vec<StepRecord> = Vec::new();
     let mut end: Option<MissionEnd> = None;
     let mut last_t = 0.0;
@@ -105,13 +108,22 @@ pub fn recorder() -> anyhow::Result<i32> {
         *rep.recorded.entry(s.to_string()).or_default() += n as u64
     };
     loop {
-        if !final_pass && !stop && !wait(&waiter, None)? {
+        // a result whose tick misses a required message waits briefly: a publisher
+        // delivers to its subscribers one after the other, so the simulator may have
+        // answered before the same sample reached the recorder's queue
+        let until = (!queued.is_empty()).then(|| Instant::now() + Duration::from_millis(1));
+        if !final_pass && !stop && !wait(&waiter, until)? {
             break;
         }
         // step results first: everything of their tick was sent before them
-        let mut results = Vec::new();
         res_rx.drain_events()?;
-        res_rx.receive_all(&mut results)?;
+        let n_before = queued.len();
+        res_rx.receive_all(&mut queued)?;
+        count(
+            &mut rep,
+            services::STEP_RESULT.as_str(),
+            queued.len() - n_before,
+        );
         macro_rules! take {
             ($rx:expr, $field:ident, $svc:expr) => {{
                 $rx.drain_events()?;
@@ -141,7 +153,43 @@ pub fn recorder() -> anyhow::Result<i32> {
                 stop = true;
             }
         }
-        count(&mut rep, services::STEP_RESULT.as_str(), results.len());
+        let mut results = Vec::new();
+        while let Some(r) = queued.first().copied() {
+            let complete = pending.get(&r.tick).is_some_and(|set| {
+                let Some(st) = set.state else { return false };
+                // due subsystem: its safe command (unless the simulator used the
+                // fallback) and its nominal command (unless the filter flagged it missing)
+                let missing_flag = sc_cbf::faults::UPSTREAM_MISSING;
+                let need = |bit: u32, nom: bool, safe: Option<u32>| {
+                    st.due_mask & bit == 0
+                        || r.fallback_mask & bit != 0
+                        || safe.is_some_and(|f| nom || f & missing_flag != 0)
+                };
+                need(
+                    due::TRANSLATIONAL,
+                    set.nt.is_some(),
+                    set.st.map(|m| m.fault_flags),
+                ) && need(
+                    due::ATTITUDE,
+                    set.na.is_some(),
+                    set.sa.map(|m| m.fault_flags),
+                ) && need(
+                    due::ROBOTIC,
+                    set.nr.is_some(),
+                    set.sr.map(|m| m.fault_flags),
+                )
+            });
+            let waited =
+                queued_since.is_some_and(|t: Instant| t.elapsed() > Duration::from_millis(200));
+            if complete || waited || stop || final_pass {
+                results.push(r);
+                queued.remove(0);
+                queued_since = None;
+            } else {
+                queued_since.get_or_insert_with(Instant::now);
+                break;
+            }
+        }
         for r in results {
             mcap.write(services::STEP_RESULT.as_str(), r.publish_ns, &r)?;
             let set = pending.remove(&r.tick).unwrap_or_default();
@@ -302,7 +350,8 @@ pub fn recorder() -> anyhow::Result<i32> {
             )?;
             records.push(rec);
             last_t = r.t;
-            end = match r.end {
+            // the first end counts (with max_ticks the run goes on after it)
+            end = end.or(match r.end {
                 end::CAPTURED => Some(MissionEnd::Captured { t: r.t }),
                 end::TIMEOUT => Some(MissionEnd::Timeout { t: r.t }),
                 end::SIMULATOR_FAILED => Some(MissionEnd::SimulatorFailed {
@@ -310,7 +359,7 @@ pub fn recorder() -> anyhow::Result<i32> {
                     message: "simulator failed".into(),
                 }),
                 _ => None,
-            };
+            });
         }
         if final_pass {
             break;

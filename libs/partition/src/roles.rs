@@ -139,7 +139,8 @@ pub fn scheduler() -> anyhow::Result<i32> {
                 }
             }
             if let Some(r) = done {
-                if r.end != end::RUNNING {
+                if r.end == end::SIMULATOR_FAILED || (r.end != end::RUNNING && p.cfg.max_ticks == 0)
+                {
                     rep.end = match r.end {
                         end::CAPTURED => "captured",
                         end::TIMEOUT => "timeout",
@@ -242,6 +243,7 @@ pub fn simulator() -> anyhow::Result<i32> {
     let layer = SafetyLayer::from_scenario(&scenario, p.setup.mass());
     let robot = p.setup.robot.clone();
     let deadline = p.deadline(p.cfg.deadlines.simulator_ms);
+    let keep_going = p.cfg.max_ticks > 0;
     p.handshake()?;
     let mut ticks: Vec<Tick> = Vec::new();
     let (mut got_t, mut got_a, mut got_r): (
@@ -409,15 +411,17 @@ pub fn simulator() -> anyhow::Result<i32> {
         } else if sc_mission::timeout_check(&scenario, o.t) {
             end::TIMEOUT
         } else {
-            match sim.step(&held) {
-                Ok(()) => end::RUNNING,
-                Err(e) => {
-                    eprintln!("simulator: {e}");
-                    end::SIMULATOR_FAILED
-                }
-            }
+            end::RUNNING
         };
-        ended = res.end != end::RUNNING;
+        // with max_ticks (benchmarks, soak runs) the physics goes on after the end
+        // and the scheduler stops after exactly max_ticks
+        if res.end == end::RUNNING || keep_going {
+            if let Err(e) = sim.step(&held) {
+                eprintln!("simulator: {e}");
+                res.end = end::SIMULATOR_FAILED;
+            }
+        }
+        ended = res.end == end::SIMULATOR_FAILED || (res.end != end::RUNNING && !keep_going);
         res.publish_ns = now();
         send(&result_tx, &res)?;
     }
