@@ -415,11 +415,11 @@ pub fn simulator() -> anyhow::Result<i32> {
         };
         // with max_ticks (benchmarks, soak runs) the physics goes on after the end
         // and the scheduler stops after exactly max_ticks
-        if res.end == end::RUNNING || keep_going {
-            if let Err(e) = sim.step(&held) {
-                eprintln!("simulator: {e}");
-                res.end = end::SIMULATOR_FAILED;
-            }
+        if (res.end == end::RUNNING || keep_going)
+            && let Err(e) = sim.step(&held)
+        {
+            eprintln!("simulator: {e}");
+            res.end = end::SIMULATOR_FAILED;
         }
         ended = res.end == end::SIMULATOR_FAILED || (res.end != end::RUNNING && !keep_going);
         res.publish_ns = now();
