@@ -435,7 +435,6 @@ pub struct Health {
     pub publish_ns: u64,
 }
 
-
 zeroed!(
     Tick,
     SimState,
