@@ -3,7 +3,6 @@
 use crate::record::StepRecord;
 use crate::setup::{Setup, SetupError};
 use crate::stages;
-use nalgebra::Vector3;
 use sc_cbf::{QpDump, SafetyLayer};
 use sc_nominal::NominalControllers;
 use sc_sim::{Command, Simulator};
@@ -196,9 +195,4 @@ pub fn capture_check(
 pub fn timeout_check(scenario: &sc_scenario::Scenario, t: f64) -> bool {
     let m = &scenario.mission;
     t + 0.5 * m.control_period_s >= m.duration_s
-}
-
-/// Zero vector helper for callers building records by hand.
-pub fn zero3() -> Vector3<f64> {
-    Vector3::zeros()
 }

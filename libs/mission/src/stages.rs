@@ -92,9 +92,6 @@ pub fn hill_to_body(o: &Observation, f_h: &Vector3<f64>) -> Vector3<f64> {
     r_hb.transpose() * f_h
 }
 
-/// Joint torques as a plain vector type (re-export convenience).
-pub type JointTorques = Vector7;
-
 /// The robotic filter's defined output when its model cannot even be evaluated (a
 /// non-finite state): zero joint torque, status `Fallback`, flag `INVALID_STATE`.
 pub fn robotic_invalid_state() -> sc_cbf::RoboticOutput {

@@ -283,7 +283,6 @@ impl Simulator {
         let u = cmd.as_vector();
         let mut x = self.state.pack();
         let h = self.p.physics_step;
-        let t0 = self.state.t;
         for _ in 0..self.p.substeps {
             x = self
                 .rk4(&x, &u, h)
@@ -292,7 +291,6 @@ impl Simulator {
         self.step += 1;
         // time from the step count, so that it never accumulates rounding
         let period = h * self.p.substeps as f64;
-        let _ = t0;
         self.state = SimState::unpack(self.step as f64 * period, &x);
         Ok(())
     }
