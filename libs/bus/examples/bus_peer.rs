@@ -49,7 +49,7 @@ fn run(run_id: &str, base: &str) -> sc_bus::Result<()> {
         match outcome {
             WaitOutcome::Handled => {}
             WaitOutcome::Timeout => return Ok(()),
-            WaitOutcome::TerminationRequest | WaitOutcome::Interrupt => return Ok(()),
+            WaitOutcome::TerminationRequest => return Ok(()),
         }
     }
 }

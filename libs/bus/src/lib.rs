@@ -5,6 +5,7 @@
 //!   runs/tests), node creation, teardown of every file the prefix left behind;
 //! - [`Publisher`] / [`Subscriber`]: pub/sub + same-name event service;
 //!   `send` = loan, write, send, notify; subscribers block on the event;
+//! - [`SignalSender`] / [`SignalListener`]: payload-less wake-ups (the stage-deadline watchdog);
 //! - [`Waiter`]: one thread sleeps on several subscribers, deadlines and intervals;
 //! - [`PeerMonitor`] / [`reap_dead_nodes`]: detect peers that died (e.g. SIGKILL);
 //! - [`Coordinator`] / [`Participant`]: start-up handshake before the first tick.
@@ -29,6 +30,7 @@ pub mod handshake;
 pub mod liveness;
 pub mod pubsub;
 pub mod run;
+pub mod signal;
 pub mod waiter;
 
 pub use error::{BusError, Result};
@@ -36,6 +38,7 @@ pub use handshake::{Coordinator, Participant};
 pub use liveness::{NodeReport, PeerInfo, PeerMonitor, reap_dead_nodes};
 pub use pubsub::{Events, Publisher, ServiceSettings, Subscriber};
 pub use run::{BusNode, RUN_ID_ENV, RunScope};
+pub use signal::{SignalListener, SignalSender};
 pub use waiter::{Attachment, WaitOutcome, Waitable, Waiter, Wake};
 
 /// Message bound of the bus: what sc-icd's messages derive.

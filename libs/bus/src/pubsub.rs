@@ -30,8 +30,7 @@ use iceoryx2::service::port_factory::event::PortFactory as EventFactory;
 use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSubFactory;
 use sc_icd::ServiceName as IcdServiceName;
 use std::fmt::Debug;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 /// Event id a publisher notifies with after each send.
@@ -41,6 +40,9 @@ pub const EVENT_SAMPLE: usize = 0;
 pub const EVENT_NOTIFIER_DEAD: usize = 1;
 /// Event id iceoryx2 emits when a notifier is dropped normally (peer left).
 pub const EVENT_NOTIFIER_DROPPED: usize = 2;
+/// A subscriber that stayed full for the backpressure timeout is dropped at once
+/// (no wait) for this many timeouts before it gets the full wait again.
+pub const STUCK_HOLD_FACTOR: u32 = 20;
 /// Highest event id used on data services.
 pub const EVENT_ID_MAX: usize = 7;
 
@@ -178,7 +180,6 @@ fn open_pubsub<T: Debug + ZeroCopySend + Copy>(
 pub struct Publisher<T: Debug + ZeroCopySend + Copy + 'static> {
     name: String,
     timeout: Duration,
-    stuck: Arc<AtomicBool>,
     // Field order matters for drop order: ports before their factories.
     publisher: iceoryx2::port::publisher::Publisher<ipc::Service, T, ()>,
     notifier: Notifier<ipc::Service>,
@@ -203,23 +204,28 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Publisher<T> {
             EVENT_ID_MAX,
         )?;
         let timeout = settings.backpressure_timeout;
-        let stuck = Arc::new(AtomicBool::new(false));
         let mut builder = pubsub.publisher_builder().max_loaned_samples(2);
         if !settings.safe_overflow {
             // Retry while the subscriber may still drain; after `timeout` drop the
             // sample for that subscriber only and report it (never block forever).
-            // Once a subscriber stayed full for `timeout` (hung or dead), later sends
-            // give up on a full buffer at once instead of stalling every send by
-            // `timeout`; the first send that meets no full buffer re-arms the wait.
-            let stuck = stuck.clone();
+            // A subscriber that stayed full for `timeout` (hung or dead) is *stuck*
+            // for the next `STUCK_HOLD_FACTOR × timeout`: sends drop its samples at
+            // once instead of stalling every send by `timeout`; then it gets the full
+            // wait again. Only that subscriber: the others (e.g. a recorder that is
+            // momentarily behind) keep the lossless wait.
+            let stuck: Mutex<Vec<(u128, Instant)>> = Mutex::new(Vec::new());
+            let hold = timeout * STUCK_HOLD_FACTOR;
             builder =
                 builder.set_backpressure_handler(move |info: &iceoryx2::port::BackpressureInfo| {
-                    if stuck.load(Ordering::Relaxed) {
+                    let now = Instant::now();
+                    let mut stuck = stuck.lock().unwrap_or_else(|p| p.into_inner());
+                    stuck.retain(|(_, since)| now.duration_since(*since) < hold);
+                    if stuck.iter().any(|(id, _)| *id == info.receiver_port_id) {
                         BackpressureAction::DiscardDataAndFail
                     } else if info.elapsed_time < timeout {
                         BackpressureAction::Retry
                     } else {
-                        stuck.store(true, Ordering::Relaxed);
+                        stuck.push((info.receiver_port_id, now));
                         BackpressureAction::DiscardDataAndFail
                     }
                 });
@@ -241,7 +247,6 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Publisher<T> {
         Ok(Self {
             name: name.to_string(),
             timeout,
-            stuck,
             publisher,
             notifier,
             _pubsub: pubsub,
@@ -263,10 +268,7 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Publisher<T> {
         })?;
         let sample = sample.write_payload(*msg);
         let delivered = match sample.send() {
-            Ok(n) => {
-                self.stuck.store(false, Ordering::Relaxed);
-                n
-            }
+            Ok(n) => n,
             Err(iceoryx2::port::SendError::UnableToDeliver) => {
                 // Still wake the subscribers that did get it before reporting.
                 let _ = self.notifier.notify();
@@ -327,22 +329,53 @@ impl Events {
 }
 
 /// Subscribing side of one service.
+///
+/// Its event listener is what a publisher's `notify` wakes: every listener of a
+/// service costs the publisher one wake-up message per send, on the critical path
+/// of a control loop. A subscriber that only reads the service when something else
+/// woke it is created with [`polled`](Self::polled) and has no listener until it
+/// is first attached to a [`crate::Waiter`] or waited on.
 pub struct Subscriber<T: Debug + ZeroCopySend + Copy + 'static> {
     name: String,
     subscriber: iceoryx2::port::subscriber::Subscriber<ipc::Service, T, ()>,
-    listener: Listener<ipc::Service>,
+    // ports before their factories (drop order)
+    listener: std::cell::OnceCell<Listener<ipc::Service>>,
     _pubsub: PubSubFactory<ipc::Service, T, ()>,
-    _event: EventFactory<ipc::Service>,
+    event: EventFactory<ipc::Service>,
 }
 
 impl<T: Debug + ZeroCopySend + Copy + 'static> Subscriber<T> {
     /// Opens/creates service `name` (pub/sub + event) and a subscriber and listener on it.
     pub fn new(node: &BusNode, name: IcdServiceName, settings: &ServiceSettings) -> Result<Self> {
-        Self::with_name(node, name.as_str(), settings)
+        let s = Self::polled_with_name(node, name.as_str(), settings)?;
+        s.ensure_listener()?;
+        Ok(s)
     }
 
     /// Like [`new`](Self::new) with a free-form service name (tests, tools).
     pub fn with_name(node: &BusNode, name: &str, settings: &ServiceSettings) -> Result<Self> {
+        let s = Self::polled_with_name(node, name, settings)?;
+        s.ensure_listener()?;
+        Ok(s)
+    }
+
+    /// A subscriber without an event listener (nobody wakes it; it is read when
+    /// something else woke its process). The listener is created when it is first
+    /// needed: attached to a [`crate::Waiter`], or [`wait`](Self::wait)ed on.
+    pub fn polled(
+        node: &BusNode,
+        name: IcdServiceName,
+        settings: &ServiceSettings,
+    ) -> Result<Self> {
+        Self::polled_with_name(node, name.as_str(), settings)
+    }
+
+    /// Like [`polled`](Self::polled) with a free-form service name.
+    pub fn polled_with_name(
+        node: &BusNode,
+        name: &str,
+        settings: &ServiceSettings,
+    ) -> Result<Self> {
         let pubsub = open_pubsub::<T>(node, name, settings)?;
         let event = open_event(
             node,
@@ -360,20 +393,12 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Subscriber<T> {
                 service: name.to_string(),
                 reason: reason(e),
             })?;
-        let listener = event
-            .listener_builder()
-            .create()
-            .map_err(|e| BusError::Port {
-                port: "listener",
-                service: name.to_string(),
-                reason: reason(e),
-            })?;
         Ok(Self {
             name: name.to_string(),
             subscriber,
-            listener,
+            listener: std::cell::OnceCell::new(),
             _pubsub: pubsub,
-            _event: event,
+            event,
         })
     }
 
@@ -382,9 +407,28 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Subscriber<T> {
         &self.name
     }
 
-    /// The event listener, to attach to a [`crate::Waiter`].
-    pub fn listener(&self) -> &Listener<ipc::Service> {
-        &self.listener
+    /// True if the subscriber has an event listener (publishers wake it).
+    pub fn has_listener(&self) -> bool {
+        self.listener.get().is_some()
+    }
+
+    /// The event listener, created on first use; to attach to a [`crate::Waiter`].
+    /// Notifications sent before it existed are not seen: read the queue after
+    /// creating it.
+    pub fn ensure_listener(&self) -> Result<&Listener<ipc::Service>> {
+        if let Some(l) = self.listener.get() {
+            return Ok(l);
+        }
+        let l = self
+            .event
+            .listener_builder()
+            .create()
+            .map_err(|e| BusError::Port {
+                port: "listener",
+                service: self.name.clone(),
+                reason: reason(e),
+            })?;
+        Ok(self.listener.get_or_init(|| l))
     }
 
     fn check(&self, r: core::result::Result<u64, impl Debug>) -> Result<()> {
@@ -397,18 +441,23 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Subscriber<T> {
 
     /// Takes the pending events without blocking. Call it when a [`crate::Waiter`]
     /// reports this subscriber, or the waiter wakes up again at once.
+    /// Without a listener there are no events (empty).
     pub fn drain_events(&self) -> Result<Events> {
         let mut ev = Events::default();
-        let r = self.listener.try_wait(|a| ev.add(a.id.as_value(), a.count));
+        let Some(l) = self.listener.get() else {
+            return Ok(ev);
+        };
+        let r = l.try_wait(|a| ev.add(a.id.as_value(), a.count));
         self.check(r)?;
         Ok(ev)
     }
 
     /// Blocks until an event arrives or `timeout` passes (then `Events::is_empty()`).
+    /// Creates the listener if the subscriber has none yet.
     pub fn wait(&self, timeout: Duration) -> Result<Events> {
         let mut ev = Events::default();
         let r = self
-            .listener
+            .ensure_listener()?
             .timed_wait(|a| ev.add(a.id.as_value(), a.count), timeout);
         self.check(r)?;
         Ok(ev)

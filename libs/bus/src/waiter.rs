@@ -34,19 +34,19 @@ use std::time::Duration;
 
 /// Something whose event listener can be attached to a [`Waiter`].
 pub trait Waitable {
-    /// The listener to sleep on.
-    fn listener(&self) -> &Listener<ipc::Service>;
+    /// The listener to sleep on (created here if the source creates it lazily).
+    fn listener(&self) -> Result<&Listener<ipc::Service>>;
 }
 
 impl<T: core::fmt::Debug + ZeroCopySend + Copy + 'static> Waitable for crate::Subscriber<T> {
-    fn listener(&self) -> &Listener<ipc::Service> {
-        crate::Subscriber::listener(self)
+    fn listener(&self) -> Result<&Listener<ipc::Service>> {
+        self.ensure_listener()
     }
 }
 
 impl Waitable for Listener<ipc::Service> {
-    fn listener(&self) -> &Listener<ipc::Service> {
-        self
+    fn listener(&self) -> Result<&Listener<ipc::Service>> {
+        Ok(self)
     }
 }
 
@@ -72,10 +72,8 @@ pub enum WaitOutcome {
     Handled,
     /// Nothing fired before the timeout.
     Timeout,
-    /// SIGTERM received (iceoryx2 signal handling).
+    /// SIGTERM or SIGINT received (iceoryx2 signal handling).
     TerminationRequest,
-    /// SIGINT received.
-    Interrupt,
 }
 
 impl Attachment<'_, '_> {
@@ -118,7 +116,7 @@ impl Waiter {
     ) -> Result<Attachment<'w, 'a>> {
         let guard = self
             .ws
-            .attach_notification(src.listener())
+            .attach_notification(src.listener()?)
             .map_err(attach_err("attach notification"))?;
         Ok(Attachment { guard })
     }
@@ -132,7 +130,7 @@ impl Waiter {
     ) -> Result<Attachment<'w, 'a>> {
         let guard = self
             .ws
-            .attach_deadline(src.listener(), deadline)
+            .attach_deadline(src.listener()?, deadline)
             .map_err(attach_err("attach deadline"))?;
         Ok(Attachment { guard })
     }
@@ -148,29 +146,39 @@ impl Waiter {
 
     /// Sleeps until something fires (or `timeout`), then calls `on_wake` once per
     /// fired attachment. The callback must drain the listeners it is told about.
+    ///
+    /// A wait interrupted by a signal (EINTR) is not a termination request by
+    /// itself: iceoryx2 reports every EINTR as `Interrupt`, including the SIGCONT
+    /// that resumes a stopped process or a debugger attaching. The waiter then
+    /// looks once more without blocking, which reports a pending SIGTERM/SIGINT as
+    /// [`WaitOutcome::TerminationRequest`]; any other signal is a spurious wake-up.
     pub fn wait_once<F: FnMut(Wake)>(
         &self,
         timeout: Duration,
         mut on_wake: F,
     ) -> Result<WaitOutcome> {
         let mut fired = false;
-        let r = self
-            .ws
-            .wait_and_process_once_with_timeout(
-                |id| {
-                    fired = true;
-                    on_wake(Wake(id));
-                    CallbackProgression::Continue
-                },
-                timeout,
-            )
-            .map_err(|e| BusError::WaitSet {
-                op: "wait",
-                reason: reason(e),
-            })?;
+        let mut once = |timeout: Duration| {
+            self.ws
+                .wait_and_process_once_with_timeout(
+                    |id| {
+                        fired = true;
+                        on_wake(Wake(id));
+                        CallbackProgression::Continue
+                    },
+                    timeout,
+                )
+                .map_err(|e| BusError::WaitSet {
+                    op: "wait",
+                    reason: reason(e),
+                })
+        };
+        let mut r = once(timeout)?;
+        if r == WaitSetRunResult::Interrupt {
+            r = once(Duration::ZERO)?;
+        }
         Ok(match r {
             WaitSetRunResult::TerminationRequest => WaitOutcome::TerminationRequest,
-            WaitSetRunResult::Interrupt => WaitOutcome::Interrupt,
             _ if fired => WaitOutcome::Handled,
             _ => WaitOutcome::Timeout,
         })
