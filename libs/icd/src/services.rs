@@ -48,6 +48,12 @@ pub const SAFE_ROBOTIC: ServiceName = ServiceName("safe_capture/safe/robotic");
 pub const STEP_RESULT: ServiceName = ServiceName("safe_capture/sim/step_result");
 /// [`crate::Health`]. Publishers: every process (up to 16). Subscribers: scheduler, recorder.
 pub const HEALTH: ServiceName = ServiceName("safe_capture/health");
+/// Stage-deadline watchdog (event service, no payload). Notifier: scheduler, when a
+/// stage deadline of `[deadlines]` passed (counted from the tick) and the tick is
+/// unfinished. Listeners: the three safety filters, which wake on their nominal and
+/// upstream commands only, never on every state, and need this wake-up to apply
+/// their fallback to a tick whose nominal or upstream command is late.
+pub const STAGE_DEADLINE: ServiceName = ServiceName("safe_capture/scheduler/deadline");
 /// Start-up handshake (event services `<HANDSHAKE>/ready` and `<HANDSHAKE>/go`, no payload).
 /// Participants notify `ready` with their role id + 1; the coordinator (scheduler)
 /// notifies `go` once all expected participants were seen.

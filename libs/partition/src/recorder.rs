@@ -27,6 +27,11 @@ pub struct RecorderReport {
     /// Required samples that never reached the recorder (lost or never sent, e.g.
     /// a dead producer), per service.
     pub missing: BTreeMap<String, u64>,
+    /// Required samples that reached the recorder only after their step was written
+    /// (in recording.mcap, not in that step's telemetry row), per service: e.g. the
+    /// nominal command of a subsystem the simulator had already put on its fallback.
+    #[serde(default)]
+    pub late: BTreeMap<String, u64>,
     /// Steps written to telemetry.csv.
     pub steps: u64,
     /// Steps with a subsystem on the simulator's fallback (missing safe command).
@@ -51,21 +56,22 @@ struct Tickset {
 pub fn recorder() -> anyhow::Result<i32> {
     let p = Proc::start("recorder")?;
     let q = qos();
-    let tick_rx = Subscriber::<Tick>::new(&p.node, services::TICK, &q)?;
-    let state_rx = Subscriber::<SimState>::new(&p.node, services::SIM_STATE, &q)?;
+    let tick_rx = Subscriber::<Tick>::polled(&p.node, services::TICK, &q)?;
+    let state_rx = Subscriber::<SimState>::polled(&p.node, services::SIM_STATE, &q)?;
     let nt_rx =
-        Subscriber::<NominalTranslational>::new(&p.node, services::NOMINAL_TRANSLATIONAL, &q)?;
-    let na_rx = Subscriber::<NominalAttitude>::new(&p.node, services::NOMINAL_ATTITUDE, &q)?;
-    let nr_rx = Subscriber::<NominalRobotic>::new(&p.node, services::NOMINAL_ROBOTIC, &q)?;
-    let st_rx = Subscriber::<SafeTranslational>::new(&p.node, services::SAFE_TRANSLATIONAL, &q)?;
-    let sa_rx = Subscriber::<SafeAttitude>::new(&p.node, services::SAFE_ATTITUDE, &q)?;
-    let sr_rx = Subscriber::<SafeRobotic>::new(&p.node, services::SAFE_ROBOTIC, &q)?;
+        Subscriber::<NominalTranslational>::polled(&p.node, services::NOMINAL_TRANSLATIONAL, &q)?;
+    let na_rx = Subscriber::<NominalAttitude>::polled(&p.node, services::NOMINAL_ATTITUDE, &q)?;
+    let nr_rx = Subscriber::<NominalRobotic>::polled(&p.node, services::NOMINAL_ROBOTIC, &q)?;
+    let st_rx = Subscriber::<SafeTranslational>::polled(&p.node, services::SAFE_TRANSLATIONAL, &q)?;
+    let sa_rx = Subscriber::<SafeAttitude>::polled(&p.node, services::SAFE_ATTITUDE, &q)?;
+    let sr_rx = Subscriber::<SafeRobotic>::polled(&p.node, services::SAFE_ROBOTIC, &q)?;
     let res_rx = Subscriber::<StepResult>::new(&p.node, services::STEP_RESULT, &q)?;
     let waiter = Waiter::new()?;
-    // Wake only on step results and ticks: every message of a tick was sent before
-    // its step result, so the recorder drains them all then, once per tick and off
-    // the critical path of the tick (the buffers of 16 hold them).
-    let _a = [waiter.attach(&tick_rx)?, waiter.attach(&res_rx)?];
+    // Wake only on step results: every message of a tick was sent before its step
+    // result, so the recorder drains them all then, once per tick and off the
+    // critical path of the tick (the buffers of 16 hold them). The tick queue (for
+    // the stop) is read at every wake-up; the simulator wakes it once when it stops.
+    let _a = waiter.attach(&res_rx)?;
     std::fs::create_dir_all(&p.out)
         .with_context(|| format!("cannot create {}", p.out.display()))?;
     let open = |name: &str| -> anyhow::Result<std::io::BufWriter<std::fs::File>> {
@@ -104,6 +110,8 @@ pub fn recorder() -> anyhow::Result<i32> {
     let mut h = Tickset::default();
     let mut stop = false;
     let mut final_pass = false;
+    // required (service, tick) pairs not there when their step was written
+    let mut absent_at_write: std::collections::BTreeSet<(&'static str, u64)> = Default::default();
     let count = |rep: &mut RecorderReport, s: &str, n: usize| {
         *rep.recorded.entry(s.to_string()).or_default() += n as u64
     };
@@ -131,6 +139,9 @@ pub fn recorder() -> anyhow::Result<i32> {
                 $rx.receive_all(&mut v)?;
                 count(&mut rep, $svc.as_str(), v.len());
                 for m in v {
+                    if absent_at_write.remove(&($svc.as_str(), m.tick)) {
+                        *rep.late.entry($svc.as_str().into()).or_default() += 1;
+                    }
                     mcap.write($svc.as_str(), m.publish_ns, &m)?;
                     pending.entry(m.tick).or_default().$field = Some(m);
                 }
@@ -208,8 +219,10 @@ pub fn recorder() -> anyhow::Result<i32> {
                 let mut need = |svc: ServiceName, due_bit: u32, present: bool| {
                     if due_bit == 0 || due & due_bit != 0 {
                         *rep.expected.entry(svc.as_str().into()).or_default() += 1;
-                        let m = rep.missing.entry(svc.as_str().into()).or_default();
-                        *m += (!present) as u64;
+                        rep.missing.entry(svc.as_str().into()).or_default();
+                        if !present {
+                            absent_at_write.insert((svc.as_str(), r.tick));
+                        }
                     }
                 };
                 need(services::SIM_STATE, 0, true);
@@ -369,6 +382,9 @@ pub fn recorder() -> anyhow::Result<i32> {
             final_pass = true;
         }
     }
+    for (svc, _) in &absent_at_write {
+        *rep.missing.entry((*svc).into()).or_default() += 1;
+    }
     writer.flush()?;
     latency.flush()?;
     mcap.finish()?;
@@ -387,8 +403,9 @@ pub fn recorder() -> anyhow::Result<i32> {
     .context("writing recorder.json")?;
     let safe = summary.violated_constraints.is_empty() && summary.fault_count == 0;
     let missing: u64 = rep.missing.values().sum();
+    let late: u64 = rep.late.values().sum();
     eprintln!(
-        "recorder: recorded per service {:?}; missing {missing} of the samples the schedule requires",
+        "recorder: recorded per service {:?}; missing {missing} of the samples the schedule requires, {late} late",
         rep.recorded
     );
     eprintln!(

@@ -7,7 +7,7 @@ use crate::fallback;
 use crate::process::{Proc, qos, send, wait};
 use anyhow::Context;
 use nalgebra::Vector3;
-use sc_bus::{PeerMonitor, Publisher, Subscriber, Waiter};
+use sc_bus::{PeerMonitor, Publisher, SignalListener, SignalSender, Subscriber, Waiter};
 use sc_cbf::SafetyLayer;
 use sc_icd::*;
 use sc_mission::stages;
@@ -29,6 +29,16 @@ fn drain<T: core::fmt::Debug + sc_bus::ZeroCopySend + Copy + 'static>(
     Ok(v)
 }
 
+/// The `Instant` of a monotonic time stamp `ns` of another process (same clock).
+fn instant_of(ns: u64) -> Instant {
+    let t = Instant::now();
+    if ns == 0 {
+        return t; // no stamp: count from now
+    }
+    let ago = Duration::from_nanos(now().saturating_sub(ns));
+    t.checked_sub(ago).unwrap_or(t)
+}
+
 fn stop_seen(ticks: &[Tick]) -> bool {
     ticks.iter().any(|t| t.command == tick_command::STOP)
 }
@@ -42,6 +52,9 @@ pub struct SchedulerReport {
     pub base_period_s: f64,
     pub ticks: u64,
     pub cycle_slips: u64,
+    /// Stage deadlines that passed with the tick unfinished (each woke the filters).
+    #[serde(default)]
+    pub watchdog_wakeups: u64,
     pub end: String,
     pub lost_peers: Vec<String>,
     pub aborted: bool,
@@ -55,8 +68,17 @@ pub fn scheduler() -> anyhow::Result<i32> {
     let q = qos();
     let tick_tx = Publisher::<Tick>::new(&p.node, services::TICK, &q)?;
     let result_rx = Subscriber::<StepResult>::new(&p.node, services::STEP_RESULT, &q)?;
+    let watchdog = SignalSender::new(&p.node, services::STAGE_DEADLINE.as_str(), &q)?;
     let waiter = Waiter::new()?;
     let _a = waiter.attach(&result_rx)?;
+    let d = &p.cfg.deadlines;
+    // The filters wake on their inputs only; the watchdog wakes them when a stage
+    // deadline of an unfinished tick passed, so that they apply their fallback.
+    let stage_deadlines = [
+        p.deadline(d.safety_translational_ms),
+        p.deadline(d.safety_attitude_ms),
+        p.deadline(d.safety_robotic_ms),
+    ];
     let peers: Vec<&str> = crate::config::ROLES[1..].to_vec();
     let ids: Vec<u32> = (1..crate::config::ROLES.len() as u32).collect();
     let coord = sc_bus::Coordinator::new(&p.node, services::HANDSHAKE, &ids)?;
@@ -122,13 +144,18 @@ pub fn scheduler() -> anyhow::Result<i32> {
         };
         send(&tick_tx, &tick)?;
         let sent = Instant::now();
+        let mut next_stage = 0;
         // wait for the step result of tick k
         loop {
             let until = match clock_mode {
                 clock_mode::REAL_TIME => started + period * slot,
                 _ => sent + step_timeout,
             };
-            if !wait(&waiter, Some(until))? {
+            let wake = match stage_deadlines.get(next_stage) {
+                Some(d) => until.min(sent + *d),
+                None => until,
+            };
+            if !wait(&waiter, Some(wake))? {
                 rep.end = "interrupted".into();
                 break 'ticks;
             }
@@ -137,6 +164,14 @@ pub fn scheduler() -> anyhow::Result<i32> {
                 if r.tick == k {
                     done = Some(r);
                 }
+            }
+            while stage_deadlines
+                .get(next_stage)
+                .is_some_and(|d| done.is_none() && sent.elapsed() >= *d)
+            {
+                watchdog.notify()?;
+                rep.watchdog_wakeups += 1;
+                next_stage += 1;
             }
             if let Some(r) = done {
                 if r.end == end::SIMULATOR_FAILED || (r.end != end::RUNNING && p.cfg.max_ticks == 0)
@@ -225,18 +260,23 @@ pub fn simulator() -> anyhow::Result<i32> {
     let p = Proc::start("simulator")?;
     let q = qos();
     let tick_rx = Subscriber::<Tick>::new(&p.node, services::TICK, &q)?;
-    let st_rx = Subscriber::<SafeTranslational>::new(&p.node, services::SAFE_TRANSLATIONAL, &q)?;
-    let sa_rx = Subscriber::<SafeAttitude>::new(&p.node, services::SAFE_ATTITUDE, &q)?;
+    let st_rx = Subscriber::<SafeTranslational>::polled(&p.node, services::SAFE_TRANSLATIONAL, &q)?;
+    let sa_rx = Subscriber::<SafeAttitude>::polled(&p.node, services::SAFE_ATTITUDE, &q)?;
     let sr_rx = Subscriber::<SafeRobotic>::new(&p.node, services::SAFE_ROBOTIC, &q)?;
     let state_tx = Publisher::<SimState>::new(&p.node, services::SIM_STATE, &q)?;
     let result_tx = Publisher::<StepResult>::new(&p.node, services::STEP_RESULT, &q)?;
-    let waiter = Waiter::new()?;
-    let _a = [
-        waiter.attach(&tick_rx)?,
-        waiter.attach(&st_rx)?,
-        waiter.attach(&sa_rx)?,
-        waiter.attach(&sr_rx)?,
-    ];
+    // Wake-ups (docs/PARTITION.md, "Who wakes whom"): between ticks on the tick only;
+    // within a tick on the robotic safe command, the last of the causal chain (the
+    // earlier ones were sent before it). While a filter is absent (dead or late: its
+    // command may never come) or the robotic group is not due, on every safe
+    // command: their listeners are created then, so that in a healthy run the
+    // translational and attitude filters wake only their downstream filter.
+    let on_tick = Waiter::new()?;
+    let _a0 = on_tick.attach(&tick_rx)?;
+    let on_robotic = Waiter::new()?;
+    let _a1 = [on_robotic.attach(&tick_rx)?, on_robotic.attach(&sr_rx)?];
+    let on_any = Waiter::new()?;
+    let mut any_attached = Vec::new();
     let scenario = p.scenario_with_period(p.schedule.base_period_s);
     let mut sim =
         Simulator::new(&scenario, p.setup.robot.clone()).map_err(|e| anyhow::anyhow!("{e}"))?;
@@ -259,7 +299,7 @@ pub fn simulator() -> anyhow::Result<i32> {
     let mut misses = 0u64;
     loop {
         if ticks.is_empty() {
-            if !wait(&waiter, None)? {
+            if !wait(&on_tick, None)? {
                 break;
             }
             ticks.extend(drain(&tick_rx)?);
@@ -277,6 +317,9 @@ pub fn simulator() -> anyhow::Result<i32> {
         }
         let tick = ticks.remove(0);
         if tick.command == tick_command::STOP {
+            // wake the consumers once so that they see the stop too
+            state_tx.notify()?;
+            result_tx.notify()?;
             break;
         }
         if ended {
@@ -310,7 +353,16 @@ pub fn simulator() -> anyhow::Result<i32> {
                 misses += 1;
                 break;
             }
-            if !wait(&waiter, Some(until))? {
+            let wake_on_any = absent.iter().any(|a| *a) || due & due::ROBOTIC == 0;
+            if wake_on_any && any_attached.is_empty() {
+                any_attached = vec![
+                    on_any.attach(&tick_rx)?,
+                    on_any.attach(&st_rx)?,
+                    on_any.attach(&sa_rx)?,
+                    on_any.attach(&sr_rx)?,
+                ];
+                // no wait this time: what came before the listeners existed is read now
+            } else if !wait(if wake_on_any { &on_any } else { &on_robotic }, Some(until))? {
                 return Ok(0);
             }
             ticks.extend(drain(&tick_rx)?);
@@ -443,7 +495,7 @@ pub fn nominal(which: usize) -> anyhow::Result<i32> {
     ][which];
     let p = Proc::start(role)?;
     let q = qos();
-    let tick_rx = Subscriber::<Tick>::new(&p.node, services::TICK, &q)?;
+    let tick_rx = Subscriber::<Tick>::polled(&p.node, services::TICK, &q)?;
     let state_rx = Subscriber::<SimState>::new(&p.node, services::SIM_STATE, &q)?;
     let tx_t = if which == 0 {
         Some(Publisher::<NominalTranslational>::new(
@@ -472,8 +524,10 @@ pub fn nominal(which: usize) -> anyhow::Result<i32> {
     } else {
         None
     };
+    // Wakes on states only; the tick queue is read at every wake-up for the stop
+    // (the simulator wakes its consumers once when it stops).
     let waiter = Waiter::new()?;
-    let _a = [waiter.attach(&tick_rx)?, waiter.attach(&state_rx)?];
+    let _a = waiter.attach(&state_rx)?;
     let scenario = p.scenario_with_period(p.schedule.period_s[which]);
     let ctl = NominalControllers::new(&scenario, (*p.setup.robot).clone())?;
     let subsystems = [
@@ -539,6 +593,12 @@ pub fn nominal(which: usize) -> anyhow::Result<i32> {
             handled += 1;
         }
         if stop_seen(&drain(&tick_rx)?) {
+            // wake the filter once so that it sees the stop too
+            match which {
+                0 => tx_t.as_ref().context("publisher")?.notify()?,
+                1 => tx_a.as_ref().context("publisher")?.notify()?,
+                _ => tx_r.as_ref().context("publisher")?.notify()?,
+            }
             break 'run;
         }
     }
@@ -553,8 +613,9 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
     let role = ["safety_translational", "safety_attitude", "safety_robotic"][which];
     let p = Proc::start(role)?;
     let q = qos();
-    let tick_rx = Subscriber::<Tick>::new(&p.node, services::TICK, &q)?;
-    let state_rx = Subscriber::<SimState>::new(&p.node, services::SIM_STATE, &q)?;
+    // Subscribers without a listener until needed (see the wake-ups below).
+    let tick_rx = Subscriber::<Tick>::polled(&p.node, services::TICK, &q)?;
+    let state_rx = Subscriber::<SimState>::polled(&p.node, services::SIM_STATE, &q)?;
     let nt_rx = if which == 0 {
         Some(Subscriber::<NominalTranslational>::new(
             &p.node,
@@ -583,7 +644,7 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
         None
     };
     let st_rx = if which >= 1 {
-        Some(Subscriber::<SafeTranslational>::new(
+        Some(Subscriber::<SafeTranslational>::polled(
             &p.node,
             services::SAFE_TRANSLATIONAL,
             &q,
@@ -627,22 +688,61 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
     } else {
         None
     };
-    let waiter = Waiter::new()?;
-    let mut att = vec![waiter.attach(&tick_rx)?, waiter.attach(&state_rx)?];
+    let watchdog = SignalListener::new(&p.node, services::STAGE_DEADLINE.as_str(), &q)?;
+    // Wake-ups (docs/PARTITION.md, "Who wakes whom"). Normally on the nominal
+    // command and the immediately upstream safe command only: the state of the tick
+    // was published before either, so it is read without waking on it. While an
+    // input is absent (dead or late producer), on every input including the state.
+    // Always on the scheduler's stage-deadline watchdog. The tick queue is read at
+    // every wake-up for the stop.
+    let on_inputs = Waiter::new()?;
+    let mut att = vec![on_inputs.attach(&watchdog)?];
     if let Some(s) = &nt_rx {
-        att.push(waiter.attach(s)?);
+        att.push(on_inputs.attach(s)?);
     }
     if let Some(s) = &na_rx {
-        att.push(waiter.attach(s)?);
+        att.push(on_inputs.attach(s)?);
     }
     if let Some(s) = &nr_rx {
-        att.push(waiter.attach(s)?);
+        att.push(on_inputs.attach(s)?);
     }
-    if let Some(s) = &st_rx {
-        att.push(waiter.attach(s)?);
+    if let Some(s) = &st_rx
+        && which == 1
+    {
+        att.push(on_inputs.attach(s)?);
     }
     if let Some(s) = &sa_rx {
-        att.push(waiter.attach(s)?);
+        att.push(on_inputs.attach(s)?);
+    }
+    // attached on first need (creates the listeners of the state and of the
+    // translational command at the robotic filter then)
+    let on_any = Waiter::new()?;
+    let mut any_attached = Vec::new();
+    macro_rules! attach_any {
+        () => {{
+            if any_attached.is_empty() {
+                any_attached.push(on_any.attach(&watchdog)?);
+                any_attached.push(on_any.attach(&state_rx)?);
+                if let Some(s) = &nt_rx {
+                    any_attached.push(on_any.attach(s)?);
+                }
+                if let Some(s) = &na_rx {
+                    any_attached.push(on_any.attach(s)?);
+                }
+                if let Some(s) = &nr_rx {
+                    any_attached.push(on_any.attach(s)?);
+                }
+                if let Some(s) = &st_rx {
+                    any_attached.push(on_any.attach(s)?);
+                }
+                if let Some(s) = &sa_rx {
+                    any_attached.push(on_any.attach(s)?);
+                }
+                true
+            } else {
+                false
+            }
+        }};
     }
     let mut layer = SafetyLayer::from_scenario(&p.setup.scenario, p.setup.mass());
     let robot = p.setup.robot.clone();
@@ -669,6 +769,7 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
     let mut stop = false;
     macro_rules! pump {
         () => {{
+            watchdog.drain()?;
             stop |= stop_seen(&drain(&tick_rx)?);
             states.extend(
                 drain(&state_rx)?
@@ -712,7 +813,10 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
             if stop {
                 break;
             }
-            if !wait(&waiter, None)? {
+            let wake_on_any = absent.iter().any(|a| *a);
+            // just attached: no wait, read what came before the listeners existed
+            let fresh = wake_on_any && attach_any!();
+            if !fresh && !wait(if wake_on_any { &on_any } else { &on_inputs }, None)? {
                 break;
             }
             pump!();
@@ -720,9 +824,14 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
         }
         let s = states.remove(0);
         let k = s.tick;
-        let until = Instant::now() + deadline;
+        // the stage deadline counts from the publication of the state
+        let until = instant_of(s.publish_ns) + deadline;
         let need_t = which >= 1 && s.due_mask & due::TRANSLATIONAL != 0;
         let need_a = which == 2 && s.due_mask & due::ATTITUDE != 0;
+        // the robotic filter in a tick where only the translational group is due
+        // upstream has no wake-up on the translational command among its inputs
+        let wake_on_any = absent.iter().any(|a| *a) || (which == 2 && need_t && !need_a);
+        let mut fresh = wake_on_any && attach_any!();
         loop {
             let nom_ok = absent[0]
                 || match which {
@@ -755,9 +864,10 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
                 }
                 break;
             }
-            if !wait(&waiter, Some(until))? {
+            if !fresh && !wait(if wake_on_any { &on_any } else { &on_inputs }, Some(until))? {
                 return Ok(0);
             }
+            fresh = false;
             pump!();
         }
         let recv_ns = now();
@@ -855,6 +965,12 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
         let _ = publish_ns;
     }
     drop(att);
+    // wake the downstream filter (and the simulator) once so that they see the stop
+    match which {
+        0 => tx_t.as_ref().context("publisher")?.notify()?,
+        1 => tx_a.as_ref().context("publisher")?.notify()?,
+        _ => tx_r.as_ref().context("publisher")?.notify()?,
+    }
     eprintln!("{role}: done, {misses} deadline misses");
     Ok(0)
 }
