@@ -61,6 +61,11 @@ pub struct RoleExec {
     /// `SC_PARTITION_CONFIG` / `SC_OUT_DIR` from the environment instead).
     #[serde(default)]
     pub no_standard_args: bool,
+    /// SCHED_FIFO priority of this role in real-time mode (1..=99), instead of
+    /// `real_time_priority`: e.g. lower for the processes off the causal chain of a
+    /// tick, so that they never delay it on a machine with few cores.
+    #[serde(default)]
+    pub priority: Option<u32>,
 }
 
 /// Per-stage deadlines in real-time mode, measured from the simulator's publication
@@ -100,6 +105,13 @@ pub struct PartitionConfig {
     /// normal scheduler. Needs CAP_SYS_NICE (or root); refused → a warning.
     #[serde(default)]
     pub real_time_priority: u32,
+    /// Real-time mode: the longest wake-up latency [µs] the CPUs' idle states may
+    /// add, requested from Linux PM QoS (`/dev/cpu_dma_latency`) by the launcher for
+    /// the whole run, as cyclictest does. 0 = idle CPUs poll instead of halting
+    /// (fastest wake-ups, burns idle CPU time). Absent = the system's idle states
+    /// are left alone. Needs write access to the device (root); refused → a warning.
+    #[serde(default)]
+    pub cpu_wakeup_latency_us: Option<u32>,
     pub rate_groups: Vec<RateGroup>,
     pub deadlines: Deadlines,
     pub lock_step: LockStep,
@@ -186,6 +198,17 @@ impl PartitionConfig {
         ms * scale / 1e3
     }
 
+    /// SCHED_FIFO priority of `role` in real-time mode (0 = normal scheduling).
+    pub fn priority_of(&self, role: &str) -> u32 {
+        if self.real_time_priority == 0 {
+            return 0;
+        }
+        self.roles
+            .get(role)
+            .and_then(|e| e.priority)
+            .unwrap_or(self.real_time_priority)
+    }
+
     /// Checks the schedule and roles.
     pub fn validate(&self) -> Result<(), ConfigError> {
         if !(self.handshake_timeout_s.is_finite() && self.handshake_timeout_s > 0.0) {
@@ -204,6 +227,20 @@ impl PartitionConfig {
             return err(format!(
                 "real_time_priority = {}: must be 0 (off) or 1..=99",
                 self.real_time_priority
+            ));
+        }
+        for (r, e) in &self.roles {
+            if let Some(p) = e.priority
+                && !(1..=99).contains(&p)
+            {
+                return err(format!("roles.{r}.priority = {p}: must be 1..=99"));
+            }
+        }
+        if let Some(us) = self.cpu_wakeup_latency_us
+            && us > 1_000_000
+        {
+            return err(format!(
+                "cpu_wakeup_latency_us = {us}: must be 0..=1000000 (µs; remove the key to leave the system alone)"
             ));
         }
         let d = &self.deadlines;

@@ -57,6 +57,9 @@ pub struct LaunchReport {
     pub leftovers: Vec<PathBuf>,
     /// Stale files of earlier dead runs removed at start-up.
     pub stale_removed: usize,
+    /// The CPU wake-up latency during the run (config `cpu_wakeup_latency_us`,
+    /// real-time mode only).
+    pub cpu_wakeup_latency: String,
     pub wall_s: f64,
 }
 
@@ -224,6 +227,19 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
         Some(id) => RunScope::new(id)?,
         None => RunScope::unique("run")?,
     };
+    // held until the launcher returns (after teardown)
+    let wakeup_request = match cfg.cpu_wakeup_latency_us {
+        Some(us) if cfg.clock == ClockMode::RealTime => Some(us),
+        _ => None,
+    };
+    let wakeup_held = match wakeup_request {
+        Some(us) => crate::pm_qos::CpuWakeupLatency::request(us)
+            .map_err(|e| format!("{}: {e}", crate::pm_qos::DEVICE)),
+        None => Err(String::new()),
+    };
+    if let (Some(_), Err(e)) = (wakeup_request, &wakeup_held) {
+        eprintln!("launch: warning: CPU wake-up latency not set ({e})");
+    }
     let stale_removed = clean_stale_runs(run.run_id());
     let _ = sc_bus::reap_dead_nodes(&run);
     let mut procs: Vec<Proc> = Vec::new();
@@ -367,6 +383,7 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
         interrupted,
         leftovers,
         stale_removed,
+        cpu_wakeup_latency: crate::pm_qos::describe(wakeup_request, &wakeup_held),
         wall_s: started.elapsed().as_secs_f64(),
     };
     std::fs::write(

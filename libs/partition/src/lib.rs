@@ -5,6 +5,7 @@
 //! * [`config`]: `config/partition.toml` — rate groups, deadlines, clock, roles.
 //! * [`roles`] / [`recorder`]: the loop of each process (thin binaries call them).
 //! * [`launcher`]: starts every process from the config, supervises, tears down.
+//! * [`pm_qos`]: the CPU wake-up latency request of real-time runs.
 //! * [`latency`]: the latency report of `safe-capture bench latency`.
 //!
 //! In lock-step mode with one rate group the partition calls exactly the stage
@@ -17,6 +18,7 @@ pub mod fallback;
 pub mod latency;
 pub mod launcher;
 pub mod mcap_out;
+pub mod pm_qos;
 pub mod process;
 pub mod recorder;
 pub mod roles;

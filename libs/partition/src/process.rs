@@ -57,8 +57,9 @@ impl Proc {
         let setup = Setup::load(&cfg.scenario_path())?;
         let run = RunScope::from_env()
             .context("SC_RUN_ID is not set (processes are started by the launcher)")??;
-        if cfg.clock == crate::ClockMode::RealTime && cfg.real_time_priority > 0 {
-            set_fifo(role, cfg.real_time_priority);
+        let prio = cfg.priority_of(role);
+        if cfg.clock == crate::ClockMode::RealTime && prio > 0 {
+            set_fifo(role, prio);
         }
         let node = run.node(role)?;
         Ok(Self {
@@ -106,10 +107,7 @@ pub fn wait(waiter: &Waiter, until: Option<Instant>) -> anyhow::Result<bool> {
         return Ok(true);
     }
     let r = waiter.wait_once(left, |_| {})?;
-    Ok(!matches!(
-        r,
-        WaitOutcome::TerminationRequest | WaitOutcome::Interrupt
-    ))
+    Ok(!matches!(r, WaitOutcome::TerminationRequest))
 }
 
 /// Sends, tolerating a dead or stuck subscriber (backpressure), which is reported.
