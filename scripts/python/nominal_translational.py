@@ -14,13 +14,15 @@ What a partner's controller has to do (every step below is in this file):
 
 1. join the run: iceoryx2 ``global.prefix`` = ``sc_<SC_RUN_ID>_`` (set by the launcher);
 2. create its ports: subscriber + listener on ``safe_capture/sim/state`` (SimState),
-   subscriber + listener on ``safe_capture/scheduler/tick`` (Tick, for the stop),
+   a subscriber without listener on ``safe_capture/scheduler/tick`` (Tick, read at
+   every wake-up for the stop; only the simulator listens to ticks),
    publisher + notifier on ``safe_capture/nominal/translational`` (NominalTranslational);
 3. announce itself on the start-up handshake until the scheduler's ``go``;
 4. for every SimState whose ``due_mask`` has the translational bit: compute f_H and
    publish it with the same ``tick``, then notify; the safety filter does the rest
    (the command may be unsafe: the filter keeps the servicer safe);
-5. exit on a Tick with ``command == 1`` (stop), deleting ports before the node.
+5. exit on a Tick with ``command == 1`` (stop), after notifying once more (the
+   filter wakes and sees the stop too), deleting ports before the node.
 
 The law here is deliberately simple: a PD towards the Go-for-Capture point on the
 corridor axis, f_H = m (-kp e - kd v_H), in the Hill frame, switched off in phases
@@ -144,26 +146,27 @@ def main():
     state_svc = open_pubsub(node, sc_icd.SERVICE_SIM_STATE, sc_icd.SimState)
     state_ev = data_event(node, sc_icd.SERVICE_SIM_STATE)
     tick_svc = open_pubsub(node, sc_icd.SERVICE_TICK, sc_icd.Tick)
-    tick_ev = data_event(node, sc_icd.SERVICE_TICK)
     cmd_svc = open_pubsub(node, sc_icd.SERVICE_NOMINAL_TRANSLATIONAL, sc_icd.NominalTranslational)
     cmd_ev = data_event(node, sc_icd.SERVICE_NOMINAL_TRANSLATIONAL)
     state_sub = state_svc.subscriber_builder().create()
     state_lis = state_ev.listener_builder().create()
+    # no listener on the tick: only the simulator wakes on ticks (every listener
+    # costs the scheduler one wake-up message per tick); the tick queue is read at
+    # every wake-up for the stop
     tick_sub = tick_svc.subscriber_builder().create()
-    tick_lis = tick_ev.listener_builder().create()
     pub = cmd_svc.publisher_builder().create()
     notifier = cmd_ev.notifier_builder().default_event_id(iox2.EventId.new(sc_icd.EVENT_SAMPLE)).create()
-    ports = [state_sub, state_lis, tick_sub, tick_lis, pub, notifier]
+    ports = [state_sub, state_lis, tick_sub, pub, notifier]
     handled = 0
     try:
         if not handshake(node, sc_icd.ROLE_NOMINAL_TRANSLATIONAL):
             print("nominal_translational.py: handshake timed out", file=sys.stderr)
             return 1
         while True:
-            # sleep until a state arrives (event wake-up); the timeout only bounds
-            # how late the final stop tick (sent when no more states come) is seen
+            # sleep until a state arrives (event wake-up; the simulator also wakes
+            # us once when it stops); the timeout only bounds how late the stop is
+            # seen if the simulator died
             state_lis.timed_wait(iox2.Duration.from_millis(100))
-            tick_lis.try_wait()
             while True:
                 sample = state_sub.receive()
                 if sample is None:
@@ -196,12 +199,13 @@ def main():
                 stop |= sample.payload().contents.command == sc_icd.TICK_STOP
                 sample.delete()
             if stop:
+                notifier.notify()  # wake the safety filter once so that it sees the stop too
                 print(f"nominal_translational.py: handled {handled} states", file=sys.stderr)
                 return 0
     finally:
         for p in ports:
             p.delete()
-        del state_svc, state_ev, tick_svc, tick_ev, cmd_svc, cmd_ev
+        del state_svc, state_ev, tick_svc, cmd_svc, cmd_ev
         del node
 
 

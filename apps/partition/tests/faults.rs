@@ -165,16 +165,10 @@ fn killed_recorder_aborts_the_run() {
 
 /// A hung (SIGSTOPped) robotic filter: its missed deadlines put the robotic
 /// subsystem on the fallback applied by the simulator; the launcher kills it at
-/// teardown; nothing is left behind.
-///
-/// KNOWN DEFECT (open): while the stopped filter's subscriber queue is full, a SimState
-/// send can report `UnableToDeliver` and the recorder occasionally misses that tick's
-/// sample (seen: 1 of 601 rows lost, "no state recorded, step skipped" in the recorder
-/// log), so the telemetry is not gap-free. The fallback and fault detection work; the
-/// gap-free assertion fails. Kept as the reproducer: `cargo test -p sc-partition-apps
-/// --test faults -- --ignored`.
+/// teardown; nothing is left behind; the telemetry is gap-free and the recorder lost
+/// nothing that was sent: the stopped filter's full queues make its publishers drop
+/// samples for *it* after the backpressure timeout, never for the recorder.
 #[test]
-#[ignore = "known defect: a hung subscriber can cost the recorder one SimState sample"]
 fn hung_robotic_filter_is_detected_by_deadlines() {
     let dir = tmp("hung");
     let out = dir.join("out");
@@ -197,5 +191,12 @@ fn hung_robotic_filter_is_detected_by_deadlines() {
     let f = flagged_steps(&out, "robotic");
     let first = *f.first().expect("robotic steps flagged");
     assert_eq!(f, (first..=600).collect::<Vec<u64>>());
+    let rec: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("recorder.json")).unwrap()).unwrap();
+    for (service, n) in rec["missing"].as_object().unwrap() {
+        if service != "safe_capture/safe/robotic" {
+            assert_eq!(n, 0, "recorder missed samples of {service}: {rec}");
+        }
+    }
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -1,33 +1,50 @@
 //! The third-party Python nominal translational controller (iceoryx2 PyPI package)
 //! replaces the Rust role from config and the mission runs through it to capture.
-//! Skipped, with the reason printed, when scripts/.venv is missing (CI creates it:
-//! `python3 -m venv scripts/.venv && scripts/.venv/bin/pip install -r scripts/requirements.txt`).
+//! The interpreter is `SC_PYTHON` (set by scripts/test.sh, which creates the venv; then
+//! a missing or broken interpreter fails the test), else scripts/.venv/bin/python;
+//! without either the test is skipped, with the reason printed.
 
 mod common;
 use common::*;
 
 #[test]
 fn python_nominal_controller_runs_the_mission() {
-    let py = repo().join("scripts/.venv/bin/python");
-    if !py.exists() {
-        eprintln!(
-            "SKIPPED: {} missing (create the venv from scripts/requirements.txt)",
-            py.display()
-        );
-        return;
-    }
+    let required = std::env::var_os("SC_PYTHON");
+    let py = required
+        .clone()
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| repo().join("scripts/.venv/bin/python"));
     let ok = std::process::Command::new(&py)
         .args(["-c", "import iceoryx2"])
         .status()
         .map(|s| s.success());
     if ok.ok() != Some(true) {
-        eprintln!("SKIPPED: iceoryx2 is not installed in {}", py.display());
+        assert!(
+            required.is_none(),
+            "SC_PYTHON={} cannot import iceoryx2",
+            py.display()
+        );
+        eprintln!(
+            "SKIPPED: no python with iceoryx2 at {} (create the venv from scripts/requirements.txt or set SC_PYTHON)",
+            py.display()
+        );
         return;
     }
     let dir = tmp("python");
     let out = dir.join("out");
     let config = repo().join("config/partition_python.toml");
-    let rep = sc_partition::launch(&options(&config, &out, "py")).unwrap();
+    let mut opts = options(&config, &out, "py");
+    opts.role_override.push((
+        "nominal_translational".into(),
+        py.display().to_string(),
+        vec![
+            repo()
+                .join("scripts/python/nominal_translational.py")
+                .display()
+                .to_string(),
+        ],
+    ));
+    let rep = sc_partition::launch(&opts).unwrap();
     assert_clean(&rep, &out);
     assert_eq!(rep.code, 0, "{rep:?}");
     let s = summary(&out);
