@@ -10,6 +10,8 @@ mod cmd_model;
 mod cmd_montecarlo;
 mod cmd_run;
 mod cmd_simulate;
+// `montecarlo --mode partition`: runs through the process partition
+mod montecarlo_partition;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
