@@ -39,7 +39,8 @@ enum Command {
     Launch(cmd_launch::Args),
     /// Benchmarks: simulator speed, safety-layer solve times, partition latency.
     Bench(cmd_bench::Args),
-    /// Monte Carlo campaigns: dispersed runs in parallel, shards, merge, rerun.
+    /// Monte Carlo campaigns: dispersed runs in parallel (in-process or through the
+    /// process partition), shards, merge, rerun.
     Montecarlo(cmd_montecarlo::Args),
 }
 

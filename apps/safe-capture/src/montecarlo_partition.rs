@@ -254,6 +254,20 @@ impl Executor for PartitionExecutor {
                 rec_path.display()
             ));
         }
+        // a state sample the recorder never got is a step missing from the telemetry
+        let sched_path = out.join("scheduler.json");
+        let sched: serde_json::Value = serde_json::from_str(&read(&sched_path)?)
+            .map_err(|e| format!("partition: {}: {e}", sched_path.display()))?;
+        let ticks = sched["ticks"]
+            .as_u64()
+            .ok_or_else(|| format!("partition: {}: no `ticks`", sched_path.display()))?;
+        if records.len() as u64 != ticks {
+            return Err(format!(
+                "partition: the recorder wrote {} steps of the scheduler's {ticks} ticks ({}): the telemetry is incomplete",
+                records.len(),
+                out.join("logs/recorder.log").display()
+            ));
+        }
         if let Some((i, r)) = records
             .iter()
             .enumerate()
