@@ -1,20 +1,25 @@
 //! `safe-capture montecarlo`: dispersed campaigns, in parallel, sharded, merged, rerun.
 
+use crate::montecarlo_partition::PartitionExecutor;
 use anyhow::Context;
 use sc_mission::{RunOptions, TelemetryWriter, summarize};
-use sc_montecarlo::{CampaignOptions, CampaignSummary, MonteCarloConfig};
+use sc_montecarlo::{CampaignOptions, CampaignSummary, Executor, InProcess, MonteCarloConfig};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Monte Carlo campaign over dispersed initial positions (inside the approach corridor)
-/// and target tumbling rates (config/montecarlo.toml). Runs in parallel in one process;
-/// every run's seed derives from (--seed, run index), so shards and reruns reproduce
-/// exactly.
+/// and target tumbling rates (config/montecarlo.toml). Runs in parallel in one process,
+/// or with --mode partition each run through the process partition (one process per
+/// module, lock-step; same results as in-process except the solve times); every run's
+/// seed derives from (--seed, run index), so shards and reruns reproduce exactly.
 ///
 /// Writes to OUT: runs/K/ (scenario.toml, result.json, trace.csv, timing.json per run),
 /// runs.csv, runs_timing.csv, summary.json, report.md, figures/*.svg. Exit code 0 when
 /// every run completed safe and captured, 1 otherwise, 2 on errors.
+/// Partition config of --mode partition unless --partition-config is given.
+const DEFAULT_PARTITION_CONFIG: &str = "config/partition.toml";
+
 #[derive(clap::Args)]
 #[command(args_conflicts_with_subcommands = true)]
 pub struct Args {
@@ -37,7 +42,9 @@ enum Action {
 enum Mode {
     /// Simulator, nominal controllers and filters in one process.
     InProcess,
-    /// Through the process partition (not available yet).
+    /// Each run through the process partition (one process per module, iceoryx2,
+    /// lock-step): the deployed configuration. Results equal in-process runs except the
+    /// solve times (with a partition config of one rate group at the control period).
     Partition,
 }
 
@@ -49,7 +56,8 @@ struct RunArgs {
     /// Campaign seed.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Worker threads (default: all cores).
+    /// Runs at a time (default: all cores in-process; 1 with --mode partition, where a
+    /// run is nine processes).
     #[arg(long, short)]
     jobs: Option<usize>,
     /// Output directory.
@@ -67,6 +75,15 @@ struct RunArgs {
     /// Where the runs execute.
     #[arg(long, value_enum, default_value_t = Mode::InProcess)]
     mode: Mode,
+    /// With --mode partition: the partition config (schedule, deadlines, executables;
+    /// default config/partition.toml). Each run replaces its scenario and runs lock-step
+    /// to the end of the mission.
+    #[arg(long, value_name = "FILE")]
+    partition_config: Option<PathBuf>,
+    /// With --mode partition: keep every run's telemetry.csv, timing.csv, recording.mcap
+    /// and latency.csv in runs/K/partition/ (several MB per run; removed otherwise).
+    #[arg(long)]
+    keep_recordings: bool,
     /// No progress bar.
     #[arg(long, short)]
     quiet: bool,
@@ -112,10 +129,13 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
 }
 
 fn campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
-    if a.mode == Mode::Partition {
-        anyhow::bail!(
-            "--mode partition is not available yet: the process partition (sc-partition) exposes no run function; use --mode in-process"
-        );
+    if a.mode == Mode::InProcess {
+        if a.partition_config.is_some() {
+            anyhow::bail!("--partition-config needs --mode partition");
+        }
+        if a.keep_recordings {
+            anyhow::bail!("--keep-recordings needs --mode partition");
+        }
     }
     let config = MonteCarloConfig::load(&a.config)?;
     let shard = a
@@ -136,9 +156,24 @@ fn campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
         // keep the injected panics' messages off the progress bar; they are recorded
         std::panic::set_hook(Box::new(|_| {}));
     }
-    let jobs = a
-        .jobs
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let jobs = a.jobs.unwrap_or_else(|| match a.mode {
+        Mode::InProcess => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        Mode::Partition => 1,
+    });
+    let executor: Box<dyn Executor> = match a.mode {
+        Mode::InProcess => Box::new(InProcess),
+        Mode::Partition => {
+            let config = a
+                .partition_config
+                .clone()
+                .unwrap_or_else(|| PathBuf::from(DEFAULT_PARTITION_CONFIG));
+            let (executor, note) = PartitionExecutor::new(&config, a.keep_recordings, &a.scenario)?;
+            if let Some(n) = note {
+                eprintln!("{n}");
+            }
+            Box::new(executor)
+        }
+    };
     let opts = CampaignOptions {
         scenario: a.scenario,
         config,
@@ -150,7 +185,7 @@ fn campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
         inject_panic: inject,
         progress: !a.quiet,
     };
-    let s = sc_montecarlo::run_campaign(&opts)?;
+    let s = sc_montecarlo::run_campaign_with(&opts, executor.as_ref())?;
     Ok(report(&s, &a.out))
 }
 

@@ -10,6 +10,8 @@ mod cmd_model;
 mod cmd_montecarlo;
 mod cmd_run;
 mod cmd_simulate;
+// `montecarlo --mode partition`: runs through the process partition
+mod montecarlo_partition;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -37,7 +39,8 @@ enum Command {
     Launch(cmd_launch::Args),
     /// Benchmarks: simulator speed, safety-layer solve times, partition latency.
     Bench(cmd_bench::Args),
-    /// Monte Carlo campaigns: dispersed runs in parallel, shards, merge, rerun.
+    /// Monte Carlo campaigns: dispersed runs in parallel (in-process or through the
+    /// process partition), shards, merge, rerun.
     Montecarlo(cmd_montecarlo::Args),
 }
 

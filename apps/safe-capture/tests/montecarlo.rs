@@ -1,8 +1,10 @@
-//! `safe-capture montecarlo` (campaign, rerun, merge, injected failure, --mode partition)
-//! and the figures of `safe-capture run`, on short missions.
+//! `safe-capture montecarlo` (campaign, rerun, merge, injected failure, --mode partition
+//! against in-process) and the figures of `safe-capture run`, mostly on short missions.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::{Command, Output, Stdio};
+use std::sync::{Mutex, MutexGuard, OnceLock};
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -40,6 +42,15 @@ fn cli(args: &[&str], env: &[(&str, &str)]) -> Output {
     c.output().unwrap()
 }
 
+/// Held by the tests that keep the CPU busy, one at a time: a partition in lock-step
+/// is nine processes handing every tick on, and its recorder gives up on a sample that
+/// reaches it more than 200 ms late (the run then fails), which an overloaded 2-core
+/// machine can cause.
+fn exclusive() -> MutexGuard<'static, ()> {
+    static CPU: Mutex<()> = Mutex::new(());
+    CPU.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 fn text(o: &Output) -> String {
     format!(
         "{}{}",
@@ -50,6 +61,7 @@ fn text(o: &Output) -> String {
 
 #[test]
 fn campaign_rerun_and_merge_from_the_command_line() {
+    let _cpu = exclusive();
     let d = tmp("cli");
     let sc = short_scenario(&d, 2.0);
     let sc = sc.to_str().unwrap();
@@ -181,6 +193,7 @@ fn campaign_rerun_and_merge_from_the_command_line() {
 
 #[test]
 fn an_injected_panic_is_reported_and_the_campaign_completes() {
+    let _cpu = exclusive();
     let d = tmp("inject");
     let sc = short_scenario(&d, 1.0);
     let out = d.join("c");
@@ -215,8 +228,45 @@ fn an_injected_panic_is_reported_and_the_campaign_completes() {
 #[test]
 fn bad_montecarlo_arguments_are_one_line_errors() {
     let d = tmp("args");
-    let cases: [&[&str]; 4] = [
-        &["montecarlo", "--mode", "partition", "--runs", "1"],
+    let missing_exec = d.join("partition.toml");
+    std::fs::write(
+        &missing_exec,
+        std::fs::read_to_string(root().join("config/partition.toml"))
+            .unwrap()
+            .replace(
+                "scenario = \"scenario.toml\"",
+                &format!(
+                    "scenario = \"{}\"",
+                    root().join("config/scenario.toml").display()
+                ),
+            )
+            .replace(
+                "exec = \"sc-scheduler\"",
+                "exec = \"/nonexistent/sc-scheduler\"",
+            ),
+    )
+    .unwrap();
+    let missing_exec = missing_exec.to_str().unwrap();
+    let cases: [&[&str]; 6] = [
+        &[
+            "montecarlo",
+            "--mode",
+            "partition",
+            "--partition-config",
+            "/nonexistent/partition.toml",
+            "--runs",
+            "1",
+        ],
+        &[
+            "montecarlo",
+            "--mode",
+            "partition",
+            "--partition-config",
+            missing_exec,
+            "--runs",
+            "1",
+        ],
+        &["montecarlo", "--keep-recordings", "--runs", "1"],
         &["montecarlo", "--shard", "2/2", "--runs", "1"],
         &[
             "montecarlo",
@@ -228,7 +278,9 @@ fn bad_montecarlo_arguments_are_one_line_errors() {
         &["montecarlo", "rerun", "/nonexistent/campaign", "--run", "0"],
     ];
     let expect = [
-        "not available yet",
+        "/nonexistent/partition.toml",
+        "the executable /nonexistent/sc-scheduler of role `scheduler` does not exist",
+        "--keep-recordings needs --mode partition",
         "2/2",
         "/nonexistent/mc.toml",
         "/nonexistent/campaign",
@@ -249,6 +301,7 @@ fn bad_montecarlo_arguments_are_one_line_errors() {
 
 #[test]
 fn run_writes_figures_with_the_nominal_comparison() {
+    let _cpu = exclusive();
     let d = tmp("run");
     let sc = short_scenario(&d, 3.0);
     let out = d.join("r");
@@ -300,6 +353,281 @@ fn run_writes_figures_with_the_nominal_comparison() {
         !std::fs::read_to_string(out2.join("figures/barriers.svg"))
             .unwrap()
             .contains("nominal")
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// The partition's executables (package sc-partition-apps), built with this test's
+/// profile into its target directory, beside the safe-capture under test, which looks
+/// for them next to itself. `CARGO_BIN_EXE_*` only names this package's binaries, so
+/// cargo builds them once per test binary (a no-op when they are up to date, e.g. under
+/// `cargo test --workspace`; safe-capture is named too so that the features, and so the
+/// artifacts, are this build's).
+fn partition_bin_dir() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let exe = Path::new(env!("CARGO_BIN_EXE_safe-capture"));
+        let dir = exe.parent().unwrap().to_path_buf();
+        let profile_dir = dir.file_name().unwrap().to_str().unwrap().to_string();
+        let mut c = Command::new(env!("CARGO"));
+        c.current_dir(root())
+            .args(["build", "--quiet", "--bins", "-p", "sc-partition-apps"])
+            .args(["-p", "safe-capture", "--target-dir"])
+            .arg(dir.parent().unwrap());
+        match profile_dir.as_str() {
+            "debug" => c.args(["--profile", "test"]),
+            "release" => c.arg("--release"),
+            p => c.args(["--profile", p]),
+        };
+        let o = c.output().unwrap();
+        assert!(
+            o.status.success(),
+            "building the partition's executables failed: {}",
+            text(&o)
+        );
+        for b in [
+            "sc-scheduler",
+            "sc-simulator",
+            "sc-recorder",
+            "sc-safety-robotic",
+        ] {
+            assert!(dir.join(b).is_file(), "{b} missing in {}", dir.display());
+        }
+        dir
+    })
+}
+
+/// Runs the CLI with the partition's executables of this build; returns its output and pid.
+fn cli_partition(args: &[&str], env: &[(&str, &str)]) -> (Output, u32) {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_safe-capture"));
+    c.current_dir(root())
+        .args(args)
+        .env("SC_PARTITION_BIN_DIR", partition_bin_dir())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    let child = c.spawn().unwrap();
+    let pid = child.id();
+    (child.wait_with_output().unwrap(), pid)
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap())
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// Nothing of the campaign process `pid` left in /dev/shm (run ids `mc<K>-<pid>-…`).
+fn assert_no_shm_leftovers(pid: u32) {
+    let left: Vec<String> = std::fs::read_dir("/dev/shm")
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with("sc_mc") && n.contains(&format!("-{pid}-")))
+        .collect();
+    assert!(left.is_empty(), "left in /dev/shm: {left:?}");
+}
+
+/// `runs.csv` as run → (column → value).
+fn runs_csv(dir: &Path) -> (Vec<String>, BTreeMap<String, BTreeMap<String, String>>) {
+    let text = std::fs::read_to_string(dir.join("runs.csv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    let mut rows = BTreeMap::new();
+    for l in lines {
+        // no quoted fields in completed runs (the error column is empty)
+        let f: Vec<&str> = l.split(',').collect();
+        assert_eq!(f.len(), header.len(), "{l}");
+        let row: BTreeMap<String, String> = header
+            .iter()
+            .cloned()
+            .zip(f.iter().map(|x| x.to_string()))
+            .collect();
+        rows.insert(row["run"].clone(), row);
+    }
+    (header, rows)
+}
+
+/// The issue's guarantee: a campaign through the process partition gives exactly the
+/// in-process results (every per-run row field, result.json, trace, summary, figures);
+/// only the wall-clock outputs (solve times, wall time) differ. Full missions, so
+/// capture and capture time are compared too; one partition at a time (the default).
+#[test]
+fn partition_mode_gives_exactly_the_in_process_results() {
+    let _cpu = exclusive();
+    let d = tmp("partition");
+    let (inp, part) = (d.join("in-process"), d.join("partition"));
+    let common = ["montecarlo", "--runs", "3", "--seed", "2", "-q"];
+    let o = cli(
+        &[&common[..], &["--out", inp.to_str().unwrap()]].concat(),
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let args = [
+        &common[..],
+        &["--mode", "partition", "--out", part.to_str().unwrap()],
+    ]
+    .concat();
+    let (o, pid) = cli_partition(&args, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let t = text(&o);
+    assert!(
+        t.contains("3 runs (seed 2): 3 safe, 3 captured, 0 failed"),
+        "{t}"
+    );
+    assert!(!t.contains("launch:"), "the launcher must be quiet: {t}");
+    assert_no_shm_leftovers(pid);
+
+    // every per-run row, field by field (runs.csv holds no wall-clock column)
+    let (hi, ri) = runs_csv(&inp);
+    let (hp, rp) = runs_csv(&part);
+    assert_eq!(hi, hp);
+    assert_eq!(ri.len(), 3);
+    for (run, row) in &ri {
+        for col in &hi {
+            assert_eq!(
+                row[col], rp[run][col],
+                "run {run}, column {col}: in-process {} vs partition {}",
+                row[col], rp[run][col]
+            );
+        }
+        assert_eq!(row["captured"], "true", "run {run}");
+    }
+    for k in 0..3 {
+        let (a, b) = (
+            inp.join(format!("runs/{k}")),
+            part.join(format!("runs/{k}")),
+        );
+        for f in ["result.json", "trace.csv", "scenario.toml"] {
+            assert_eq!(
+                std::fs::read(a.join(f)).unwrap(),
+                std::fs::read(b.join(f)).unwrap(),
+                "runs/{k}/{f} differs"
+            );
+        }
+        // the solve times are the partition filters' own, one per step
+        let steps = json(&b.join("result.json"))["metrics"]["steps"]
+            .as_u64()
+            .unwrap();
+        let timing = json(&b.join("timing.json"));
+        assert_eq!(timing["stats"]["total"]["samples"].as_u64(), Some(steps));
+        // evidence of the launch; the large recordings are not kept by default
+        let pd = b.join("partition");
+        let launch = json(&pd.join("launch.json"));
+        assert_eq!(launch["code"], 0, "{launch}");
+        assert_eq!(launch["leftovers"].as_array().unwrap().len(), 0, "{launch}");
+        assert_eq!(launch["exits"].as_array().unwrap().len(), 9, "{launch}");
+        let rid = launch["run_id"].as_str().unwrap();
+        assert!(rid.starts_with(&format!("mc{k}-{pid}-")), "{rid}");
+        let rec = json(&pd.join("recorder.json"));
+        assert_eq!(rec["steps"].as_u64(), Some(steps));
+        assert!(
+            rec["missing"].as_object().unwrap().values().all(|v| v == 0),
+            "{rec}"
+        );
+        assert!(!pd.join("telemetry.csv").exists() && !pd.join("recording.mcap").exists());
+    }
+    let strip = |mut v: serde_json::Value| {
+        for k in ["solve_time_us", "wall_time_s"] {
+            v.as_object_mut().unwrap().remove(k);
+        }
+        v
+    };
+    assert_eq!(
+        strip(json(&inp.join("summary.json"))),
+        strip(json(&part.join("summary.json")))
+    );
+    for f in [
+        "trajectories_xy.svg",
+        "attitude_los.svg",
+        "torque_vs_sync.svg",
+        "barrier_minima.svg",
+    ] {
+        assert_eq!(
+            std::fs::read(inp.join("figures").join(f)).unwrap(),
+            std::fs::read(part.join("figures").join(f)).unwrap(),
+            "figures/{f} differs"
+        );
+    }
+    assert_eq!(json(&part.join("campaign.json"))["execution"], "partition");
+    assert!(
+        std::fs::read_to_string(part.join("report.md"))
+            .unwrap()
+            .contains("through the process partition")
+    );
+    // and the in-process rerun of a partition run reproduces it exactly
+    let o = cli(
+        &[
+            "montecarlo",
+            "rerun",
+            part.to_str().unwrap(),
+            "--run",
+            "1",
+            "--no-figures",
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    assert!(text(&o).contains("reproduced exactly"), "{}", text(&o));
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// A partition launch that fails is a failed run with its reason; the other runs
+/// complete, two partitions at a time (each with its own run id); nothing is left in
+/// /dev/shm. `--keep-recordings` keeps the telemetry.
+#[test]
+fn a_failed_partition_launch_is_a_failed_run_and_the_campaign_goes_on() {
+    let _cpu = exclusive();
+    let d = tmp("partition-fail");
+    let sc = short_scenario(&d, 1.0);
+    let out = d.join("c");
+    let (o, pid) = cli_partition(
+        &[
+            "montecarlo",
+            "--mode",
+            "partition",
+            "--runs",
+            "3",
+            "--scenario",
+            sc.to_str().unwrap(),
+            "--keep-recordings",
+            "--jobs",
+            "2",
+            "--out",
+            out.to_str().unwrap(),
+            "-q",
+        ],
+        &[("SC_MONTECARLO_INJECT_PANIC", "1")],
+    );
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    let t = text(&o);
+    assert!(
+        t.contains("3 runs (seed 1): 2 safe, 0 captured, 1 failed")
+            && t.contains("run 1 failed: partition: cannot start role `simulator`"),
+        "{t}"
+    );
+    assert_no_shm_leftovers(pid);
+    let r = json(&out.join("runs/1/result.json"));
+    assert_eq!(r["status"], "failed");
+    let launch = json(&out.join("runs/1/partition/launch.json"));
+    assert_eq!(launch["code"], 3, "{launch}");
+    assert_eq!(launch["leftovers"].as_array().unwrap().len(), 0, "{launch}");
+    for k in [0, 2] {
+        let pd = out.join(format!("runs/{k}/partition"));
+        for f in [
+            "telemetry.csv",
+            "timing.csv",
+            "recording.mcap",
+            "latency.csv",
+        ] {
+            assert!(pd.join(f).is_file(), "runs/{k}/partition/{f} not kept");
+        }
+    }
+    let s = json(&out.join("summary.json"));
+    assert_eq!(
+        (s["runs"].as_u64(), s["failed_runs"].as_u64()),
+        (Some(3), Some(1))
     );
     let _ = std::fs::remove_dir_all(&d);
 }

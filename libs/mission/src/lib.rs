@@ -12,7 +12,7 @@ pub mod stages;
 pub mod summary;
 
 pub use mission::{Mission, MissionEnd, RunOptions, capture_check, timeout_check};
-pub use record::{StepRecord, TelemetryWriter, telemetry_columns, timing_columns};
+pub use record::{StepRecord, TelemetryWriter, parse_telemetry, telemetry_columns, timing_columns};
 pub use setup::{Setup, SetupError};
 pub use summary::{Summary, summarize};
 

@@ -26,6 +26,40 @@ pub enum MissionEnd {
     SimulatorFailed { t: f64, message: String },
 }
 
+impl MissionEnd {
+    /// The name in `summary.json`: "captured", "timeout" or "simulator_failed".
+    pub fn name(&self) -> &'static str {
+        match self {
+            MissionEnd::Captured { .. } => "captured",
+            MissionEnd::Timeout { .. } => "timeout",
+            MissionEnd::SimulatorFailed { .. } => "simulator_failed",
+        }
+    }
+
+    /// The mission time of the last step [s].
+    pub fn t(&self) -> f64 {
+        match self {
+            MissionEnd::Captured { t }
+            | MissionEnd::Timeout { t }
+            | MissionEnd::SimulatorFailed { t, .. } => *t,
+        }
+    }
+
+    /// The end named `name` (see [`Self::name`]) at `t`; `None` for an unknown name.
+    /// A simulator failure rebuilt this way carries no message of its own.
+    pub fn from_name(name: &str, t: f64) -> Option<Self> {
+        match name {
+            "captured" => Some(MissionEnd::Captured { t }),
+            "timeout" => Some(MissionEnd::Timeout { t }),
+            "simulator_failed" => Some(MissionEnd::SimulatorFailed {
+                t,
+                message: "simulator failed".into(),
+            }),
+            _ => None,
+        }
+    }
+}
+
 /// Simulator + nominal controllers + safety layer, stepped at the control period.
 pub struct Mission {
     pub setup: Setup,

@@ -205,3 +205,287 @@ impl<W: Write> TelemetryWriter<W> {
         self.timing.flush()
     }
 }
+
+/// Bit-for-bit equality of two floats (NaN equals NaN).
+fn same_bits(a: f64, b: f64) -> bool {
+    a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
+}
+
+/// The comma-separated fields of one CSV line, read in order.
+struct Fields<'a> {
+    file: &'static str,
+    line: usize,
+    names: &'a [String],
+    fields: Vec<&'a str>,
+    next: usize,
+}
+
+impl<'a> Fields<'a> {
+    fn new(
+        file: &'static str,
+        line: usize,
+        text: &'a str,
+        names: &'a [String],
+    ) -> Result<Self, String> {
+        let fields: Vec<&str> = text.split(',').collect();
+        if fields.len() != names.len() {
+            return Err(format!(
+                "{file} line {line}: {} fields, the header has {}",
+                fields.len(),
+                names.len()
+            ));
+        }
+        Ok(Self {
+            file,
+            line,
+            names,
+            fields,
+            next: 0,
+        })
+    }
+
+    fn raw(&mut self) -> (&'a str, &'a str) {
+        let i = self.next;
+        self.next += 1;
+        (self.fields[i], self.names[i].as_str())
+    }
+
+    fn parse<T: std::str::FromStr>(&mut self, what: &str) -> Result<T, String> {
+        let (v, name) = self.raw();
+        v.parse().map_err(|_| {
+            format!(
+                "{} line {}: `{name}` = `{v}` is not {what}",
+                self.file, self.line
+            )
+        })
+    }
+
+    fn f(&mut self) -> Result<f64, String> {
+        self.parse("a number")
+    }
+
+    fn array<const N: usize>(&mut self) -> Result<[f64; N], String> {
+        let mut a = [0.0; N];
+        for x in a.iter_mut() {
+            *x = self.f()?;
+        }
+        Ok(a)
+    }
+
+    fn v3(&mut self) -> Result<Vector3<f64>, String> {
+        Ok(Vector3::from(self.array::<3>()?))
+    }
+
+    fn v7(&mut self) -> Result<Vector7, String> {
+        Ok(Vector7::from(self.array::<7>()?))
+    }
+
+    /// A solve time written in µs (of whole ns, see [`timing_line`]) back in ns.
+    fn ns(&mut self) -> Result<u64, String> {
+        let us = self.f()?;
+        if !(us.is_finite() && us >= 0.0) {
+            return Err(format!(
+                "{} line {}: solve time {us} us is not a finite number >= 0",
+                self.file, self.line
+            ));
+        }
+        Ok((us * 1e3).round() as u64)
+    }
+
+    fn check(&self, what: &str, ok: bool) -> Result<(), String> {
+        if ok {
+            Ok(())
+        } else {
+            Err(format!(
+                "{} line {}: {what} does not match the state it derives from (a corrupt file or another version)",
+                self.file, self.line
+            ))
+        }
+    }
+}
+
+fn status_of(v: u8, file: &'static str, line: usize) -> Result<sc_cbf::FilterStatus, String> {
+    use sc_cbf::FilterStatus as S;
+    [S::Skipped, S::Solved, S::Relaxed, S::Fallback]
+        .into_iter()
+        .find(|s| *s as u8 == v)
+        .ok_or_else(|| format!("{file} line {line}: filter status {v} is not one of 0..=3"))
+}
+
+/// Rebuilds the records of a run from its `telemetry.csv` and `timing.csv` (as written
+/// by [`TelemetryWriter`], by `safe-capture run` or the partition's recorder), e.g. to
+/// measure a run that executed in other processes.
+///
+/// Everything the files hold comes back with the same bits (floats are written in
+/// shortest round-trip form, solve times in µs of whole ns), hence so does everything
+/// [`crate::summarize`] reads. With `filtered` (the filters were in the loop) the
+/// attitude and robotic filters' safe commands are the applied ones and the
+/// translational one's actuated force is the applied force; without, they are NaN.
+/// `obs.grasp_b` is recomputed from the attitude and positions
+/// ([`Observation::grasp_in_base`]), the derived columns (synchronisation error, grasp
+/// distance) are checked against the state they come from. Not in the files, so NaN:
+/// the CBF conditions φ and the relaxed-QP slack, the Hill frame's attitude and rates,
+/// the mean motion, the target's angular acceleration, the grasping point's velocity
+/// and acceleration, the end-effector in F_B and its velocity.
+pub fn parse_telemetry(
+    telemetry: &str,
+    timing: &str,
+    filtered: bool,
+) -> Result<Vec<StepRecord>, String> {
+    let tel_names = telemetry_columns();
+    let tim_names = timing_columns();
+    let mut tel = telemetry.lines();
+    let mut tim = timing.lines();
+    if tel.next() != Some(tel_names.join(",").as_str()) {
+        return Err("telemetry.csv: the header is not this version's columns".into());
+    }
+    if tim.next() != Some(tim_names.join(",").as_str()) {
+        return Err("timing.csv: the header is not this version's columns".into());
+    }
+    let nan3 = Vector3::from_element(f64::NAN);
+    let mut out = Vec::new();
+    for (i, line) in tel.enumerate() {
+        let n = i + 2;
+        let mut c = Fields::new("telemetry.csv", n, line, &tel_names)?;
+        let step: u64 = c.parse("a step number")?;
+        let t = c.f()?;
+        let phase: usize = c.parse("a phase index")?;
+        let r_h = c.v3()?;
+        let v_h = c.v3()?;
+        let r_r = c.v3()?;
+        let v_r = c.v3()?;
+        let q_rb = c.array::<4>()?;
+        let omega_b = c.v3()?;
+        let theta = c.v7()?;
+        let theta_dot = c.v7()?;
+        let q_rt = c.array::<4>()?;
+        let omega_t = c.v3()?;
+        let sync_error = c.v3()?;
+        let grasp_distance = c.f()?;
+        let ee_r = c.v3()?;
+        let grasp_r = c.v3()?;
+        let obs = Observation {
+            step,
+            t,
+            r_h,
+            v_h,
+            r_r,
+            v_r,
+            q_hr: [f64::NAN; 4],
+            omega_h: nan3,
+            omega_dot_h: nan3,
+            mean_motion: f64::NAN,
+            q_rb,
+            omega_b,
+            theta,
+            theta_dot,
+            q_rt,
+            omega_t,
+            omega_dot_t: nan3,
+            grasp_r,
+            grasp_v_r: nan3,
+            grasp_a_r: nan3,
+            grasp_b: Observation::grasp_in_base(&q_rb, &r_r, &grasp_r),
+            ee_b: nan3,
+            ee_r,
+            ee_v_r: nan3,
+        };
+        let s = obs.sync_error();
+        c.check(
+            "sync_error_b",
+            (0..3).all(|k| same_bits(s[k], sync_error[k])),
+        )?;
+        c.check(
+            "grasp_distance_m",
+            same_bits(obs.grasp_distance(), grasp_distance),
+        )?;
+        let f_h_nom = c.v3()?;
+        let tau_b_nom = c.v3()?;
+        let tau_m_nom = c.v7()?;
+        let f_h_safe = c.v3()?;
+        let applied = Command {
+            force_b: c.v3()?,
+            torque_b: c.v3()?,
+            tau: c.v7()?,
+        };
+        let mut translational = sc_cbf::TranslationalOutput {
+            u: f_h_safe,
+            actuated: if filtered { applied.force_b } else { nan3 },
+            report: Default::default(),
+        };
+        let mut attitude = sc_cbf::AttitudeOutput {
+            u: if filtered { applied.torque_b } else { nan3 },
+            actuated: if filtered { applied.torque_b } else { nan3 },
+            report: Default::default(),
+        };
+        let nan7 = Vector7::from_element(f64::NAN);
+        let mut robotic = sc_cbf::RoboticOutput {
+            u: if filtered { applied.tau } else { nan7 },
+            actuated: if filtered { applied.tau } else { nan7 },
+            report: Default::default(),
+        };
+        for h in translational.report.h.iter_mut() {
+            *h = c.f()?;
+        }
+        for h in attitude.report.h.iter_mut() {
+            *h = c.f()?;
+        }
+        for h in robotic.report.h.iter_mut() {
+            *h = c.f()?;
+        }
+        macro_rules! report {
+            ($r:expr) => {{
+                $r.status = status_of(c.parse("a filter status")?, "telemetry.csv", n)?;
+                $r.iterations = c.parse("an iteration count")?;
+                $r.active = c.parse("an active-set bitset")?;
+                $r.faults = c.parse("a fault bitset")?;
+                $r.slack = f64::NAN;
+            }};
+        }
+        report!(translational.report);
+        report!(attitude.report);
+        report!(robotic.report);
+        // solve times from the same step of timing.csv
+        let tl = tim.next().ok_or_else(|| {
+            format!("timing.csv: ends before step {step} (telemetry.csv line {n})")
+        })?;
+        let mut tc = Fields::new("timing.csv", n, tl, &tim_names)?;
+        let tstep: u64 = tc.parse("a step number")?;
+        let tt = tc.f()?;
+        if tstep != step || !same_bits(tt, t) {
+            return Err(format!(
+                "timing.csv line {n}: step {tstep} at t = {tt} s, telemetry.csv has step {step} at t = {t} s"
+            ));
+        }
+        translational.report.solve_time_ns = tc.ns()?;
+        attitude.report.solve_time_ns = tc.ns()?;
+        robotic.report.solve_time_ns = tc.ns()?;
+        if c.next != tel_names.len() {
+            return Err(format!(
+                "telemetry.csv line {n}: read {} of {} columns (the reader is out of step with telemetry_columns)",
+                c.next,
+                tel_names.len()
+            ));
+        }
+        out.push(StepRecord {
+            step,
+            t,
+            phase,
+            obs,
+            f_h_nom,
+            tau_b_nom,
+            tau_m_nom,
+            translational,
+            attitude,
+            robotic,
+            applied,
+        });
+    }
+    if tim.next().is_some_and(|l| !l.is_empty()) {
+        return Err(format!(
+            "timing.csv: more rows than the {} of telemetry.csv",
+            out.len()
+        ));
+    }
+    Ok(out)
+}

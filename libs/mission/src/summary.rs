@@ -224,11 +224,11 @@ pub fn summarize(
         .zip(solve.iter())
         .map(|(n, v)| (n.to_string(), TimeStats::of(v)))
         .collect();
-    let (captured, capture_time_s, end_name, final_time_s) = match end {
-        MissionEnd::Captured { t } => (true, Some(*t), "captured", *t),
-        MissionEnd::Timeout { t } => (false, None, "timeout", *t),
-        MissionEnd::SimulatorFailed { t, .. } => (false, None, "simulator_failed", *t),
+    let (captured, capture_time_s) = match end {
+        MissionEnd::Captured { t } => (true, Some(*t)),
+        _ => (false, None),
     };
+    let (end_name, final_time_s) = (end.name(), end.t());
     Summary {
         filtered,
         captured,

@@ -23,7 +23,7 @@
 
 use crate::config::MonteCarloConfig;
 use crate::hist::LogHistogram;
-use crate::run::{self, CampaignBase, RunResult, RunTiming, TIMERS};
+use crate::run::{self, CampaignBase, Execution, Executor, RunResult, RunTiming, TIMERS};
 use crate::sample::{run_seed, sample};
 use rayon::prelude::*;
 use sc_mission::summary::TimeStats;
@@ -81,6 +81,9 @@ pub struct CampaignInfo {
     /// File name of the URDF copy.
     pub urdf: String,
     pub config: MonteCarloConfig,
+    /// How the runs executed (absent: in-process).
+    #[serde(default, skip_serializing_if = "Execution::is_in_process")]
+    pub execution: Execution,
 }
 
 /// How a campaign is run.
@@ -289,8 +292,18 @@ fn run_dir(dir: &Path, k: usize) -> PathBuf {
     dir.join("runs").join(k.to_string())
 }
 
-/// Runs a campaign (or one shard) into `opts.out` and aggregates it.
+/// Runs a campaign (or one shard) in this process into `opts.out` and aggregates it.
 pub fn run_campaign(opts: &CampaignOptions) -> Result<CampaignSummary, McError> {
+    run_campaign_with(opts, &run::InProcess)
+}
+
+/// [`run_campaign`] with every run's mission executed by `executor` (on `opts.jobs`
+/// threads). If the executor stops (Ctrl-C), no further run starts, the runs completed
+/// so far are aggregated and the result is an error saying so.
+pub fn run_campaign_with(
+    opts: &CampaignOptions,
+    executor: &dyn Executor,
+) -> Result<CampaignSummary, McError> {
     let started = std::time::Instant::now();
     let setup = load_base(&opts.scenario, &opts.config)?;
     if opts.jobs == 0 {
@@ -311,6 +324,7 @@ pub fn run_campaign(opts: &CampaignOptions) -> Result<CampaignSummary, McError> 
         shard: opts.shard.map(|(i, n)| [i, n]),
         urdf,
         config: opts.config.clone(),
+        execution: executor.execution(),
     };
     let base = write_base(&opts.out, &setup, &info)?;
     let indices = shard_runs(opts.runs, opts.shard);
@@ -336,8 +350,16 @@ pub fn run_campaign(opts: &CampaignOptions) -> Result<CampaignSummary, McError> 
         indices
             .par_iter()
             .filter_map(|&k| {
+                if executor.stopped() {
+                    return None;
+                }
                 let dir = run_dir(&opts.out, k);
-                let out = run::execute(&base, k, &dir, opts.inject_panic.contains(&k));
+                let inject = opts.inject_panic.contains(&k);
+                let out = run::execute_with(&base, k, &dir, inject, executor);
+                if out.result.failed() && executor.stopped() {
+                    // cut short, not a result of the run: leave no trace of it
+                    return std::fs::remove_dir_all(&dir).map_err(io(&dir)).err();
+                }
                 if out.result.failed() {
                     failed.fetch_add(1, Ordering::Relaxed);
                 }
@@ -352,7 +374,16 @@ pub fn run_campaign(opts: &CampaignOptions) -> Result<CampaignSummary, McError> 
     if let Some(e) = save_errors.into_iter().next() {
         return Err(e);
     }
-    aggregate(&opts.out, started.elapsed().as_secs_f64())
+    let s = aggregate(&opts.out, started.elapsed().as_secs_f64())?;
+    if executor.stopped() {
+        return Err(McError::Invalid(format!(
+            "interrupted: {} of {} runs completed, aggregated in {}",
+            s.runs,
+            indices.len(),
+            opts.out.display()
+        )));
+    }
+    Ok(s)
 }
 
 /// One run as read back from its directory.
@@ -686,7 +717,13 @@ pub fn aggregate(dir: &Path, wall_time_s: f64) -> Result<CampaignSummary, McErro
     write(&dir.join("summary.json"), text + "\n")?;
     write(
         &dir.join("report.md"),
-        crate::report::report(&s, &loaded_results(&loaded), grasp.as_deref(), &phases),
+        crate::report::report(
+            &s,
+            &loaded_results(&loaded),
+            grasp.as_deref(),
+            &phases,
+            info.execution,
+        ),
     )?;
 
     let runtime: Vec<RuntimeBar> = ["total", "translational", "attitude", "robotic"]
@@ -717,13 +754,20 @@ fn loaded_results(l: &[Loaded]) -> Vec<RunResult> {
     l.iter().map(|x| x.result.clone()).collect()
 }
 
-fn copy_dir(from: &Path, to: &Path) -> Result<(), McError> {
+/// Sub-directory of a run with the reports of its partition launch (`--mode partition`).
+pub const PARTITION_DIR: &str = "partition";
+
+/// Copies the files of a directory; of its sub-directories every one with `all`, else
+/// only the partition reports of a run (not, e.g., a rerun's output).
+fn copy_dir(from: &Path, to: &Path, all: bool) -> Result<(), McError> {
     std::fs::create_dir_all(to).map_err(io(to))?;
     for e in std::fs::read_dir(from).map_err(io(from))? {
         let e = e.map_err(io(from))?;
         let p = e.path();
         if p.is_file() {
             std::fs::copy(&p, to.join(e.file_name())).map_err(io(&p))?;
+        } else if p.is_dir() && (all || e.file_name() == PARTITION_DIR) {
+            copy_dir(&p, &to.join(e.file_name()), true)?;
         }
     }
     Ok(())
@@ -752,11 +796,12 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<CampaignSummary, McError> {
             && info.runs == info0.runs
             && info.config == info0.config
             && info.urdf == info0.urdf
+            && info.execution == info0.execution
             && read(&d.join("base_scenario.toml"))? == base0
             && std::fs::read(d.join(&info.urdf)).map_err(io(&d.join(&info.urdf)))? == urdf0;
         if !same {
             return Err(McError::Invalid(format!(
-                "merge: {} belongs to a different campaign than {} (seed, runs, config or scenario differ)",
+                "merge: {} belongs to a different campaign than {} (seed, runs, config, scenario or execution mode differ)",
                 d.display(),
                 first.display()
             )));
@@ -796,7 +841,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<CampaignSummary, McError> {
                     info.runs
                 )));
             }
-            copy_dir(&e.path(), &run_dir(out, k))?;
+            copy_dir(&e.path(), &run_dir(out, k), false)?;
             seen.insert(k, d.clone());
         }
         if let Ok(sum) = json::<serde_json::Value>(&d.join("summary.json")) {

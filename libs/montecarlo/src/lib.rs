@@ -4,7 +4,9 @@
 //! * [`sample`] — per-run seeds derived from (campaign seed, run index) and the sampled
 //!   initial position (inside the approach corridor) and target tumbling rate.
 //! * [`run`] — one run: dispersed scenario → mission → metrics, trace, timing; failures
-//!   and panics become failed results.
+//!   and panics become failed results. The mission runs in this process ([`InProcess`])
+//!   or in any other [`Executor`] (the app runs it through the process partition); the
+//!   measurement is the same.
 //! * [`campaign`] — run a campaign or a shard in parallel (rayon, `--jobs` threads, an
 //!   indicatif progress bar), aggregate, merge shards, rerun one run.
 //! * [`report`] — the Markdown report beside the paper's numbers.
@@ -18,7 +20,7 @@ pub mod sample;
 
 pub use campaign::{
     CampaignInfo, CampaignOptions, CampaignSummary, McError, WALL_CLOCK_FILES, WALL_CLOCK_KEYS,
-    aggregate, merge, parse_shard, rerun, run_campaign, shard_runs,
+    aggregate, merge, parse_shard, rerun, run_campaign, run_campaign_with, shard_runs,
 };
 pub use config::{ConfigError, DEFAULT_CONFIG, MonteCarloConfig};
-pub use run::RunResult;
+pub use run::{Execution, Executor, InProcess, RunResult};

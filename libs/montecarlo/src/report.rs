@@ -31,6 +31,7 @@ pub fn report(
     results: &[RunResult],
     grasp: Option<&str>,
     phases: &[String],
+    execution: crate::run::Execution,
 ) -> String {
     let mut o = String::new();
     let _ = writeln!(o, "# Monte Carlo campaign\n");
@@ -43,6 +44,14 @@ pub fn report(
         "{} runs (campaign of {}{shard}, seed {}), wall time {:.1} s.\n",
         s.runs, s.campaign_runs, s.seed, s.wall_time_s
     );
+    if execution == crate::run::Execution::Partition {
+        let _ = writeln!(
+            o,
+            "Every run executed through the process partition (one process per module, \
+             iceoryx2, lock-step); its launch, scheduler and recorder reports are in \
+             `runs/K/partition/`.\n"
+        );
+    }
     let _ = writeln!(o, "| | runs |\n|---|---|");
     let _ = writeln!(
         o,

@@ -220,9 +220,81 @@ pub fn measure(
     (metrics, trace, timing)
 }
 
-/// Samples, saves and runs run `k` of the campaign (files under `run_dir`); never panics,
-/// never fails: every problem ends up in the result as a failure.
+/// How the runs of a campaign execute (recorded in `campaign.json` and the report).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Execution {
+    /// Simulator, nominal controllers and filters in this process ([`InProcess`]).
+    #[default]
+    InProcess,
+    /// Through the process partition, one process per module.
+    Partition,
+}
+
+impl Execution {
+    pub fn is_in_process(&self) -> bool {
+        *self == Execution::InProcess
+    }
+}
+
+/// Executes the mission of one run. Everything else of a run — sampling, the saved
+/// scenario, the metrics, trace and timing ([`measure`]) — is the same whatever the
+/// executor, so executors that reproduce the mission's records give the same results.
+pub trait Executor: Sync {
+    /// Runs the mission of run `k`, whose dispersed scenario `setup` was read back from
+    /// `run_dir/scenario.toml`; returns every step's record and how the mission ended,
+    /// or why the run failed (one line). `inject_failure` (tests) makes the run fail.
+    fn execute(
+        &self,
+        k: usize,
+        setup: Setup,
+        run_dir: &Path,
+        inject_failure: bool,
+    ) -> Result<(Vec<StepRecord>, MissionEnd), String>;
+
+    /// True once no further run may start (e.g. after Ctrl-C); a run that failed by then
+    /// is discarded, not recorded.
+    fn stopped(&self) -> bool {
+        false
+    }
+
+    /// What `campaign.json` records.
+    fn execution(&self) -> Execution;
+}
+
+/// The mission in this process ([`simulate`]); an injected failure panics at step 10.
+pub struct InProcess;
+
+impl Executor for InProcess {
+    fn execute(
+        &self,
+        _k: usize,
+        setup: Setup,
+        _run_dir: &Path,
+        inject_failure: bool,
+    ) -> Result<(Vec<StepRecord>, MissionEnd), String> {
+        simulate(setup, inject_failure)
+    }
+
+    fn execution(&self) -> Execution {
+        Execution::InProcess
+    }
+}
+
+/// Samples, saves and runs run `k` of the campaign in this process (files under
+/// `run_dir`); never panics, never fails: every problem ends up in the result as a failure.
 pub fn execute(base: &CampaignBase, k: usize, run_dir: &Path, inject_panic: bool) -> RunOutput {
+    execute_with(base, k, run_dir, inject_panic, &InProcess)
+}
+
+/// [`execute`] with the mission executed by `executor`.
+pub fn execute_with(
+    base: &CampaignBase,
+    k: usize,
+    run_dir: &Path,
+    inject_failure: bool,
+    executor: &dyn Executor,
+) -> RunOutput {
     let seed = run_seed(base.seed, k);
     let mut result = RunResult {
         run: k,
@@ -260,7 +332,11 @@ pub fn execute(base: &CampaignBase, k: usize, run_dir: &Path, inject_panic: bool
         scenario: scenario.clone(),
         robot: base.setup.robot.clone(),
     };
-    let (records, end) = match simulate(setup, inject_panic) {
+    let executed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        executor.execute(k, setup, run_dir, inject_failure)
+    }))
+    .unwrap_or_else(|p| Err(format!("panicked: {}", panic_message(p))));
+    let (records, end) = match executed {
         Ok(x) => x,
         Err(e) => return fail(result, e),
     };

@@ -1,14 +1,17 @@
 //! Campaigns: config rules, seeds and dispersions, shard/merge byte-identity, rerun,
 //! injected failures. Short missions (a few seconds) keep them fast.
 
+use sc_mission::{MissionEnd, Setup, StepRecord, TelemetryWriter, parse_telemetry};
 use sc_montecarlo::campaign::{WALL_CLOCK_FILES, WALL_CLOCK_KEYS};
 use sc_montecarlo::sample::{initial_los_deg, run_seed, sample};
 use sc_montecarlo::{
-    CampaignOptions, MonteCarloConfig, merge, parse_shard, rerun, run_campaign, shard_runs,
+    CampaignOptions, Execution, Executor, MonteCarloConfig, merge, parse_shard, rerun,
+    run_campaign, run_campaign_with, shard_runs,
 };
 use sc_scenario::Scenario;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -329,5 +332,130 @@ fn bad_campaign_inputs_are_one_line_errors() {
         .to_string();
     assert!(m.contains("campaign.json"), "{m}");
     assert!(foreign.join("precious.txt").is_file());
+    let _ = std::fs::remove_dir_all(&base);
+}
+
+/// Runs the mission here but hands over only what its telemetry files hold, as the
+/// partition's recorder does; runs from `stop_at` on find the campaign stopped (Ctrl-C).
+struct ViaTelemetry {
+    stop_at: usize,
+    stopped: AtomicBool,
+}
+
+impl Executor for ViaTelemetry {
+    fn execute(
+        &self,
+        k: usize,
+        setup: Setup,
+        _run_dir: &Path,
+        inject_failure: bool,
+    ) -> Result<(Vec<StepRecord>, MissionEnd), String> {
+        if k >= self.stop_at {
+            self.stopped.store(true, Ordering::SeqCst);
+            return Err("interrupted".into());
+        }
+        let (records, end) = sc_montecarlo::run::simulate(setup, inject_failure)?;
+        let (mut tel, mut tim) = (Vec::new(), Vec::new());
+        {
+            let mut w = TelemetryWriter::new(&mut tel, &mut tim).unwrap();
+            for r in &records {
+                w.write(r).unwrap();
+            }
+            w.flush().unwrap();
+        }
+        let parsed = parse_telemetry(
+            std::str::from_utf8(&tel).unwrap(),
+            std::str::from_utf8(&tim).unwrap(),
+            true,
+        )?;
+        let end = MissionEnd::from_name(end.name(), parsed.last().unwrap().t).unwrap();
+        Ok((parsed, end))
+    }
+
+    fn stopped(&self) -> bool {
+        self.stopped.load(Ordering::SeqCst)
+    }
+
+    fn execution(&self) -> Execution {
+        Execution::Partition
+    }
+}
+
+/// Runs measured from their telemetry (what `--mode partition` does) give the in-process
+/// campaign's deterministic outputs byte for byte; campaign.json records the execution.
+#[test]
+fn runs_rebuilt_from_telemetry_give_the_in_process_results() {
+    let base = tmp("via-telemetry");
+    let sc = short_scenario(&base, scenario().mission.duration_s);
+    let a = options(sc.clone(), base.join("in-process"), 3);
+    let b = options(sc, base.join("via-telemetry"), 3);
+    let sa = run_campaign(&a).unwrap();
+    let ex = ViaTelemetry {
+        stop_at: usize::MAX,
+        stopped: AtomicBool::new(false),
+    };
+    let sb = run_campaign_with(&b, &ex).unwrap();
+    assert_eq!(sa.captured_runs, 3, "full missions capture");
+    let (mut fa, mut fb) = (deterministic(&a.out), deterministic(&b.out));
+    let ca: serde_json::Value =
+        serde_json::from_slice(&fa.remove("campaign.json").unwrap()).unwrap();
+    let cb: serde_json::Value =
+        serde_json::from_slice(&fb.remove("campaign.json").unwrap()).unwrap();
+    assert!(
+        ca.get("execution").is_none(),
+        "in-process campaign.json is unchanged"
+    );
+    assert_eq!(cb["execution"], "partition");
+    assert_eq!(fa.keys().collect::<Vec<_>>(), fb.keys().collect::<Vec<_>>());
+    for (k, v) in &fa {
+        assert!(*v == fb[k], "{k} differs");
+    }
+    assert_eq!(sa.worst, sb.worst);
+    // the solve times come from the timing file (whole ns), one per step
+    assert_eq!(
+        sa.solve_time_us["total"].samples,
+        sb.solve_time_us["total"].samples
+    );
+    // shards of different executions do not merge
+    let m = merge(&[a.out.clone(), b.out.clone()], &base.join("m"))
+        .unwrap_err()
+        .to_string();
+    assert!(m.contains("execution mode"), "{m}");
+    let _ = std::fs::remove_dir_all(&base);
+}
+
+/// A stopped executor (Ctrl-C): no further run starts, the run cut short leaves no
+/// trace, the completed ones are aggregated, and the campaign says it was interrupted.
+#[test]
+fn a_stopped_campaign_keeps_only_completed_runs() {
+    let base = tmp("stopped");
+    let sc = short_scenario(&base, 1.0);
+    let mut o = options(sc, base.join("c"), 4);
+    o.jobs = 1;
+    let ex = ViaTelemetry {
+        stop_at: 2,
+        stopped: AtomicBool::new(false),
+    };
+    let m = run_campaign_with(&o, &ex).unwrap_err().to_string();
+    assert_eq!(
+        m,
+        format!(
+            "interrupted: 2 of 4 runs completed, aggregated in {}",
+            o.out.display()
+        )
+    );
+    let mut runs: Vec<String> = std::fs::read_dir(o.out.join("runs"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    runs.sort();
+    assert_eq!(runs, ["0", "1"]);
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(o.out.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(
+        (s["runs"].as_u64(), s["failed_runs"].as_u64()),
+        (Some(2), Some(0))
+    );
     let _ = std::fs::remove_dir_all(&base);
 }

@@ -30,6 +30,10 @@ pub struct LaunchOptions {
     pub timeout: Option<Duration>,
     /// Replace role executables: (role, exec, args).
     pub role_override: Vec<(String, String, Vec<String>)>,
+    /// Run this scenario instead of the config's (relative to the working directory).
+    pub scenario: Option<PathBuf>,
+    /// Print nothing on stderr (how each process ended is in the report and launch.json).
+    pub quiet: bool,
 }
 
 /// How one process ended.
@@ -61,9 +65,18 @@ pub struct LaunchReport {
     /// real-time mode only).
     pub cpu_wakeup_latency: String,
     pub wall_s: f64,
+    /// Why a role could not be started, if one could not.
+    pub error: Option<String>,
 }
 
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// True when SIGINT or SIGTERM arrived since the last [`launch`] started (the launcher
+/// handles both once it ran; a caller running launches in a row checks this between
+/// them, since the next launch starts with a cleared flag).
+pub fn interrupted() -> bool {
+    INTERRUPTED.load(Ordering::SeqCst)
+}
 
 extern "C" fn on_signal(_: libc::c_int) {
     INTERRUPTED.store(true, Ordering::SeqCst);
@@ -121,7 +134,11 @@ pub fn clean_stale_runs(except: &str) -> usize {
     removed
 }
 
-fn resolve_exec(exec: &str, base_dir: &Path, bin_dir: &Option<PathBuf>) -> PathBuf {
+/// The executable a role's `exec` names: a path relative to the config directory
+/// `base_dir`, or a bare name looked up in `bin_dir`, `SC_PARTITION_BIN_DIR` and the
+/// launcher's own directory; a bare name found in none of them is returned as is
+/// (then `PATH` decides).
+pub fn resolve_exec(exec: &str, base_dir: &Path, bin_dir: &Option<PathBuf>) -> PathBuf {
     if exec.contains('/') {
         let p = PathBuf::from(exec);
         return if p.is_absolute() { p } else { base_dir.join(p) };
@@ -181,6 +198,9 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
     INTERRUPTED.store(false, Ordering::SeqCst);
     let started = Instant::now();
     let mut cfg = PartitionConfig::load(&opts.config)?;
+    if let Some(sc) = &opts.scenario {
+        cfg.scenario = abs(sc);
+    }
     if let Some(c) = opts.clock {
         cfg.clock = c;
     }
@@ -292,16 +312,18 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
                     signal: st.signal(),
                     killed_by_launcher: termed,
                 };
-                eprintln!(
-                    "launch: {} (pid {}) exited: {}",
-                    p.role,
-                    ex.pid,
-                    match (ex.code, ex.signal) {
-                        (Some(c), _) => format!("code {c}"),
-                        (_, Some(s)) => format!("signal {s}"),
-                        _ => "?".into(),
-                    }
-                );
+                if !opts.quiet {
+                    eprintln!(
+                        "launch: {} (pid {}) exited: {}",
+                        p.role,
+                        ex.pid,
+                        match (ex.code, ex.signal) {
+                            (Some(c), _) => format!("code {c}"),
+                            (_, Some(s)) => format!("signal {s}"),
+                            _ => "?".into(),
+                        }
+                    );
+                }
                 let ok = ex.code == Some(0) || (p.role == "recorder" && ex.code == Some(1));
                 if !ok && !termed {
                     failed = true;
@@ -329,11 +351,15 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
         }
         if INTERRUPTED.load(Ordering::SeqCst) && !interrupted {
             interrupted = true;
-            eprintln!("launch: interrupted, tearing down");
+            if !opts.quiet {
+                eprintln!("launch: interrupted, tearing down");
+            }
             teardown_at = Some(Instant::now());
         }
         if started.elapsed() > timeout && teardown_at.is_none() {
-            eprintln!("launch: run timed out after {timeout:?}, tearing down");
+            if !opts.quiet {
+                eprintln!("launch: run timed out after {timeout:?}, tearing down");
+            }
             failed = true;
             teardown_at = Some(Instant::now());
         }
@@ -350,7 +376,9 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
                 for p in procs.iter_mut().filter(|p| p.exit.is_none()) {
                     // a process that ignores the stop tick and SIGTERM is hung: a failure
                     failed = true;
-                    eprintln!("launch: killing {} (pid {})", p.role, p.child.id());
+                    if !opts.quiet {
+                        eprintln!("launch: killing {} (pid {})", p.role, p.child.id());
+                    }
                     let _ = p.child.kill();
                 }
             }
@@ -373,7 +401,7 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
     } else {
         1
     };
-    if let Some(e) = &spawn_err {
+    if let Some(e) = spawn_err.as_ref().filter(|_| !opts.quiet) {
         eprintln!("launch: {e}");
     }
     let rep = LaunchReport {
@@ -385,6 +413,7 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
         stale_removed,
         cpu_wakeup_latency: crate::pm_qos::describe(wakeup_request, &wakeup_held),
         wall_s: started.elapsed().as_secs_f64(),
+        error: spawn_err,
     };
     std::fs::write(
         out.join("launch.json"),

@@ -68,6 +68,14 @@ impl Observation {
         (self.ee_v_r - self.grasp_v_r).norm()
     }
 
+    /// The grasping point relative to the base origin in F_B, `R_RB^T (grasp_r − r_r)`,
+    /// from the attitude `q_RB`, the base position `r_r` and the grasping point `grasp_r`
+    /// (both relative to the target CoM in F_R) — what [`Simulator::observe`] reports as
+    /// `grasp_b`, so records rebuilt from telemetry get the same bits.
+    pub fn grasp_in_base(q_rb: &Quat, r_r: &Vector3<f64>, grasp_r: &Vector3<f64>) -> Vector3<f64> {
+        quat::to_matrix(q_rb).transpose() * (grasp_r - r_r)
+    }
+
     /// Rate-synchronisation error ω_B − R_BT ω_T [rad/s, F_B].
     pub fn sync_error(&self) -> Vector3<f64> {
         let r_bt = quat::to_matrix(&quat::mul(&quat::conj(&self.q_rb), &self.q_rt));
@@ -123,7 +131,7 @@ impl Simulator {
             grasp_r,
             grasp_v_r,
             grasp_a_r,
-            grasp_b: r_rb.transpose() * (grasp_r - r_r),
+            grasp_b: Observation::grasp_in_base(&q_rb, &r_r, &grasp_r),
             ee_b,
             ee_r,
             ee_v_r,

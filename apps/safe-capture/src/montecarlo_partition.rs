@@ -1,0 +1,313 @@
+//! `safe-capture montecarlo --mode partition`: every run's mission through the process
+//! partition (sc-partition), measured from the recorder's telemetry by the same code as
+//! an in-process run.
+//!
+//! Per run K: `sc_partition::launch` with the user's partition config (schedule,
+//! deadlines, executables), the run's `runs/K/scenario.toml`, lock-step, to the end of
+//! the mission, a run id of its own, output in `runs/K/partition/`. The recorder's
+//! `telemetry.csv` (bit-for-bit the in-process one in lock-step with one rate group at
+//! the control period) and `timing.csv` are read back into step records
+//! (`sc_mission::parse_telemetry`) and handed to the campaign, which measures them like
+//! any run. A launch that fails (a process crashed, hung or did not start, samples
+//! missing, files left in /dev/shm) is a failed run; the campaign goes on.
+
+use anyhow::Context;
+use sc_mission::{MissionEnd, Setup, StepRecord, parse_telemetry};
+use sc_montecarlo::campaign::PARTITION_DIR;
+use sc_montecarlo::{Execution, Executor};
+use sc_partition::config::ROLES;
+use sc_partition::launcher::{LaunchReport, interrupted, resolve_exec};
+use sc_partition::recorder::RecorderReport;
+use sc_partition::{ClockMode, LaunchOptions, PartitionConfig, launch};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// The recorder's large outputs, removed from `runs/K/partition/` once the run is
+/// measured unless kept (`--keep-recordings`).
+pub const RECORDINGS: [&str; 4] = [
+    "telemetry.csv",
+    "timing.csv",
+    "recording.mcap",
+    "latency.csv",
+];
+
+/// The simulator executable of a run with an injected failure: it does not exist, so
+/// the launch fails as a real one would.
+const INJECTED_MISSING_EXEC: &str = "/nonexistent/injected-failure/sc-simulator";
+
+/// Runs missions through the process partition.
+pub struct PartitionExecutor {
+    config: PathBuf,
+    keep_recordings: bool,
+    /// Unique per campaign process: run ids are `mc<K>-<tag>`.
+    tag: String,
+    stopped: AtomicBool,
+}
+
+impl PartitionExecutor {
+    /// Checks the partition config and that every role's executable exists, before any
+    /// run starts. Returns the executor and, when the config's schedule is not the
+    /// scenario's single control period, a note that results will differ from
+    /// in-process runs.
+    pub fn new(
+        config: &Path,
+        keep_recordings: bool,
+        scenario: &Path,
+    ) -> anyhow::Result<(Self, Option<String>)> {
+        let cfg = PartitionConfig::load(config).context("--partition-config")?;
+        let schedule = cfg.schedule().context("--partition-config")?;
+        for role in ROLES {
+            let Some(e) = cfg.roles.get(role) else {
+                anyhow::bail!("{}: no executable for role `{role}`", config.display());
+            };
+            let exe = resolve_exec(&e.exec, &cfg.base_dir, &None);
+            if executable_exists(&exe) {
+                continue;
+            }
+            if e.exec.contains('/') {
+                anyhow::bail!(
+                    "{}: the executable {} of role `{role}` does not exist",
+                    config.display(),
+                    exe.display()
+                );
+            }
+            anyhow::bail!(
+                "--mode partition: the executable `{}` of role `{role}` was found neither next to safe-capture, nor in {}, nor on PATH; build it with `cargo build --release -p sc-partition-apps`",
+                e.exec,
+                sc_partition::launcher::BIN_DIR_ENV
+            );
+        }
+        let period = sc_scenario::Scenario::load(scenario)
+            .map(|s| s.mission.control_period_s)
+            .ok();
+        let note = match period {
+            Some(p) if schedule.period_s.iter().all(|x| *x == p) => None,
+            Some(p) => Some(format!(
+                "note: the schedule of {} (periods translational {} s, attitude {} s, robotic {} s) is not the scenario's control period {p} s: results will differ from --mode in-process",
+                config.display(),
+                schedule.period_s[0],
+                schedule.period_s[1],
+                schedule.period_s[2]
+            )),
+            None => None, // the campaign reports the scenario's problem
+        };
+        let now = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.as_nanos() % 10_000_000_000)
+            .unwrap_or(0);
+        Ok((
+            Self {
+                config: config.to_path_buf(),
+                keep_recordings,
+                tag: format!("{}-{now}", std::process::id()),
+                stopped: AtomicBool::new(false),
+            },
+            note,
+        ))
+    }
+
+    fn stop(&self) -> String {
+        self.stopped.store(true, Ordering::SeqCst);
+        "interrupted".into()
+    }
+}
+
+fn executable_exists(p: &Path) -> bool {
+    if p.components().count() > 1 || p.is_absolute() {
+        return p.is_file();
+    }
+    std::env::var_os("PATH")
+        .is_some_and(|path| std::env::split_paths(&path).any(|d| d.join(p).is_file()))
+}
+
+/// The last non-empty line of a log (for a failed run's error), shortened.
+fn last_line(log: &Path) -> Option<String> {
+    let text = std::fs::read_to_string(log).ok()?;
+    let line = text.lines().rev().find(|l| !l.trim().is_empty())?.trim();
+    let mut s: String = line.chars().take(200).collect();
+    if s.len() < line.len() {
+        s.push('…');
+    }
+    Some(s)
+}
+
+/// Why a launch failed, in one line.
+fn failure(rep: &LaunchReport, out: &Path) -> String {
+    if let Some(e) = &rep.error {
+        return format!("partition: {e}");
+    }
+    let bad = |e: &&sc_partition::launcher::ProcessExit| {
+        !(e.code == Some(0) || (e.role == "recorder" && e.code == Some(1)))
+    };
+    // the processes that failed by themselves, with the last line of their log
+    let mut parts: Vec<String> = rep
+        .exits
+        .iter()
+        .filter(|e| bad(e) && !e.killed_by_launcher)
+        .map(|e| {
+            let how = match (e.code, e.signal) {
+                (Some(c), _) => format!("exit code {c}"),
+                (_, Some(s)) => format!("signal {s}"),
+                _ => "unknown end".into(),
+            };
+            let log = last_line(&out.join("logs").join(format!("{}.log", e.role)))
+                .map(|l| format!(": {l}"))
+                .unwrap_or_default();
+            format!("{} ({how}){log}", e.role)
+        })
+        .collect();
+    let stopped: Vec<&str> = rep
+        .exits
+        .iter()
+        .filter(|e| bad(e) && e.killed_by_launcher)
+        .map(|e| e.role.as_str())
+        .collect();
+    if !stopped.is_empty() {
+        parts.push(format!(
+            "then stopped by the launcher: {}",
+            stopped.join(", ")
+        ));
+    }
+    let started: Vec<&str> = rep.exits.iter().map(|e| e.role.as_str()).collect();
+    let missing: Vec<&str> = ROLES
+        .iter()
+        .copied()
+        .filter(|r| !started.contains(r))
+        .collect();
+    if !missing.is_empty() {
+        parts.push(format!("not started: {}", missing.join(", ")));
+    }
+    if !rep.leftovers.is_empty() {
+        parts.push(format!("{} files left in /dev/shm", rep.leftovers.len()));
+    }
+    if parts.is_empty() {
+        parts.push("the launch reported a failure".into());
+    }
+    format!(
+        "partition failed: {}; see {}",
+        parts.join("; ").replace('\n', " "),
+        out.join("logs").display()
+    )
+}
+
+fn read(path: &Path) -> Result<String, String> {
+    std::fs::read_to_string(path).map_err(|e| format!("partition: {}: {e}", path.display()))
+}
+
+impl Executor for PartitionExecutor {
+    fn execute(
+        &self,
+        k: usize,
+        _setup: Setup,
+        run_dir: &Path,
+        inject_failure: bool,
+    ) -> Result<(Vec<StepRecord>, MissionEnd), String> {
+        if interrupted() {
+            return Err(self.stop());
+        }
+        let out = run_dir.join(PARTITION_DIR);
+        let mut opts = LaunchOptions {
+            config: self.config.clone(),
+            out: out.clone(),
+            run_id: Some(format!("mc{k}-{}", self.tag)),
+            clock: Some(ClockMode::LockStep),
+            max_ticks: Some(0),
+            scenario: Some(run_dir.join("scenario.toml")),
+            quiet: true,
+            ..Default::default()
+        };
+        if inject_failure {
+            opts.role_override
+                .push(("simulator".into(), INJECTED_MISSING_EXEC.into(), Vec::new()));
+        }
+        let rep = launch(&opts).map_err(|e| {
+            let chain: Vec<String> = e.chain().map(|c| c.to_string()).collect();
+            format!("partition: {}", chain.join(": ").replace('\n', " "))
+        })?;
+        if rep.interrupted || interrupted() {
+            return Err(self.stop());
+        }
+        if rep.code == 3 {
+            return Err(failure(&rep, &out));
+        }
+        let rec_path = out.join("recorder.json");
+        let rec: RecorderReport = serde_json::from_str(&read(&rec_path)?)
+            .map_err(|e| format!("partition: {}: {e}", rec_path.display()))?;
+        let missing: u64 = rec.missing.values().sum();
+        if missing > 0 {
+            return Err(format!(
+                "partition: the recorder missed {missing} of the samples the schedule requires ({}): the telemetry is incomplete",
+                rec_path.display()
+            ));
+        }
+        let records = parse_telemetry(
+            &read(&out.join("telemetry.csv"))?,
+            &read(&out.join("timing.csv"))?,
+            true,
+        )
+        .map_err(|e| format!("partition: {}: {e}", out.display()))?;
+        if records.len() as u64 != rec.steps {
+            return Err(format!(
+                "partition: telemetry.csv has {} steps, the recorder wrote {} ({})",
+                records.len(),
+                rec.steps,
+                rec_path.display()
+            ));
+        }
+        // a state sample the recorder never got is a step missing from the telemetry
+        let sched_path = out.join("scheduler.json");
+        let sched: serde_json::Value = serde_json::from_str(&read(&sched_path)?)
+            .map_err(|e| format!("partition: {}: {e}", sched_path.display()))?;
+        let ticks = sched["ticks"]
+            .as_u64()
+            .ok_or_else(|| format!("partition: {}: no `ticks`", sched_path.display()))?;
+        if records.len() as u64 != ticks {
+            return Err(format!(
+                "partition: the recorder wrote {} steps of the scheduler's {ticks} ticks ({}): the telemetry is incomplete",
+                records.len(),
+                out.join("logs/recorder.log").display()
+            ));
+        }
+        if let Some((i, r)) = records
+            .iter()
+            .enumerate()
+            .find(|(i, r)| r.step != *i as u64)
+        {
+            return Err(format!(
+                "partition: telemetry.csv row {i} holds step {} (a step is missing)",
+                r.step
+            ));
+        }
+        let Some(last) = records.last() else {
+            return Err(format!(
+                "partition: no step recorded ({})",
+                out.join("telemetry.csv").display()
+            ));
+        };
+        let end = MissionEnd::from_name(&rec.end, last.t).ok_or_else(|| {
+            format!(
+                "partition: {}: unknown end `{}`",
+                rec_path.display(),
+                rec.end
+            )
+        })?;
+        if !self.keep_recordings {
+            for f in RECORDINGS {
+                let p = out.join(f);
+                if p.exists() {
+                    std::fs::remove_file(&p)
+                        .map_err(|e| format!("partition: cannot remove {}: {e}", p.display()))?;
+                }
+            }
+        }
+        Ok((records, end))
+    }
+
+    fn stopped(&self) -> bool {
+        self.stopped.load(Ordering::SeqCst)
+    }
+
+    fn execution(&self) -> Execution {
+        Execution::Partition
+    }
+}

@@ -1,0 +1,258 @@
+//! `parse_telemetry` gives back what `TelemetryWriter` wrote: every recorded field with
+//! the same bits, and so the same summary.
+
+use sc_mission::{
+    Mission, MissionEnd, RunOptions, Setup, StepRecord, TelemetryWriter, parse_telemetry, summarize,
+};
+use std::path::Path;
+
+fn run(
+    duration_s: f64,
+    no_filter: bool,
+) -> (Vec<StepRecord>, MissionEnd, String, String, Vec<String>) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/scenario.toml");
+    let mut setup = Setup::load(&path).unwrap();
+    setup.scenario.mission.duration_s = duration_s;
+    let phases = setup
+        .scenario
+        .mission
+        .phases
+        .iter()
+        .map(|p| p.name.clone())
+        .collect();
+    let mut tel = Vec::new();
+    let mut tim = Vec::new();
+    let mut records = Vec::new();
+    let end = {
+        let mut w = TelemetryWriter::new(&mut tel, &mut tim).unwrap();
+        let mut m = Mission::new(setup, RunOptions { no_filter }).unwrap();
+        let end = m.run(|_, r| {
+            w.write(r).unwrap();
+            records.push(*r);
+        });
+        w.flush().unwrap();
+        end
+    };
+    (
+        records,
+        end,
+        String::from_utf8(tel).unwrap(),
+        String::from_utf8(tim).unwrap(),
+        phases,
+    )
+}
+
+fn bits<const N: usize>(a: &[f64], b: &[f64], what: &str, step: u64) {
+    assert_eq!(a.len(), N);
+    for (x, y) in a.iter().zip(b) {
+        assert!(
+            x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()),
+            "step {step}: {what}: {x} != {y}"
+        );
+    }
+}
+
+fn assert_recorded_fields_equal(a: &StepRecord, b: &StepRecord, filtered: bool) {
+    let s = a.step;
+    assert_eq!((a.step, a.phase), (b.step, b.phase));
+    assert_eq!(a.t.to_bits(), b.t.to_bits());
+    let (o, p) = (&a.obs, &b.obs);
+    for (what, x, y) in [
+        ("r_h", o.r_h, p.r_h),
+        ("v_h", o.v_h, p.v_h),
+        ("r_r", o.r_r, p.r_r),
+        ("v_r", o.v_r, p.v_r),
+        ("omega_b", o.omega_b, p.omega_b),
+        ("omega_t", o.omega_t, p.omega_t),
+        ("grasp_r", o.grasp_r, p.grasp_r),
+        ("grasp_b", o.grasp_b, p.grasp_b),
+        ("ee_r", o.ee_r, p.ee_r),
+        ("f_h_nom", a.f_h_nom, b.f_h_nom),
+        ("tau_b_nom", a.tau_b_nom, b.tau_b_nom),
+        ("f_h_safe", a.translational.u, b.translational.u),
+        ("force_b", a.applied.force_b, b.applied.force_b),
+        ("torque_b", a.applied.torque_b, b.applied.torque_b),
+    ] {
+        bits::<3>(x.as_slice(), y.as_slice(), what, s);
+    }
+    bits::<4>(&o.q_rb, &p.q_rb, "q_rb", s);
+    bits::<4>(&o.q_rt, &p.q_rt, "q_rt", s);
+    for (what, x, y) in [
+        ("theta", o.theta, p.theta),
+        ("theta_dot", o.theta_dot, p.theta_dot),
+        ("tau_m_nom", a.tau_m_nom, b.tau_m_nom),
+        ("tau", a.applied.tau, b.applied.tau),
+    ] {
+        bits::<7>(x.as_slice(), y.as_slice(), what, s);
+    }
+    bits::<51>(&a.h(), &b.h(), "h", s);
+    assert_eq!(a.solve_time_us(), b.solve_time_us(), "step {s}");
+    for (x, y) in [
+        (
+            (
+                a.translational.report.status,
+                a.translational.report.iterations,
+            ),
+            (
+                b.translational.report.status,
+                b.translational.report.iterations,
+            ),
+        ),
+        (
+            (a.attitude.report.status, a.attitude.report.iterations),
+            (b.attitude.report.status, b.attitude.report.iterations),
+        ),
+        (
+            (a.robotic.report.status, a.robotic.report.iterations),
+            (b.robotic.report.status, b.robotic.report.iterations),
+        ),
+    ] {
+        assert_eq!(x, y, "step {s}");
+    }
+    assert_eq!(
+        [
+            a.translational.report.faults,
+            a.attitude.report.faults,
+            a.robotic.report.faults
+        ],
+        [
+            b.translational.report.faults,
+            b.attitude.report.faults,
+            b.robotic.report.faults
+        ],
+        "step {s}"
+    );
+    assert_eq!(
+        [
+            a.translational.report.active,
+            a.attitude.report.active,
+            a.robotic.report.active
+        ],
+        [
+            b.translational.report.active,
+            b.attitude.report.active,
+            b.robotic.report.active
+        ],
+        "step {s}"
+    );
+    if filtered {
+        bits::<3>(
+            a.attitude.u.as_slice(),
+            b.attitude.u.as_slice(),
+            "attitude.u",
+            s,
+        );
+        bits::<7>(
+            a.robotic.u.as_slice(),
+            b.robotic.u.as_slice(),
+            "robotic.u",
+            s,
+        );
+        bits::<3>(
+            a.translational.actuated.as_slice(),
+            b.translational.actuated.as_slice(),
+            "translational.actuated",
+            s,
+        );
+    } else {
+        assert!(b.attitude.u.iter().all(|x| x.is_nan()));
+        assert!(b.robotic.u.iter().all(|x| x.is_nan()));
+    }
+    // not in the files
+    assert!(b.obs.mean_motion.is_nan() && b.obs.ee_b.iter().all(|x| x.is_nan()));
+}
+
+#[test]
+fn filtered_run_round_trips_bit_for_bit_and_summarizes_the_same() {
+    let (records, end, tel, tim, phases) = run(30.0, false);
+    let parsed = parse_telemetry(&tel, &tim, true).unwrap();
+    assert_eq!(parsed.len(), records.len());
+    for (a, b) in records.iter().zip(&parsed) {
+        assert_recorded_fields_equal(a, b, true);
+    }
+    let end2 = MissionEnd::from_name(end.name(), parsed.last().unwrap().t).unwrap();
+    assert_eq!(end2, end);
+    // the whole summary, solve times and interventions included
+    assert_eq!(
+        serde_json::to_value(summarize(&records, &end, &phases, true)).unwrap(),
+        serde_json::to_value(summarize(&parsed, &end2, &phases, true)).unwrap()
+    );
+}
+
+#[test]
+fn unfiltered_run_round_trips_with_its_faults() {
+    let (records, end, tel, tim, phases) = run(60.0, true);
+    let parsed = parse_telemetry(&tel, &tim, false).unwrap();
+    for (a, b) in records.iter().zip(&parsed) {
+        assert_recorded_fields_equal(a, b, false);
+    }
+    let mut x = serde_json::to_value(summarize(&records, &end, &phases, false)).unwrap();
+    let mut y = serde_json::to_value(summarize(&parsed, &end, &phases, false)).unwrap();
+    assert!(
+        x["fault_count"].as_u64().unwrap() > 0,
+        "{}",
+        x["fault_count"]
+    );
+    // the unapplied safe commands of an unfiltered run are not in the files
+    x.as_object_mut().unwrap().remove("interventions");
+    y.as_object_mut().unwrap().remove("interventions");
+    assert_eq!(x, y);
+}
+
+#[test]
+fn bad_files_are_one_line_errors() {
+    let (_, _, tel, tim, _) = run(0.5, false);
+    let cases: Vec<(String, String, &str)> = vec![
+        (
+            tel.replacen("step,", "stp,", 1),
+            tim.clone(),
+            "telemetry.csv: the header",
+        ),
+        (
+            tel.clone(),
+            tim.replacen("step,", "stp,", 1),
+            "timing.csv: the header",
+        ),
+        (
+            {
+                let mut l: Vec<&str> = tel.lines().collect();
+                let bad = l[2].replacen(',', ",x", 2);
+                l[2] = &bad;
+                l.join("\n")
+            },
+            tim.clone(),
+            "telemetry.csv line 3: `t_s`",
+        ),
+        (
+            tel.clone(),
+            tim.lines().take(2).collect::<Vec<_>>().join("\n"),
+            "timing.csv: ends before step 1",
+        ),
+        (
+            tel.lines().take(2).collect::<Vec<_>>().join("\n"),
+            tim.clone(),
+            "timing.csv: more rows",
+        ),
+        (
+            {
+                // a changed synchronisation error no longer matches the state
+                let l: Vec<&str> = tel.lines().collect();
+                let hdr: Vec<&str> = l[0].split(',').collect();
+                let col = hdr
+                    .iter()
+                    .position(|c| *c == "sync_error_b_x_rad_s")
+                    .unwrap();
+                let mut f: Vec<String> = l[1].split(',').map(String::from).collect();
+                f[col] = "12.5".into();
+                format!("{}\n{}\n", l[0], f.join(","))
+            },
+            tim.lines().take(2).collect::<Vec<_>>().join("\n"),
+            "telemetry.csv line 2: sync_error_b does not match",
+        ),
+    ];
+    for (t, m, want) in cases {
+        let e = parse_telemetry(&t, &m, true).unwrap_err();
+        assert!(e.contains(want), "{e}\nwanted: {want}");
+        assert!(!e.contains('\n'), "{e}");
+    }
+}
