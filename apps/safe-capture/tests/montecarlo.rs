@@ -43,9 +43,8 @@ fn cli(args: &[&str], env: &[(&str, &str)]) -> Output {
 }
 
 /// Held by the tests that keep the CPU busy, one at a time: a partition in lock-step
-/// is nine processes handing every tick on, and its recorder gives up on a sample that
-/// reaches it more than 200 ms late (the run then fails), which an overloaded 2-core
-/// machine can cause.
+/// is nine processes handing every tick on; several at once on a 2-core machine only
+/// make each slower.
 fn exclusive() -> MutexGuard<'static, ()> {
     static CPU: Mutex<()> = Mutex::new(());
     CPU.lock().unwrap_or_else(|e| e.into_inner())

@@ -410,7 +410,8 @@ pub struct StepResult {
     pub tau: [f64; N_JOINTS],
 }
 
-/// Every process → scheduler, recorder: health and counters.
+/// Recorder → scheduler: the recorder's progress (lock-step flow control); the
+/// fields are those of a health report any process could publish.
 #[derive(Debug, Clone, Copy, ZeroCopySend, PartialEq)]
 #[repr(C)]
 #[type_name("safe_capture::v1::Health")]

@@ -46,7 +46,9 @@ pub const SAFE_ATTITUDE: ServiceName = ServiceName("safe_capture/safe/attitude")
 pub const SAFE_ROBOTIC: ServiceName = ServiceName("safe_capture/safe/robotic");
 /// [`crate::StepResult`]. Publisher: simulator. Subscribers: scheduler (step completion), recorder.
 pub const STEP_RESULT: ServiceName = ServiceName("safe_capture/sim/step_result");
-/// [`crate::Health`]. Publishers: every process (up to 16). Subscribers: scheduler, recorder.
+/// [`crate::Health`]. Publisher: recorder (its progress: `last_tick` = the newest step
+/// result it took). Subscriber: scheduler (lock-step flow control: it stays at most
+/// `recorder_window_ticks` ticks ahead of the recorder).
 pub const HEALTH: ServiceName = ServiceName("safe_capture/health");
 /// Stage-deadline watchdog (event service, no payload). Notifier: scheduler, when a
 /// stage deadline of `[deadlines]` passed (counted from the tick) and the tick is

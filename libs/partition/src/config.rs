@@ -87,6 +87,10 @@ pub struct LockStep {
     /// Deadlines are multiplied by this in lock-step mode: there a missed deadline
     /// means a hung or dead process, not a slow machine.
     pub deadline_scale: f64,
+    /// Flow control: the scheduler sends tick k only when the recorder has taken the
+    /// step results up to k − this window, so that the recorder's queues (16 per
+    /// service) never fill on a loaded machine and nothing is lost. 1..=14.
+    pub recorder_window_ticks: u64,
 }
 
 /// The partition configuration file.
@@ -221,6 +225,12 @@ impl PartitionConfig {
             return err(format!(
                 "lock_step.deadline_scale = {}: must be >= 1",
                 self.lock_step.deadline_scale
+            ));
+        }
+        if !(1..=14).contains(&self.lock_step.recorder_window_ticks) {
+            return err(format!(
+                "lock_step.recorder_window_ticks = {}: must be 1..=14 (below the subscriber buffer of 16)",
+                self.lock_step.recorder_window_ticks
             ));
         }
         if self.real_time_priority > 99 {
@@ -376,7 +386,7 @@ mod tests {
             "scenario = \"scenario.toml\"\nclock = \"lock_step\"\nhandshake_timeout_s = 30\n",
         );
         s += groups;
-        s += "\n[deadlines]\nsafety_translational_ms = 40\nsafety_attitude_ms = 60\nsafety_robotic_ms = 80\nsimulator_ms = 90\n[lock_step]\ndeadline_scale = 20\n";
+        s += "\n[deadlines]\nsafety_translational_ms = 40\nsafety_attitude_ms = 60\nsafety_robotic_ms = 80\nsimulator_ms = 90\n[lock_step]\ndeadline_scale = 20\nrecorder_window_ticks = 8\n";
         for r in ROLES {
             s += &format!("[roles.{r}]\nexec = \"sc-{r}\"\n");
         }

@@ -66,6 +66,8 @@ pub fn recorder() -> anyhow::Result<i32> {
     let sa_rx = Subscriber::<SafeAttitude>::polled(&p.node, services::SAFE_ATTITUDE, &q)?;
     let sr_rx = Subscriber::<SafeRobotic>::polled(&p.node, services::SAFE_ROBOTIC, &q)?;
     let res_rx = Subscriber::<StepResult>::new(&p.node, services::STEP_RESULT, &q)?;
+    // progress for the scheduler's lock-step flow control
+    let health_tx = sc_bus::Publisher::<Health>::new(&p.node, services::HEALTH, &q)?;
     let waiter = Waiter::new()?;
     // Wake only on step results: every message of a tick was sent before its step
     // result, so the recorder drains them all then, once per tick and off the
@@ -204,6 +206,21 @@ pub fn recorder() -> anyhow::Result<i32> {
         for r in results {
             mcap.write(services::STEP_RESULT.as_str(), r.publish_ns, &r)?;
             let set = pending.remove(&r.tick).unwrap_or_default();
+            // this step is taken care of (written below, or skipped and reported)
+            crate::process::send(
+                &health_tx,
+                &Health {
+                    role: role::RECORDER,
+                    pid: std::process::id(),
+                    state: health_state::RUNNING,
+                    last_fault_flags: 0,
+                    ticks_handled: rep.steps + 1,
+                    deadline_misses: 0,
+                    cycle_slips: 0,
+                    last_tick: r.tick,
+                    publish_ns: monotonic_ns(),
+                },
+            )?;
             // drop anything older (late messages of steps already written)
             pending.retain(|k, _| *k > r.tick);
             let Some(state) = set.state else {

@@ -69,6 +69,12 @@ pub fn scheduler() -> anyhow::Result<i32> {
     let tick_tx = Publisher::<Tick>::new(&p.node, services::TICK, &q)?;
     let result_rx = Subscriber::<StepResult>::new(&p.node, services::STEP_RESULT, &q)?;
     let watchdog = SignalSender::new(&p.node, services::STAGE_DEADLINE.as_str(), &q)?;
+    // lock-step flow control: the recorder's progress (listener created on first wait)
+    let recorder_rx = Subscriber::<Health>::polled(&p.node, services::HEALTH, &q)?;
+    let on_recorder = Waiter::new()?;
+    let mut recorder_attached = Vec::new();
+    let mut recorder_taken: u64 = 0; // step results the recorder has taken
+    let window = p.cfg.lock_step.recorder_window_ticks;
     let waiter = Waiter::new()?;
     let _a = waiter.attach(&result_rx)?;
     let d = &p.cfg.deadlines;
@@ -132,6 +138,42 @@ pub fn scheduler() -> anyhow::Result<i32> {
                 drain(&result_rx)?;
             }
             slot += 1;
+        }
+        // the recorder's progress (drained in every mode: its queue must not fill);
+        // lock-step: stay at most `window` ticks ahead of the recorder, so that its
+        // queues never fill and nothing is lost on a loaded machine
+        let since = Instant::now();
+        loop {
+            for h in drain(&recorder_rx)? {
+                if h.role == sc_icd::role::RECORDER {
+                    recorder_taken = recorder_taken.max(h.last_tick + 1);
+                }
+            }
+            if clock_mode != clock_mode::LOCK_STEP || recorder_taken + window >= k {
+                break;
+            }
+            if recorder_attached.is_empty() {
+                recorder_attached.push(on_recorder.attach(&recorder_rx)?);
+                continue; // read what came before the listener existed
+            }
+            if !wait(&on_recorder, Some(Instant::now() + Duration::from_secs(1)))? {
+                rep.end = "interrupted".into();
+                break 'ticks;
+            }
+            if since.elapsed() > Duration::from_secs(1) && check(&mut monitor, &mut rep)? {
+                code = 3;
+                rep.aborted = true;
+                break 'ticks;
+            }
+            if since.elapsed() > step_timeout * 5 {
+                eprintln!(
+                    "scheduler: FAULT the recorder took no step result for {:?} (at tick {recorder_taken} of {k})",
+                    since.elapsed()
+                );
+                code = 3;
+                rep.aborted = true;
+                break 'ticks;
+            }
         }
         let tick = Tick {
             tick: k,
