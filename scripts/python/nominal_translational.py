@@ -14,8 +14,8 @@ What a partner's controller has to do (every step below is in this file):
 
 1. join the run: iceoryx2 ``global.prefix`` = ``sc_<SC_RUN_ID>_`` (set by the launcher);
 2. create its ports: subscriber + listener on ``safe_capture/sim/state`` (SimState),
-   a subscriber without listener on ``safe_capture/scheduler/tick`` (Tick, read at
-   every wake-up for the stop; only the simulator listens to ticks),
+   a subscriber without listener on ``safe_capture/scheduler/control`` (Tick
+   messages: the stop; read at every wake-up),
    publisher + notifier on ``safe_capture/nominal/translational`` (NominalTranslational);
 3. announce itself on the start-up handshake until the scheduler's ``go``;
 4. for every SimState whose ``due_mask`` has the translational bit: compute f_H and
@@ -145,14 +145,13 @@ def main():
     node = iox2.NodeBuilder.new().name(iox2.NodeName.new("nominal_translational")).config(cfg).create(iox2.ServiceType.Ipc)
     state_svc = open_pubsub(node, sc_icd.SERVICE_SIM_STATE, sc_icd.SimState)
     state_ev = data_event(node, sc_icd.SERVICE_SIM_STATE)
-    tick_svc = open_pubsub(node, sc_icd.SERVICE_TICK, sc_icd.Tick)
+    tick_svc = open_pubsub(node, sc_icd.SERVICE_CONTROL, sc_icd.Tick)
     cmd_svc = open_pubsub(node, sc_icd.SERVICE_NOMINAL_TRANSLATIONAL, sc_icd.NominalTranslational)
     cmd_ev = data_event(node, sc_icd.SERVICE_NOMINAL_TRANSLATIONAL)
     state_sub = state_svc.subscriber_builder().create()
     state_lis = state_ev.listener_builder().create()
-    # no listener on the tick: only the simulator wakes on ticks (every listener
-    # costs the scheduler one wake-up message per tick); the tick queue is read at
-    # every wake-up for the stop
+    # the scheduler's control service (Tick messages; the stop), no listener: it is
+    # read at every wake-up (only the simulator and the recorder get every tick)
     tick_sub = tick_svc.subscriber_builder().create()
     pub = cmd_svc.publisher_builder().create()
     notifier = cmd_ev.notifier_builder().default_event_id(iox2.EventId.new(sc_icd.EVENT_SAMPLE)).create()

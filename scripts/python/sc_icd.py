@@ -35,6 +35,7 @@ def _vec(n):
 # Service names (same as sc_icd::services). Each pub/sub service has an event
 # service of the same name: the publisher notifies it after every send.
 SERVICE_TICK = "safe_capture/scheduler/tick"
+SERVICE_CONTROL = "safe_capture/scheduler/control"  # Tick messages; the stop
 SERVICE_SIM_STATE = "safe_capture/sim/state"
 SERVICE_NOMINAL_TRANSLATIONAL = "safe_capture/nominal/translational"
 SERVICE_NOMINAL_ATTITUDE = "safe_capture/nominal/attitude"

@@ -23,6 +23,12 @@ impl core::fmt::Display for ServiceName {
 
 /// [`crate::Tick`] of the main rate group. Publisher: scheduler. Subscribers: simulator, recorder.
 pub const TICK: ServiceName = ServiceName("safe_capture/scheduler/tick");
+/// [`crate::Tick`] commands to every other process; today only the stop (`command ==
+/// tick_command::STOP`), sent with the stop tick. Publisher: scheduler. Subscribers:
+/// nominal controllers, safety filters (read at every wake-up, no listener). Kept apart
+/// from [`TICK`] so that a tick is delivered to the two processes that need it, not
+/// to all eight: each subscriber costs the scheduler's send, on the critical path.
+pub const CONTROL: ServiceName = ServiceName("safe_capture/scheduler/control");
 /// [`crate::SimState`]. Publisher: simulator. Subscribers: the three nominal controllers,
 /// the three safety filters, scheduler (step completion), recorder.
 pub const SIM_STATE: ServiceName = ServiceName("safe_capture/sim/state");
@@ -64,6 +70,7 @@ pub const HANDSHAKE: ServiceName = ServiceName("safe_capture/handshake");
 /// All pub/sub services with their iceoryx2 type names, for tools and docs.
 pub const ALL: &[(ServiceName, &str)] = &[
     (TICK, "safe_capture::v2::Tick"),
+    (CONTROL, "safe_capture::v2::Tick"),
     (SIM_STATE, "safe_capture::v2::SimState"),
     (
         NOMINAL_TRANSLATIONAL,

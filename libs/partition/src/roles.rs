@@ -67,6 +67,7 @@ pub fn scheduler() -> anyhow::Result<i32> {
     let p = Proc::start("scheduler")?;
     let q = qos();
     let tick_tx = Publisher::<Tick>::new(&p.node, services::TICK, &q)?;
+    let control_tx = Publisher::<Tick>::new(&p.node, services::CONTROL, &q)?;
     let result_rx = Subscriber::<StepResult>::new(&p.node, services::STEP_RESULT, &q)?;
     let watchdog = SignalSender::new(&p.node, services::STAGE_DEADLINE.as_str(), &q)?;
     // lock-step flow control: the recorder's progress (listener created on first wait)
@@ -271,15 +272,14 @@ pub fn scheduler() -> anyhow::Result<i32> {
         rep.end = "aborted".into();
     }
     rep.wall_s = started.elapsed().as_secs_f64();
-    send(
-        &tick_tx,
-        &Tick {
-            tick: k,
-            command: tick_command::STOP,
-            send_ns: now(),
-            ..Default::default()
-        },
-    )?;
+    let stop = Tick {
+        tick: k,
+        command: tick_command::STOP,
+        send_ns: now(),
+        ..Default::default()
+    };
+    send(&tick_tx, &stop)?;
+    send(&control_tx, &stop)?;
     eprintln!(
         "scheduler: {} after {} ticks, {} cycle slips, lost peers {:?}, wall {:.2} s",
         rep.end, rep.ticks, rep.cycle_slips, rep.lost_peers, rep.wall_s
@@ -537,7 +537,7 @@ pub fn nominal(which: usize) -> anyhow::Result<i32> {
     ][which];
     let p = Proc::start(role)?;
     let q = qos();
-    let tick_rx = Subscriber::<Tick>::polled(&p.node, services::TICK, &q)?;
+    let tick_rx = Subscriber::<Tick>::polled(&p.node, services::CONTROL, &q)?;
     let state_rx = Subscriber::<SimState>::new(&p.node, services::SIM_STATE, &q)?;
     let tx_t = if which == 0 {
         Some(Publisher::<NominalTranslational>::new(
@@ -656,7 +656,7 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
     let p = Proc::start(role)?;
     let q = qos();
     // Subscribers without a listener until needed (see the wake-ups below).
-    let tick_rx = Subscriber::<Tick>::polled(&p.node, services::TICK, &q)?;
+    let tick_rx = Subscriber::<Tick>::polled(&p.node, services::CONTROL, &q)?;
     let state_rx = Subscriber::<SimState>::polled(&p.node, services::SIM_STATE, &q)?;
     let nt_rx = if which == 0 {
         Some(Subscriber::<NominalTranslational>::new(
