@@ -66,6 +66,11 @@ pub struct RoleExec {
     /// tick, so that they never delay it on a machine with few cores.
     #[serde(default)]
     pub priority: Option<u32>,
+    /// CPUs this role may run on in real-time mode (Linux CPU numbers), e.g. the
+    /// causal chain of a tick on one core and the rest on another, so that its
+    /// hand-overs are same-core switches. Empty/absent = any CPU.
+    #[serde(default)]
+    pub cpus: Vec<usize>,
 }
 
 /// Per-stage deadlines in real-time mode, measured from the simulator's publication
@@ -244,6 +249,9 @@ impl PartitionConfig {
                 && !(1..=99).contains(&p)
             {
                 return err(format!("roles.{r}.priority = {p}: must be 1..=99"));
+            }
+            if let Some(c) = e.cpus.iter().find(|c| **c >= 1024) {
+                return err(format!("roles.{r}.cpus: CPU {c} is out of range (0..1024)"));
             }
         }
         if let Some(us) = self.cpu_wakeup_latency_us

@@ -28,6 +28,11 @@ pub struct Machine {
     pub cores: usize,
     pub kernel: String,
     pub cpu: String,
+    /// The CPU wake-up latency in effect during the run (the launcher's PM QoS
+    /// request, config `cpu_wakeup_latency_us`); per-role priorities and CPUs are in
+    /// the run's `partition.effective.toml`.
+    #[serde(default)]
+    pub cpu_wakeup_latency: String,
 }
 
 /// The latency report.
@@ -140,6 +145,7 @@ pub fn machine() -> Machine {
             .map(|s| s.trim().to_string())
             .unwrap_or_else(|_| "unknown".into()),
         cpu,
+        cpu_wakeup_latency: String::new(),
     }
 }
 
@@ -326,7 +332,8 @@ pub fn bench(o: &BenchOptions) -> anyhow::Result<LatencyReport> {
     if rep.code == 3 {
         anyhow::bail!("the partition run failed (see {}/logs)", o.out.display());
     }
-    let r = analyse(&o.out, o.warmup)?;
+    let mut r = analyse(&o.out, o.warmup)?;
+    r.machine.cpu_wakeup_latency = rep.cpu_wakeup_latency.clone();
     std::fs::write(
         o.out.join("latency_report.json"),
         serde_json::to_string_pretty(&r)? + "\n",
@@ -338,10 +345,15 @@ pub fn bench(o: &BenchOptions) -> anyhow::Result<LatencyReport> {
 /// The report as a Markdown table.
 pub fn markdown(r: &LatencyReport) -> String {
     let mut s = format!(
-        "Machine: {} cores, {}, kernel {}. Clock {} at {} s; {} ticks measured ({} warm-up excluded); cycle slips {}; deadline misses {}.\n\n| hop | N | min | p50 | p90 | p99 | p99.9 | max |\n|---|---|---|---|---|---|---|---|\n",
+        "Machine: {} cores, {}, kernel {}; CPU wake-up latency {}. Clock {} at {} s; {} ticks measured ({} warm-up excluded); cycle slips {}; deadline misses {}.\n\n| hop | N | min | p50 | p90 | p99 | p99.9 | max |\n|---|---|---|---|---|---|---|---|\n",
         r.machine.cores,
         r.machine.cpu,
         r.machine.kernel,
+        if r.machine.cpu_wakeup_latency.is_empty() {
+            "not recorded"
+        } else {
+            &r.machine.cpu_wakeup_latency
+        },
         r.clock,
         r.period_s,
         r.whole_tick.n,

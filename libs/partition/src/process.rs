@@ -61,6 +61,12 @@ impl Proc {
         if cfg.clock == crate::ClockMode::RealTime && prio > 0 {
             set_fifo(role, prio);
         }
+        if let Some(e) = cfg.roles.get(role)
+            && cfg.clock == crate::ClockMode::RealTime
+            && !e.cpus.is_empty()
+        {
+            set_cpus(role, &e.cpus);
+        }
         let node = run.node(role)?;
         Ok(Self {
             role,
@@ -135,6 +141,27 @@ fn set_fifo(role: &str, prio: u32) {
     if rc != 0 {
         eprintln!(
             "warning: {role}: SCHED_FIFO priority {prio} refused ({}); normal scheduling",
+            std::io::Error::last_os_error()
+        );
+    }
+}
+
+/// Restricts this process to `cpus` (real-time mode); a refusal (e.g. a CPU the
+/// machine does not have) is a warning.
+fn set_cpus(role: &str, cpus: &[usize]) {
+    // SAFETY: cpu_set_t is plain data; CPU_ZERO/CPU_SET write inside it (cpus were
+    // validated < 1024 = CPU_SETSIZE); sched_setaffinity reads it.
+    let rc = unsafe {
+        let mut set: libc::cpu_set_t = std::mem::zeroed();
+        libc::CPU_ZERO(&mut set);
+        for c in cpus {
+            libc::CPU_SET(*c, &mut set);
+        }
+        libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &set)
+    };
+    if rc != 0 {
+        eprintln!(
+            "warning: {role}: CPU affinity {cpus:?} refused ({}); any CPU",
             std::io::Error::last_os_error()
         );
     }
