@@ -33,6 +33,14 @@ fn latency_report_is_consistent() {
     // the whole tick contains the causal chain of hops 1, 2, 6, 7, 8, 9
     assert!(r.whole_tick.max_us >= r.hops["8 attitude -> robotic filter out"].min_us);
     assert!(r.machine.cores > 0 && !r.machine.kernel.is_empty());
+    // what the launcher did about the CPU wake-up latency is reported, whatever it was
+    assert!(!r.machine.cpu_wakeup_latency.is_empty(), "{:?}", r.machine);
+    let launch: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("launch.json")).unwrap()).unwrap();
+    assert_eq!(
+        launch["cpu_wakeup_latency"].as_str(),
+        Some(r.machine.cpu_wakeup_latency.as_str())
+    );
     for f in [
         "latency_whole_tick.hgrm",
         "latency.svg",

@@ -1,4 +1,4 @@
-//! Faults: SIGKILL of each kind of process mid-mission. The partition reacts with
+//! Faults: SIGKILL of each kind of process mid-mission, and hung (SIGSTOPped) ones. The partition reacts with
 //! the defined fallback and a recorded fault; telemetry up to that point is complete;
 //! no process is left behind and nothing is left in /dev/shm.
 
@@ -198,5 +198,49 @@ fn hung_robotic_filter_is_detected_by_deadlines() {
             assert_eq!(n, 0, "recorder missed samples of {service}: {rec}");
         }
     }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A hung (SIGSTOPped) nominal translational controller: the translational filter,
+/// which wakes only on its inputs, is woken by the scheduler's stage-deadline
+/// watchdog, applies its own fallback (flagged) and publishes it on every later tick,
+/// so the simulator never has to substitute the translational command.
+#[test]
+fn hung_nominal_is_caught_by_the_stage_deadline_watchdog() {
+    let dir = tmp("hungnom");
+    let out = dir.join("out");
+    let config = write_config(&dir, Some(60.0), None, 5.0);
+    let opts = options(&config, &out, "hungnom");
+    let h = std::thread::spawn(move || sc_partition::launch(&opts).unwrap());
+    let t0 = std::time::Instant::now();
+    while rows(&out) < 100 {
+        assert!(t0.elapsed() < std::time::Duration::from_secs(120));
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    let pids = pids_of("sc-nominal-translational", &out);
+    assert_eq!(pids.len(), 1);
+    // SAFETY: kill(2) on the pid found above.
+    unsafe { libc::kill(pids[0], libc::SIGSTOP) };
+    let rep = h.join().unwrap();
+    assert_clean(&rep, &out);
+    assert_eq!(contiguous_steps(&out), 601);
+    let f = flagged_steps(&out, "translational");
+    let first = *f.first().expect("translational steps flagged");
+    assert!(first >= 100, "flagged before the stop (step {first})");
+    assert_eq!(f, (first..=600).collect::<Vec<u64>>());
+    let sched: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("scheduler.json")).unwrap())
+            .unwrap();
+    assert!(
+        sched["watchdog_wakeups"].as_u64().unwrap() >= 1,
+        "the watchdog never fired: {sched}"
+    );
+    let rec: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("recorder.json")).unwrap()).unwrap();
+    assert_eq!(
+        rec["missing"]["safe_capture/safe/translational"], 0,
+        "the filter published on every tick: {rec}"
+    );
+    assert_eq!(rec["fallback_steps"], 0, "no simulator fallback: {rec}");
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -54,7 +54,19 @@ fn run(run_id: &str, base: &str) -> sc_bus::Result<()> {
     }
 }
 
+/// A no-op SIGUSR1 handler: stands for the handlers of profilers, debuggers and
+/// runtime libraries, whose signals interrupt a blocking wait (EINTR). The tests send
+/// SIGUSR1 to check that such a wake-up is not taken for a stop.
+extern "C" fn ignore_signal(_: libc::c_int) {}
+
 fn main() -> ExitCode {
+    // SAFETY: the handler does nothing, which is async-signal-safe.
+    unsafe {
+        libc::signal(
+            libc::SIGUSR1,
+            ignore_signal as *const () as libc::sighandler_t,
+        )
+    };
     let args: Vec<String> = std::env::args().collect();
     if args.len() != 3 {
         eprintln!("usage: sc-bus-peer <run id> <base service name>");

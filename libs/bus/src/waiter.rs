@@ -151,18 +151,19 @@ impl Waiter {
     /// itself: iceoryx2 reports every EINTR as `Interrupt`, including the SIGCONT
     /// that resumes a stopped process or a debugger attaching. The waiter then
     /// looks once more without blocking, which reports a pending SIGTERM/SIGINT as
-    /// [`WaitOutcome::TerminationRequest`]; any other signal is a spurious wake-up.
+    /// [`WaitOutcome::TerminationRequest`]; after any other signal it goes on
+    /// waiting for the rest of `timeout`.
     pub fn wait_once<F: FnMut(Wake)>(
         &self,
         timeout: Duration,
         mut on_wake: F,
     ) -> Result<WaitOutcome> {
-        let mut fired = false;
+        let fired = std::cell::Cell::new(false);
         let mut once = |timeout: Duration| {
             self.ws
                 .wait_and_process_once_with_timeout(
                     |id| {
-                        fired = true;
+                        fired.set(true);
                         on_wake(Wake(id));
                         CallbackProgression::Continue
                     },
@@ -173,13 +174,26 @@ impl Waiter {
                     reason: reason(e),
                 })
         };
-        let mut r = once(timeout)?;
-        if r == WaitSetRunResult::Interrupt {
-            r = once(Duration::ZERO)?;
-        }
+        // None: a timeout too long to add to now, i.e. no end
+        let until = std::time::Instant::now().checked_add(timeout);
+        let left = || match until {
+            Some(u) => u.saturating_duration_since(std::time::Instant::now()),
+            None => timeout,
+        };
+        let r = loop {
+            let r = once(left())?;
+            if r != WaitSetRunResult::Interrupt {
+                break r;
+            }
+            // EINTR: a pending SIGTERM/SIGINT shows now; any other signal goes on waiting
+            let r = once(Duration::ZERO)?;
+            if r == WaitSetRunResult::TerminationRequest || fired.get() || left().is_zero() {
+                break r;
+            }
+        };
         Ok(match r {
             WaitSetRunResult::TerminationRequest => WaitOutcome::TerminationRequest,
-            _ if fired => WaitOutcome::Handled,
+            _ if fired.get() => WaitOutcome::Handled,
             _ => WaitOutcome::Timeout,
         })
     }

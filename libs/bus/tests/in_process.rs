@@ -51,6 +51,102 @@ fn lock_step_never_drops_and_stuck_subscriber_cannot_block_forever() {
     assert!(run.leftovers().is_empty(), "{:?}", run.leftovers());
 }
 
+/// A subscriber that stays full (hung) is dropped at once after its first timeout,
+/// but only it: another subscriber that is merely full at that moment still gets the
+/// lossless wait.
+#[test]
+fn a_stuck_subscriber_is_dropped_alone() {
+    let run = RunScope::unique("stuck").unwrap();
+    {
+        let node = run.node("main").unwrap();
+        let qos = ServiceSettings::lock_step();
+        let tx = Publisher::<Tick>::with_name(&node, "st", &qos).unwrap();
+        let hung = Subscriber::<Tick>::with_name(&node, "st", &qos).unwrap();
+        let busy = Subscriber::<Tick>::with_name(&node, "st", &qos).unwrap();
+        let tick = |i: u64| Tick {
+            tick: i,
+            ..Default::default()
+        };
+        for i in 0..qos.subscriber_buffer as u64 {
+            assert_eq!(tx.send(&tick(i)).unwrap(), 2);
+        }
+        let mut got = Vec::new();
+        busy.receive_all(&mut got).unwrap();
+        // `hung` is full: the first send waits the timeout, then drops it for `hung`
+        let t0 = Instant::now();
+        assert!(tx.send(&tick(100)).is_err());
+        assert!(t0.elapsed() >= qos.backpressure_timeout);
+        // from now on `hung` costs nothing, and `busy` still gets every sample
+        let t0 = Instant::now();
+        for i in 101..101 + qos.subscriber_buffer as u64 - 1 {
+            assert!(tx.send(&tick(i)).is_err());
+        }
+        assert!(
+            t0.elapsed() < qos.backpressure_timeout,
+            "{:?}",
+            t0.elapsed()
+        );
+        // `busy` is full now too: it is not taken for hung, the send waits for it
+        let t0 = Instant::now();
+        assert!(tx.send(&tick(200)).is_err());
+        assert!(
+            t0.elapsed() >= qos.backpressure_timeout,
+            "{:?}",
+            t0.elapsed()
+        );
+        got.clear();
+        busy.receive_all(&mut got).unwrap();
+        assert_eq!(
+            got.iter().map(|t| t.tick).collect::<Vec<_>>(),
+            vec![100, 101, 102, 103],
+            "nothing was dropped for the subscriber that only was busy"
+        );
+        let mut none = Vec::new();
+        hung.receive_all(&mut none).unwrap();
+        assert_eq!(
+            none.len(),
+            qos.subscriber_buffer,
+            "the hung one kept its old queue"
+        );
+    }
+    run.teardown().unwrap();
+    assert!(run.leftovers().is_empty(), "{:?}", run.leftovers());
+}
+
+/// A polled subscriber has no listener (publishers do not wake it) until it is
+/// attached to a waiter; then a send wakes the waiter.
+#[test]
+fn polled_subscriber_gets_its_listener_when_attached() {
+    let run = RunScope::unique("polled").unwrap();
+    {
+        let node = run.node("main").unwrap();
+        let qos = ServiceSettings::lock_step();
+        let tx = Publisher::<Tick>::with_name(&node, "pl", &qos).unwrap();
+        let rx = Subscriber::<Tick>::polled_with_name(&node, "pl", &qos).unwrap();
+        assert!(!rx.has_listener());
+        tx.send(&Tick::default()).unwrap();
+        assert!(
+            rx.drain_events().unwrap().is_empty(),
+            "no listener, no events"
+        );
+        assert_eq!(rx.receive_latest().unwrap().map(|t| t.tick), Some(0));
+        let waiter = Waiter::new().unwrap();
+        let _a = waiter.attach(&rx).unwrap();
+        assert!(rx.has_listener());
+        tx.send(&Tick {
+            tick: 7,
+            ..Default::default()
+        })
+        .unwrap();
+        let outcome = waiter.wait_once(Duration::from_secs(5), |_| {}).unwrap();
+        assert_eq!(outcome, WaitOutcome::Handled);
+        assert!(rx.drain_events().unwrap().notifications >= 1);
+        assert_eq!(rx.receive_latest().unwrap().map(|t| t.tick), Some(7));
+    }
+    run.teardown().unwrap();
+    assert!(run.leftovers().is_empty(), "{:?}", run.leftovers());
+}
+
 #[test]
 fn wrong_payload_type_is_a_typed_error() {
     let run = RunScope::unique("types").unwrap();

@@ -104,3 +104,53 @@ fn peer_exits_cleanly_on_stop_tick() {
     run.teardown().unwrap();
     assert!(run.leftovers().is_empty(), "{:?}", run.leftovers());
 }
+
+/// A signal that interrupts the peer's wait (EINTR, which iceoryx2 reports as an
+/// interrupt) — here SIGUSR1, for which the peer has a handler like a profiler would —
+/// and a stop/continue (SIGSTOP, SIGCONT) leave it running and answering; only
+/// SIGTERM stops it.
+#[test]
+fn interrupting_signals_are_not_a_termination_request() {
+    let run = RunScope::unique("sigcont").unwrap();
+    {
+        let node = run.node("main").unwrap();
+        let qos = ServiceSettings::lock_step();
+        let ping = Publisher::<Tick>::with_name(&node, "test/ping", &qos).unwrap();
+        let pong = Subscriber::<Tick>::with_name(&node, "test/pong", &qos).unwrap();
+        let coord = Coordinator::new(&node, services::HANDSHAKE, &[1]).unwrap();
+        let mut peer = spawn_peer(&run, "test");
+        coord.wait_all(Duration::from_secs(20)).unwrap();
+        let pid = peer.0.id() as i32;
+        for round in 0..3u64 {
+            // SAFETY: kill(2) on our own child's pid.
+            unsafe { libc::kill(pid, libc::SIGSTOP) };
+            std::thread::sleep(Duration::from_millis(50));
+            // SAFETY: as above.
+            unsafe { libc::kill(pid, libc::SIGCONT) };
+            std::thread::sleep(Duration::from_millis(50));
+            // SAFETY: as above; the peer handles SIGUSR1.
+            unsafe { libc::kill(pid, libc::SIGUSR1) };
+            std::thread::sleep(Duration::from_millis(50));
+            assert!(
+                peer.0.try_wait().unwrap().is_none(),
+                "the peer exited after the signals of round {round}"
+            );
+            ping.send(&Tick {
+                tick: round,
+                ..Default::default()
+            })
+            .unwrap();
+            let reply = pong
+                .receive_timeout(Duration::from_secs(5))
+                .unwrap()
+                .unwrap_or_else(|| panic!("no pong after the signals of round {round}"));
+            assert_eq!(reply.tick, round + 1000);
+        }
+        // SAFETY: as above.
+        unsafe { libc::kill(pid, libc::SIGTERM) };
+        let status = peer.0.wait().unwrap();
+        assert!(status.success(), "SIGTERM is a clean stop: {status:?}");
+    }
+    run.teardown().unwrap();
+    assert!(run.leftovers().is_empty(), "{:?}", run.leftovers());
+}

@@ -474,4 +474,61 @@ mod tests {
             assert!(!e.contains('\n'), "{e}");
         }
     }
+
+    #[test]
+    fn real_time_and_flow_control_keys_are_validated() {
+        let ok = text(
+            "[[rate_groups]]\nname = \"c\"\nperiod_s = 0.1\nmembers = [\"translational\", \"attitude\", \"robotic\"]\n",
+        );
+        let c = PartitionConfig::from_toml_str(
+            &ok.replace(
+                "[roles.recorder]\nexec = \"sc-recorder\"\n",
+                "[roles.recorder]\nexec = \"sc-recorder\"\ncpus = [0]\npriority = 40\n",
+            )
+            .replace(
+                "handshake_timeout_s = 30\n",
+                "handshake_timeout_s = 30\nreal_time_priority = 50\ncpu_wakeup_latency_us = 0\n",
+            ),
+            Path::new("."),
+        )
+        .unwrap();
+        assert_eq!(c.priority_of("recorder"), 40);
+        assert_eq!(c.priority_of("simulator"), 50);
+        assert_eq!(c.roles["recorder"].cpus, vec![0]);
+        assert_eq!(c.cpu_wakeup_latency_us, Some(0));
+        for (from, to, want) in [
+            (
+                "recorder_window_ticks = 8",
+                "recorder_window_ticks = 0",
+                "recorder_window_ticks = 0: must be 1..=14",
+            ),
+            (
+                "recorder_window_ticks = 8",
+                "recorder_window_ticks = 16",
+                "recorder_window_ticks = 16: must be 1..=14",
+            ),
+            (
+                "[roles.recorder]\nexec = \"sc-recorder\"\n",
+                "[roles.recorder]\nexec = \"sc-recorder\"\npriority = 0\n",
+                "roles.recorder.priority = 0: must be 1..=99",
+            ),
+            (
+                "[roles.recorder]\nexec = \"sc-recorder\"\n",
+                "[roles.recorder]\nexec = \"sc-recorder\"\ncpus = [4096]\n",
+                "roles.recorder.cpus: CPU 4096 is out of range",
+            ),
+            (
+                "handshake_timeout_s = 30\n",
+                "handshake_timeout_s = 30\ncpu_wakeup_latency_us = 2000000\n",
+                "cpu_wakeup_latency_us = 2000000: must be 0..=1000000",
+            ),
+        ] {
+            assert!(ok.contains(from), "{from}");
+            let e = PartitionConfig::from_toml_str(&ok.replace(from, to), Path::new("."))
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(want), "{e}");
+            assert!(!e.contains('\n'), "{e}");
+        }
+    }
 }
