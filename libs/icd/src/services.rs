@@ -29,8 +29,8 @@ pub const TICK: ServiceName = ServiceName("safe_capture/scheduler/tick");
 /// from [`TICK`] so that a tick is delivered to the two processes that need it, not
 /// to all eight: each subscriber costs the scheduler's send, on the critical path.
 pub const CONTROL: ServiceName = ServiceName("safe_capture/scheduler/control");
-/// [`crate::SimState`]. Publisher: simulator. Subscribers: the three nominal controllers,
-/// the three safety filters, scheduler (step completion), recorder.
+/// [`crate::SimState`]. Publisher: simulator. Subscribers: the three nominal controllers
+/// (woken by it), the three safety filters, recorder.
 pub const SIM_STATE: ServiceName = ServiceName("safe_capture/sim/state");
 /// [`crate::NominalTranslational`]. Publisher: nominal translational controller.
 /// Subscribers: translational safety filter, recorder.
@@ -42,13 +42,14 @@ pub const NOMINAL_ATTITUDE: ServiceName = ServiceName("safe_capture/nominal/atti
 /// Subscribers: robotic safety filter, recorder.
 pub const NOMINAL_ROBOTIC: ServiceName = ServiceName("safe_capture/nominal/robotic");
 /// [`crate::SafeTranslational`]. Publisher: translational safety filter.
-/// Subscribers: attitude safety filter (causal order), simulator, recorder.
+/// Subscribers: attitude safety filter (woken by it: causal order), robotic safety
+/// filter (ξ), simulator, recorder.
 pub const SAFE_TRANSLATIONAL: ServiceName = ServiceName("safe_capture/safe/translational");
 /// [`crate::SafeAttitude`]. Publisher: attitude safety filter.
-/// Subscribers: robotic safety filter (causal order), simulator, recorder.
+/// Subscribers: robotic safety filter (woken by it: causal order), simulator, recorder.
 pub const SAFE_ATTITUDE: ServiceName = ServiceName("safe_capture/safe/attitude");
 /// [`crate::SafeRobotic`]. Publisher: robotic safety filter.
-/// Subscribers: simulator (closes the step), scheduler, recorder.
+/// Subscribers: simulator (woken by it: closes the step), recorder.
 pub const SAFE_ROBOTIC: ServiceName = ServiceName("safe_capture/safe/robotic");
 /// [`crate::StepResult`]. Publisher: simulator. Subscribers: scheduler (step completion), recorder.
 pub const STEP_RESULT: ServiceName = ServiceName("safe_capture/sim/step_result");
