@@ -7,7 +7,7 @@ use crate::fallback;
 use crate::process::{Proc, qos, send, wait};
 use anyhow::Context;
 use nalgebra::Vector3;
-use sc_bus::{PeerMonitor, Publisher, SignalListener, SignalSender, Subscriber, Waiter};
+use sc_bus::{PeerMonitor, Publisher, SignalListener, SignalSender, Subscriber, Waitable, Waiter};
 use sc_cbf::SafetyLayer;
 use sc_icd::*;
 use sc_mission::stages;
@@ -539,33 +539,17 @@ pub fn nominal(which: usize) -> anyhow::Result<i32> {
     let q = qos();
     let tick_rx = Subscriber::<Tick>::polled(&p.node, services::CONTROL, &q)?;
     let state_rx = Subscriber::<SimState>::new(&p.node, services::SIM_STATE, &q)?;
-    let tx_t = if which == 0 {
-        Some(Publisher::<NominalTranslational>::new(
-            &p.node,
-            services::NOMINAL_TRANSLATIONAL,
-            &q,
-        )?)
-    } else {
-        None
-    };
-    let tx_a = if which == 1 {
-        Some(Publisher::<NominalAttitude>::new(
-            &p.node,
-            services::NOMINAL_ATTITUDE,
-            &q,
-        )?)
-    } else {
-        None
-    };
-    let tx_r = if which == 2 {
-        Some(Publisher::<NominalRobotic>::new(
-            &p.node,
-            services::NOMINAL_ROBOTIC,
-            &q,
-        )?)
-    } else {
-        None
-    };
+    let tx_t = (which == 0)
+        .then(|| {
+            Publisher::<NominalTranslational>::new(&p.node, services::NOMINAL_TRANSLATIONAL, &q)
+        })
+        .transpose()?;
+    let tx_a = (which == 1)
+        .then(|| Publisher::<NominalAttitude>::new(&p.node, services::NOMINAL_ATTITUDE, &q))
+        .transpose()?;
+    let tx_r = (which == 2)
+        .then(|| Publisher::<NominalRobotic>::new(&p.node, services::NOMINAL_ROBOTIC, &q))
+        .transpose()?;
     // Wakes on states only; the tick queue is read at every wake-up for the stop
     // (the simulator wakes its consumers once when it stops).
     let waiter = Waiter::new()?;
@@ -658,78 +642,32 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
     // Subscribers without a listener until needed (see the wake-ups below).
     let tick_rx = Subscriber::<Tick>::polled(&p.node, services::CONTROL, &q)?;
     let state_rx = Subscriber::<SimState>::polled(&p.node, services::SIM_STATE, &q)?;
-    let nt_rx = if which == 0 {
-        Some(Subscriber::<NominalTranslational>::new(
-            &p.node,
-            services::NOMINAL_TRANSLATIONAL,
-            &q,
-        )?)
-    } else {
-        None
-    };
-    let na_rx = if which == 1 {
-        Some(Subscriber::<NominalAttitude>::new(
-            &p.node,
-            services::NOMINAL_ATTITUDE,
-            &q,
-        )?)
-    } else {
-        None
-    };
-    let nr_rx = if which == 2 {
-        Some(Subscriber::<NominalRobotic>::new(
-            &p.node,
-            services::NOMINAL_ROBOTIC,
-            &q,
-        )?)
-    } else {
-        None
-    };
-    let st_rx = if which >= 1 {
-        Some(Subscriber::<SafeTranslational>::polled(
-            &p.node,
-            services::SAFE_TRANSLATIONAL,
-            &q,
-        )?)
-    } else {
-        None
-    };
-    let sa_rx = if which == 2 {
-        Some(Subscriber::<SafeAttitude>::new(
-            &p.node,
-            services::SAFE_ATTITUDE,
-            &q,
-        )?)
-    } else {
-        None
-    };
-    let tx_t = if which == 0 {
-        Some(Publisher::<SafeTranslational>::new(
-            &p.node,
-            services::SAFE_TRANSLATIONAL,
-            &q,
-        )?)
-    } else {
-        None
-    };
-    let tx_a = if which == 1 {
-        Some(Publisher::<SafeAttitude>::new(
-            &p.node,
-            services::SAFE_ATTITUDE,
-            &q,
-        )?)
-    } else {
-        None
-    };
-    let tx_r = if which == 2 {
-        Some(Publisher::<SafeRobotic>::new(
-            &p.node,
-            services::SAFE_ROBOTIC,
-            &q,
-        )?)
-    } else {
-        None
-    };
+    let nt_rx = (which == 0)
+        .then(|| {
+            Subscriber::<NominalTranslational>::new(&p.node, services::NOMINAL_TRANSLATIONAL, &q)
+        })
+        .transpose()?;
+    let na_rx = (which == 1)
+        .then(|| Subscriber::<NominalAttitude>::new(&p.node, services::NOMINAL_ATTITUDE, &q))
+        .transpose()?;
+    let nr_rx = (which == 2)
+        .then(|| Subscriber::<NominalRobotic>::new(&p.node, services::NOMINAL_ROBOTIC, &q))
+        .transpose()?;
+    let st_rx = (which >= 1)
+        .then(|| Subscriber::<SafeTranslational>::polled(&p.node, services::SAFE_TRANSLATIONAL, &q))
+        .transpose()?;
+    let sa_rx = (which == 2)
+        .then(|| Subscriber::<SafeAttitude>::new(&p.node, services::SAFE_ATTITUDE, &q))
+        .transpose()?;
+    let tx_t = (which == 0)
+        .then(|| Publisher::<SafeTranslational>::new(&p.node, services::SAFE_TRANSLATIONAL, &q))
+        .transpose()?;
+    let tx_a = (which == 1)
+        .then(|| Publisher::<SafeAttitude>::new(&p.node, services::SAFE_ATTITUDE, &q))
+        .transpose()?;
+    let tx_r = (which == 2)
+        .then(|| Publisher::<SafeRobotic>::new(&p.node, services::SAFE_ROBOTIC, &q))
+        .transpose()?;
     let watchdog = SignalListener::new(&p.node, services::STAGE_DEADLINE.as_str(), &q)?;
     // Wake-ups (docs/PARTITION.md, "Who wakes whom"). Normally on the nominal
     // command and the immediately upstream safe command only: the state of the tick
@@ -737,24 +675,22 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
     // input is absent (dead or late producer), on every input including the state.
     // Always on the scheduler's stage-deadline watchdog. The tick queue is read at
     // every wake-up for the stop.
+    // the command inputs of this filter, and whether each wakes it normally (the
+    // translational command wakes only the attitude filter, its direct downstream)
+    let inputs: Vec<(&dyn Waitable, bool)> = [
+        (nt_rx.as_ref().map(|s| s as &dyn Waitable), true),
+        (na_rx.as_ref().map(|s| s as &dyn Waitable), true),
+        (nr_rx.as_ref().map(|s| s as &dyn Waitable), true),
+        (st_rx.as_ref().map(|s| s as &dyn Waitable), which == 1),
+        (sa_rx.as_ref().map(|s| s as &dyn Waitable), true),
+    ]
+    .into_iter()
+    .filter_map(|(s, wakes)| Some((s?, wakes)))
+    .collect();
     let on_inputs = Waiter::new()?;
     let mut att = vec![on_inputs.attach(&watchdog)?];
-    if let Some(s) = &nt_rx {
-        att.push(on_inputs.attach(s)?);
-    }
-    if let Some(s) = &na_rx {
-        att.push(on_inputs.attach(s)?);
-    }
-    if let Some(s) = &nr_rx {
-        att.push(on_inputs.attach(s)?);
-    }
-    if let Some(s) = &st_rx
-        && which == 1
-    {
-        att.push(on_inputs.attach(s)?);
-    }
-    if let Some(s) = &sa_rx {
-        att.push(on_inputs.attach(s)?);
+    for (s, _) in inputs.iter().filter(|(_, wakes)| *wakes) {
+        att.push(on_inputs.attach(*s)?);
     }
     // attached on first need (creates the listeners of the state and of the
     // translational command at the robotic filter then)
@@ -765,20 +701,8 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
             if any_attached.is_empty() {
                 any_attached.push(on_any.attach(&watchdog)?);
                 any_attached.push(on_any.attach(&state_rx)?);
-                if let Some(s) = &nt_rx {
-                    any_attached.push(on_any.attach(s)?);
-                }
-                if let Some(s) = &na_rx {
-                    any_attached.push(on_any.attach(s)?);
-                }
-                if let Some(s) = &nr_rx {
-                    any_attached.push(on_any.attach(s)?);
-                }
-                if let Some(s) = &st_rx {
-                    any_attached.push(on_any.attach(s)?);
-                }
-                if let Some(s) = &sa_rx {
-                    any_attached.push(on_any.attach(s)?);
+                for (s, _) in &inputs {
+                    any_attached.push(on_any.attach(*s)?);
                 }
                 true
             } else {
