@@ -35,6 +35,12 @@ fn latency_report_is_consistent() {
     assert!(r.machine.cores > 0 && !r.machine.kernel.is_empty());
     // what the launcher did about the CPU wake-up latency is reported, whatever it was
     assert!(!r.machine.cpu_wakeup_latency.is_empty(), "{:?}", r.machine);
+    // Linux reports steal time in /proc/stat; it can only grow during the run
+    assert!(
+        r.machine.steal_s.is_some_and(|s| s >= 0.0),
+        "{:?}",
+        r.machine
+    );
     let launch: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("launch.json")).unwrap()).unwrap();
     assert_eq!(

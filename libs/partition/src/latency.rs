@@ -33,6 +33,12 @@ pub struct Machine {
     /// the run's `partition.effective.toml`.
     #[serde(default)]
     pub cpu_wakeup_latency: String,
+    /// CPU time the hypervisor gave to others while the run wanted it ("steal",
+    /// `/proc/stat`, summed over all CPUs) during the benchmark [s]; None where the
+    /// kernel does not report it. Bursts of steal are what the latency tail follows
+    /// on a virtual machine.
+    #[serde(default)]
+    pub steal_s: Option<f64>,
 }
 
 /// The latency report.
@@ -146,7 +152,18 @@ pub fn machine() -> Machine {
             .unwrap_or_else(|_| "unknown".into()),
         cpu,
         cpu_wakeup_latency: String::new(),
+        steal_s: None,
     }
+}
+
+/// Steal time of all CPUs since boot [s] (`/proc/stat`, line `cpu`, 8th value).
+pub fn steal_time_s() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/stat").ok()?;
+    let line = stat.lines().find(|l| l.starts_with("cpu "))?;
+    let jiffies: f64 = line.split_whitespace().nth(8)?.parse().ok()?;
+    // SAFETY: sysconf has no preconditions.
+    let hz = unsafe { libc::sysconf(libc::_SC_CLK_TCK) };
+    (hz > 0).then(|| jiffies / hz as f64)
 }
 
 /// Computes the report from a run's output directory, excluding the first `warmup` ticks;
@@ -320,6 +337,7 @@ pub struct BenchOptions {
 
 /// Runs the partition in real-time mode for `warmup + ticks` ticks and analyses it.
 pub fn bench(o: &BenchOptions) -> anyhow::Result<LatencyReport> {
+    let steal_before = steal_time_s();
     let rep = launch(&LaunchOptions {
         config: o.config.clone(),
         out: o.out.clone(),
@@ -334,6 +352,9 @@ pub fn bench(o: &BenchOptions) -> anyhow::Result<LatencyReport> {
     }
     let mut r = analyse(&o.out, o.warmup)?;
     r.machine.cpu_wakeup_latency = rep.cpu_wakeup_latency.clone();
+    r.machine.steal_s = steal_before
+        .zip(steal_time_s())
+        .map(|(a, b)| (b - a).max(0.0));
     std::fs::write(
         o.out.join("latency_report.json"),
         serde_json::to_string_pretty(&r)? + "\n",
@@ -345,7 +366,7 @@ pub fn bench(o: &BenchOptions) -> anyhow::Result<LatencyReport> {
 /// The report as a Markdown table.
 pub fn markdown(r: &LatencyReport) -> String {
     let mut s = format!(
-        "Machine: {} cores, {}, kernel {}; CPU wake-up latency {}. Clock {} at {} s; {} ticks measured ({} warm-up excluded); cycle slips {}; deadline misses {}.\n\n| hop | N | min | p50 | p90 | p99 | p99.9 | max |\n|---|---|---|---|---|---|---|---|\n",
+        "Machine: {} cores, {}, kernel {}; CPU wake-up latency {}; host steal time during the run {}. Clock {} at {} s; {} ticks measured ({} warm-up excluded); cycle slips {}; deadline misses {}.\n\n| hop | N | min | p50 | p90 | p99 | p99.9 | max |\n|---|---|---|---|---|---|---|---|\n",
         r.machine.cores,
         r.machine.cpu,
         r.machine.kernel,
@@ -354,6 +375,9 @@ pub fn markdown(r: &LatencyReport) -> String {
         } else {
             &r.machine.cpu_wakeup_latency
         },
+        r.machine
+            .steal_s
+            .map_or("not reported".to_string(), |s| format!("{s:.2} s")),
         r.clock,
         r.period_s,
         r.whole_tick.n,
