@@ -22,67 +22,11 @@ import time
 import iceoryx2 as iox2
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import sc_bus  # noqa: E402
 import sc_icd  # noqa: E402
 
 GAIN = 0.5
 TIMEOUT_S = 20.0
-# Same service settings as sc_bus::ServiceSettings::lock_step() and the event
-# settings of sc_bus (whoever creates a service first fixes them).
-LOCK_STEP = dict(buffer=4, history=0, max_publishers=2, max_subscribers=8, max_nodes=16)
-
-
-def open_pubsub(node, name, ctype):
-    return (
-        node.service_builder(iox2.ServiceName.new(name))
-        .publish_subscribe(ctype)
-        .subscriber_max_buffer_size(LOCK_STEP["buffer"])
-        .history_size(LOCK_STEP["history"])
-        .max_publishers(LOCK_STEP["max_publishers"])
-        .max_subscribers(LOCK_STEP["max_subscribers"])
-        .max_nodes(LOCK_STEP["max_nodes"])
-        .enable_safe_overflow(False)
-        .subscriber_max_borrowed_samples(2)
-        .open_or_create()
-    )
-
-
-def open_event(node, name, max_ports, max_nodes, id_max):
-    return (
-        node.service_builder(iox2.ServiceName.new(name))
-        .event()
-        .max_notifiers(max_ports)
-        .max_listeners(max_ports)
-        .max_nodes(max_nodes)
-        .event_id_max_value(id_max)
-        .notifier_dead_event(iox2.EventId.new(sc_icd.EVENT_NOTIFIER_DEAD))
-        .notifier_dropped_event(iox2.EventId.new(sc_icd.EVENT_NOTIFIER_DROPPED))
-        .open_or_create()
-    )
-
-
-def data_event(node, name):
-    return open_event(
-        node, name, LOCK_STEP["max_publishers"] + LOCK_STEP["max_subscribers"], LOCK_STEP["max_nodes"], 7
-    )
-
-
-def handshake(node, role):
-    """Announce `role` until the coordinator says go (sc_bus::handshake)."""
-    ready_svc = open_event(node, sc_icd.SERVICE_HANDSHAKE + "/ready", 32, 40, 8 + 64)
-    go_svc = open_event(node, sc_icd.SERVICE_HANDSHAKE + "/go", 32, 40, 8 + 64)
-    go = go_svc.listener_builder().create()  # listener first: the go cannot be lost
-    ready = ready_svc.notifier_builder().default_event_id(iox2.EventId.new(sc_icd.HANDSHAKE_ID_OFFSET + role)).create()
-    deadline = time.monotonic() + TIMEOUT_S
-    try:
-        while time.monotonic() < deadline:
-            ready.notify()
-            for ev in go.timed_wait(iox2.Duration.from_millis(20)):
-                if ev.id.as_value == sc_icd.EVENT_GO:
-                    return True
-        return False
-    finally:
-        ready.delete()
-        go.delete()
 
 
 def main():
@@ -95,10 +39,10 @@ def main():
     cfg.global_cfg.prefix = iox2.FileName.new(sc_icd.run_prefix(run_id))
     node = iox2.NodeBuilder.new().name(iox2.NodeName.new("py_nominal_t")).config(cfg).create(iox2.ServiceType.Ipc)
 
-    state_svc = open_pubsub(node, sc_icd.SERVICE_SIM_STATE, sc_icd.SimState)
-    state_ev = data_event(node, sc_icd.SERVICE_SIM_STATE)
-    cmd_svc = open_pubsub(node, sc_icd.SERVICE_NOMINAL_TRANSLATIONAL, sc_icd.NominalTranslational)
-    cmd_ev = data_event(node, sc_icd.SERVICE_NOMINAL_TRANSLATIONAL)
+    state_svc = sc_bus.open_pubsub(node, sc_icd.SERVICE_SIM_STATE, sc_icd.SimState, sc_bus.LOCK_STEP)
+    state_ev = sc_bus.data_event(node, sc_icd.SERVICE_SIM_STATE, sc_bus.LOCK_STEP)
+    cmd_svc = sc_bus.open_pubsub(node, sc_icd.SERVICE_NOMINAL_TRANSLATIONAL, sc_icd.NominalTranslational, sc_bus.LOCK_STEP)
+    cmd_ev = sc_bus.data_event(node, sc_icd.SERVICE_NOMINAL_TRANSLATIONAL, sc_bus.LOCK_STEP)
     sub = state_svc.subscriber_builder().create()
     listener = state_ev.listener_builder().create()
     pub = cmd_svc.publisher_builder().create()
@@ -107,7 +51,7 @@ def main():
 
     rc = 1
     try:
-        if not handshake(node, sc_icd.ROLE_NOMINAL_TRANSLATIONAL):
+        if not sc_bus.handshake(node, sc_icd.ROLE_NOMINAL_TRANSLATIONAL, TIMEOUT_S):
             print("interop_check: handshake timed out", file=sys.stderr)
             return 1
         handled = 0

@@ -39,14 +39,13 @@ import tomllib
 import iceoryx2 as iox2
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import sc_bus  # noqa: E402
 import sc_icd  # noqa: E402
 
 OMEGA = 0.06  # closed-loop natural frequency [rad/s]
 ZETA = 1.0  # damping ratio
 MASS_KG = 269.0  # servicer mass (bus + arm); only scales the gains
 TIMEOUT_S = 60.0
-# Same settings as sc_partition::process::qos() (whoever creates a service first fixes them).
-QOS = dict(buffer=16, history=0, max_publishers=2, max_subscribers=8, max_nodes=16)
 
 
 def arg(name, env):
@@ -75,57 +74,6 @@ def rotate(q, v):
     return [v[i] + 2.0 * w * ux[i] + 2.0 * uux[i] for i in range(3)]
 
 
-def open_pubsub(node, name, ctype):
-    return (
-        node.service_builder(iox2.ServiceName.new(name))
-        .publish_subscribe(ctype)
-        .subscriber_max_buffer_size(QOS["buffer"])
-        .history_size(QOS["history"])
-        .max_publishers(QOS["max_publishers"])
-        .max_subscribers(QOS["max_subscribers"])
-        .max_nodes(QOS["max_nodes"])
-        .enable_safe_overflow(False)
-        .subscriber_max_borrowed_samples(2)
-        .open_or_create()
-    )
-
-
-def open_event(node, name, max_ports, max_nodes, id_max):
-    return (
-        node.service_builder(iox2.ServiceName.new(name))
-        .event()
-        .max_notifiers(max_ports)
-        .max_listeners(max_ports)
-        .max_nodes(max_nodes)
-        .event_id_max_value(id_max)
-        .notifier_dead_event(iox2.EventId.new(sc_icd.EVENT_NOTIFIER_DEAD))
-        .notifier_dropped_event(iox2.EventId.new(sc_icd.EVENT_NOTIFIER_DROPPED))
-        .open_or_create()
-    )
-
-
-def data_event(node, name):
-    return open_event(node, name, QOS["max_publishers"] + QOS["max_subscribers"], QOS["max_nodes"], 7)
-
-
-def handshake(node, role):
-    ready_svc = open_event(node, sc_icd.SERVICE_HANDSHAKE + "/ready", 32, 40, 8 + 64)
-    go_svc = open_event(node, sc_icd.SERVICE_HANDSHAKE + "/go", 32, 40, 8 + 64)
-    go = go_svc.listener_builder().create()  # listener first: the go cannot be lost
-    ready = ready_svc.notifier_builder().default_event_id(iox2.EventId.new(sc_icd.HANDSHAKE_ID_OFFSET + role)).create()
-    deadline = time.monotonic() + TIMEOUT_S
-    try:
-        while time.monotonic() < deadline:
-            ready.notify()
-            for ev in go.timed_wait(iox2.Duration.from_millis(20)):
-                if ev.id.as_value == sc_icd.EVENT_GO:
-                    return True
-        return False
-    finally:
-        ready.delete()
-        go.delete()
-
-
 def main():
     run_id = os.environ.get("SC_RUN_ID")
     config = arg("--config", "SC_PARTITION_CONFIG")
@@ -143,11 +91,11 @@ def main():
     cfg = iox2.config.default()
     cfg.global_cfg.prefix = iox2.FileName.new(sc_icd.run_prefix(run_id))
     node = iox2.NodeBuilder.new().name(iox2.NodeName.new("nominal_translational")).config(cfg).create(iox2.ServiceType.Ipc)
-    state_svc = open_pubsub(node, sc_icd.SERVICE_SIM_STATE, sc_icd.SimState)
-    state_ev = data_event(node, sc_icd.SERVICE_SIM_STATE)
-    tick_svc = open_pubsub(node, sc_icd.SERVICE_CONTROL, sc_icd.Tick)
-    cmd_svc = open_pubsub(node, sc_icd.SERVICE_NOMINAL_TRANSLATIONAL, sc_icd.NominalTranslational)
-    cmd_ev = data_event(node, sc_icd.SERVICE_NOMINAL_TRANSLATIONAL)
+    state_svc = sc_bus.open_pubsub(node, sc_icd.SERVICE_SIM_STATE, sc_icd.SimState, sc_bus.PARTITION)
+    state_ev = sc_bus.data_event(node, sc_icd.SERVICE_SIM_STATE, sc_bus.PARTITION)
+    tick_svc = sc_bus.open_pubsub(node, sc_icd.SERVICE_CONTROL, sc_icd.Tick, sc_bus.PARTITION)
+    cmd_svc = sc_bus.open_pubsub(node, sc_icd.SERVICE_NOMINAL_TRANSLATIONAL, sc_icd.NominalTranslational, sc_bus.PARTITION)
+    cmd_ev = sc_bus.data_event(node, sc_icd.SERVICE_NOMINAL_TRANSLATIONAL, sc_bus.PARTITION)
     state_sub = state_svc.subscriber_builder().create()
     state_lis = state_ev.listener_builder().create()
     # the scheduler's control service (Tick messages; the stop), no listener: it is
@@ -158,7 +106,7 @@ def main():
     ports = [state_sub, state_lis, tick_sub, pub, notifier]
     handled = 0
     try:
-        if not handshake(node, sc_icd.ROLE_NOMINAL_TRANSLATIONAL):
+        if not sc_bus.handshake(node, sc_icd.ROLE_NOMINAL_TRANSLATIONAL, TIMEOUT_S):
             print("nominal_translational.py: handshake timed out", file=sys.stderr)
             return 1
         while True:

@@ -1,0 +1,84 @@
+#!/usr/bin/env python3
+"""Python counterpart of the Rust crate ``sc-bus``: how a partner process opens the
+partition's iceoryx2 services with the same settings as the Rust processes, and
+joins the start-up handshake (docs/ICD.md, docs/PARTITION.md).
+
+Needs ``pip install iceoryx2==0.10.0`` (same x.y.z as the Rust crate: the version is
+part of the shared-memory names). Whoever creates a service first fixes its settings,
+so every process must ask for the same ones.
+"""
+
+import os
+import sys
+import time
+
+import iceoryx2 as iox2
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import sc_icd  # noqa: E402
+
+# sc_bus::ServiceSettings::lock_step()
+LOCK_STEP = dict(buffer=4, history=0, max_publishers=2, max_subscribers=8, max_nodes=16)
+# sc_partition::process::qos(): the partition's data services
+PARTITION = dict(LOCK_STEP, buffer=16)
+# event ids up to this on data services (sc_bus::pubsub::EVENT_ID_MAX)
+EVENT_ID_MAX = 7
+# the handshake's event services (sc_bus::handshake)
+HANDSHAKE_MAX_PORTS = 32
+HANDSHAKE_MAX_NODES = 40
+HANDSHAKE_MAX_PARTICIPANTS = 64
+
+
+def open_pubsub(node, name, ctype, qos):
+    """The pub/sub service `name` carrying `ctype` (a sc_icd class), settings `qos`."""
+    return (
+        node.service_builder(iox2.ServiceName.new(name))
+        .publish_subscribe(ctype)
+        .subscriber_max_buffer_size(qos["buffer"])
+        .history_size(qos["history"])
+        .max_publishers(qos["max_publishers"])
+        .max_subscribers(qos["max_subscribers"])
+        .max_nodes(qos["max_nodes"])
+        .enable_safe_overflow(False)
+        .subscriber_max_borrowed_samples(2)
+        .open_or_create()
+    )
+
+
+def open_event(node, name, max_ports, max_nodes, id_max):
+    return (
+        node.service_builder(iox2.ServiceName.new(name))
+        .event()
+        .max_notifiers(max_ports)
+        .max_listeners(max_ports)
+        .max_nodes(max_nodes)
+        .event_id_max_value(id_max)
+        .notifier_dead_event(iox2.EventId.new(sc_icd.EVENT_NOTIFIER_DEAD))
+        .notifier_dropped_event(iox2.EventId.new(sc_icd.EVENT_NOTIFIER_DROPPED))
+        .open_or_create()
+    )
+
+
+def data_event(node, name, qos):
+    """The event service beside the pub/sub service `name` (publish, then notify)."""
+    return open_event(node, name, qos["max_publishers"] + qos["max_subscribers"], qos["max_nodes"], EVENT_ID_MAX)
+
+
+def handshake(node, role, timeout_s):
+    """Announce `role` until the coordinator says go (sc_bus::handshake); False on timeout."""
+    id_max = sc_icd.HANDSHAKE_ID_OFFSET + HANDSHAKE_MAX_PARTICIPANTS
+    ready_svc = open_event(node, sc_icd.SERVICE_HANDSHAKE + "/ready", HANDSHAKE_MAX_PORTS, HANDSHAKE_MAX_NODES, id_max)
+    go_svc = open_event(node, sc_icd.SERVICE_HANDSHAKE + "/go", HANDSHAKE_MAX_PORTS, HANDSHAKE_MAX_NODES, id_max)
+    go = go_svc.listener_builder().create()  # listener first: the go cannot be lost
+    ready = ready_svc.notifier_builder().default_event_id(iox2.EventId.new(sc_icd.HANDSHAKE_ID_OFFSET + role)).create()
+    deadline = time.monotonic() + timeout_s
+    try:
+        while time.monotonic() < deadline:
+            ready.notify()
+            for ev in go.timed_wait(iox2.Duration.from_millis(20)):
+                if ev.id.as_value == sc_icd.EVENT_GO:
+                    return True
+        return False
+    finally:
+        ready.delete()
+        go.delete()
