@@ -11,7 +11,7 @@ fn latency_report_is_consistent() {
     let out = dir.join("out");
     let config = write_config(&dir, None, None, 20.0);
     let r = bench(&BenchOptions {
-        config,
+        config: config.clone(),
         out: out.clone(),
         ticks: 25,
         warmup: 5,
@@ -60,5 +60,42 @@ fn latency_report_is_consistent() {
     let launch: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("launch.json")).unwrap()).unwrap();
     assert!(launch["leftovers"].as_array().unwrap().is_empty());
+
+    // The default config has the pre-tick warm-up, so the processes rehearsed their
+    // step before every tick. It changes no command: without a deadline miss (a miss
+    // applies a fallback, and then the runs part), the real-time telemetry is the
+    // in-process run's, row for row.
+    let lead = sc_partition::PartitionConfig::load(&config)
+        .unwrap()
+        .warmup_lead_us;
+    assert!(lead > 0, "the default config has the warm-up");
+    assert_eq!(r.warmup_lead_us, lead);
+    let md = std::fs::read_to_string(out.join("latency_report.md")).unwrap();
+    assert!(md.contains(&format!("pre-tick warm-up {lead} us")), "{md}");
+    let part = std::fs::read_to_string(out.join("telemetry.csv")).unwrap();
+    let part: Vec<&str> = part.lines().collect();
+    assert_eq!(part.len(), 1 + 30, "header + one row per tick");
+    if r.deadline_misses == 0 {
+        let setup = sc_mission::Setup::load(&dir.join("scenario.toml")).unwrap();
+        let mut tel = Vec::new();
+        let mut tim = Vec::new();
+        {
+            let mut w = sc_mission::TelemetryWriter::new(&mut tel, &mut tim).unwrap();
+            let mut m = sc_mission::Mission::new(setup, sc_mission::RunOptions::default()).unwrap();
+            m.run(|_, rec| w.write(rec).unwrap());
+            w.flush().unwrap();
+        }
+        let tel = String::from_utf8(tel).unwrap();
+        let want: Vec<&str> = tel.lines().take(part.len()).collect();
+        assert!(
+            part == want,
+            "real-time telemetry differs from the in-process run"
+        );
+    } else {
+        eprintln!(
+            "{} deadline misses on this loaded machine: the telemetry comparison is not applicable",
+            r.deadline_misses
+        );
+    }
     std::fs::remove_dir_all(&dir).ok();
 }

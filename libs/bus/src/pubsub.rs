@@ -288,6 +288,18 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Publisher<T> {
         Ok(delivered)
     }
 
+    /// Loans a sample and returns it unsent: touches the publisher's loan path and
+    /// data segment, so that the next [`send`](Self::send) finds them in the caches
+    /// (the partition's pre-tick warm-up). Subscribers see nothing.
+    pub fn warm(&self) -> Result<()> {
+        let sample = self.publisher.loan_uninit().map_err(|e| BusError::Send {
+            service: self.name.clone(),
+            reason: reason(e),
+        })?;
+        drop(std::hint::black_box(sample));
+        Ok(())
+    }
+
     /// Wakes the listeners without sending (e.g. after a batch of `send`s).
     pub fn notify(&self) -> Result<()> {
         self.notifier

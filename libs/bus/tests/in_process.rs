@@ -147,6 +147,36 @@ fn polled_subscriber_gets_its_listener_when_attached() {
     assert!(run.leftovers().is_empty(), "{:?}", run.leftovers());
 }
 
+/// `warm` (the pre-tick warm-up) loans and returns a sample: subscribers get
+/// nothing and no wake-up, the sample goes back to the pool (warming more often
+/// than the pool is deep does not exhaust it), and the next send is delivered once.
+#[test]
+fn warming_a_publisher_sends_nothing() {
+    let run = RunScope::unique("warm").unwrap();
+    {
+        let node = run.node("main").unwrap();
+        let qos = ServiceSettings::lock_step();
+        let tx = Publisher::<Tick>::with_name(&node, "wm", &qos).unwrap();
+        let rx = Subscriber::<Tick>::with_name(&node, "wm", &qos).unwrap();
+        for _ in 0..4 * qos.subscriber_buffer {
+            tx.warm().unwrap();
+        }
+        assert!(rx.drain_events().unwrap().is_empty(), "no wake-up");
+        assert_eq!(rx.try_receive().unwrap().map(|t| t.tick), None);
+        tx.send(&Tick {
+            tick: 3,
+            ..Default::default()
+        })
+        .unwrap();
+        assert_eq!(rx.drain_events().unwrap().notifications, 1);
+        let mut got = Vec::new();
+        rx.receive_all(&mut got).unwrap();
+        assert_eq!(got.iter().map(|t| t.tick).collect::<Vec<_>>(), [3]);
+    }
+    run.teardown().unwrap();
+    assert!(run.leftovers().is_empty(), "{:?}", run.leftovers());
+}
+
 #[test]
 fn wrong_payload_type_is_a_typed_error() {
     let run = RunScope::unique("types").unwrap();

@@ -63,6 +63,12 @@ pub const HEALTH: ServiceName = ServiceName("safe_capture/health");
 /// upstream commands only, never on every state, and need this wake-up to apply
 /// their fallback to a tick whose nominal or upstream command is late.
 pub const STAGE_DEADLINE: ServiceName = ServiceName("safe_capture/scheduler/deadline");
+/// Pre-tick warm-up (event service, no payload), real-time mode only. Notifier:
+/// scheduler, `warmup_lead_us` before each tick. Listeners: the simulator, the
+/// nominal controllers and the safety filters, which rehearse their step on their
+/// latest inputs (nothing is published) so that the tick finds their code and data
+/// in the caches instead of cold after a period asleep.
+pub const PREPARE: ServiceName = ServiceName("safe_capture/scheduler/prepare");
 /// Start-up handshake (event services `<HANDSHAKE>/ready` and `<HANDSHAKE>/go`, no payload).
 /// Participants notify `ready` with their role id + 1; the coordinator (scheduler)
 /// notifies `go` once all expected participants were seen.

@@ -121,6 +121,13 @@ pub struct PartitionConfig {
     /// are left alone. Needs write access to the device (root); refused → a warning.
     #[serde(default)]
     pub cpu_wakeup_latency_us: Option<u32>,
+    /// Real-time mode: this long [µs] before each tick the scheduler signals
+    /// `PREPARE`, and the simulator, the nominal controllers and the filters rehearse
+    /// their step on their latest inputs (publishing nothing), so that the tick finds
+    /// their code and data warm in the caches instead of cold after a period asleep.
+    /// 0 = off. Must be under half the base period.
+    #[serde(default)]
+    pub warmup_lead_us: u32,
     pub rate_groups: Vec<RateGroup>,
     pub deadlines: Deadlines,
     pub lock_step: LockStep,
@@ -259,6 +266,20 @@ impl PartitionConfig {
         {
             return err(format!(
                 "cpu_wakeup_latency_us = {us}: must be 0..=1000000 (µs; remove the key to leave the system alone)"
+            ));
+        }
+        if let Some(base) = self
+            .rate_groups
+            .iter()
+            .map(|g| g.period_s)
+            .filter(|p| p.is_finite() && *p > 0.0)
+            .reduce(f64::min)
+            && f64::from(self.warmup_lead_us) >= base * 1e6 / 2.0
+        {
+            return err(format!(
+                "warmup_lead_us = {}: must be under half the base period ({} µs)",
+                self.warmup_lead_us,
+                base * 1e6 / 2.0
             ));
         }
         let d = &self.deadlines;
@@ -487,11 +508,12 @@ mod tests {
             )
             .replace(
                 "handshake_timeout_s = 30\n",
-                "handshake_timeout_s = 30\nreal_time_priority = 50\ncpu_wakeup_latency_us = 0\n",
+                "handshake_timeout_s = 30\nreal_time_priority = 50\ncpu_wakeup_latency_us = 0\nwarmup_lead_us = 1000\n",
             ),
             Path::new("."),
         )
         .unwrap();
+        assert_eq!(c.warmup_lead_us, 1000);
         assert_eq!(c.priority_of("recorder"), 40);
         assert_eq!(c.priority_of("simulator"), 50);
         assert_eq!(c.roles["recorder"].cpus, vec![0]);
@@ -521,6 +543,11 @@ mod tests {
                 "handshake_timeout_s = 30\n",
                 "handshake_timeout_s = 30\ncpu_wakeup_latency_us = 2000000\n",
                 "cpu_wakeup_latency_us = 2000000: must be 0..=1000000",
+            ),
+            (
+                "handshake_timeout_s = 30\n",
+                "handshake_timeout_s = 30\nwarmup_lead_us = 50000\n",
+                "warmup_lead_us = 50000: must be under half the base period (50000 µs)",
             ),
         ] {
             assert!(ok.contains(from), "{from}");

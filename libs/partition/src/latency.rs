@@ -55,6 +55,9 @@ pub struct LatencyReport {
     pub cycle_slips: u64,
     /// Ticks (after warm-up) in which a stage missed its deadline (a fallback was used).
     pub deadline_misses: u64,
+    /// The pre-tick warm-up lead in effect [µs] (config `warmup_lead_us`; 0 = off).
+    #[serde(default)]
+    pub warmup_lead_us: u32,
     pub machine: Machine,
 }
 
@@ -234,6 +237,9 @@ pub fn analyse(out: &Path, warmup: u64) -> anyhow::Result<LatencyReport> {
             .collect(),
         cycle_slips: sched["cycle_slips"].as_u64().unwrap_or(0),
         deadline_misses: misses,
+        // what every process of the run read
+        warmup_lead_us: crate::PartitionConfig::load(&out.join("partition.effective.toml"))
+            .map_or(0, |c| c.warmup_lead_us),
         machine: machine(),
     };
     // HDR percentile distribution of the whole tick
@@ -366,7 +372,7 @@ pub fn bench(o: &BenchOptions) -> anyhow::Result<LatencyReport> {
 /// The report as a Markdown table.
 pub fn markdown(r: &LatencyReport) -> String {
     let mut s = format!(
-        "Machine: {} cores, {}, kernel {}; CPU wake-up latency {}; host steal time during the run {}. Clock {} at {} s; {} ticks measured ({} warm-up excluded); cycle slips {}; deadline misses {}.\n\n| hop | N | min | p50 | p90 | p99 | p99.9 | max |\n|---|---|---|---|---|---|---|---|\n",
+        "Machine: {} cores, {}, kernel {}; CPU wake-up latency {}; host steal time during the run {}. Clock {} at {} s; pre-tick warm-up {}; {} ticks measured ({} warm-up excluded); cycle slips {}; deadline misses {}.\n\n| hop | N | min | p50 | p90 | p99 | p99.9 | max |\n|---|---|---|---|---|---|---|---|\n",
         r.machine.cores,
         r.machine.cpu,
         r.machine.kernel,
@@ -380,6 +386,11 @@ pub fn markdown(r: &LatencyReport) -> String {
             .map_or("not reported".to_string(), |s| format!("{s:.2} s")),
         r.clock,
         r.period_s,
+        if r.warmup_lead_us == 0 {
+            "off".to_string()
+        } else {
+            format!("{} us before each tick", r.warmup_lead_us)
+        },
         r.whole_tick.n,
         r.warmup_ticks,
         r.cycle_slips,

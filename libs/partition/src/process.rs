@@ -4,6 +4,7 @@
 use crate::config::{PartitionConfig, Schedule};
 use anyhow::Context;
 use sc_bus::{BusNode, RunScope, ServiceSettings, WaitOutcome, Waiter};
+use sc_icd::services;
 use sc_mission::Setup;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -99,6 +100,19 @@ impl Proc {
         p.announce_and_wait(Duration::from_secs_f64(self.cfg.handshake_timeout_s + 5.0))?;
         Ok(())
     }
+}
+
+/// True if this run has the pre-tick warm-up (real-time mode, `warmup_lead_us > 0`).
+pub fn warmup_enabled(p: &Proc) -> bool {
+    p.cfg.clock == crate::ClockMode::RealTime && p.cfg.warmup_lead_us > 0
+}
+
+/// The listener of the pre-tick warm-up signal ([`services::PREPARE`]) if this run
+/// has it; a process attaches it to the waiter it sleeps on between ticks.
+pub fn prepare_listener(p: &Proc) -> anyhow::Result<Option<sc_bus::SignalListener>> {
+    Ok(warmup_enabled(p)
+        .then(|| sc_bus::SignalListener::new(&p.node, services::PREPARE.as_str(), &qos()))
+        .transpose()?)
 }
 
 /// Sleeps on the waiter until an event or `until` (at most 1 s at a time).

@@ -4,7 +4,7 @@
 use crate::config::ClockMode;
 use crate::convert;
 use crate::fallback;
-use crate::process::{Proc, qos, send, wait};
+use crate::process::{Proc, prepare_listener, qos, send, wait, warmup_enabled};
 use anyhow::Context;
 use nalgebra::Vector3;
 use sc_bus::{PeerMonitor, Publisher, SignalListener, SignalSender, Subscriber, Waitable, Waiter};
@@ -70,6 +70,11 @@ pub fn scheduler() -> anyhow::Result<i32> {
     let control_tx = Publisher::<Tick>::new(&p.node, services::CONTROL, &q)?;
     let result_rx = Subscriber::<StepResult>::new(&p.node, services::STEP_RESULT, &q)?;
     let watchdog = SignalSender::new(&p.node, services::STAGE_DEADLINE.as_str(), &q)?;
+    // real time: the pre-tick warm-up signal, `warmup_lead_us` before each tick
+    let lead = Duration::from_micros(u64::from(p.cfg.warmup_lead_us));
+    let prepare = warmup_enabled(&p)
+        .then(|| SignalSender::new(&p.node, services::PREPARE.as_str(), &q))
+        .transpose()?;
     // lock-step flow control: the recorder's progress (listener created on first wait)
     let recorder_rx = Subscriber::<Health>::polled(&p.node, services::HEALTH, &q)?;
     let on_recorder = Waiter::new()?;
@@ -131,6 +136,19 @@ pub fn scheduler() -> anyhow::Result<i32> {
         }
         if clock_mode == clock_mode::REAL_TIME {
             let target = started + period * slot;
+            if let Some(prepare) = &prepare {
+                let at = target.checked_sub(lead).unwrap_or(target);
+                if Instant::now() < at {
+                    while Instant::now() < at {
+                        if !wait(&waiter, Some(at))? {
+                            rep.end = "interrupted".into();
+                            break 'ticks;
+                        }
+                        drain(&result_rx)?;
+                    }
+                    prepare.notify()?;
+                }
+            }
             while Instant::now() < target {
                 if !wait(&waiter, Some(target))? {
                     rep.end = "interrupted".into();
@@ -315,6 +333,9 @@ pub fn simulator() -> anyhow::Result<i32> {
     // translational and attitude filters wake only their downstream filter.
     let on_tick = Waiter::new()?;
     let _a0 = on_tick.attach(&tick_rx)?;
+    // real time: the pre-tick warm-up (docs/PARTITION.md, "What a hop costs")
+    let prepare = prepare_listener(&p)?;
+    let _a2 = prepare.as_ref().map(|l| on_tick.attach(l)).transpose()?;
     let on_robotic = Waiter::new()?;
     let _a1 = [on_robotic.attach(&tick_rx)?, on_robotic.attach(&sr_rx)?];
     let on_any = Waiter::new()?;
@@ -343,6 +364,13 @@ pub fn simulator() -> anyhow::Result<i32> {
         if ticks.is_empty() {
             if !wait(&on_tick, None)? {
                 break;
+            }
+            if let Some(l) = &prepare
+                && l.drain()? > 0
+            {
+                // rehearse the start of a tick on the current state; nothing is sent
+                std::hint::black_box(convert::sim_state(&sim.observe()));
+                state_tx.warm()?;
             }
             ticks.extend(drain(&tick_rx)?);
             // keep only the newest safe commands; tick-matched below
@@ -554,6 +582,10 @@ pub fn nominal(which: usize) -> anyhow::Result<i32> {
     // (the simulator wakes its consumers once when it stops).
     let waiter = Waiter::new()?;
     let _a = waiter.attach(&state_rx)?;
+    // real time: the pre-tick warm-up (docs/PARTITION.md, "What a hop costs")
+    let prepare = prepare_listener(&p)?;
+    let _a1 = prepare.as_ref().map(|l| waiter.attach(l)).transpose()?;
+    let mut last_state: Option<SimState> = None;
     let scenario = p.scenario_with_period(p.schedule.period_s[which]);
     let ctl = NominalControllers::new(&scenario, (*p.setup.robot).clone())?;
     let subsystems = [
@@ -568,10 +600,24 @@ pub fn nominal(which: usize) -> anyhow::Result<i32> {
         if !wait(&waiter, None)? {
             break;
         }
+        if let Some(l) = &prepare
+            && l.drain()? > 0
+            && let Some(s) = &last_state
+        {
+            // rehearse the last step (the controllers are pure); nothing is sent
+            let o = convert::observation(s);
+            std::hint::black_box(ctl.command_subsystems(&stages::nominal_input(&o), subsystems));
+            match which {
+                0 => tx_t.as_ref().context("publisher")?.warm()?,
+                1 => tx_a.as_ref().context("publisher")?.warm()?,
+                _ => tx_r.as_ref().context("publisher")?.warm()?,
+            }
+        }
         for s in drain(&state_rx)? {
             if s.due_mask & bit == 0 {
                 continue;
             }
+            last_state = Some(s);
             let recv_ns = now();
             let o = convert::observation(&s);
             let out = ctl.command_subsystems(&stages::nominal_input(&o), subsystems);
@@ -669,6 +715,8 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
         .then(|| Publisher::<SafeRobotic>::new(&p.node, services::SAFE_ROBOTIC, &q))
         .transpose()?;
     let watchdog = SignalListener::new(&p.node, services::STAGE_DEADLINE.as_str(), &q)?;
+    // real time: the pre-tick warm-up (docs/PARTITION.md, "What a hop costs")
+    let prepare = prepare_listener(&p)?;
     // Wake-ups (docs/PARTITION.md, "Who wakes whom"). Normally on the nominal
     // command and the immediately upstream safe command only: the state of the tick
     // was published before either, so it is read without waking on it. While an
@@ -689,6 +737,9 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
     .collect();
     let on_inputs = Waiter::new()?;
     let mut att = vec![on_inputs.attach(&watchdog)?];
+    if let Some(l) = &prepare {
+        att.push(on_inputs.attach(l)?);
+    }
     for (s, _) in inputs.iter().filter(|(_, wakes)| *wakes) {
         att.push(on_inputs.attach(*s)?);
     }
@@ -700,6 +751,9 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
         () => {{
             if any_attached.is_empty() {
                 any_attached.push(on_any.attach(&watchdog)?);
+                if let Some(l) = &prepare {
+                    any_attached.push(on_any.attach(l)?);
+                }
                 any_attached.push(on_any.attach(&state_rx)?);
                 for (s, _) in &inputs {
                     any_attached.push(on_any.attach(*s)?);
@@ -733,9 +787,14 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
     let mut phase = 0u32;
     let mut misses = 0u64;
     let mut stop = false;
+    let mut last_state: Option<SimState> = None;
+    let mut rehearse = false;
     macro_rules! pump {
         () => {{
             watchdog.drain()?;
+            if let Some(l) = &prepare {
+                rehearse |= l.drain()? > 0;
+            }
             stop |= stop_seen(&drain(&tick_rx)?);
             states.extend(
                 drain(&state_rx)?
@@ -786,9 +845,52 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
                 break;
             }
             pump!();
+            if std::mem::take(&mut rehearse)
+                && states.is_empty()
+                && let Some(s) = &last_state
+            {
+                // the pre-tick warm-up: this filter's step on the last tick's inputs
+                // (the filters are memoryless); the output is dropped, nothing is sent
+                let o = convert::observation(s);
+                let f_b = up_t.map_or_else(Vector3::zeros, |m| convert::vec3(&m.actuated));
+                let tau_b = up_a.map_or_else(Vector3::zeros, |m| convert::vec3(&m.u));
+                match which {
+                    0 => {
+                        if let Some(n) = nom_t {
+                            std::hint::black_box(
+                                layer.translational.filter(
+                                    &stages::translational_input(&o),
+                                    &convert::vec3(&n.f_h),
+                                ),
+                            );
+                        }
+                        tx_t.as_ref().context("publisher")?.warm()?;
+                    }
+                    1 => {
+                        if let Some(n) = nom_a {
+                            std::hint::black_box(layer.attitude.filter(
+                                &stages::attitude_input(&o, &robot, &f_b),
+                                &convert::vec3(&n.tau_b),
+                            ));
+                        }
+                        tx_a.as_ref().context("publisher")?.warm()?;
+                    }
+                    _ => {
+                        if let (Some(n), Some(x)) =
+                            (nom_r, stages::robotic_input(&o, &robot, &f_b, &tau_b))
+                        {
+                            std::hint::black_box(
+                                layer.robotic.filter(&x, &convert::vec7(&n.tau_m)),
+                            );
+                        }
+                        tx_r.as_ref().context("publisher")?.warm()?;
+                    }
+                }
+            }
             continue;
         }
         let s = states.remove(0);
+        last_state = Some(s);
         let k = s.tick;
         // the stage deadline counts from the publication of the state
         let until = instant_of(s.publish_ns) + deadline;
