@@ -47,7 +47,32 @@ fn latency_report_is_consistent() {
         launch["cpu_wakeup_latency"].as_str(),
         Some(r.machine.cpu_wakeup_latency.as_str())
     );
+    // the steal series beside the run: every measured tick is either in a window with
+    // steal or counted in the latency without steal
+    let st = r.steal.as_ref().expect("steal.csv sampled beside the run");
+    assert_eq!(
+        st.ticks_with_steal + st.whole_tick_without_steal.n,
+        25,
+        "{st:?}"
+    );
+    assert!(
+        st.over_1ms_with_steal <= st.over_1ms && st.over_1ms <= 25,
+        "{st:?}"
+    );
+    assert!(
+        st.sample_period_s > 0.05 && st.sample_period_s < 1.0,
+        "{st:?}"
+    );
+    let series = sc_partition::steal::read_csv(&out.join("steal.csv"))
+        .unwrap()
+        .unwrap();
+    assert!(
+        (series.last().unwrap().steal_s - series[0].steal_s - r.machine.steal_s.unwrap()).abs()
+            < 1e-9
+    );
     for f in [
+        "latency_timeline.svg",
+        "steal.csv",
         "latency_whole_tick.hgrm",
         "latency.svg",
         "latency_report.json",

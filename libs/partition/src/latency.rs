@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 
 /// Percentiles of one hop [µs].
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
@@ -58,7 +59,25 @@ pub struct LatencyReport {
     /// The pre-tick warm-up lead in effect [µs] (config `warmup_lead_us`; 0 = off).
     #[serde(default)]
     pub warmup_lead_us: u32,
+    /// The host's steal time around the measured ticks (from `steal.csv`, when the
+    /// run has one).
+    #[serde(default)]
+    pub steal: Option<StealSummary>,
     pub machine: Machine,
+}
+
+/// Which ticks had host steal around them, and the latency of the others.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct StealSummary {
+    /// Sampling period of the steal counter [s].
+    pub sample_period_s: f64,
+    /// Measured ticks whose sampling window had steal (the counter counts 10 ms units).
+    pub ticks_with_steal: u64,
+    /// Whole-tick latency of the ticks without steal around them.
+    pub whole_tick_without_steal: HopStats,
+    /// Ticks over the 1 ms target, and how many of them had steal around them.
+    pub over_1ms: u64,
+    pub over_1ms_with_steal: u64,
 }
 
 /// Hops measured, (name, from column, to column) of latency.csv.
@@ -159,16 +178,6 @@ pub fn machine() -> Machine {
     }
 }
 
-/// Steal time of all CPUs since boot [s] (`/proc/stat`, line `cpu`, 8th value).
-pub fn steal_time_s() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/stat").ok()?;
-    let line = stat.lines().find(|l| l.starts_with("cpu "))?;
-    let jiffies: f64 = line.split_whitespace().nth(8)?.parse().ok()?;
-    // SAFETY: sysconf has no preconditions.
-    let hz = unsafe { libc::sysconf(libc::_SC_CLK_TCK) };
-    (hz > 0).then(|| jiffies / hz as f64)
-}
-
 /// Computes the report from a run's output directory, excluding the first `warmup` ticks;
 /// writes `latency_whole_tick.hgrm` (HDR percentile distribution) and
 /// `latency.svg` (log-scale percentile plot) next to it.
@@ -201,6 +210,8 @@ pub fn analyse(out: &Path, warmup: u64) -> anyhow::Result<LatencyReport> {
         .collect::<anyhow::Result<_>>()?;
     let mut total = 0;
     let mut misses = 0;
+    // (tick send, whole-tick latency) [ns] of the measured ticks
+    let mut ticks: Vec<(u64, u64)> = Vec::new();
     for l in lines {
         let v: Vec<&str> = l.split(',').collect();
         total += 1;
@@ -214,6 +225,7 @@ pub fn analyse(out: &Path, warmup: u64) -> anyhow::Result<LatencyReport> {
         let num = |i: usize| v.get(i).and_then(|x| x.parse::<u64>().ok());
         if let (Some(a), Some(b)) = (num(c_send), num(c_recv)) {
             whole.saturating_record(b.saturating_sub(a).max(1));
+            ticks.push((a, b.saturating_sub(a).max(1)));
         }
         for (h, (a, b)) in hops.iter_mut().zip(&hop_cols) {
             if let (Some(a), Some(b)) = (num(*a), num(*b)) {
@@ -224,6 +236,38 @@ pub fn analyse(out: &Path, warmup: u64) -> anyhow::Result<LatencyReport> {
     let sched: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(out.join("scheduler.json")).context("reading scheduler.json")?,
     )?;
+    let series = crate::steal::read_csv(&out.join("steal.csv"))?;
+    let steal_of: Vec<Option<f64>> = ticks
+        .iter()
+        .map(|(a, d)| {
+            series
+                .as_ref()
+                .and_then(|v| crate::steal::steal_around(v, *a, a + d))
+        })
+        .collect();
+    let steal = series.as_ref().filter(|v| v.len() >= 2).map(|v| {
+        let mut calm = hist();
+        let (mut with, mut over, mut over_with) = (0, 0, 0);
+        for ((_, d), st) in ticks.iter().zip(&steal_of) {
+            let stolen = st.is_some_and(|x| x > 0.0);
+            with += u64::from(stolen);
+            if *d > 1_000_000 {
+                over += 1;
+                over_with += u64::from(stolen);
+            }
+            if !stolen {
+                calm.saturating_record(*d);
+            }
+        }
+        let span = v[v.len() - 1].t_ns.saturating_sub(v[0].t_ns) as f64 * 1e-9;
+        StealSummary {
+            sample_period_s: span / (v.len() - 1) as f64,
+            ticks_with_steal: with,
+            whole_tick_without_steal: stats(&calm),
+            over_1ms: over,
+            over_1ms_with_steal: over_with,
+        }
+    });
     let rep = LatencyReport {
         clock: sched["clock"].as_str().unwrap_or("").to_string(),
         period_s: sched["base_period_s"].as_f64().unwrap_or(0.0),
@@ -240,6 +284,7 @@ pub fn analyse(out: &Path, warmup: u64) -> anyhow::Result<LatencyReport> {
         // what every process of the run read
         warmup_lead_us: crate::PartitionConfig::load(&out.join("partition.effective.toml"))
             .map_or(0, |c| c.warmup_lead_us),
+        steal,
         machine: machine(),
     };
     // HDR percentile distribution of the whole tick
@@ -285,6 +330,12 @@ pub fn analyse(out: &Path, warmup: u64) -> anyhow::Result<LatencyReport> {
     )?;
     f.flush()?;
     plot(&out.join("latency.svg"), &points, &rep)?;
+    plot_timeline(
+        &out.join("latency_timeline.svg"),
+        &ticks,
+        series.as_deref().unwrap_or(&[]),
+        &rep,
+    )?;
     Ok(rep)
 }
 
@@ -330,6 +381,9 @@ fn plot(path: &Path, pts: &[(f64, f64)], rep: &LatencyReport) -> anyhow::Result<
     Ok(())
 }
 
+/// How often the benchmark reads the host's steal counter.
+pub const STEAL_SAMPLE_PERIOD: Duration = Duration::from_millis(100);
+
 /// Options of the benchmark.
 #[derive(Debug, Clone)]
 pub struct BenchOptions {
@@ -343,7 +397,7 @@ pub struct BenchOptions {
 
 /// Runs the partition in real-time mode for `warmup + ticks` ticks and analyses it.
 pub fn bench(o: &BenchOptions) -> anyhow::Result<LatencyReport> {
-    let steal_before = steal_time_s();
+    let sampler = crate::steal::StealSampler::start(STEAL_SAMPLE_PERIOD);
     let rep = launch(&LaunchOptions {
         config: o.config.clone(),
         out: o.out.clone(),
@@ -353,14 +407,17 @@ pub fn bench(o: &BenchOptions) -> anyhow::Result<LatencyReport> {
         max_ticks: Some(o.ticks + o.warmup),
         ..Default::default()
     })?;
+    let series = sampler.finish();
+    crate::steal::write_csv(&o.out.join("steal.csv"), &series)?;
     if rep.code == 3 {
         anyhow::bail!("the partition run failed (see {}/logs)", o.out.display());
     }
     let mut r = analyse(&o.out, o.warmup)?;
     r.machine.cpu_wakeup_latency = rep.cpu_wakeup_latency.clone();
-    r.machine.steal_s = steal_before
-        .zip(steal_time_s())
-        .map(|(a, b)| (b - a).max(0.0));
+    r.machine.steal_s = series
+        .first()
+        .zip(series.last())
+        .map(|(a, b)| (b.steal_s - a.steal_s).max(0.0));
     std::fs::write(
         o.out.join("latency_report.json"),
         serde_json::to_string_pretty(&r)? + "\n",
@@ -409,6 +466,110 @@ pub fn markdown(r: &LatencyReport) -> String {
         "**whole tick** (tick -> robotic safe command at the simulator)",
         &r.whole_tick,
     );
+    if let Some(st) = &r.steal {
+        s += &row(
+            "whole tick, ticks without host steal around them",
+            &st.whole_tick_without_steal,
+        );
+        s += &format!(
+            "\nHost steal (counter read every {:.2} s, in 10 ms units): {} of {} ticks had steal in their sampling window; of the {} ticks over 1 ms, {} had. `latency_timeline.svg` plots both over the run.\n",
+            st.sample_period_s,
+            st.ticks_with_steal,
+            r.whole_tick.n,
+            st.over_1ms,
+            st.over_1ms_with_steal
+        );
+    }
     s += "\nAll times in µs.\n";
     s
+}
+
+/// Whole-tick latency of every measured tick over the run (log scale) above the
+/// host's steal rate, so that a reader sees whether the tail follows the host.
+fn plot_timeline(
+    path: &Path,
+    ticks: &[(u64, u64)],
+    steal: &[crate::steal::StealSample],
+    rep: &LatencyReport,
+) -> anyhow::Result<()> {
+    use plotters::prelude::*;
+    let e = |e: &dyn std::fmt::Display| anyhow::anyhow!("timeline plot: {e}");
+    let root = SVGBackend::new(path, (1000, 640)).into_drawing_area();
+    root.fill(&WHITE).map_err(|x| e(&x))?;
+    let (top, bottom) = root.split_vertically(420);
+    let t0 = ticks.first().map_or(0, |t| t.0);
+    let secs = |ns: u64| ns.saturating_sub(t0) as f64 * 1e-9;
+    let t_end = ticks.last().map_or(1.0, |t| secs(t.0)).max(1e-3);
+    let pts: Vec<(f64, f64)> = ticks
+        .iter()
+        .map(|(a, d)| (secs(*a), *d as f64 / 1e3))
+        .collect();
+    let ymax = pts.iter().map(|p| p.1).fold(1000.0, f64::max) * 1.5;
+    let ymin = pts
+        .iter()
+        .map(|p| p.1)
+        .fold(f64::INFINITY, f64::min)
+        .min(100.0)
+        / 1.5;
+    let mut chart = ChartBuilder::on(&top)
+        .caption(
+            format!(
+                "whole-tick latency over the run ({} ticks at {} s)",
+                rep.whole_tick.n, rep.period_s
+            ),
+            ("sans-serif", 18),
+        )
+        .margin(12)
+        .x_label_area_size(30)
+        .y_label_area_size(65)
+        .build_cartesian_2d(0.0..t_end, (ymin..ymax).log_scale())
+        .map_err(|x| e(&x))?;
+    chart
+        .configure_mesh()
+        .y_desc("latency [us] (log)")
+        .draw()
+        .map_err(|x| e(&x))?;
+    chart
+        .draw_series(
+            pts.iter()
+                .map(|p| Circle::new(*p, 2, BLUE.mix(0.6).filled())),
+        )
+        .map_err(|x| e(&x))?;
+    // the 1 ms target
+    chart
+        .draw_series(LineSeries::new(
+            [(0.0, 1000.0), (t_end, 1000.0)],
+            RED.mix(0.7),
+        ))
+        .map_err(|x| e(&x))?;
+    // steal rate between consecutive readings [ms of CPU per s]
+    let rate: Vec<(f64, f64)> = steal
+        .windows(2)
+        .filter(|w| w[1].t_ns > w[0].t_ns)
+        .map(|w| {
+            let dt = (w[1].t_ns - w[0].t_ns) as f64 * 1e-9;
+            (
+                secs(w[1].t_ns),
+                (w[1].steal_s - w[0].steal_s).max(0.0) * 1e3 / dt,
+            )
+        })
+        .collect();
+    let rmax = rate.iter().map(|p| p.1).fold(10.0, f64::max) * 1.1;
+    let mut chart = ChartBuilder::on(&bottom)
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(65)
+        .build_cartesian_2d(0.0..t_end, 0.0..rmax)
+        .map_err(|x| e(&x))?;
+    chart
+        .configure_mesh()
+        .x_desc("time since the first measured tick [s]")
+        .y_desc("host steal [ms/s]")
+        .draw()
+        .map_err(|x| e(&x))?;
+    chart
+        .draw_series(LineSeries::new(rate, &BLACK))
+        .map_err(|x| e(&x))?;
+    root.present().map_err(|x| e(&x))?;
+    Ok(())
 }

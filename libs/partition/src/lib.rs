@@ -22,6 +22,7 @@ pub mod pm_qos;
 pub mod process;
 pub mod recorder;
 pub mod roles;
+pub mod steal;
 
 pub use config::{ClockMode, PartitionConfig, Schedule};
 pub use launcher::{LaunchOptions, LaunchReport, launch};
