@@ -23,6 +23,8 @@ pub struct Proc {
     pub schedule: Schedule,
     pub setup: Setup,
     pub out: PathBuf,
+    /// The SCHED_FIFO priority this process runs at (real-time mode), if granted.
+    pub fifo_priority: Option<u32>,
 }
 
 /// Service settings of the partition's data services: no sample is ever lost
@@ -59,9 +61,9 @@ impl Proc {
         let run = RunScope::from_env()
             .context("SC_RUN_ID is not set (processes are started by the launcher)")??;
         let prio = cfg.priority_of(role);
-        if cfg.clock == crate::ClockMode::RealTime && prio > 0 {
-            set_fifo(role, prio);
-        }
+        let fifo_priority = (cfg.clock == crate::ClockMode::RealTime && prio > 0)
+            .then(|| set_fifo(role, prio).then_some(prio))
+            .flatten();
         if let Some(e) = cfg.roles.get(role)
             && cfg.clock == crate::ClockMode::RealTime
             && !e.cpus.is_empty()
@@ -77,7 +79,24 @@ impl Proc {
             schedule,
             setup,
             out,
+            fifo_priority,
         })
+    }
+
+    /// Runs a pre-tick rehearsal one SCHED_FIFO priority below this process's own,
+    /// so that the tick's causal chain preempts a rehearsal that is still running
+    /// instead of waiting behind it. Without SCHED_FIFO (or at priority 1) it runs
+    /// as is.
+    pub fn rehearse<R>(&self, f: impl FnOnce() -> R) -> R {
+        let Some(prio) = self.fifo_priority.filter(|p| *p >= 2) else {
+            return f();
+        };
+        let lowered = set_priority(prio - 1);
+        let r = f();
+        if lowered {
+            set_priority(prio);
+        }
+        r
     }
 
     /// The scenario with the control period of a subsystem's rate group (the
@@ -145,8 +164,18 @@ pub fn send<T: core::fmt::Debug + sc_bus::ZeroCopySend + Copy + 'static>(
     }
 }
 
-/// Puts this process in the SCHED_FIFO class (real-time mode); a refusal is a warning.
-fn set_fifo(role: &str, prio: u32) {
+/// Changes this process's SCHED_FIFO priority; false if refused.
+fn set_priority(prio: u32) -> bool {
+    let param = libc::sched_param {
+        sched_priority: prio as libc::c_int,
+    };
+    // SAFETY: sched_setparam on this process with a valid, initialised param.
+    unsafe { libc::sched_setparam(0, &param) == 0 }
+}
+
+/// Puts this process in the SCHED_FIFO class (real-time mode); a refusal is a
+/// warning (and false).
+fn set_fifo(role: &str, prio: u32) -> bool {
     let param = libc::sched_param {
         sched_priority: prio as libc::c_int,
     };
@@ -158,6 +187,7 @@ fn set_fifo(role: &str, prio: u32) {
             std::io::Error::last_os_error()
         );
     }
+    rc == 0
 }
 
 /// Restricts this process to `cpus` (real-time mode); a refusal (e.g. a CPU the

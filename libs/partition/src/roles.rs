@@ -369,8 +369,10 @@ pub fn simulator() -> anyhow::Result<i32> {
                 && l.drain()? > 0
             {
                 // rehearse the start of a tick on the current state; nothing is sent
-                std::hint::black_box(convert::sim_state(&sim.observe()));
-                state_tx.warm()?;
+                p.rehearse(|| {
+                    std::hint::black_box(convert::sim_state(&sim.observe()));
+                    state_tx.warm()
+                })?;
             }
             ticks.extend(drain(&tick_rx)?);
             // keep only the newest safe commands; tick-matched below
@@ -605,13 +607,18 @@ pub fn nominal(which: usize) -> anyhow::Result<i32> {
             && let Some(s) = &last_state
         {
             // rehearse the last step (the controllers are pure); nothing is sent
-            let o = convert::observation(s);
-            std::hint::black_box(ctl.command_subsystems(&stages::nominal_input(&o), subsystems));
-            match which {
-                0 => tx_t.as_ref().context("publisher")?.warm()?,
-                1 => tx_a.as_ref().context("publisher")?.warm()?,
-                _ => tx_r.as_ref().context("publisher")?.warm()?,
-            }
+            p.rehearse(|| {
+                let o = convert::observation(s);
+                std::hint::black_box(
+                    ctl.command_subsystems(&stages::nominal_input(&o), subsystems),
+                );
+                match which {
+                    0 => tx_t.as_ref().context("publisher")?.warm(),
+                    1 => tx_a.as_ref().context("publisher")?.warm(),
+                    _ => tx_r.as_ref().context("publisher")?.warm(),
+                }
+                .map_err(anyhow::Error::from)
+            })?;
         }
         for s in drain(&state_rx)? {
             if s.due_mask & bit == 0 {
@@ -851,41 +858,42 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
             {
                 // the pre-tick warm-up: this filter's step on the last tick's inputs
                 // (the filters are memoryless); the output is dropped, nothing is sent
-                let o = convert::observation(s);
-                let f_b = up_t.map_or_else(Vector3::zeros, |m| convert::vec3(&m.actuated));
-                let tau_b = up_a.map_or_else(Vector3::zeros, |m| convert::vec3(&m.u));
-                match which {
-                    0 => {
-                        if let Some(n) = nom_t {
-                            std::hint::black_box(
-                                layer.translational.filter(
+                p.rehearse(|| -> anyhow::Result<()> {
+                    let o = convert::observation(s);
+                    let f_b = up_t.map_or_else(Vector3::zeros, |m| convert::vec3(&m.actuated));
+                    let tau_b = up_a.map_or_else(Vector3::zeros, |m| convert::vec3(&m.u));
+                    match which {
+                        0 => {
+                            if let Some(n) = nom_t {
+                                std::hint::black_box(layer.translational.filter(
                                     &stages::translational_input(&o),
                                     &convert::vec3(&n.f_h),
-                                ),
-                            );
+                                ));
+                            }
+                            tx_t.as_ref().context("publisher")?.warm()?;
                         }
-                        tx_t.as_ref().context("publisher")?.warm()?;
-                    }
-                    1 => {
-                        if let Some(n) = nom_a {
-                            std::hint::black_box(layer.attitude.filter(
-                                &stages::attitude_input(&o, &robot, &f_b),
-                                &convert::vec3(&n.tau_b),
-                            ));
+                        1 => {
+                            if let Some(n) = nom_a {
+                                std::hint::black_box(layer.attitude.filter(
+                                    &stages::attitude_input(&o, &robot, &f_b),
+                                    &convert::vec3(&n.tau_b),
+                                ));
+                            }
+                            tx_a.as_ref().context("publisher")?.warm()?;
                         }
-                        tx_a.as_ref().context("publisher")?.warm()?;
-                    }
-                    _ => {
-                        if let (Some(n), Some(x)) =
-                            (nom_r, stages::robotic_input(&o, &robot, &f_b, &tau_b))
-                        {
-                            std::hint::black_box(
-                                layer.robotic.filter(&x, &convert::vec7(&n.tau_m)),
-                            );
+                        _ => {
+                            if let (Some(n), Some(x)) =
+                                (nom_r, stages::robotic_input(&o, &robot, &f_b, &tau_b))
+                            {
+                                std::hint::black_box(
+                                    layer.robotic.filter(&x, &convert::vec7(&n.tau_m)),
+                                );
+                            }
+                            tx_r.as_ref().context("publisher")?.warm()?;
                         }
-                        tx_r.as_ref().context("publisher")?.warm()?;
                     }
-                }
+                    Ok(())
+                })?;
             }
             continue;
         }
