@@ -78,6 +78,36 @@ fn degraded(exec: &str, filter: &str) {
         f, expect,
         "{filter}: every step from the kill on is on the flagged fallback"
     );
+    // latency.csv marks the same steps, and the latency report counts them as
+    // deadline misses (a filter's fallback as much as the simulator's)
+    let bit = match filter {
+        "translational" => 1,
+        "attitude" => 2,
+        _ => 4,
+    };
+    let lat = std::fs::read_to_string(out.join("latency.csv")).unwrap();
+    let mut lines = lat.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let c = header
+        .iter()
+        .position(|h| *h == "upstream_missing_mask")
+        .unwrap();
+    let marked: Vec<u64> = lines
+        .filter_map(|l| {
+            let v: Vec<&str> = l.split(',').collect();
+            (v[c].parse::<u32>().unwrap() & bit != 0).then(|| v[0].parse().unwrap())
+        })
+        .collect();
+    assert_eq!(
+        marked, expect,
+        "{filter}: latency.csv upstream_missing_mask"
+    );
+    let r = sc_partition::latency::analyse(&out, 0).unwrap();
+    assert!(
+        r.deadline_misses >= expect.len() as u64,
+        "{}",
+        r.deadline_misses
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -54,7 +54,8 @@ pub struct LatencyReport {
     /// Per hop, in causal order.
     pub hops: BTreeMap<String, HopStats>,
     pub cycle_slips: u64,
-    /// Ticks (after warm-up) in which a stage missed its deadline (a fallback was used).
+    /// Ticks (after warm-up) in which a stage missed its deadline: the simulator or a
+    /// filter used a fallback for an input that was missing at it.
     pub deadline_misses: u64,
     /// The pre-tick warm-up lead in effect [µs] (config `warmup_lead_us`; 0 = off).
     #[serde(default)]
@@ -204,6 +205,8 @@ pub fn analyse(out: &Path, warmup: u64) -> anyhow::Result<LatencyReport> {
         col("sim_safe_recv_ns")?,
         col("fallback_mask")?,
     );
+    // filters that applied their fallback at a stage deadline (absent in older files)
+    let c_um = col("upstream_missing_mask").ok();
     let hop_cols: Vec<(usize, usize)> = HOPS
         .iter()
         .map(|(_, a, b)| Ok((col(a)?, col(b)?)))
@@ -219,7 +222,8 @@ pub fn analyse(out: &Path, warmup: u64) -> anyhow::Result<LatencyReport> {
         if tick < warmup {
             continue;
         }
-        if v[c_fb] != "0" {
+        let flagged = |c: Option<usize>| c.and_then(|c| v.get(c)).is_some_and(|x| *x != "0");
+        if flagged(Some(c_fb)) || flagged(c_um) {
             misses += 1;
         }
         let num = |i: usize| v.get(i).and_then(|x| x.parse::<u64>().ok());

@@ -87,7 +87,7 @@ pub fn recorder() -> anyhow::Result<i32> {
     let mut latency = open("latency.csv")?;
     writeln!(
         latency,
-        "tick,tick_send_ns,sim_recv_ns,state_publish_ns,nom_t_publish_ns,nom_a_publish_ns,nom_r_publish_ns,safe_t_recv_ns,safe_t_publish_ns,safe_a_recv_ns,safe_a_publish_ns,safe_r_recv_ns,safe_r_publish_ns,sim_safe_recv_ns,result_publish_ns,fallback_mask,held_mask"
+        "tick,tick_send_ns,sim_recv_ns,state_publish_ns,nom_t_publish_ns,nom_a_publish_ns,nom_r_publish_ns,safe_t_recv_ns,safe_t_publish_ns,safe_a_recv_ns,safe_a_publish_ns,safe_r_recv_ns,safe_r_publish_ns,sim_safe_recv_ns,result_publish_ns,fallback_mask,held_mask,upstream_missing_mask"
     )?;
     let mut mcap = crate::mcap_out::McapOut::create(&p.out.join("recording.mcap"))?;
     let layer = SafetyLayer::from_scenario(&p.setup.scenario, p.setup.mass());
@@ -353,9 +353,20 @@ pub fn recorder() -> anyhow::Result<i32> {
                 rep.upstream_missing_steps += 1;
             }
             let ns = |o: Option<u64>| o.map(|x| x.to_string()).unwrap_or_default();
+            // the filters that used a fallback for an input missing at their deadline
+            let missing = |faults: u32, bit: u32| {
+                if faults & sc_cbf::faults::UPSTREAM_MISSING != 0 {
+                    bit
+                } else {
+                    0
+                }
+            };
+            let upstream_missing_mask = missing(tr.report.faults, due::TRANSLATIONAL)
+                | missing(at.report.faults, due::ATTITUDE)
+                | missing(rb.report.faults, due::ROBOTIC);
             writeln!(
                 latency,
-                "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                 r.tick,
                 state.tick_send_ns,
                 state.recv_ns,
@@ -376,7 +387,8 @@ pub fn recorder() -> anyhow::Result<i32> {
                 },
                 r.publish_ns,
                 r.fallback_mask,
-                r.held_mask
+                r.held_mask,
+                upstream_missing_mask
             )?;
             records.push(rec);
             last_t = r.t;
