@@ -146,6 +146,62 @@ pub(crate) fn open_event(
         })
 }
 
+/// The event service beside a data service (or a payload-less signal) `name`,
+/// sized by the data service's settings.
+pub(crate) fn data_event(
+    node: &BusNode,
+    name: &str,
+    s: &ServiceSettings,
+) -> Result<EventFactory<ipc::Service>> {
+    open_event(
+        node,
+        name,
+        s.max_publishers + s.max_subscribers,
+        s.max_nodes,
+        EVENT_ID_MAX,
+    )
+}
+
+/// A notifier on `event` that notifies [`EVENT_SAMPLE`].
+pub(crate) fn sample_notifier(
+    event: &EventFactory<ipc::Service>,
+    name: &str,
+) -> Result<Notifier<ipc::Service>> {
+    event
+        .notifier_builder()
+        .default_event_id(EventId::new(EVENT_SAMPLE))
+        .create()
+        .map_err(|e| BusError::Port {
+            port: "notifier",
+            service: name.to_string(),
+            reason: reason(e),
+        })
+}
+
+/// A listener on `event`.
+pub(crate) fn listener(
+    event: &EventFactory<ipc::Service>,
+    name: &str,
+) -> Result<Listener<ipc::Service>> {
+    event
+        .listener_builder()
+        .create()
+        .map_err(|e| BusError::Port {
+            port: "listener",
+            service: name.to_string(),
+            reason: reason(e),
+        })
+}
+
+/// Wakes every listener of `notifier`'s service.
+pub(crate) fn notify(notifier: &Notifier<ipc::Service>, name: &str) -> Result<()> {
+    notifier.notify().map(|_| ()).map_err(|e| BusError::Event {
+        op: "notify",
+        service: name.to_string(),
+        reason: reason(e),
+    })
+}
+
 fn open_pubsub<T: Debug + ZeroCopySend + Copy>(
     node: &BusNode,
     name: &str,
@@ -196,13 +252,7 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Publisher<T> {
     /// Like [`new`](Self::new) with a free-form service name (tests, tools).
     pub fn with_name(node: &BusNode, name: &str, settings: &ServiceSettings) -> Result<Self> {
         let pubsub = open_pubsub::<T>(node, name, settings)?;
-        let event = open_event(
-            node,
-            name,
-            settings.max_publishers + settings.max_subscribers,
-            settings.max_nodes,
-            EVENT_ID_MAX,
-        )?;
+        let event = data_event(node, name, settings)?;
         let timeout = settings.backpressure_timeout;
         let mut builder = pubsub.publisher_builder().max_loaned_samples(2);
         if !settings.safe_overflow {
@@ -235,15 +285,7 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Publisher<T> {
             service: name.to_string(),
             reason: reason(e),
         })?;
-        let notifier = event
-            .notifier_builder()
-            .default_event_id(EventId::new(EVENT_SAMPLE))
-            .create()
-            .map_err(|e| BusError::Port {
-                port: "notifier",
-                service: name.to_string(),
-                reason: reason(e),
-            })?;
+        let notifier = sample_notifier(&event, name)?;
         Ok(Self {
             name: name.to_string(),
             timeout,
@@ -302,14 +344,7 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Publisher<T> {
 
     /// Wakes the listeners without sending (e.g. after a batch of `send`s).
     pub fn notify(&self) -> Result<()> {
-        self.notifier
-            .notify()
-            .map(|_| ())
-            .map_err(|e| BusError::Event {
-                op: "notify",
-                service: self.name.clone(),
-                reason: reason(e),
-            })
+        notify(&self.notifier, &self.name)
     }
 }
 
@@ -389,13 +424,7 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Subscriber<T> {
         settings: &ServiceSettings,
     ) -> Result<Self> {
         let pubsub = open_pubsub::<T>(node, name, settings)?;
-        let event = open_event(
-            node,
-            name,
-            settings.max_publishers + settings.max_subscribers,
-            settings.max_nodes,
-            EVENT_ID_MAX,
-        )?;
+        let event = data_event(node, name, settings)?;
         let subscriber = pubsub
             .subscriber_builder()
             .buffer_size(settings.subscriber_buffer)
@@ -431,15 +460,7 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Subscriber<T> {
         if let Some(l) = self.listener.get() {
             return Ok(l);
         }
-        let l = self
-            .event
-            .listener_builder()
-            .create()
-            .map_err(|e| BusError::Port {
-                port: "listener",
-                service: self.name.clone(),
-                reason: reason(e),
-            })?;
+        let l = listener(&self.event, &self.name)?;
         Ok(self.listener.get_or_init(|| l))
     }
 

@@ -19,22 +19,12 @@
 //! ```
 
 use crate::error::{BusError, Result, reason};
-use crate::pubsub::{EVENT_ID_MAX, EVENT_SAMPLE, ServiceSettings, open_event};
+use crate::pubsub::{EVENT_SAMPLE, ServiceSettings, data_event, listener, notify, sample_notifier};
 use crate::run::BusNode;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::event::PortFactory as EventFactory;
-
-fn event(node: &BusNode, name: &str, s: &ServiceSettings) -> Result<EventFactory<ipc::Service>> {
-    open_event(
-        node,
-        name,
-        s.max_publishers + s.max_subscribers,
-        s.max_nodes,
-        EVENT_ID_MAX,
-    )
-}
 
 /// Notifying side of a signal.
 pub struct SignalSender {
@@ -47,16 +37,8 @@ pub struct SignalSender {
 impl SignalSender {
     /// Opens/creates the event service `name` and a notifier on it.
     pub fn new(node: &BusNode, name: &str, settings: &ServiceSettings) -> Result<Self> {
-        let ev = event(node, name, settings)?;
-        let notifier = ev
-            .notifier_builder()
-            .default_event_id(EventId::new(EVENT_SAMPLE))
-            .create()
-            .map_err(|e| BusError::Port {
-                port: "notifier",
-                service: name.to_string(),
-                reason: reason(e),
-            })?;
+        let ev = data_event(node, name, settings)?;
+        let notifier = sample_notifier(&ev, name)?;
         Ok(Self {
             name: name.to_string(),
             notifier,
@@ -66,14 +48,7 @@ impl SignalSender {
 
     /// Wakes every listener of the signal.
     pub fn notify(&self) -> Result<()> {
-        self.notifier
-            .notify()
-            .map(|_| ())
-            .map_err(|e| BusError::Event {
-                op: "notify",
-                service: self.name.clone(),
-                reason: reason(e),
-            })
+        notify(&self.notifier, &self.name)
     }
 }
 
@@ -87,15 +62,10 @@ pub struct SignalListener {
 impl SignalListener {
     /// Opens/creates the event service `name` and a listener on it.
     pub fn new(node: &BusNode, name: &str, settings: &ServiceSettings) -> Result<Self> {
-        let ev = event(node, name, settings)?;
-        let listener = ev.listener_builder().create().map_err(|e| BusError::Port {
-            port: "listener",
-            service: name.to_string(),
-            reason: reason(e),
-        })?;
+        let ev = data_event(node, name, settings)?;
         Ok(Self {
             name: name.to_string(),
-            listener,
+            listener: listener(&ev, name)?,
             _event: ev,
         })
     }
