@@ -124,3 +124,40 @@ fn latency_report_is_consistent() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `sc-hop-cost` measures round trips through a second process it starts, reports
+/// ordered percentiles, leaves nothing in /dev/shm, and rejects bad arguments.
+#[test]
+fn hop_cost_reports_round_trips_and_cleans_up() {
+    let exe = bin_dir().join("sc-hop-cost");
+    let out = std::process::Command::new(&exe)
+        .args(["--n", "20", "--period-us", "1000", "--prewarm-us", "300"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{text} {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(text.contains("round trip (2 hops), 20 samples"), "{text}");
+    let v: Vec<f64> = ["min", "p50", "p90", "p99", "max"]
+        .iter()
+        .map(|k| {
+            let rest = &text[text.find(&format!(" {k} ")).unwrap() + k.len() + 2..];
+            rest.split_whitespace().next().unwrap().parse().unwrap()
+        })
+        .collect();
+    assert!(v[0] > 0.0 && v.windows(2).all(|w| w[0] <= w[1]), "{v:?}");
+    let left: Vec<String> = std::fs::read_dir("/dev/shm")
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| n.contains("hopcost"))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+    let bad = std::process::Command::new(&exe)
+        .args(["--cpus", "1"])
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+}

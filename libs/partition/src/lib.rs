@@ -15,6 +15,7 @@
 pub mod config;
 pub mod convert;
 pub mod fallback;
+pub mod hop_cost;
 pub mod latency;
 pub mod launcher;
 pub mod mcap_out;

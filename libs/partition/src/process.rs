@@ -175,7 +175,7 @@ fn set_priority(prio: u32) -> bool {
 
 /// Puts this process in the SCHED_FIFO class (real-time mode); a refusal is a
 /// warning (and false).
-fn set_fifo(role: &str, prio: u32) -> bool {
+pub fn set_fifo(role: &str, prio: u32) -> bool {
     let param = libc::sched_param {
         sched_priority: prio as libc::c_int,
     };
@@ -192,7 +192,7 @@ fn set_fifo(role: &str, prio: u32) -> bool {
 
 /// Restricts this process to `cpus` (real-time mode); a refusal (e.g. a CPU the
 /// machine does not have) is a warning.
-fn set_cpus(role: &str, cpus: &[usize]) {
+pub fn set_cpus(role: &str, cpus: &[usize]) {
     // SAFETY: cpu_set_t is plain data; CPU_ZERO/CPU_SET write inside it (cpus were
     // validated < 1024 = CPU_SETSIZE); sched_setaffinity reads it.
     let rc = unsafe {
