@@ -126,11 +126,14 @@ impl Mission {
         } else {
             at.u
         };
-        let rob_in = stages::robotic_input(&o, &robot, &f_b, &tau_b);
-        let rb = match rob_in {
-            Some(x) => self.safety.robotic.filter(&x, &nom.tau_m),
-            None => stages::robotic_invalid_state(),
-        };
+        let rb = stages::robotic_step(
+            &mut self.safety.robotic,
+            &o,
+            &robot,
+            &f_b,
+            &tau_b,
+            &nom.tau_m,
+        );
         let tau_m = if self.options.no_filter {
             stages::saturate(&nom.tau_m, limits.joint_torque_max_nm)
         } else {

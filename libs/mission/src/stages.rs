@@ -71,6 +71,22 @@ pub fn robotic_input(
     sc_cbf::robotic_input_from_model(robot, &o.theta, &o.theta_dot, &o.omega_b, f_b_sf, tau_b_sf)
 }
 
+/// One robotic filter step: the filter on [`robotic_input`], or
+/// [`robotic_invalid_state`] when the model cannot be evaluated.
+pub fn robotic_step(
+    filter: &mut sc_cbf::RoboticFilter,
+    o: &Observation,
+    robot: &Robot,
+    f_b_sf: &Vector3<f64>,
+    tau_b_sf: &Vector3<f64>,
+    tau_m_nom: &Vector7,
+) -> sc_cbf::RoboticOutput {
+    match robotic_input(o, robot, f_b_sf, tau_b_sf) {
+        Some(x) => filter.filter(&x, tau_m_nom),
+        None => robotic_invalid_state(),
+    }
+}
+
 /// Saturates a nominal command to the actuator bounds (what the hardware does when no
 /// filter is in the loop); non-finite components become zero.
 pub fn saturate<const M: usize>(

@@ -882,12 +882,15 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
                             tx_a.as_ref().context("publisher")?.warm()?;
                         }
                         _ => {
-                            if let (Some(n), Some(x)) =
-                                (nom_r, stages::robotic_input(&o, &robot, &f_b, &tau_b))
-                            {
-                                std::hint::black_box(
-                                    layer.robotic.filter(&x, &convert::vec7(&n.tau_m)),
-                                );
+                            if let Some(n) = nom_r {
+                                std::hint::black_box(stages::robotic_step(
+                                    &mut layer.robotic,
+                                    &o,
+                                    &robot,
+                                    &f_b,
+                                    &tau_b,
+                                    &convert::vec7(&n.tau_m),
+                                ));
                             }
                             tx_r.as_ref().context("publisher")?.warm()?;
                         }
@@ -1021,10 +1024,14 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
                 let mut out = match nom {
                     Some(n) => {
                         phase = n.phase;
-                        match stages::robotic_input(&o, &robot, &f_b, &tau_b) {
-                            Some(x) => layer.robotic.filter(&x, &convert::vec7(&n.tau_m)),
-                            None => stages::robotic_invalid_state(),
-                        }
+                        stages::robotic_step(
+                            &mut layer.robotic,
+                            &o,
+                            &robot,
+                            &f_b,
+                            &tau_b,
+                            &convert::vec7(&n.tau_m),
+                        )
                     }
                     None => fallback::robotic(&layer, &o, &robot, &f_b, &tau_b),
                 };
