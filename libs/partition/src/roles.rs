@@ -375,15 +375,16 @@ pub fn simulator() -> anyhow::Result<i32> {
                 })?;
             }
             ticks.extend(drain(&tick_rx)?);
-            // keep only the newest safe commands; tick-matched below
-            for m in drain(&st_rx)? {
-                got_t = Some(m);
+            // keep only the newest safe commands; tick-matched below (read in
+            // reverse causal order, as in the loop below)
+            for m in drain(&sr_rx)? {
+                got_r = Some(m);
             }
             for m in drain(&sa_rx)? {
                 got_a = Some(m);
             }
-            for m in drain(&sr_rx)? {
-                got_r = Some(m);
+            for m in drain(&st_rx)? {
+                got_t = Some(m);
             }
             continue;
         }
@@ -425,7 +426,11 @@ pub fn simulator() -> anyhow::Result<i32> {
                 misses += 1;
                 break;
             }
-            let wake_on_any = absent.iter().any(|a| *a) || due & due::ROBOTIC == 0;
+            // On every safe command while one is absent, in a tick where the robotic
+            // group is not due, and when the robotic command of the tick is here
+            // without an earlier one of the chain (its filter was preempted between
+            // the downstream filter's queue and the simulator's).
+            let wake_on_any = absent.iter().any(|a| *a) || due & due::ROBOTIC == 0 || ok_r;
             if wake_on_any && any_attached.is_empty() {
                 any_attached = vec![
                     on_any.attach(&tick_rx)?,
@@ -437,15 +442,10 @@ pub fn simulator() -> anyhow::Result<i32> {
             } else if !wait(if wake_on_any { &on_any } else { &on_robotic }, Some(until))? {
                 return Ok(0);
             }
+            // Reverse causal order (docs/PARTITION.md, "Who wakes whom"): a command
+            // published while the queues are read is never seen without the earlier
+            // commands of its tick, which do not wake the simulator.
             ticks.extend(drain(&tick_rx)?);
-            for m in drain(&st_rx)? {
-                got_t = Some(m);
-                absent[0] = false;
-            }
-            for m in drain(&sa_rx)? {
-                got_a = Some(m);
-                absent[1] = false;
-            }
             for m in drain(&sr_rx)? {
                 if m.tick == k {
                     // delivered: the simulator holds the tick's last safe command
@@ -453,6 +453,14 @@ pub fn simulator() -> anyhow::Result<i32> {
                 }
                 got_r = Some(m);
                 absent[2] = false;
+            }
+            for m in drain(&sa_rx)? {
+                got_a = Some(m);
+                absent[1] = false;
+            }
+            for m in drain(&st_rx)? {
+                got_t = Some(m);
+                absent[0] = false;
             }
         }
         let mut fallback_mask = 0;
@@ -796,6 +804,12 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
     let mut stop = false;
     let mut last_state: Option<SimState> = None;
     let mut rehearse = false;
+    // The queues are read in reverse causal order (docs/PARTITION.md, "Who wakes
+    // whom"): the upstream attitude command before the translational one it was
+    // computed from, the commands before the state. A message published while the
+    // pump runs is then never seen without the messages it depends on: seeing the
+    // attitude command of tick k while the translational command of k was missed
+    // would leave this filter asleep on an input that does not wake it.
     macro_rules! pump {
         () => {{
             watchdog.drain()?;
@@ -803,11 +817,18 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
                 rehearse |= l.drain()? > 0;
             }
             stop |= stop_seen(&drain(&tick_rx)?);
-            states.extend(
-                drain(&state_rx)?
-                    .into_iter()
-                    .filter(|s| s.due_mask & bit != 0),
-            );
+            if let Some(s) = &sa_rx {
+                for m in drain(s)? {
+                    up_a = Some(m);
+                    absent[2] = false;
+                }
+            }
+            if let Some(s) = &st_rx {
+                for m in drain(s)? {
+                    up_t = Some(m);
+                    absent[1] = false;
+                }
+            }
             if let Some(s) = &nt_rx {
                 for m in drain(s)? {
                     nom_t = Some(m);
@@ -826,18 +847,11 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
                     absent[0] = false;
                 }
             }
-            if let Some(s) = &st_rx {
-                for m in drain(s)? {
-                    up_t = Some(m);
-                    absent[1] = false;
-                }
-            }
-            if let Some(s) = &sa_rx {
-                for m in drain(s)? {
-                    up_a = Some(m);
-                    absent[2] = false;
-                }
-            }
+            states.extend(
+                drain(&state_rx)?
+                    .into_iter()
+                    .filter(|s| s.due_mask & bit != 0),
+            );
         }};
     }
     loop {
@@ -845,7 +859,21 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
             if stop {
                 break;
             }
-            let wake_on_any = absent.iter().any(|a| *a);
+            // A command of a tick whose state is not queued: the state was sent
+            // before it, so its sender was preempted between this filter's queue and
+            // the others'. The state does not wake this filter: wake on every input.
+            let newest = [
+                nom_t.map(|m| m.tick),
+                nom_a.map(|m| m.tick),
+                nom_r.map(|m| m.tick),
+                up_t.map(|m| m.tick),
+                up_a.map(|m| m.tick),
+            ]
+            .into_iter()
+            .flatten()
+            .max();
+            let state_in_flight = newest > last_state.map(|s| s.tick);
+            let wake_on_any = absent.iter().any(|a| *a) || state_in_flight;
             // just attached: no wait, read what came before the listeners existed
             let fresh = wake_on_any && attach_any!();
             if !fresh && !wait(if wake_on_any { &on_any } else { &on_inputs }, None)? {
@@ -907,10 +935,7 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
         let until = instant_of(s.publish_ns) + deadline;
         let need_t = which >= 1 && s.due_mask & due::TRANSLATIONAL != 0;
         let need_a = which == 2 && s.due_mask & due::ATTITUDE != 0;
-        // the robotic filter in a tick where only the translational group is due
-        // upstream has no wake-up on the translational command among its inputs
-        let wake_on_any = absent.iter().any(|a| *a) || (which == 2 && need_t && !need_a);
-        let mut fresh = wake_on_any && attach_any!();
+        let mut fresh = false;
         loop {
             let nom_ok = absent[0]
                 || match which {
@@ -942,6 +967,16 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
                     absent[2] = true;
                 }
                 break;
+            }
+            // The robotic filter does not wake on the translational command. It
+            // waits for it on every input in a tick where only the translational
+            // group is due upstream, and when the attitude command of the tick is
+            // already here without it (the translational filter was preempted between
+            // the attitude filter's queue and this one's).
+            let t_unwoken = which == 2 && !t_ok && (!need_a || up_a.is_some_and(|m| m.tick == k));
+            let wake_on_any = absent.iter().any(|a| *a) || t_unwoken;
+            if wake_on_any && attach_any!() {
+                fresh = true; // just attached: no wait, read what came before
             }
             if !fresh && !wait(if wake_on_any { &on_any } else { &on_inputs }, Some(until))? {
                 return Ok(0);
