@@ -114,11 +114,12 @@ pub struct PartitionConfig {
     /// normal scheduler. Needs CAP_SYS_NICE (or root); refused → a warning.
     #[serde(default)]
     pub real_time_priority: u32,
-    /// Real-time mode: the longest wake-up latency [µs] the CPUs' idle states may
-    /// add, requested from Linux PM QoS (`/dev/cpu_dma_latency`) by the launcher for
-    /// the whole run, as cyclictest does. 0 = idle CPUs poll instead of halting
-    /// (fastest wake-ups, burns idle CPU time). Absent = the system's idle states
-    /// are left alone. Needs write access to the device (root); refused → a warning.
+    /// The longest wake-up latency [µs] the CPUs' idle states may add, requested
+    /// from Linux PM QoS (`/dev/cpu_dma_latency`) by the launcher for the whole run
+    /// (both clock modes: a lock-step tick waits for a wake-up at every hop too), as
+    /// cyclictest does. 0 = idle CPUs poll instead of halting (fastest wake-ups,
+    /// burns idle CPU time). Absent = the system's idle states are left alone.
+    /// Needs write access to the device (root); refused → a warning.
     #[serde(default)]
     pub cpu_wakeup_latency_us: Option<u32>,
     /// Real-time mode: this long [µs] before each tick the scheduler signals

@@ -247,11 +247,9 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
         Some(id) => RunScope::new(id)?,
         None => RunScope::unique("run")?,
     };
-    // held until the launcher returns (after teardown)
-    let wakeup_request = match cfg.cpu_wakeup_latency_us {
-        Some(us) if cfg.clock == ClockMode::RealTime => Some(us),
-        _ => None,
-    };
+    // held until the launcher returns (after teardown); in both clock modes, since
+    // every hop of a lock-step tick waits for a wake-up as well
+    let wakeup_request = cfg.cpu_wakeup_latency_us;
     let wakeup_held = match wakeup_request {
         Some(us) => crate::pm_qos::CpuWakeupLatency::request(us)
             .map_err(|e| format!("{}: {e}", crate::pm_qos::DEVICE)),
