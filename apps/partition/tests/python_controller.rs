@@ -47,6 +47,9 @@ fn python_nominal_controller_runs_the_mission() {
     let rep = sc_partition::launch(&opts).unwrap();
     assert_clean(&rep, &out);
     assert_eq!(rep.code, 0, "{rep:?}");
+    // the Python process is woken and wakes the filter like the Rust one: nothing
+    // waited for the stage-deadline watchdog
+    assert_no_watchdog_wakeups(&out);
     let s = summary(&out);
     assert_eq!(s["end"], "captured", "{s}");
     assert!(
