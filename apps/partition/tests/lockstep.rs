@@ -15,7 +15,7 @@ fn lock_step_telemetry_is_identical_to_in_process_run() {
     let rep = sc_partition::launch(&options(&config, &out, "ident")).unwrap();
     assert_eq!(rep.code, 0, "{rep:?}");
     assert_clean(&rep, &out);
-    assert_no_watchdog_wakeups(&out);
+    assert_no_lost_wakeups(&out);
 
     let setup = Setup::load(&repo().join("config/scenario.toml")).unwrap();
     let names: Vec<String> = setup
@@ -74,7 +74,7 @@ fn multi_rate_schedule_runs_to_capture() {
     let rep = sc_partition::launch(&options(&config, &out, "multi")).unwrap();
     assert_eq!(rep.code, 0, "{rep:?}");
     assert_clean(&rep, &out);
-    assert_no_watchdog_wakeups(&out);
+    assert_no_lost_wakeups(&out);
     let s = summary(&out);
     assert_eq!(s["end"], "captured", "{s}");
     assert!(

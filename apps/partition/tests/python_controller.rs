@@ -48,8 +48,8 @@ fn python_nominal_controller_runs_the_mission() {
     assert_clean(&rep, &out);
     assert_eq!(rep.code, 0, "{rep:?}");
     // the Python process is woken and wakes the filter like the Rust one: nothing
-    // waited for the stage-deadline watchdog
-    assert_no_watchdog_wakeups(&out);
+    // waited for the stage-deadline watchdog or a wait timeout
+    assert_no_lost_wakeups(&out);
     let s = summary(&out);
     assert_eq!(s["end"], "captured", "{s}");
     assert!(

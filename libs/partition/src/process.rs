@@ -137,17 +137,27 @@ pub fn prepare_listener(p: &Proc) -> anyhow::Result<Option<sc_bus::SignalListene
 /// Sleeps on the waiter until an event or `until` (at most 1 s at a time).
 /// Returns false on SIGTERM/SIGINT.
 pub fn wait(waiter: &Waiter, until: Option<Instant>) -> anyhow::Result<bool> {
+    Ok(wait_outcome(waiter, until)? != WaitOutcome::TerminationRequest)
+}
+
+/// Like [`wait`], telling an event from a timeout: a process that finds new input
+/// after a timeout (with no deadline of its own passing) was not woken for it.
+pub fn wait_outcome(waiter: &Waiter, until: Option<Instant>) -> anyhow::Result<WaitOutcome> {
     let left = match until {
         Some(u) => u.saturating_duration_since(Instant::now()),
         None => Duration::from_secs(1),
     }
     .min(Duration::from_secs(1));
     if left.is_zero() {
-        return Ok(true);
+        return Ok(WaitOutcome::Timeout);
     }
-    let r = waiter.wait_once(left, |_| {})?;
-    Ok(!matches!(r, WaitOutcome::TerminationRequest))
+    Ok(waiter.wait_once(left, |_| {})?)
 }
+
+/// The log line of a process that saw the stop only when a 1 s wait ran out: the
+/// wake-up that should have brought it was lost (the lock-step tests look for it).
+pub const LOST_STOP_WAKEUP: &str =
+    "the stop was seen only at a 1 s wait timeout (its wake-up was lost)";
 
 /// Sends, tolerating a dead or stuck subscriber (backpressure), which is reported.
 pub fn send<T: core::fmt::Debug + sc_bus::ZeroCopySend + Copy + 'static>(

@@ -4,10 +4,14 @@
 use crate::config::ClockMode;
 use crate::convert;
 use crate::fallback;
-use crate::process::{Proc, prepare_listener, qos, send, wait, warmup_enabled};
+use crate::process::{
+    LOST_STOP_WAKEUP, Proc, prepare_listener, qos, send, wait, wait_outcome, warmup_enabled,
+};
 use anyhow::Context;
 use nalgebra::Vector3;
-use sc_bus::{PeerMonitor, Publisher, SignalListener, SignalSender, Subscriber, Waitable, Waiter};
+use sc_bus::{
+    PeerMonitor, Publisher, SignalListener, SignalSender, Subscriber, WaitOutcome, Waitable, Waiter,
+};
 use sc_cbf::SafetyLayer;
 use sc_icd::*;
 use sc_mission::stages;
@@ -296,8 +300,10 @@ pub fn scheduler() -> anyhow::Result<i32> {
         send_ns: now(),
         ..Default::default()
     };
-    send(&tick_tx, &stop)?;
+    // Control first: the simulator wakes on the tick and wakes the others, who
+    // then look for the stop on the control service, which must be there already.
     send(&control_tx, &stop)?;
+    send(&tick_tx, &stop)?;
     eprintln!(
         "scheduler: {} after {} ticks, {} cycle slips, lost peers {:?}, wall {:.2} s",
         rep.end, rep.ticks, rep.cycle_slips, rep.lost_peers, rep.wall_s
@@ -607,7 +613,8 @@ pub fn nominal(which: usize) -> anyhow::Result<i32> {
     p.handshake()?;
     let mut handled = 0u64;
     'run: loop {
-        if !wait(&waiter, None)? {
+        let woke = wait_outcome(&waiter, None)?;
+        if woke == WaitOutcome::TerminationRequest {
             break;
         }
         if let Some(l) = &prepare
@@ -680,6 +687,9 @@ pub fn nominal(which: usize) -> anyhow::Result<i32> {
             handled += 1;
         }
         if stop_seen(&drain(&tick_rx)?) {
+            if woke == WaitOutcome::Timeout {
+                eprintln!("{role}: {LOST_STOP_WAKEUP}");
+            }
             // wake the filter once so that it sees the stop too
             match which {
                 0 => tx_t.as_ref().context("publisher")?.notify()?,
@@ -876,10 +886,18 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
             let wake_on_any = absent.iter().any(|a| *a) || state_in_flight;
             // just attached: no wait, read what came before the listeners existed
             let fresh = wake_on_any && attach_any!();
-            if !fresh && !wait(if wake_on_any { &on_any } else { &on_inputs }, None)? {
+            let woke = if fresh {
+                WaitOutcome::Handled
+            } else {
+                wait_outcome(if wake_on_any { &on_any } else { &on_inputs }, None)?
+            };
+            if woke == WaitOutcome::TerminationRequest {
                 break;
             }
             pump!();
+            if stop && states.is_empty() && woke == WaitOutcome::Timeout {
+                eprintln!("{role}: {LOST_STOP_WAKEUP}");
+            }
             if std::mem::take(&mut rehearse)
                 && states.is_empty()
                 && let Some(s) = &last_state

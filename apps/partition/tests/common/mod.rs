@@ -157,14 +157,26 @@ pub fn summary(out: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
 }
 
-/// No stage of a healthy lock-step run was woken by the scheduler's stage-deadline
-/// watchdog. Its lock-step deadlines are 20 times the real-time ones (0.8 s and
-/// more after the state), so a wake-up there means a process slept through an input
-/// it had already been sent (a lost wake-up), not a slow machine.
-pub fn assert_no_watchdog_wakeups(out: &Path) {
+/// No process of a healthy lock-step run slept through an input it had already
+/// been sent (a lost wake-up):
+/// - no stage was woken by the scheduler's stage-deadline watchdog. Its lock-step
+///   deadlines are 20 times the real-time ones (0.8 s and more after the state), so
+///   a wake-up there means a lost wake-up, not a slow machine;
+/// - no process saw the stop only when its 1 s wait ran out (it logs
+///   [`sc_partition::process::LOST_STOP_WAKEUP`] then).
+pub fn assert_no_lost_wakeups(out: &Path) {
     let s: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("scheduler.json")).unwrap())
             .unwrap();
     assert_eq!(s["watchdog_wakeups"].as_u64(), Some(0), "{s}");
     assert_eq!(s["clock"], "LockStep", "{s}");
+    for e in std::fs::read_dir(out.join("logs")).unwrap() {
+        let path = e.unwrap().path();
+        let log = std::fs::read_to_string(&path).unwrap();
+        assert!(
+            !log.contains(sc_partition::process::LOST_STOP_WAKEUP),
+            "{}: {log}",
+            path.display()
+        );
+    }
 }
