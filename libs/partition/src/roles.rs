@@ -33,6 +33,17 @@ fn drain<T: core::fmt::Debug + sc_bus::ZeroCopySend + Copy + 'static>(
     Ok(v)
 }
 
+/// Drains an optional subscriber (a role's input that this process may not have)
+/// and returns its newest sample, if any came.
+fn newest<T: core::fmt::Debug + sc_bus::ZeroCopySend + Copy + 'static>(
+    s: Option<&Subscriber<T>>,
+) -> anyhow::Result<Option<T>> {
+    Ok(match s {
+        Some(s) => drain(s)?.pop(),
+        None => None,
+    })
+}
+
 /// The `Instant` of a monotonic time stamp `ns` of another process (same clock).
 fn instant_of(ns: u64) -> Instant {
     let t = Instant::now();
@@ -383,15 +394,9 @@ pub fn simulator() -> anyhow::Result<i32> {
             ticks.extend(drain(&tick_rx)?);
             // keep only the newest safe commands; tick-matched below (read in
             // reverse causal order, as in the loop below)
-            for m in drain(&sr_rx)? {
-                got_r = Some(m);
-            }
-            for m in drain(&sa_rx)? {
-                got_a = Some(m);
-            }
-            for m in drain(&st_rx)? {
-                got_t = Some(m);
-            }
+            got_r = newest(Some(&sr_rx))?.or(got_r);
+            got_a = newest(Some(&sa_rx))?.or(got_a);
+            got_t = newest(Some(&st_rx))?.or(got_t);
             continue;
         }
         let tick = ticks.remove(0);
@@ -460,11 +465,11 @@ pub fn simulator() -> anyhow::Result<i32> {
                 got_r = Some(m);
                 absent[2] = false;
             }
-            for m in drain(&sa_rx)? {
+            if let Some(m) = newest(Some(&sa_rx))? {
                 got_a = Some(m);
                 absent[1] = false;
             }
-            for m in drain(&st_rx)? {
+            if let Some(m) = newest(Some(&st_rx))? {
                 got_t = Some(m);
                 absent[0] = false;
             }
@@ -827,35 +832,26 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
                 rehearse |= l.drain()? > 0;
             }
             stop |= stop_seen(&drain(&tick_rx)?);
-            if let Some(s) = &sa_rx {
-                for m in drain(s)? {
-                    up_a = Some(m);
-                    absent[2] = false;
-                }
+            if let Some(m) = newest(sa_rx.as_ref())? {
+                up_a = Some(m);
+                absent[2] = false;
             }
-            if let Some(s) = &st_rx {
-                for m in drain(s)? {
-                    up_t = Some(m);
-                    absent[1] = false;
-                }
+            if let Some(m) = newest(st_rx.as_ref())? {
+                up_t = Some(m);
+                absent[1] = false;
             }
-            if let Some(s) = &nt_rx {
-                for m in drain(s)? {
-                    nom_t = Some(m);
-                    absent[0] = false;
-                }
+            // this filter's nominal command (only one of the three subscribers exists)
+            if let Some(m) = newest(nt_rx.as_ref())? {
+                nom_t = Some(m);
+                absent[0] = false;
             }
-            if let Some(s) = &na_rx {
-                for m in drain(s)? {
-                    nom_a = Some(m);
-                    absent[0] = false;
-                }
+            if let Some(m) = newest(na_rx.as_ref())? {
+                nom_a = Some(m);
+                absent[0] = false;
             }
-            if let Some(s) = &nr_rx {
-                for m in drain(s)? {
-                    nom_r = Some(m);
-                    absent[0] = false;
-                }
+            if let Some(m) = newest(nr_rx.as_ref())? {
+                nom_r = Some(m);
+                absent[0] = false;
             }
             states.extend(
                 drain(&state_rx)?
