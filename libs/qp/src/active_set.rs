@@ -1,0 +1,465 @@
+//! The Goldfarb–Idnani dual active-set projection solver (see the crate docs).
+
+use crate::{Settings, Solution, Status, dot, inf_norm};
+
+/// Outcome of the core iteration on the scaled data held in the workspace.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Core {
+    Optimal,
+    /// `y` holds an (unnormalised) certificate in the scaled rows.
+    Infeasible,
+    IterationLimit,
+}
+
+/// Dual active-set solver for `min ½‖x − x0‖²  s.t.  a_i·x ≥ b_i` with `x ∈ ℝᴹ` and at most
+/// `N ≤ 64` rows. All workspace is inside the struct: build it once, call
+/// [`solve`](Self::solve) every control step; no call allocates.
+#[derive(Debug, Clone)]
+pub struct ActiveSetQp<const M: usize, const N: usize> {
+    pub(crate) settings: Settings,
+    // ---- the scaled problem ----
+    /// Unit rows `â_i = a_i / ‖a_i‖` (zero for zero rows).
+    pub(crate) an: [[f64; M]; N],
+    /// Row norms `‖a_i‖` (0 for zero rows).
+    pub(crate) nu: [f64; N],
+    /// `b_i / ‖a_i‖` (raw `b_i` for zero rows).
+    pub(crate) bn: [f64; N],
+    /// `w_i / ‖a_i‖` (raw `w_i` for zero rows); least-violation only.
+    pub(crate) wn: [f64; N],
+    /// Right-hand side the core iteration works on (scaled rows).
+    pub(crate) rhs: [f64; N],
+    /// Bit `i`: row `i` is a zero row (never enters the iteration).
+    pub(crate) zero: u64,
+    /// Rows in use.
+    pub(crate) n: usize,
+    // ---- the factorisation of the active rows: [â_act[0] … â_act[q−1]] = J[:, ..q] R ----
+    /// `J` by columns: `jc[k]` is column `k` (orthogonal `M×M`).
+    jc: [[f64; M]; M],
+    /// `R` by columns: `rc[k][i] = R(i, k)`, upper triangular `q×q`, positive diagonal.
+    rc: [[f64; M]; M],
+    /// Row index of each active column.
+    act: [usize; M],
+    /// Multipliers of the active rows (scaled rows).
+    u: [f64; M],
+    /// Number of active rows.
+    q: usize,
+    /// Bit `i`: row `i` is active.
+    mask: u64,
+    /// Current iterate.
+    x: [f64; M],
+    /// Certificate in the scaled rows (valid after `Core::Infeasible`).
+    pub(crate) y: [f64; N],
+    /// Active-set changes in the last core iteration.
+    pub(crate) iterations: u32,
+}
+
+impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
+    /// The active set is a bit mask in a `u64`.
+    const SIZE_OK: () = assert!(N <= 64, "ActiveSetQp supports at most 64 rows");
+
+    /// A solver with its workspace for problems of `M` variables and up to `N` rows.
+    pub fn new(settings: Settings) -> Self {
+        #[allow(clippy::let_unit_value)]
+        let () = Self::SIZE_OK;
+        Self {
+            settings,
+            an: [[0.0; M]; N],
+            nu: [0.0; N],
+            bn: [0.0; N],
+            wn: [0.0; N],
+            rhs: [0.0; N],
+            zero: 0,
+            n: 0,
+            jc: [[0.0; M]; M],
+            rc: [[0.0; M]; M],
+            act: [0; M],
+            u: [0.0; M],
+            q: 0,
+            mask: 0,
+            x: [0.0; M],
+            y: [0.0; N],
+            iterations: 0,
+        }
+    }
+
+    /// The settings in use.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Projects `x0` onto `{x : a_i·x ≥ b_i, i < n}`; rows `n..N` of `a` and `b` are ignored.
+    ///
+    /// Never panics and never allocates; see [`Solution`] for the outputs and [`Status`] for
+    /// the outcomes.
+    pub fn solve(
+        &mut self,
+        x0: &[f64; M],
+        a: &[[f64; M]; N],
+        b: &[f64; N],
+        n: usize,
+    ) -> Solution<M, N> {
+        if n > N || !x0.iter().all(|v| v.is_finite()) || !self.prepare(a, b, None, n) {
+            return Solution::empty(Status::InvalidInput, *x0);
+        }
+        for i in 0..n {
+            if self.zero >> i & 1 == 1 && self.bn[i] > 0.0 {
+                let mut s = Solution::empty(Status::Infeasible, *x0);
+                s.certificate[i] = 1.0;
+                return s;
+            }
+        }
+        self.rhs[..n].copy_from_slice(&self.bn[..n]);
+        let c = self.core(x0, self.max_iterations());
+        self.solution(c, x0)
+    }
+
+    pub(crate) fn max_iterations(&self) -> u32 {
+        self.settings
+            .max_iterations
+            .unwrap_or(10 * (self.n + M) as u32)
+    }
+
+    /// Scales rows `0..n` to unit norm into the workspace. `false` for non-finite data (or
+    /// data that overflows when scaled) and negative weights.
+    pub(crate) fn prepare(
+        &mut self,
+        a: &[[f64; M]; N],
+        b: &[f64; N],
+        w: Option<&[f64; N]>,
+        n: usize,
+    ) -> bool {
+        self.n = n;
+        self.zero = 0;
+        for i in 0..n {
+            let wi = w.map_or(0.0, |w| w[i]);
+            if !b[i].is_finite() || !wi.is_finite() || wi < 0.0 {
+                return false;
+            }
+            let row = &a[i];
+            if !row.iter().all(|v| v.is_finite()) {
+                return false;
+            }
+            let m = inf_norm(row);
+            if m == 0.0 {
+                self.zero |= 1 << i;
+                self.an[i] = [0.0; M];
+                self.nu[i] = 0.0;
+                self.bn[i] = b[i];
+                self.wn[i] = wi;
+                continue;
+            }
+            // ‖a‖ = m·h with h = ‖a/m‖ ∈ [1, √M]: no overflow or underflow in the squares.
+            let mut s = 0.0;
+            for &v in row {
+                let v = v / m;
+                s += v * v;
+            }
+            let h = s.sqrt();
+            for k in 0..M {
+                self.an[i][k] = (row[k] / m) / h;
+            }
+            self.nu[i] = m * h;
+            self.bn[i] = (b[i] / m) / h;
+            self.wn[i] = (wi / m) / h;
+            if !self.nu[i].is_finite() || !self.bn[i].is_finite() || !self.wn[i].is_finite() {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// The dual active-set iteration from `x0` on `an`, `rhs` (rows `0..n`, zero rows
+    /// skipped).
+    pub(crate) fn core(&mut self, x0: &[f64; M], max_iter: u32) -> Core {
+        let n = self.n;
+        self.q = 0;
+        self.mask = 0;
+        self.x = *x0;
+        self.iterations = 0;
+        for k in 0..M {
+            self.jc[k] = [0.0; M];
+            self.jc[k][k] = 1.0;
+            self.rc[k] = [0.0; M];
+        }
+        let x0s = inf_norm(x0);
+        let ptol = self.settings.primal_tol;
+        let dtol = self.settings.dependence_tol;
+        loop {
+            // Step 1: the most violated row (distances: the rows have unit norm).
+            let sx = x0s.max(inf_norm(&self.x));
+            let skip = self.zero | self.mask;
+            let mut p = usize::MAX;
+            let mut worst = 0.0;
+            for i in 0..n {
+                if skip >> i & 1 == 1 {
+                    continue;
+                }
+                let s = dot(&self.an[i], &self.x) - self.rhs[i];
+                let tol = ptol * self.rhs[i].abs().max(sx);
+                if s < -tol && (p == usize::MAX || s < worst) {
+                    p = i;
+                    worst = s;
+                }
+            }
+            if p == usize::MAX {
+                return Core::Optimal;
+            }
+            // Step 2: move towards satisfying row p, dropping blocking rows on the way.
+            let mut up = 0.0;
+            loop {
+                if self.iterations >= max_iter {
+                    return Core::IterationLimit;
+                }
+                self.iterations += 1;
+                let q = self.q;
+                let mut d = [0.0; M];
+                for (k, dk) in d.iter_mut().enumerate() {
+                    *dk = dot(&self.jc[k], &self.an[p]);
+                }
+                // z = J₂J₂ᵀ â_p, ‖z‖² = Σ_{k≥q} d_k²
+                let mut z = [0.0; M];
+                let mut zz = 0.0;
+                for k in q..M {
+                    zz += d[k] * d[k];
+                    for i in 0..M {
+                        z[i] += d[k] * self.jc[k][i];
+                    }
+                }
+                // r = R⁻¹ J₁ᵀ â_p
+                let mut r = d;
+                self.r_solve(&mut r);
+                let rtol = self.settings.dual_tol * (1.0 + inf_norm(&r[..q]));
+                let mut t1 = f64::INFINITY;
+                let mut kdrop = usize::MAX;
+                for j in 0..q {
+                    if r[j] > rtol {
+                        let ratio = self.u[j] / r[j];
+                        if ratio < t1 {
+                            t1 = ratio;
+                            kdrop = j;
+                        }
+                    }
+                }
+                let t2 = if zz.sqrt() > dtol {
+                    let sp = dot(&self.an[p], &self.x) - self.rhs[p];
+                    -sp / zz
+                } else {
+                    f64::INFINITY
+                };
+                if kdrop == usize::MAX && t2 == f64::INFINITY {
+                    // â_p = Σ r_j â_j with r ≤ 0 and row p violated: Farkas.
+                    self.y[..n].fill(0.0);
+                    self.y[p] = 1.0;
+                    for j in 0..q {
+                        self.y[self.act[j]] = (-r[j]).max(0.0);
+                    }
+                    return Core::Infeasible;
+                }
+                let t = t1.min(t2);
+                if t2 != f64::INFINITY {
+                    for i in 0..M {
+                        self.x[i] += t * z[i];
+                    }
+                }
+                for j in 0..q {
+                    self.u[j] = (self.u[j] - t * r[j]).max(0.0);
+                }
+                up += t;
+                if t2 <= t1 {
+                    self.add(p, d, up);
+                    break;
+                }
+                self.u[kdrop] = 0.0;
+                self.drop(kdrop);
+            }
+        }
+    }
+
+    /// Appends row `p` (with `d = Jᵀ â_p`) to the factorisation.
+    fn add(&mut self, p: usize, mut d: [f64; M], up: f64) {
+        let q = self.q;
+        // Rotate d[q..] into d[q], and J's columns along.
+        for k in (q + 1..M).rev() {
+            let (a, b) = (d[k - 1], d[k]);
+            if b == 0.0 {
+                continue;
+            }
+            let h = a.hypot(b);
+            let (c, s) = (a / h, b / h);
+            d[k - 1] = h;
+            d[k] = 0.0;
+            rotate_columns(&mut self.jc, k - 1, k, c, s);
+        }
+        if d[q] < 0.0 {
+            d[q] = -d[q];
+            for v in self.jc[q].iter_mut() {
+                *v = -*v;
+            }
+        }
+        self.rc[q] = [0.0; M];
+        self.rc[q][..=q].copy_from_slice(&d[..=q]);
+        self.act[q] = p;
+        self.u[q] = up;
+        self.mask |= 1 << p;
+        self.q = q + 1;
+    }
+
+    /// Removes the active row at position `l` and restores `R` to triangular form.
+    fn drop(&mut self, l: usize) {
+        let q = self.q;
+        self.mask &= !(1u64 << self.act[l]);
+        for k in l..q - 1 {
+            self.rc[k] = self.rc[k + 1];
+            self.act[k] = self.act[k + 1];
+            self.u[k] = self.u[k + 1];
+        }
+        self.rc[q - 1] = [0.0; M];
+        // Columns l..q−2 are Hessenberg now: zero their sub-diagonal by rotations of rows
+        // (k, k+1) of R, applied to columns (k, k+1) of J so that J R is unchanged.
+        for k in l..q - 1 {
+            let (a, b) = (self.rc[k][k], self.rc[k][k + 1]);
+            if b == 0.0 {
+                continue;
+            }
+            let h = a.hypot(b);
+            let (c, s) = (a / h, b / h);
+            for col in k..q - 1 {
+                let (x, y) = (self.rc[col][k], self.rc[col][k + 1]);
+                self.rc[col][k] = c * x + s * y;
+                self.rc[col][k + 1] = -s * x + c * y;
+            }
+            self.rc[k][k + 1] = 0.0;
+            rotate_columns(&mut self.jc, k, k + 1, c, s);
+        }
+        // (The rotated diagonal entries are hypotenuses, so R keeps a positive diagonal.)
+        self.q = q - 1;
+    }
+
+    /// `v[..q] ← R⁻¹ v[..q]`.
+    fn r_solve(&self, v: &mut [f64; M]) {
+        for i in (0..self.q).rev() {
+            let mut s = v[i];
+            for k in i + 1..self.q {
+                s -= self.rc[k][i] * v[k];
+            }
+            v[i] = s / self.rc[i][i];
+        }
+    }
+
+    /// `v[..q] ← R⁻ᵀ v[..q]`.
+    fn rt_solve(&self, v: &mut [f64; M]) {
+        for i in 0..self.q {
+            let mut s = v[i];
+            for k in 0..i {
+                s -= self.rc[i][k] * v[k];
+            }
+            v[i] = s / self.rc[i][i];
+        }
+    }
+
+    /// Worst error of `x` on the scaled rows: violation of any row, or distance from an
+    /// active row's boundary.
+    fn kkt_error(&self, x: &[f64; M]) -> f64 {
+        let mut e = 0.0f64;
+        for i in 0..self.n {
+            if self.zero >> i & 1 == 1 {
+                continue;
+            }
+            let s = dot(&self.an[i], x) - self.rhs[i];
+            e = e.max(if self.mask >> i & 1 == 1 { s.abs() } else { -s });
+        }
+        e
+    }
+
+    /// Recomputes the multipliers and `x` of the final active set from its KKT system
+    /// (`RᵀR λ̂ = b̂_A − Â x0`, `x = x0 + Âᵀλ̂`) with one step of iterative refinement, and
+    /// keeps the result when it is at least as accurate as the iterated point.
+    fn refine(&mut self, x0: &[f64; M]) {
+        let q = self.q;
+        let mut lam = [0.0; M];
+        for j in 0..q {
+            let i = self.act[j];
+            lam[j] = self.rhs[i] - dot(&self.an[i], x0);
+        }
+        self.rt_solve(&mut lam);
+        self.r_solve(&mut lam);
+        let mut xr = *x0;
+        for j in 0..q {
+            let row = &self.an[self.act[j]];
+            for k in 0..M {
+                xr[k] += lam[j] * row[k];
+            }
+        }
+        let mut dl = [0.0; M];
+        for j in 0..q {
+            let i = self.act[j];
+            dl[j] = self.rhs[i] - dot(&self.an[i], &xr);
+        }
+        self.rt_solve(&mut dl);
+        self.r_solve(&mut dl);
+        for j in 0..q {
+            lam[j] += dl[j];
+            let row = &self.an[self.act[j]];
+            for k in 0..M {
+                xr[k] += dl[j] * row[k];
+            }
+        }
+        if lam.iter().chain(xr.iter()).all(|v| v.is_finite())
+            && self.kkt_error(&xr) <= self.kkt_error(&self.x)
+        {
+            self.x = xr;
+            for j in 0..q {
+                self.u[j] = lam[j].max(0.0);
+            }
+        }
+    }
+
+    /// Builds the caller-facing solution from the state after [`core`](Self::core).
+    pub(crate) fn solution(&mut self, c: Core, x0: &[f64; M]) -> Solution<M, N> {
+        let mut s = Solution::empty(Status::Optimal, self.x);
+        s.iterations = self.iterations;
+        match c {
+            Core::Optimal | Core::IterationLimit => {
+                if c == Core::Optimal {
+                    self.refine(x0);
+                } else {
+                    s.status = Status::IterationLimit;
+                }
+                s.x = self.x;
+                for j in 0..self.q {
+                    let i = self.act[j];
+                    s.lambda[i] = self.u[j] / self.nu[i];
+                }
+                s.active = self.mask;
+            }
+            Core::Infeasible => {
+                s.status = Status::Infeasible;
+                self.certificate(&mut s.certificate);
+            }
+        }
+        s
+    }
+
+    /// The certificate `y` of the last `Core::Infeasible` in the caller's scaling, with
+    /// `Σ y_i ‖a_i‖ = 1`.
+    pub(crate) fn certificate(&self, out: &mut [f64; N]) {
+        let total: f64 = self.y[..self.n].iter().sum();
+        for i in 0..self.n {
+            out[i] = if self.y[i] > 0.0 {
+                self.y[i] / total / self.nu[i]
+            } else {
+                0.0
+            };
+        }
+    }
+}
+
+/// Columns `(k, l) ← (c·col_k + s·col_l, −s·col_k + c·col_l)`.
+#[inline]
+fn rotate_columns<const M: usize>(j: &mut [[f64; M]; M], k: usize, l: usize, c: f64, s: f64) {
+    for i in 0..M {
+        let (x, y) = (j[k][i], j[l][i]);
+        j[k][i] = c * x + s * y;
+        j[l][i] = -s * x + c * y;
+    }
+}
