@@ -148,8 +148,13 @@ impl Problem {
 pub fn dot(u: &[f64], v: &[f64]) -> f64 {
     u.iter().zip(v).map(|(a, b)| a * b).sum()
 }
+/// Euclidean norm without overflow or underflow of the squares.
 pub fn norm(v: &[f64]) -> f64 {
-    dot(v, v).sqrt()
+    let m = inf(v);
+    if m == 0.0 || !m.is_finite() {
+        return m;
+    }
+    m * v.iter().map(|e| (e / m) * (e / m)).sum::<f64>().sqrt()
 }
 pub fn inf(v: &[f64]) -> f64 {
     v.iter().fold(0.0f64, |m, e| m.max(e.abs()))
@@ -435,4 +440,54 @@ pub fn random_feasible(rng: &mut Rng, m: usize, n_rows: usize, wild: bool) -> Pr
     p.boxed(limit);
     p.shuffle(rng);
     p
+}
+
+/// 1-norm condition number of the Gram matrix `ÂÂᵀ` of the unit-scaled rows `rows`
+/// (Gauss–Jordan with partial pivoting; ∞ when singular).
+pub fn gram_cond(p: &Problem, rows: &[usize]) -> f64 {
+    let q = rows.len();
+    if q == 0 {
+        return 1.0;
+    }
+    let unit: Vec<Vec<f64>> = rows
+        .iter()
+        .map(|&i| p.a[i].iter().map(|v| v / p.row_norm(i)).collect())
+        .collect();
+    let g: Vec<Vec<f64>> = (0..q)
+        .map(|i| (0..q).map(|j| dot(&unit[i], &unit[j])).collect())
+        .collect();
+    let norm1 = |m: &Vec<Vec<f64>>| {
+        (0..q)
+            .map(|j| (0..q).map(|i| m[i][j].abs()).sum::<f64>())
+            .fold(0.0f64, f64::max)
+    };
+    let mut a = g.clone();
+    let mut inv: Vec<Vec<f64>> = (0..q)
+        .map(|i| (0..q).map(|j| if i == j { 1.0 } else { 0.0 }).collect())
+        .collect();
+    for c in 0..q {
+        let piv = (c..q)
+            .max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))
+            .unwrap();
+        if a[piv][c].abs() < 1e-300 {
+            return f64::INFINITY;
+        }
+        a.swap(c, piv);
+        inv.swap(c, piv);
+        let d = a[c][c];
+        for j in 0..q {
+            a[c][j] /= d;
+            inv[c][j] /= d;
+        }
+        for i in 0..q {
+            if i != c {
+                let f = a[i][c];
+                for j in 0..q {
+                    a[i][j] -= f * a[c][j];
+                    inv[i][j] -= f * inv[c][j];
+                }
+            }
+        }
+    }
+    norm1(&g) * norm1(&inv)
 }
