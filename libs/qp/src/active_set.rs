@@ -110,7 +110,7 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
         }
         self.rhs[..n].copy_from_slice(&self.bn[..n]);
         let c = self.core(x0, self.max_iterations());
-        self.solution(c, x0)
+        self.solution(c)
     }
 
     pub(crate) fn max_iterations(&self) -> u32 {
@@ -181,29 +181,30 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
             self.jc[k][k] = 1.0;
             self.rc[k] = [0.0; M];
         }
-        let x0s = inf_norm(x0);
+        // The iterate carries the rounding of the steps that brought it from x0: a few ulps
+        // of ‖x0‖ (however far x0 is), on top of the relative tolerance of the rows.
+        let x0_noise = 64.0 * f64::EPSILON * inf_norm(x0);
         let ptol = self.settings.primal_tol;
         let dtol = self.settings.dependence_tol;
+        // Rows found to be violated only by rounding (dependent on the active rows, and the
+        // data say they hold): not picked again until the active set grows.
+        let mut noise: u64 = 0;
+        // `tight`: the loose test has passed once and x was refined; from then on rows are
+        // tested against the refined point's own rounding. `fresh`: refined, no step since.
+        let (mut tight, mut fresh) = (false, false);
         loop {
             // Step 1: the most violated row (distances: the rows have unit norm).
-            let sx = x0s.max(inf_norm(&self.x));
-            let skip = self.zero | self.mask;
-            let mut p = usize::MAX;
-            let mut worst = 0.0;
-            for i in 0..n {
-                if skip >> i & 1 == 1 {
-                    continue;
-                }
-                let s = dot(&self.an[i], &self.x) - self.rhs[i];
-                let tol = ptol * self.rhs[i].abs().max(sx);
-                if s < -tol && (p == usize::MAX || s < worst) {
-                    p = i;
-                    worst = s;
-                }
-            }
+            let p = self.most_violated(self.zero | self.mask | noise, x0_noise, tight);
             if p == usize::MAX {
-                return Core::Optimal;
+                if fresh {
+                    return Core::Optimal;
+                }
+                self.refine(x0);
+                tight = true;
+                fresh = true;
+                continue;
             }
+            fresh = false;
             // Step 2: move towards satisfying row p, dropping blocking rows on the way.
             let mut up = 0.0;
             loop {
@@ -247,13 +248,31 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
                     f64::INFINITY
                 };
                 if kdrop == usize::MAX && t2 == f64::INFINITY {
-                    // â_p = Σ r_j â_j with r ≤ 0 and row p violated: Farkas.
-                    self.y[..n].fill(0.0);
-                    self.y[p] = 1.0;
+                    // â_p = Σ r_j â_j with r ≤ 0: y = e_p − Σ r_j e_j ≥ 0 has Σ y_i â_i ≈ 0,
+                    // and, the active rows being tight, s_p = −Σ y_i b̂_i. Decide from the
+                    // data (free of the iterate's rounding) whether row p really fails.
+                    let mut yb = self.rhs[p];
+                    let mut mag = self.rhs[p].abs();
                     for j in 0..q {
-                        self.y[self.act[j]] = (-r[j]).max(0.0);
+                        let yj = (-r[j]).max(0.0);
+                        yb += yj * self.rhs[self.act[j]];
+                        mag += yj * self.rhs[self.act[j]].abs();
                     }
-                    return Core::Infeasible;
+                    if yb > ptol * mag {
+                        self.y[..n].fill(0.0);
+                        self.y[p] = 1.0;
+                        for j in 0..q {
+                            self.y[self.act[j]] = (-r[j]).max(0.0);
+                        }
+                        return Core::Infeasible;
+                    }
+                    // Row p holds up to rounding: fold the multiplier it gathered into the
+                    // active rows it depends on (â_p = Σ r_j â_j) and set it aside.
+                    for j in 0..q {
+                        self.u[j] = (self.u[j] + up * r[j]).max(0.0);
+                    }
+                    noise |= 1 << p;
+                    break;
                 }
                 let t = t1.min(t2);
                 if t2 != f64::INFINITY {
@@ -267,12 +286,55 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
                 up += t;
                 if t2 <= t1 {
                     self.add(p, d, up);
+                    noise = 0;
                     break;
                 }
                 self.u[kdrop] = 0.0;
                 self.drop(kdrop);
             }
         }
+    }
+
+    /// The row with the most negative distance among those violated beyond tolerance, not
+    /// in `skip`; `usize::MAX` if none.
+    ///
+    /// Loose test (while iterating): `s_i < −(primal_tol · max(|b̂_i|, ‖x‖∞) + x0_noise)`,
+    /// covering the rounding the iterate gathered on its way from `x0`. Tight test (after
+    /// [`refine`](Self::refine)): the refined point's rounding from a far `x0` lies in the
+    /// null space of the active rows only, so the `x0` term is scaled by `‖J₂ᵀ â_i‖`, the
+    /// row's component in that null space (zero when `M` rows are active).
+    fn most_violated(&self, skip: u64, x0_noise: f64, tight: bool) -> usize {
+        let ptol = self.settings.primal_tol;
+        let sx = inf_norm(&self.x);
+        let mut p = usize::MAX;
+        let mut worst = 0.0;
+        for i in 0..self.n {
+            if skip >> i & 1 == 1 {
+                continue;
+            }
+            let s = dot(&self.an[i], &self.x) - self.rhs[i];
+            let base = ptol * self.rhs[i].abs().max(sx);
+            if s >= -base || (p != usize::MAX && s >= worst) {
+                continue;
+            }
+            let violated = if s < -(base + x0_noise) {
+                true
+            } else if !tight {
+                false
+            } else {
+                let mut nn = 0.0;
+                for k in self.q..M {
+                    let c = dot(&self.jc[k], &self.an[i]);
+                    nn += c * c;
+                }
+                s < -(base + x0_noise * nn.sqrt())
+            };
+            if violated {
+                p = i;
+                worst = s;
+            }
+        }
+        p
     }
 
     /// Appends row `p` (with `d = Jᵀ â_p`) to the factorisation.
@@ -415,14 +477,12 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
     }
 
     /// Builds the caller-facing solution from the state after [`core`](Self::core).
-    pub(crate) fn solution(&mut self, c: Core, x0: &[f64; M]) -> Solution<M, N> {
+    pub(crate) fn solution(&mut self, c: Core) -> Solution<M, N> {
         let mut s = Solution::empty(Status::Optimal, self.x);
         s.iterations = self.iterations;
         match c {
             Core::Optimal | Core::IterationLimit => {
-                if c == Core::Optimal {
-                    self.refine(x0);
-                } else {
+                if c == Core::IterationLimit {
                     s.status = Status::IterationLimit;
                 }
                 s.x = self.x;

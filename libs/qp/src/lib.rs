@@ -46,8 +46,13 @@
 //!   blocks (`r ≤ 0`), the problem is infeasible and `y = e_p − Σ r_j e_j ≥ 0` is a Farkas
 //!   certificate (`Σ y_i â_i = z ≈ 0`, `Σ y_i b̂_i = −s_p > 0`).
 //! * **Degenerate vertices.** A row counts as violated only when its distance
-//!   `s_i < −primal_tol · max(|b̂_i|, ‖x0‖∞, ‖x‖∞)`, so rows through the current point are
-//!   never added, and rounding cannot make the iteration chase its own noise.
+//!   `s_i < −(primal_tol · max(|b̂_i|, ‖x‖∞) + 64ε‖x0‖∞)` (the second term bounds the
+//!   rounding the iterate carries from a far-away `x0`), so rows through the current point
+//!   are not added. A violated row that depends on the active rows with `r ≤ 0` is declared
+//!   infeasible only if the data confirm it — `Σ y_i b̂_i > primal_tol · Σ |y_i b̂_i|` for
+//!   the certificate `y`, which does not involve the iterate; otherwise the row holds up to
+//!   rounding and is set aside until the active set grows. So rounding can neither make
+//!   the iteration chase its own noise nor report a false infeasibility.
 //! * **Termination / anti-cycling.** Each full step strictly increases the dual objective
 //!   (the step is `−s_p/‖z‖² > 0` because `s_p` is below a strictly negative tolerance), and
 //!   the point after a full step is the unique minimiser on its active set, so no active set
@@ -146,7 +151,8 @@ pub struct Settings {
     /// `2·(n + M) + 4`.
     pub max_outer_iterations: Option<u32>,
     /// A unit-scaled row is violated when its signed distance is below
-    /// `−primal_tol · max(|b̂_i|, ‖x0‖∞, ‖x‖∞)`.
+    /// `−(primal_tol · max(|b̂_i|, ‖x‖∞) + 64 ε ‖x0‖∞)` (`ε` = machine epsilon: the
+    /// iterate's rounding after the steps from `x0`).
     pub primal_tol: f64,
     /// A row whose unit normal is within this distance of the span of the active normals is
     /// treated as dependent on them (never factorised).

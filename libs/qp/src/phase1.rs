@@ -90,7 +90,7 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
             return (lv, s);
         }
         let c = self.parametric(x0, lv.t, &mut lv);
-        let mut s = self.solution(c, x0);
+        let mut s = self.solution(c);
         if lv.status == Status::Infeasible {
             s.certificate = lv.certificate;
         }

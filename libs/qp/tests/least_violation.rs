@@ -1,0 +1,261 @@
+//! The least-violation LP and the lexicographic problem: against Clarabel (LP and the
+//! second-stage QP), LP-dual optimality certificates, known answers, independence of x0.
+
+mod common;
+use common::*;
+use proptest::prelude::{
+    ProptestConfig, TestCaseError, any, prop_assert, prop_assert_eq, proptest,
+};
+use sc_qp::{ActiveSetQp, LeastViolation, Settings, Solution, Status};
+
+/// Hard box and a few hard rows (feasible at `xf`), soft rows with weights 10^U(−1, 1); in
+/// most cases the soft rows are contradictory (normals summing to zero), so `t* > 0`.
+fn random_lv(rng: &mut Rng, m: usize, soft: usize, hard: usize, contradict: bool) -> Problem {
+    let limit = rng.range(1.0, 10.0);
+    let xf: Vec<f64> = (0..m).map(|_| rng.range(-0.8, 0.8) * limit).collect();
+    let mut p = Problem::new(rng.vec(m).iter().map(|v| v * 3.0 * limit).collect());
+    p.boxed(limit);
+    for _ in 0..hard {
+        let a = rng.vec(m);
+        let b = dot(&a, &xf) - rng.range(0.0, 1.0) * norm(&a);
+        p.row(a, b);
+    }
+    let c: Vec<f64> = (0..m).map(|_| rng.range(-2.0, 2.0) * limit).collect();
+    let mut sum = vec![0.0; m];
+    for k in 0..soft {
+        let a = if contradict && k + 1 == soft {
+            sum.iter().map(|v: &f64| -v).collect()
+        } else {
+            rng.vec(m)
+        };
+        for j in 0..m {
+            sum[j] += a[j];
+        }
+        let sc = rng.range(0.1, 10.0);
+        let a: Vec<f64> = a.iter().map(|v| v * sc).collect();
+        let b = dot(&a, &c) + rng.range(-0.5, 1.0) * norm(&a);
+        let w = 10f64.powf(rng.range(-1.0, 1.0));
+        p.row_w(a, b, w);
+    }
+    p.shuffle(rng);
+    p
+}
+
+fn lexi<const M: usize>(p: &Problem) -> (LeastViolation<64>, Solution<M, 64>) {
+    let (x0, a, b, w) = p.arrays::<M, 64>();
+    ActiveSetQp::<M, 64>::new(Settings::default()).lexicographic(&x0, &a, &b, &w, p.n())
+}
+
+fn lv_only<const M: usize>(p: &Problem) -> LeastViolation<64> {
+    let (_, a, b, w) = p.arrays::<M, 64>();
+    ActiveSetQp::<M, 64>::new(Settings::default()).least_violation(&a, &b, &w, p.n())
+}
+
+fn run<const M: usize>(seed: u64, soft: usize, hard: usize) -> Result<(), TestCaseError> {
+    let mut rng = Rng(seed);
+    let p = random_lv(&mut rng, M, soft, hard, !seed.is_multiple_of(5));
+    let (lv, s) = lexi::<M>(&p);
+    prop_assert_eq!(lv.status, Status::Optimal);
+    let scale = p.scale();
+    // exactness on our own terms: LP-dual certificate of optimality
+    if let Err(e) = check_lp_dual(&p, &lv, 1e-12) {
+        return Err(TestCaseError::fail(format!("LP dual: {e}\n{p:?}")));
+    }
+    // t* does not depend on x0: least_violation (no x0) agrees
+    let lv0 = lv_only::<M>(&p);
+    prop_assert!(
+        (lv0.t - lv.t).abs() <= 1e-12 * lv.t.max(1.0),
+        "{} vs {}",
+        lv0.t,
+        lv.t
+    );
+    // Clarabel on the LP
+    let r = clarabel_lp(&p);
+    prop_assert!(
+        matches!(r.status, clarabel::solver::SolverStatus::Solved),
+        "clarabel LP {:?}",
+        r.status
+    );
+    let t_cl = r.x[M];
+    // relative to the LP's own scale, which includes t* (t multiplies the weights)
+    let scale = scale.max(lv.t);
+    prop_assert!(
+        (lv.t - t_cl).abs() <= 1e-9 * scale,
+        "t* = {} vs Clarabel {} (scale {:e})\n{:?}",
+        lv.t,
+        t_cl,
+        scale,
+        p
+    );
+    // second stage: KKT of the projection onto P(t*), and Clarabel on the same QP
+    let q = p.relaxed(lv.t);
+    if let Err(e) = check_kkt(&q, &s, 1e-12) {
+        return Err(TestCaseError::fail(format!("stage 2 KKT: {e}\n{p:?}")));
+    }
+    let r2 = clarabel_qp(&q);
+    if matches!(r2.status, clarabel::solver::SolverStatus::Solved) {
+        let dx = (0..M).fold(0.0f64, |m, k| m.max((s.x[k] - r2.x[k]).abs()));
+        // P(t*) usually has no interior (t* is the least t with P(t) ≠ ∅), where an
+        // interior-point method converges only like √μ: compare at 1e-6.
+        prop_assert!(
+            dx <= 1e-6 * scale,
+            "stage 2 x differs from Clarabel by {:e}",
+            dx
+        );
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 300, .. ProptestConfig::default() })]
+
+    #[test]
+    fn lexicographic_m3_vs_clarabel(seed in any::<u64>(), soft in 1usize..=10, hard in 0usize..=4) {
+        run::<3>(seed, soft, hard)?;
+    }
+
+    #[test]
+    fn lexicographic_m7_vs_clarabel(seed in any::<u64>(), soft in 1usize..=40, hard in 0usize..=4) {
+        run::<7>(seed, soft, hard)?;
+    }
+}
+
+#[test]
+fn known_answers() {
+    // box ±1; soft x ≥ 3 (w = 1): t* = 2, and the lexicographic x clamps x₀ to the box.
+    let mut p = Problem::new(vec![5.0, 0.5, -7.0]);
+    p.boxed(1.0);
+    p.row_w(vec![1.0, 0.0, 0.0], 3.0, 1.0);
+    let (lv, s) = lexi::<3>(&p);
+    assert_eq!((lv.status, lv.t), (Status::Optimal, 2.0));
+    assert_eq!(s.x, [1.0, 0.5, -1.0]);
+    check_lp_dual(&p, &lv, 1e-15).unwrap();
+
+    // x + t ≥ 1, −x + 2t ≥ 1: 3t ≥ 2, t* = 2/3, x = 1/3; y, z free keep x0.
+    let mut p = Problem::new(vec![10.0, -4.0, 2.5]);
+    p.row_w(vec![1.0, 0.0, 0.0], 1.0, 1.0);
+    p.row_w(vec![-1.0, 0.0, 0.0], 1.0, 2.0);
+    let (lv, s) = lexi::<3>(&p);
+    assert_eq!(lv.status, Status::Optimal);
+    assert!((lv.t - 2.0 / 3.0).abs() <= 2e-16, "{}", lv.t);
+    assert!((s.x[0] - 1.0 / 3.0).abs() <= 2e-16 && s.x[1] == -4.0 && s.x[2] == 2.5);
+    check_lp_dual(&p, &lv, 1e-15).unwrap();
+    assert!((lv.dual[0] - 1.0 / 3.0).abs() < 1e-15 && (lv.dual[1] - 1.0 / 3.0).abs() < 1e-15);
+
+    // the same rows scaled by 1e-6 and 1e6 (weights scaled along): same t*
+    let mut p2 = Problem::new(vec![10.0, -4.0, 2.5]);
+    p2.row_w(vec![1e-6, 0.0, 0.0], 1e-6, 1e-6);
+    p2.row_w(vec![-1e6, 0.0, 0.0], 1e6, 2e6);
+    let (lv2, s2) = lexi::<3>(&p2);
+    assert!((lv2.t - 2.0 / 3.0).abs() <= 2e-16);
+    assert!((s2.x[0] - 1.0 / 3.0).abs() <= 2e-16);
+
+    // a soft zero row 0·x + 4t ≥ 3 dominates: t* = 3/4
+    p.row_w(vec![0.0; 3], 3.0, 4.0);
+    let (lv, s) = lexi::<3>(&p);
+    assert_eq!(lv.t, 0.75);
+    check_lp_dual(&p, &lv, 1e-15).unwrap();
+    check_kkt(&p.relaxed(0.75), &s, 1e-15).unwrap();
+
+    // hard zero row 0 ≥ −1 is harmless; 0 ≥ 1 is infeasible
+    p.row(vec![0.0; 3], -1.0);
+    assert_eq!(lexi::<3>(&p).0.t, 0.75);
+    p.row(vec![0.0; 3], 1.0);
+    let lv = lv_only::<3>(&p);
+    assert_eq!(lv.status, Status::Infeasible);
+    assert_eq!(lv.certificate[p.n() - 1], 1.0);
+}
+
+#[test]
+fn feasible_means_zero_violation_and_plain_projection() {
+    let mut rng = Rng(30);
+    for _ in 0..300 {
+        let mut p = random_feasible(&mut rng, 7, 20, false);
+        for i in 0..p.n() {
+            if p.a[i].iter().filter(|v| **v != 0.0).count() > 1 {
+                p.w[i] = rng.range(0.1, 10.0);
+            }
+        }
+        let (lv, s) = lexi::<7>(&p);
+        assert_eq!((lv.status, lv.t), (Status::Optimal, 0.0));
+        assert!(lv.dual.iter().all(|v| *v == 0.0));
+        let (x0, a, b, _) = p.arrays::<7, 64>();
+        let plain = ActiveSetQp::<7, 64>::new(Settings::default()).solve(&x0, &a, &b, p.n());
+        assert_eq!(s.x, plain.x);
+        assert_eq!(s.lambda, plain.lambda);
+    }
+}
+
+#[test]
+fn hard_rows_infeasible() {
+    let mut rng = Rng(31);
+    for _ in 0..300 {
+        let mut p = random_lv(&mut rng, 3, 6, 0, true);
+        p.row(vec![1.0, 1.0, 1.0], 1e3); // outside the box: hard rows infeasible
+        let (lv, s) = lexi::<3>(&p);
+        assert_eq!(lv.status, Status::Infeasible);
+        assert_eq!(s.status, Status::Infeasible);
+        // the certificate uses hard rows only and proves them infeasible
+        for i in 0..p.n() {
+            assert!(p.w[i] == 0.0 || lv.certificate[i] == 0.0);
+        }
+        check_certificate(&p, &lv.certificate, 1e-12).unwrap();
+        assert_eq!(s.certificate, lv.certificate);
+    }
+}
+
+/// A large x0 cannot buy violation: t* is the same for x0 scaled by 1 … 1e9 (it does not
+/// even take x0), and the lexicographic x stays put when x0 moves away along a direction of
+/// the normal cone at the solution.
+#[test]
+fn large_x0_buys_nothing() {
+    let mut rng = Rng(32);
+    let mut worst = 0.0f64;
+    for _ in 0..300 {
+        let p = random_lv(&mut rng, 7, 12, 2, true);
+        let lv0 = lv_only::<7>(&p);
+        let (lv1, s1) = lexi::<7>(&p);
+        assert_eq!(lv1.status, Status::Optimal);
+        // the direction from the solution back to x0 is in the normal cone of P(t*) there
+        let d: Vec<f64> = (0..7).map(|k| p.x0[k] - s1.x[k]).collect();
+        for f in [1.0, 1e3, 1e6, 1e9] {
+            let mut q = p.clone();
+            q.x0 = p.x0.iter().map(|v| v * f).collect();
+            let (lv, _) = lexi::<7>(&q);
+            assert_eq!(lv.status, Status::Optimal);
+            assert!(
+                (lv.t - lv0.t).abs() <= 1e-12 * lv0.t.max(1.0),
+                "t* = {} for x0·{f:e}, {} without x0",
+                lv.t,
+                lv0.t
+            );
+            let mut q = p.clone();
+            q.x0 = (0..7).map(|k| s1.x[k] + f * d[k]).collect();
+            let (lv, s) = lexi::<7>(&q);
+            assert!((lv.t - lv0.t).abs() <= 1e-12 * lv0.t.max(1.0));
+            let dx = (0..7).fold(0.0f64, |m, k| m.max((s.x[k] - s1.x[k]).abs()));
+            let x0n = inf(&q.x0);
+            worst = worst.max(dx / x0n);
+            assert!(
+                dx <= 1e-13 * x0n.max(1.0),
+                "x moved by {dx:e} for x0 at distance ·{f:e} (‖x0‖ {x0n:e})"
+            );
+        }
+    }
+    eprintln!("worst |Δx| / ‖x0‖∞ = {worst:e}");
+}
+
+#[test]
+fn invalid_weights() {
+    let mut p = Problem::new(vec![0.0; 3]);
+    p.row_w(vec![1.0, 0.0, 0.0], 1.0, -1.0);
+    assert_eq!(lv_only::<3>(&p).status, Status::InvalidInput);
+    p.w[0] = f64::NAN;
+    assert_eq!(lv_only::<3>(&p).status, Status::InvalidInput);
+    p.w[0] = 1.0;
+    let mut q = p.clone();
+    q.x0[1] = f64::INFINITY;
+    assert_eq!(lexi::<3>(&q).0.status, Status::InvalidInput);
+    // alone, the soft row x ≥ 1 can be met: t* = 0
+    assert_eq!(lexi::<3>(&p).0.t, 0.0);
+}
