@@ -22,6 +22,10 @@ pub struct ActiveSetQp<const M: usize, const N: usize> {
     pub(crate) an: [[f64; M]; N],
     /// Row norms `‖a_i‖` (0 for zero rows).
     pub(crate) nu: [f64; N],
+    /// The same rows by columns (`at[k][i] = an[i][k]`), for the row scan.
+    at: [[f64; N]; M],
+    /// Slacks of the last row scan.
+    slack: [f64; N],
     /// `b_i / ‖a_i‖` (raw `b_i` for zero rows).
     pub(crate) bn: [f64; N],
     /// `w_i / ‖a_i‖` (raw `w_i` for zero rows); least-violation only.
@@ -64,6 +68,8 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
         Self {
             settings,
             an: [[0.0; M]; N],
+            at: [[0.0; N]; M],
+            slack: [0.0; N],
             nu: [0.0; N],
             bn: [0.0; N],
             wn: [0.0; N],
@@ -148,21 +154,42 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
                 self.wn[i] = wi;
                 continue;
             }
-            // ‖a‖ = m·h with h = ‖a/m‖ ∈ [1, √M]: no overflow or underflow in the squares.
-            let mut s = 0.0;
-            for &v in row {
-                let v = v / m;
-                s += v * v;
+            if (1e-100..=1e100).contains(&m) {
+                // the squares can neither overflow nor underflow to a wrong norm
+                let mut s = 0.0;
+                for &v in row {
+                    s += v * v;
+                }
+                let nu = s.sqrt();
+                let inv = 1.0 / nu;
+                for k in 0..M {
+                    self.an[i][k] = row[k] * inv;
+                }
+                self.nu[i] = nu;
+                self.bn[i] = b[i] * inv;
+                self.wn[i] = wi * inv;
+            } else {
+                // ‖a‖ = m·h with h = ‖a/m‖ ∈ [1, √M]: no overflow or underflow.
+                let mut s = 0.0;
+                for &v in row {
+                    let v = v / m;
+                    s += v * v;
+                }
+                let h = s.sqrt();
+                for k in 0..M {
+                    self.an[i][k] = (row[k] / m) / h;
+                }
+                self.nu[i] = m * h;
+                self.bn[i] = (b[i] / m) / h;
+                self.wn[i] = (wi / m) / h;
             }
-            let h = s.sqrt();
-            for k in 0..M {
-                self.an[i][k] = (row[k] / m) / h;
-            }
-            self.nu[i] = m * h;
-            self.bn[i] = (b[i] / m) / h;
-            self.wn[i] = (wi / m) / h;
             if !self.nu[i].is_finite() || !self.bn[i].is_finite() || !self.wn[i].is_finite() {
                 return false;
+            }
+        }
+        for k in 0..M {
+            for i in 0..n {
+                self.at[k][i] = self.an[i][k];
             }
         }
         true
@@ -303,16 +330,30 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
     /// [`refine`](Self::refine)): the refined point's rounding from a far `x0` lies in the
     /// null space of the active rows only, so the `x0` term is scaled by `‖J₂ᵀ â_i‖`, the
     /// row's component in that null space (zero when `M` rows are active).
-    fn most_violated(&self, skip: u64, x0_noise: f64, tight: bool) -> usize {
+    fn most_violated(&mut self, skip: u64, x0_noise: f64, tight: bool) -> usize {
         let ptol = self.settings.primal_tol;
         let sx = inf_norm(&self.x);
+        let n = self.n;
+        // slacks of all rows, by columns (vectorises across rows); the same summation
+        // order as `dot`
+        let slack = &mut self.slack[..n];
+        slack.fill(0.0);
+        for k in 0..M {
+            let xk = self.x[k];
+            for (s, &a) in slack.iter_mut().zip(&self.at[k][..n]) {
+                *s += a * xk;
+            }
+        }
+        for (s, &r) in slack.iter_mut().zip(&self.rhs[..n]) {
+            *s -= r;
+        }
         let mut p = usize::MAX;
         let mut worst = 0.0;
-        for i in 0..self.n {
+        for i in 0..n {
             if skip >> i & 1 == 1 {
                 continue;
             }
-            let s = dot(&self.an[i], &self.x) - self.rhs[i];
+            let s = self.slack[i];
             let base = ptol * self.rhs[i].abs().max(sx);
             if s >= -base || (p != usize::MAX && s >= worst) {
                 continue;
@@ -342,12 +383,9 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
         let q = self.q;
         // Rotate d[q..] into d[q], and J's columns along.
         for k in (q + 1..M).rev() {
-            let (a, b) = (d[k - 1], d[k]);
-            if b == 0.0 {
+            let Some((c, s, h)) = givens(d[k - 1], d[k]) else {
                 continue;
-            }
-            let h = a.hypot(b);
-            let (c, s) = (a / h, b / h);
+            };
             d[k - 1] = h;
             d[k] = 0.0;
             rotate_columns(&mut self.jc, k - 1, k, c, s);
@@ -379,12 +417,10 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
         // Columns l..q−2 are Hessenberg now: zero their sub-diagonal by rotations of rows
         // (k, k+1) of R, applied to columns (k, k+1) of J so that J R is unchanged.
         for k in l..q - 1 {
-            let (a, b) = (self.rc[k][k], self.rc[k][k + 1]);
-            if b == 0.0 {
+            let Some((c, s, _)) = givens(self.rc[k][k], self.rc[k][k + 1]) else {
+                self.rc[k][k + 1] = 0.0;
                 continue;
-            }
-            let h = a.hypot(b);
-            let (c, s) = (a / h, b / h);
+            };
             for col in k..q - 1 {
                 let (x, y) = (self.rc[col][k], self.rc[col][k + 1]);
                 self.rc[col][k] = c * x + s * y;
@@ -512,6 +548,22 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
             };
         }
     }
+}
+
+/// The rotation `(c, s)` with `c·a + s·b = h ≥ 0`, `−s·a + c·b = 0`; `None` when `b` is
+/// negligible. Every entry rotated here is a coordinate of a unit vector (`|a|, |b| ≤ 1`),
+/// so the squares cannot overflow; they underflow only when both entries are below
+/// ~1e-154, where the rotation is skipped (its effect would be below rounding).
+#[inline]
+fn givens(a: f64, b: f64) -> Option<(f64, f64, f64)> {
+    if b == 0.0 {
+        return None;
+    }
+    let h = (a * a + b * b).sqrt();
+    if h == 0.0 || !h.is_finite() {
+        return None;
+    }
+    Some((a / h, b / h, h))
 }
 
 /// Columns `(k, l) ← (c·col_k + s·col_l, −s·col_k + c·col_l)`.

@@ -119,6 +119,8 @@
 //! bits (on the same target and build).
 
 #![forbid(unsafe_code)]
+// Index loops mirror the linear algebra (rows, columns, active positions) of the method.
+#![allow(clippy::needless_range_loop)]
 #![warn(missing_docs)]
 
 mod active_set;
