@@ -3,6 +3,9 @@
 //! scales, trivial and invalid inputs. The solution must be right, with no NaN and no
 //! iteration limit.
 
+// Index loops mirror the linear algebra.
+#![allow(clippy::needless_range_loop)]
+
 mod common;
 use common::*;
 use sc_qp::{ActiveSetQp, Settings, Solution, Status};

@@ -1,6 +1,9 @@
 //! Infeasible problems: the status must be Infeasible and the Farkas certificate must check
 //! (y ≥ 0, ‖Σ y_i a_i‖ ≤ 1e-9 · Σ y_i ‖a_i‖, Σ y_i b_i > 0) in the caller's scaling.
 
+// Index loops mirror the linear algebra.
+#![allow(clippy::needless_range_loop)]
+
 mod common;
 use common::*;
 use sc_qp::{ActiveSetQp, Settings, Status};

@@ -2,6 +2,9 @@
 //! rows through x*, set x0 = x* − Σ λ_i a_i, add rows strictly satisfied at x* (and the
 //! input box), shuffle. The solver must return x* and λ.
 
+// Index loops mirror the linear algebra.
+#![allow(clippy::needless_range_loop)]
+
 mod common;
 use common::*;
 use sc_qp::{ActiveSetQp, Settings, Status};
@@ -37,10 +40,9 @@ pub fn known(rng: &mut Rng, m: usize, k: usize, extra: usize, e: f64) -> Known {
         let a: Vec<f64> = rng.vec(m).iter().map(|v| v * sc).collect();
         let slack = rng.range(0.05, 3.0) * norm(&a);
         p.row(a.clone(), dot(&a, &xs) - slack);
-        lam.push(0.0);
     }
     p.boxed(limit);
-    lam.resize(p.n(), 0.0);
+    lam.resize(p.n(), 0.0); // inactive and box rows
     p.x0 = x0;
     // shuffle rows and multipliers together
     let mut idx: Vec<usize> = (0..p.n()).collect();

@@ -1,45 +1,16 @@
 //! The least-violation LP and the lexicographic problem: against Clarabel (LP and the
 //! second-stage QP), LP-dual optimality certificates, known answers, independence of x0.
 
+// Index loops mirror the linear algebra.
+#![allow(clippy::needless_range_loop)]
+
 mod common;
+use clarabel::solver::SolverStatus::{AlmostSolved, Solved};
 use common::*;
 use proptest::prelude::{
     ProptestConfig, TestCaseError, any, prop_assert, prop_assert_eq, proptest,
 };
 use sc_qp::{ActiveSetQp, LeastViolation, Settings, Solution, Status};
-
-/// Hard box and a few hard rows (feasible at `xf`), soft rows with weights 10^U(−1, 1); in
-/// most cases the soft rows are contradictory (normals summing to zero), so `t* > 0`.
-fn random_lv(rng: &mut Rng, m: usize, soft: usize, hard: usize, contradict: bool) -> Problem {
-    let limit = rng.range(1.0, 10.0);
-    let xf: Vec<f64> = (0..m).map(|_| rng.range(-0.8, 0.8) * limit).collect();
-    let mut p = Problem::new(rng.vec(m).iter().map(|v| v * 3.0 * limit).collect());
-    p.boxed(limit);
-    for _ in 0..hard {
-        let a = rng.vec(m);
-        let b = dot(&a, &xf) - rng.range(0.0, 1.0) * norm(&a);
-        p.row(a, b);
-    }
-    let c: Vec<f64> = (0..m).map(|_| rng.range(-2.0, 2.0) * limit).collect();
-    let mut sum = vec![0.0; m];
-    for k in 0..soft {
-        let a = if contradict && k + 1 == soft {
-            sum.iter().map(|v: &f64| -v).collect()
-        } else {
-            rng.vec(m)
-        };
-        for j in 0..m {
-            sum[j] += a[j];
-        }
-        let sc = rng.range(0.1, 10.0);
-        let a: Vec<f64> = a.iter().map(|v| v * sc).collect();
-        let b = dot(&a, &c) + rng.range(-0.5, 1.0) * norm(&a);
-        let w = 10f64.powf(rng.range(-1.0, 1.0));
-        p.row_w(a, b, w);
-    }
-    p.shuffle(rng);
-    p
-}
 
 fn lexi<const M: usize>(p: &Problem) -> (LeastViolation<64>, Solution<M, 64>) {
     let (x0, a, b, w) = p.arrays::<M, 64>();
@@ -72,7 +43,7 @@ fn run<const M: usize>(seed: u64, soft: usize, hard: usize) -> Result<(), TestCa
     // Clarabel on the LP
     let r = clarabel_lp(&p);
     prop_assert!(
-        matches!(r.status, clarabel::solver::SolverStatus::Solved),
+        matches!(r.status, Solved | AlmostSolved),
         "clarabel LP {:?}",
         r.status
     );
@@ -93,21 +64,34 @@ fn run<const M: usize>(seed: u64, soft: usize, hard: usize) -> Result<(), TestCa
         return Err(TestCaseError::fail(format!("stage 2 KKT: {e}\n{p:?}")));
     }
     let r2 = clarabel_qp(&q);
-    if matches!(r2.status, clarabel::solver::SolverStatus::Solved) {
+    // P(t*) has no interior (t* is the least t with P(t) ≠ ∅), where an interior-point
+    // method converges only like √μ: compare x at 1e-6, and only when Clarabel reports
+    // Solved (its "almost solved" points here were off by up to 5e-3).
+    if r2.status == Solved {
         let dx = (0..M).fold(0.0f64, |m, k| m.max((s.x[k] - r2.x[k]).abs()));
-        // P(t*) usually has no interior (t* is the least t with P(t) ≠ ∅), where an
-        // interior-point method converges only like √μ: compare at 1e-6.
         prop_assert!(
             dx <= 1e-6 * scale,
             "stage 2 x differs from Clarabel by {:e}",
             dx
         );
     }
+    // Solved or almost solved, its point is (nearly) feasible, so the exact minimiser's
+    // objective cannot be above its objective. (Clarabel may also call P(t*) infeasible:
+    // it is empty up to rounding.)
+    if matches!(r2.status, Solved | AlmostSolved) {
+        let (f, fr) = (objective(&q, &s.x), objective(&q, &r2.x));
+        prop_assert!(
+            f <= fr + 1e-9 * scale * scale,
+            "stage 2 objective {} > Clarabel's {}",
+            f,
+            fr
+        );
+    }
     Ok(())
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 300, .. ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: cases(), .. ProptestConfig::default() })]
 
     #[test]
     fn lexicographic_m3_vs_clarabel(seed in any::<u64>(), soft in 1usize..=10, hard in 0usize..=4) {

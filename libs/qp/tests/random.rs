@@ -1,7 +1,11 @@
 //! Random feasible projection problems (M ∈ {3, 7}, up to 60 rows including the box rows)
 //! against Clarabel at tight tolerances, plus our own KKT check of every solution.
 
+// Index loops mirror the linear algebra.
+#![allow(clippy::needless_range_loop)]
+
 mod common;
+use clarabel::solver::SolverStatus::{AlmostSolved, Solved};
 use common::*;
 use proptest::prelude::*;
 use sc_qp::{ActiveSetQp, Settings, Status};
@@ -19,7 +23,7 @@ fn run<const M: usize>(seed: u64, extra: usize, wild: bool) -> Result<(), TestCa
     }
     let r = clarabel_qp(&p);
     prop_assert!(
-        matches!(r.status, clarabel::solver::SolverStatus::Solved),
+        matches!(r.status, Solved | AlmostSolved),
         "clarabel {:?}",
         r.status
     );
@@ -43,7 +47,7 @@ fn run<const M: usize>(seed: u64, extra: usize, wild: bool) -> Result<(), TestCa
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 300, .. ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: cases(), .. ProptestConfig::default() })]
 
     #[test]
     fn random_m3_vs_clarabel(seed in any::<u64>(), extra in 0usize..=54, wild in any::<bool>()) {
