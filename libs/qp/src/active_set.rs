@@ -115,7 +115,7 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
             }
         }
         self.rhs[..n].copy_from_slice(&self.bn[..n]);
-        let c = self.core(x0, self.max_iterations());
+        let c = self.core(x0, self.max_iterations(), false);
         self.solution(c)
     }
 
@@ -197,16 +197,23 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
 
     /// The dual active-set iteration from `x0` on `an`, `rhs` (rows `0..n`, zero rows
     /// skipped).
-    pub(crate) fn core(&mut self, x0: &[f64; M], max_iter: u32) -> Core {
+    ///
+    /// With `warm`, the iteration starts from the active set left by the previous call
+    /// (on the same rows, with another right-hand side): see [`warm_start`](Self::warm_start).
+    pub(crate) fn core(&mut self, x0: &[f64; M], max_iter: u32, warm: bool) -> Core {
         let n = self.n;
-        self.q = 0;
-        self.mask = 0;
-        self.x = *x0;
         self.iterations = 0;
-        for k in 0..M {
-            self.jc[k] = [0.0; M];
-            self.jc[k][k] = 1.0;
-            self.rc[k] = [0.0; M];
+        if warm {
+            self.warm_start(x0);
+        } else {
+            self.q = 0;
+            self.mask = 0;
+            self.x = *x0;
+            for k in 0..M {
+                self.jc[k] = [0.0; M];
+                self.jc[k][k] = 1.0;
+                self.rc[k] = [0.0; M];
+            }
         }
         // The iterate carries the rounding of the steps that brought it from x0: a few ulps
         // of ‖x0‖ (however far x0 is), on top of the relative tolerance of the rows.
@@ -319,6 +326,45 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
                 self.u[kdrop] = 0.0;
                 self.drop(kdrop);
             }
+        }
+    }
+
+    /// A dual-feasible start from the current active set for the current right-hand side:
+    /// the minimiser with the active rows as equalities has multipliers
+    /// `RᵀR λ̂ = b̂_A − Â x0`; while one is negative the most negative row is dropped (each
+    /// counted as an iteration). The result — the equality-constrained minimiser with
+    /// `λ̂ ≥ 0` — is the minimiser on its active set, which is all the method needs.
+    fn warm_start(&mut self, x0: &[f64; M]) {
+        loop {
+            let q = self.q;
+            let mut lam = [0.0; M];
+            for j in 0..q {
+                let i = self.act[j];
+                lam[j] = self.rhs[i] - dot(&self.an[i], x0);
+            }
+            self.rt_solve(&mut lam);
+            self.r_solve(&mut lam);
+            let mut jmin = usize::MAX;
+            let mut vmin = 0.0;
+            for j in 0..q {
+                if lam[j] < vmin {
+                    vmin = lam[j];
+                    jmin = j;
+                }
+            }
+            if jmin == usize::MAX {
+                self.x = *x0;
+                for j in 0..q {
+                    self.u[j] = lam[j];
+                    let row = &self.an[self.act[j]];
+                    for k in 0..M {
+                        self.x[k] += lam[j] * row[k];
+                    }
+                }
+                return;
+            }
+            self.iterations += 1;
+            self.drop(jmin);
         }
     }
 

@@ -53,7 +53,7 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
                 lv.dual[i] = 1.0 / wi;
             }
         }
-        self.parametric(&[0.0; M], t, &mut lv);
+        self.parametric(&[0.0; M], t, false, &mut lv);
         lv
     }
 
@@ -89,7 +89,9 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
             s.certificate = lv.certificate;
             return (lv, s);
         }
-        let c = self.parametric(x0, lv.t, &mut lv);
+        // Stage 2 starts cold: its x is then exactly the projection `solve` would compute
+        // on P(t*), independent of the path the first stage took.
+        let c = self.parametric(x0, lv.t, false, &mut lv);
         let mut s = self.solution(c);
         if lv.status == Status::Infeasible {
             s.certificate = lv.certificate;
@@ -100,7 +102,17 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
     /// From `t`, project `x0` onto `P(t)`; while it is empty, raise `t` to the lower bound
     /// given by the Farkas certificate. Leaves the workspace in the state of the last
     /// projection.
-    fn parametric(&mut self, x0: &[f64; M], mut t: f64, lv: &mut LeastViolation<N>) -> Core {
+    ///
+    /// Each projection after the first starts warm from the previous one's active set (the
+    /// rows are the same, only the right-hand side moves); `warm` says whether the first
+    /// one may start from the state the workspace holds.
+    fn parametric(
+        &mut self,
+        x0: &[f64; M],
+        mut t: f64,
+        mut warm: bool,
+        lv: &mut LeastViolation<N>,
+    ) -> Core {
         let n = self.n;
         let max_outer = self
             .settings
@@ -121,7 +133,8 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
                     self.bn[i] - self.wn[i] * t
                 };
             }
-            let c = self.core(x0, max_iter);
+            let c = self.core(x0, max_iter, warm);
+            warm = true;
             lv.iterations += self.iterations;
             match c {
                 Core::Optimal => {
