@@ -8,7 +8,7 @@ mod common;
 use clarabel::solver::SolverStatus::{AlmostSolved, Solved};
 use common::*;
 use proptest::prelude::{
-    ProptestConfig, TestCaseError, any, prop_assert, prop_assert_eq, proptest,
+    ProptestConfig, TestCaseError, any, prop_assert, prop_assert_eq, prop_assume, proptest,
 };
 use sc_qp::{ActiveSetQp, LeastViolation, Settings, Solution, Status};
 
@@ -42,11 +42,8 @@ fn run<const M: usize>(seed: u64, soft: usize, hard: usize) -> Result<(), TestCa
     );
     // Clarabel on the LP
     let r = clarabel_lp(&p);
-    prop_assert!(
-        matches!(r.status, Solved | AlmostSolved),
-        "clarabel LP {:?}",
-        r.status
-    );
+    // the reference must have solved it (rare degenerate cases exhaust its iterations)
+    prop_assume!(matches!(r.status, Solved | AlmostSolved));
     let t_cl = r.x[M];
     // relative to the LP's own scale, which includes t* (t multiplies the weights)
     let scale = scale.max(lv.t);

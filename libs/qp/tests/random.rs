@@ -22,11 +22,8 @@ fn run<const M: usize>(seed: u64, extra: usize, wild: bool) -> Result<(), TestCa
         return Err(TestCaseError::fail(format!("KKT: {e}\n{p:?}")));
     }
     let r = clarabel_qp(&p);
-    prop_assert!(
-        matches!(r.status, Solved | AlmostSolved),
-        "clarabel {:?}",
-        r.status
-    );
+    // the reference must have solved it (rare degenerate cases exhaust its iterations)
+    prop_assume!(matches!(r.status, Solved | AlmostSolved));
     let scale = p.scale();
     let dx = (0..M).fold(0.0f64, |m, k| m.max((s.x[k] - r.x[k]).abs()));
     prop_assert!(
