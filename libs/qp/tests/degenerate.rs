@@ -297,3 +297,50 @@ fn iteration_limit_is_reported() {
     assert_eq!(s.status, Status::IterationLimit);
     assert!(s.x.iter().all(|v| v.is_finite()));
 }
+
+/// A row that cuts the solution off by only δ = 1e-11 … 1e-6 (relative to the scale) must
+/// still be enforced: the new solution satisfies it to 1e-12 and is KKT. (Without this,
+/// a primal tolerance loosened to 1e-9 went unnoticed by every other test.) A few of these
+/// polytopes are thinner than δ in the cut's direction: then the certificate must check.
+#[test]
+fn small_violations_are_not_ignored() {
+    fn one<const M: usize>(rng: &mut Rng, k: usize) -> Option<bool> {
+        let mut p = random_feasible(rng, M, 10, false);
+        let s = solve::<M>(&p).x;
+        let delta = [1e-11, 1e-10, 1e-9, 1e-6][k % 4] * p.scale();
+        // x0 − x* is in the normal cone at x*, so the whole polytope lies in a·x ≥ a·x*
+        // for a = x* − x0: the cut removes a slab of width δ from it.
+        let a: Vec<f64> = (0..M).map(|j| s[j] - p.x0[j]).collect();
+        if norm(&a) < 1e-6 * p.scale() {
+            return None;
+        }
+        let b = dot(&a, &s) + delta * norm(&a);
+        p.row(a.clone(), b);
+        let s2 = solve::<M>(&p);
+        if s2.status == Status::Infeasible {
+            check_certificate(&p, &s2.certificate, 1e-9).unwrap();
+            return Some(false);
+        }
+        check_kkt(&p, &s2, 1e-12).unwrap_or_else(|e| panic!("δ = {delta:e}: {e}"));
+        let d = (dot(&a, &s2.x) - b) / norm(&a);
+        assert!(
+            d >= -1e-12 * p.scale(),
+            "new row violated by {d:e} (δ = {delta:e})"
+        );
+        Some(true)
+    }
+    let mut rng = Rng(18);
+    let (mut solved, mut total) = (0, 0);
+    for k in 0..600 {
+        let r = if k % 2 == 0 {
+            one::<3>(&mut rng, k)
+        } else {
+            one::<7>(&mut rng, k)
+        };
+        if let Some(ok) = r {
+            total += 1;
+            solved += ok as usize;
+        }
+    }
+    assert!(solved * 10 >= total * 9, "{solved} of {total} solved");
+}
