@@ -29,12 +29,13 @@
 //!   row is dropped, the multiplier of `p` is kept, and the step is retried).
 //! * Adding and dropping rows update `J` and `R` by Givens rotations (`O(M²)` each); nothing
 //!   is refactorised, nothing is allocated. All workspace lives in the solver struct.
-//! * At termination the solution is *refined*: the multipliers of the final active set are
-//!   recomputed from the KKT system `ÂÂᵀλ̂ = b̂_A − Âx0` (`ÂÂᵀ = RᵀR`) with one step of
-//!   iterative refinement, and `x = x0 + Âᵀλ̂`. The refined point is used when it is at
-//!   least as accurate as the iterated one (it always is, in the tests), so the active rows
-//!   hold to rounding (~1e-16 relative) rather than to the accumulated error of the
-//!   updates.
+//! * When no row is violated the solution is *refined*: the multipliers of the active set
+//!   are recomputed from the KKT system `ÂÂᵀλ̂ = b̂_A − Âx0` (`ÂÂᵀ = RᵀR`) with one step
+//!   of iterative refinement, and `x = x0 + Âᵀλ̂` (kept if it is at least as accurate as
+//!   the iterated point, which it normally is). The active rows then hold to rounding
+//!   (~1e-16 relative) rather than to the accumulated error of the updates, and all rows
+//!   are tested once more against the refined point with a tight tolerance (next
+//!   section); the iteration resumes if that finds a violated row.
 //!
 //! ## Degeneracy
 //!
@@ -45,10 +46,13 @@
 //!   vertex, …) gets a pure dual step that drops a blocking row; if no active multiplier
 //!   blocks (`r ≤ 0`), the problem is infeasible and `y = e_p − Σ r_j e_j ≥ 0` is a Farkas
 //!   certificate (`Σ y_i â_i = z ≈ 0`, `Σ y_i b̂_i = −s_p > 0`).
-//! * **Degenerate vertices.** A row counts as violated only when its distance
-//!   `s_i < −(primal_tol · max(|b̂_i|, ‖x‖∞) + 64ε‖x0‖∞)` (the second term bounds the
-//!   rounding the iterate carries from a far-away `x0`), so rows through the current point
-//!   are not added. A violated row that depends on the active rows with `r ≤ 0` is declared
+//! * **Degenerate vertices.** While iterating, a row counts as violated only when its
+//!   distance `s_i < −(primal_tol · max(|b̂_i|, ‖x‖∞) + 64ε‖x0‖∞)` (the second term bounds
+//!   the rounding the iterate carries from a far-away `x0`), so rows through the current
+//!   point are not added. After refinement that rounding lives only in the null space of
+//!   the active rows, so the final test scales the `x0` term by the row's component there,
+//!   `‖J₂ᵀâ_i‖` (zero when `M` rows are active): with `‖x0‖ = 1e10` the answer still holds
+//!   every row to ~1e-12 instead of ~1e-4. A violated row that depends on the active rows with `r ≤ 0` is declared
 //!   infeasible only if the data confirm it — `Σ y_i b̂_i > primal_tol · Σ |y_i b̂_i|` for
 //!   the certificate `y`, which does not involve the iterate; otherwise the row holds up to
 //!   rounding and is set aside until the active set grows. So rounding can neither make
@@ -57,14 +61,15 @@
 //!   (the step is `−s_p/‖z‖² > 0` because `s_p` is below a strictly negative tolerance), and
 //!   the point after a full step is the unique minimiser on its active set, so no active set
 //!   repeats; between two full steps each partial step removes one row, so there are at most
-//!   `M` of them. Ties (most violated row, blocking multiplier) are broken by the lowest
-//!   index, so the path is deterministic. The iteration limit (default `10·(n + M)`) is a
-//!   last resort and is reported as [`Status::IterationLimit`].
+//!   `M` of them; a row set aside as rounding noise is not picked again until a row is
+//!   added. Ties (most violated row, blocking multiplier) are broken by the lowest index,
+//!   so the path is deterministic. The iteration limit (default `10·(n + M)`) is a last
+//!   resort and is reported as [`Status::IterationLimit`].
 //! * **Zero rows** (`a_i = 0`) are never factorised: satisfied when `b_i ≤ 0`, otherwise
 //!   the problem is infeasible with certificate `y = e_i`.
-//! * **Scales.** Row scaling (norms from 1e-300 to 1e300) is removed exactly by the
-//!   normalisation; the norm is computed with a max-scaling that neither overflows nor
-//!   underflows. Non-finite data (or data that overflows when scaled) is
+//! * **Scales.** Row scaling is removed by the normalisation (tested with row norms from
+//!   1e-200 to 1e200, and 1e-6 … 1e6 within one problem); outside 1e±100 the norm is
+//!   computed with a max-scaling that neither overflows nor underflows. Non-finite data (or data that overflows when scaled) is
 //!   [`Status::InvalidInput`].
 //!
 //! # The least-violation (phase-1) problem
@@ -97,10 +102,12 @@
 //! determined by the active set and the added row of the projection solver (finitely many
 //! combinations), and `t` increases strictly, so no certificate repeats. In practice it
 //! takes 2–7 projections; each after the first starts warm from the previous active set
-//! (recompute its multipliers for the new right-hand side, drop negative ones: a
-//! dual-feasible start), which saves about a third of the work. The remaining inexactness is that of the projections themselves:
-//! `P(t)` is declared feasible within `primal_tol` (1e-12 relative) and certificate rows are
-//! taken as dependent within `dependence_tol`.
+//! (its multipliers recomputed for the new right-hand side and negative ones dropped: a
+//! dual-feasible start), which saves about a third of the work. The remaining inexactness
+//! is that of the projections themselves: `P(t)` is declared feasible within `primal_tol`
+//! (1e-12 relative), and a certificate's `Σ y_i a_i` is zero only to within
+//! `dependence_tol` (in practice ~1e-16: exactly dependent rows), which bounds how far `t`
+//! can overshoot `t*`.
 //!
 //! The projection used inside `least_violation` is always that of the origin, so `t*` does
 //! not depend on `x0` at all — a large nominal input cannot "buy" violation.
