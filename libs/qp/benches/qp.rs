@@ -57,6 +57,7 @@ fn percentiles<const M: usize>(name: &str, data: &[Data<M>], c: Call) {
     let mut qp = ActiveSetQp::<M, 64>::new(Settings::default());
     // statistics of the pool itself
     let (mut act, mut it, mut outer) = (0u64, 0u64, 0u64);
+    let (mut it_max, mut outer_max) = (0u32, 0u32);
     for d in data {
         let (x0, a, b, w, n) = d;
         if matches!(c, Call::Solve) {
@@ -64,12 +65,15 @@ fn percentiles<const M: usize>(name: &str, data: &[Data<M>], c: Call) {
             assert_eq!(s.status, Status::Optimal);
             act += s.active.count_ones() as u64;
             it += s.iterations as u64;
+            it_max = it_max.max(s.iterations);
         } else {
             let (l, s) = qp.lexicographic(x0, a, b, w, *n);
             assert_eq!(l.status, Status::Optimal);
             act += s.active.count_ones() as u64;
             it += l.iterations as u64;
             outer += l.outer_iterations as u64;
+            it_max = it_max.max(l.iterations);
+            outer_max = outer_max.max(l.outer_iterations);
         }
     }
     let reps = 80;
@@ -86,7 +90,7 @@ fn percentiles<const M: usize>(name: &str, data: &[Data<M>], c: Call) {
     let k = data.len() as f64;
     println!(
         "{name:<22} p50 {:7.2} µs  p90 {:7.2}  p99 {:7.2}  p99.9 {:7.2}  max {:7.2}   \
-         (mean active rows {:.1}, active-set changes {:.1}{})",
+         (mean active rows {:.1}, active-set changes mean {:.1} max {}{})",
         q(0.5),
         q(0.9),
         q(0.99),
@@ -94,10 +98,14 @@ fn percentiles<const M: usize>(name: &str, data: &[Data<M>], c: Call) {
         q(1.0),
         act as f64 / k,
         it as f64 / k,
+        it_max,
         if matches!(c, Call::Solve) {
             String::new()
         } else {
-            format!(", projections per lexicographic {:.1}", outer as f64 / k)
+            format!(
+                ", projections per lexicographic mean {:.1} max {outer_max}",
+                outer as f64 / k
+            )
         }
     );
 }

@@ -130,3 +130,19 @@ fn known_solutions_extreme_scales() {
         check::<3>(&kn, 1e-12, 1e-14);
     }
 }
+
+/// The other sizes the solver is generic over: M = 1, 2 and 8 (the largest the filters
+/// may use), with up to N = 64 rows.
+#[test]
+fn known_solutions_other_sizes() {
+    let mut rng = Rng(5);
+    for case in 0..500 {
+        let kn = known(&mut rng, 1, case % 2, 3, 0.5);
+        check::<1>(&kn, 1e-12, 1e-14);
+        let kn = known(&mut rng, 2, case % 3, 6, 0.5);
+        check::<2>(&kn, 1e-12, 1e-14);
+        let extra = case % 40;
+        let kn = known(&mut rng, 8, case % 9, extra, 0.5);
+        check::<8>(&kn, 1e-12, 1e-14);
+    }
+}
