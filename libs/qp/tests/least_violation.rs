@@ -240,3 +240,54 @@ fn invalid_weights() {
     // alone, the soft row x ≥ 1 can be met: t* = 0
     assert_eq!(lexi::<3>(&p).0.t, 0.0);
 }
+
+/// Scaling a row (a_i, b_i, w_i) by any positive factor gives the same problem: with
+/// factors 1e-6 … 1e6, t* and the lexicographic x must not change (beyond rounding), and
+/// the scaled problem's own LP-dual certificate and KKT conditions must hold.
+#[test]
+fn row_scaling_invariance() {
+    let mut rng = Rng(33);
+    for k in 0..400 {
+        let m7 = k % 2 == 1;
+        let p = random_lv(
+            &mut rng,
+            if m7 { 7 } else { 3 },
+            if m7 { 30 } else { 8 },
+            2,
+            true,
+        );
+        let mut q = p.clone();
+        for i in 0..q.n() {
+            let f = 10f64.powf(rng.range(-6.0, 6.0));
+            q.a[i].iter_mut().for_each(|v| *v *= f);
+            q.b[i] *= f;
+            q.w[i] *= f;
+        }
+        let ((l1, x1), (l2, x2)) = if m7 {
+            let (l1, s1) = lexi::<7>(&p);
+            let (l2, s2) = lexi::<7>(&q);
+            check_kkt(&q.relaxed(l2.t), &s2, 1e-12).unwrap();
+            ((l1, s1.x.to_vec()), (l2, s2.x.to_vec()))
+        } else {
+            let (l1, s1) = lexi::<3>(&p);
+            let (l2, s2) = lexi::<3>(&q);
+            check_kkt(&q.relaxed(l2.t), &s2, 1e-12).unwrap();
+            ((l1, s1.x.to_vec()), (l2, s2.x.to_vec()))
+        };
+        check_lp_dual(&q, &l2, 1e-12).unwrap();
+        assert!(
+            (l1.t - l2.t).abs() <= 1e-12 * l1.t.max(1.0),
+            "t* {} vs {} after row scaling",
+            l1.t,
+            l2.t
+        );
+        let dx = x1
+            .iter()
+            .zip(&x2)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(
+            dx <= 1e-12 * p.scale(),
+            "x moved by {dx:e} after row scaling"
+        );
+    }
+}
