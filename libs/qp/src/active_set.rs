@@ -285,18 +285,21 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
                     // â_p = Σ r_j â_j with r ≤ 0: y = e_p − Σ r_j e_j ≥ 0 has Σ y_i â_i ≈ 0,
                     // and, the active rows being tight, s_p = −Σ y_i b̂_i. Decide from the
                     // data (free of the iterate's rounding) whether row p really fails.
+                    // Entries of r within the dual tolerance are zero (as for the steps):
+                    // rounding noise must not put weight on a row (for the least-violation
+                    // iteration, noise on a soft row would fake Σ y_i w_i > 0).
+                    let yj = |rj: f64| if -rj > rtol { -rj } else { 0.0 };
                     let mut yb = self.rhs[p];
                     let mut mag = self.rhs[p].abs();
                     for j in 0..q {
-                        let yj = (-r[j]).max(0.0);
-                        yb += yj * self.rhs[self.act[j]];
-                        mag += yj * self.rhs[self.act[j]].abs();
+                        yb += yj(r[j]) * self.rhs[self.act[j]];
+                        mag += yj(r[j]) * self.rhs[self.act[j]].abs();
                     }
                     if yb > ptol * mag {
                         self.y[..n].fill(0.0);
                         self.y[p] = 1.0;
                         for j in 0..q {
-                            self.y[self.act[j]] = (-r[j]).max(0.0);
+                            self.y[self.act[j]] = yj(r[j]);
                         }
                         return Core::Infeasible;
                     }

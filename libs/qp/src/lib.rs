@@ -222,8 +222,8 @@ impl<const M: usize, const N: usize> Solution<M, N> {
 /// Result of [`ActiveSetQp::least_violation`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LeastViolation<const N: usize> {
-    /// `Optimal`, `Infeasible` (the hard rows alone are infeasible), `IterationLimit` or
-    /// `InvalidInput`.
+    /// `Optimal`, `Infeasible` (the hard rows alone are infeasible), `IterationLimit` (an
+    /// iteration limit, or `t` would overflow) or `InvalidInput`.
     pub status: Status,
     /// The least violation `t* ≥ 0` when `Optimal`; the last lower bound otherwise.
     pub t: f64,

@@ -291,3 +291,41 @@ fn row_scaling_invariance() {
         );
     }
 }
+
+/// Hard rows contradictory by a pair `a·x ≥ g`, `−a·x ≥ 0` (g > 0), found while soft rows
+/// are active: the status must be Infeasible — never a huge "optimal" t from rounding
+/// noise on a soft row in the certificate — and the certificate must use hard rows only.
+#[test]
+fn hard_contradiction_among_active_soft_rows() {
+    let mut rng = Rng(34);
+    for k in 0..2000 {
+        let m7 = k % 2 == 1;
+        let m = if m7 { 7 } else { 3 };
+        let mut p = random_lv(&mut rng, m, if m7 { 30 } else { 8 }, 0, true);
+        // every other case: parallel to a soft row (whose coefficient in the dependence
+        // r is then exactly zero in exact arithmetic, rounding noise in floating point)
+        let a = if k % 4 < 2 {
+            let soft: Vec<usize> = (0..p.n()).filter(|&i| p.w[i] > 0.0).collect();
+            p.a[soft[rng.below(soft.len())]].clone()
+        } else {
+            rng.vec(m)
+        };
+        let gap = [1e-6, 1e-3, 1.0][k % 3];
+        p.row(a.clone(), gap);
+        p.row(a.iter().map(|v| -v).collect(), 0.0);
+        p.shuffle(&mut rng);
+        let lv = if m7 {
+            lv_only::<7>(&p)
+        } else {
+            lv_only::<3>(&p)
+        };
+        assert_eq!(lv.status, Status::Infeasible, "t = {} (gap {gap})", lv.t);
+        for i in 0..p.n() {
+            assert!(
+                p.w[i] == 0.0 || lv.certificate[i] == 0.0,
+                "soft row {i} in certificate"
+            );
+        }
+        check_certificate(&p, &lv.certificate, 1e-12).unwrap();
+    }
+}
