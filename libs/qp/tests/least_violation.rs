@@ -45,10 +45,13 @@ fn run<const M: usize>(seed: u64, soft: usize, hard: usize) -> Result<(), TestCa
     // the reference must have solved it (rare degenerate cases exhaust its iterations)
     prop_assume!(matches!(r.status, Solved | AlmostSolved));
     let t_cl = r.x[M];
-    // relative to the LP's own scale, which includes t* (t multiplies the weights)
+    // relative to the LP's own scale, which includes t* (t multiplies the weights); an
+    // "almost solved" reference is only good to its reduced tolerances (one such point was
+    // infeasible by 6e-9, its t below the certified optimum by 1e-8 relative)
     let scale = scale.max(lv.t);
+    let tol = r.trust();
     prop_assert!(
-        (lv.t - t_cl).abs() <= 1e-9 * scale,
+        (lv.t - t_cl).abs() <= tol * scale,
         "t* = {} vs Clarabel {} (scale {:e})\n{:?}",
         lv.t,
         t_cl,

@@ -26,8 +26,17 @@ fn run<const M: usize>(seed: u64, extra: usize, wild: bool) -> Result<(), TestCa
     prop_assume!(matches!(r.status, Solved | AlmostSolved));
     let scale = p.scale();
     let dx = (0..M).fold(0.0f64, |m, k| m.max((s.x[k] - r.x[k]).abs()));
+    // An interior-point method leaves a weakly active row (tiny λ̂ = λ‖a‖) at a slack of
+    // about μ/λ̂: seen as 8e-8 for λ̂ = 4e-5 with μ ≈ 1e-15·scale² at Clarabel's 1e-14.
+    // The x comparison allows that term (10× margin); the objectives must agree anyway.
+    let lam_min = (0..p.n())
+        .map(|i| s.lambda[i] * p.row_norm(i))
+        .filter(|&l| l > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    // an "almost solved" reference is only good to its reduced tolerances
+    let tol = r.trust();
     prop_assert!(
-        dx <= 1e-9 * scale,
+        dx <= tol * scale + 1e-13 * scale * scale / lam_min,
         "x differs from Clarabel by {:e} (scale {:e}); active {:b}\n{:?}",
         dx,
         scale,
@@ -37,7 +46,7 @@ fn run<const M: usize>(seed: u64, extra: usize, wild: bool) -> Result<(), TestCa
     let (f, fr) = (objective(&p, &s.x), objective(&p, &r.x));
     // ours is exact: it can only be lower than Clarabel's up to Clarabel's infeasibility
     prop_assert!(
-        (f - fr).abs() <= 1e-9 * scale * scale,
+        (f - fr).abs() <= tol * scale * scale,
         "objective {f} vs Clarabel {fr}"
     );
     Ok(())

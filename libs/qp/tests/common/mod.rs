@@ -203,6 +203,22 @@ fn dense_csc(rows: &[Vec<f64>], cols: usize) -> CscMatrix<f64> {
 pub struct Reference {
     pub status: SolverStatus,
     pub x: Vec<f64>,
+    /// The Clarabel tolerance this result was obtained with.
+    pub tol: f64,
+}
+
+impl Reference {
+    /// How far the reference can be trusted, relative to the problem scale: 1e-9 when
+    /// Clarabel solved it at 1e-12 or tighter; otherwise (solved only at 1e-10, or "almost
+    /// solved" with its reduced tolerances) 1e-6. Exactness itself is checked by the
+    /// certificates (KKT, LP dual), not by this comparison.
+    pub fn trust(&self) -> f64 {
+        if self.status == SolverStatus::Solved && self.tol <= 1e-12 {
+            1e-9
+        } else {
+            1e-6
+        }
+    }
 }
 
 fn clarabel(p_diag: &[f64], q: &[f64], rows: &[Vec<f64>], rhs: &[f64]) -> Reference {
@@ -231,6 +247,7 @@ fn clarabel(p_diag: &[f64], q: &[f64], rows: &[Vec<f64>], rhs: &[f64]) -> Refere
         let r = Reference {
             status: solver.solution.status,
             x: solver.solution.x.clone(),
+            tol,
         };
         match r.status {
             SolverStatus::Solved => return r,
