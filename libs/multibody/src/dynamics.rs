@@ -36,6 +36,31 @@ pub struct Momentum {
     pub angular_com: Vector3<f64>,
 }
 
+/// The base's angular acceleration as an affine map of the inputs, from the 13-DoF
+/// forward dynamics:
+///
+/// ```text
+/// ω̇_B = P τ_B + Q τ_M + r = P_L τ_B + r_L + Q (τ_M − τ_hold(τ_B))
+/// ```
+///
+/// where `τ_hold` is the joint torque that keeps the joint rates constant (`θ̈ = 0`, the
+/// arm "locked" as it moves) and `P_L`, `r_L` describe the base with the arm locked.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BaseAngularDynamics {
+    /// `∂ω̇_B/∂τ_B` (3×3, 1/(kg m²)): the inverse of the base's articulated inertia.
+    pub p: Matrix3<f64>,
+    /// `∂ω̇_B/∂τ_M` (3×7, 1/(kg m²)): the arm's reaction on the base per joint torque.
+    pub q: SMatrix<f64, 3, NJ>,
+    /// `ω̇_B` at `τ_B = 0`, `τ_M = 0` under the given base force (rad/s²): velocity
+    /// products of the whole servicer and the torque of the force about the system CoM.
+    pub r: Vector3<f64>,
+    /// `∂ω̇_B/∂τ_B` with the arm locked (`θ̈ = 0`): the inverse of the locked inertia
+    /// about the base, 1/(kg m²).
+    pub p_locked: Matrix3<f64>,
+    /// `ω̇_B` at `τ_B = 0` with the arm locked, under the given base force (rad/s²).
+    pub r_locked: Vector3<f64>,
+}
+
 /// Arm dynamics on a free-floating base reduced to the joint space (Schur complement):
 /// `θ̈ = M_eff⁻¹ (τ_M − c_eff)` reproduces the 13-DoF forward dynamics exactly for the given
 /// base angular velocity and base wrench.
@@ -309,6 +334,41 @@ impl Robot {
         })
     }
 
+    /// `ω̇_B = P τ_B + Q τ_M + r` at `(θ, θ̇)` with base angular velocity `omega_b` and base
+    /// force `force_b` (N, base frame, at the base origin). The base linear velocity does
+    /// not enter. `None` if the mass matrix is not positive definite.
+    pub fn base_angular_dynamics(
+        &self,
+        theta: &Vector7,
+        theta_dot: &Vector7,
+        omega_b: &Vector3<f64>,
+        force_b: &Vector3<f64>,
+    ) -> Option<BaseAngularDynamics> {
+        let m = self.mass_matrix(theta);
+        let mut nu = Vector13::zeros();
+        nu.fixed_rows_mut::<3>(3).copy_from(omega_b);
+        nu.fixed_rows_mut::<NJ>(NB).copy_from(theta_dot);
+        let b = self.nonlinear_effects(theta, &nu);
+        let minv = Cholesky::new(m)?.inverse();
+        let mut u0 = -b;
+        u0[0] += force_b.x;
+        u0[1] += force_b.y;
+        u0[2] += force_b.z;
+        let acc = minv * u0;
+        // arm locked: M_bb ν̇_b = [f; τ_B] − b_b
+        let mbb: Matrix6<f64> = m.fixed_view::<6, 6>(0, 0).into();
+        let mbb_inv = Cholesky::new(mbb)?.inverse();
+        let u0b: Vector6<f64> = u0.fixed_rows::<6>(0).into();
+        let acc_locked = mbb_inv * u0b;
+        Some(BaseAngularDynamics {
+            p: minv.fixed_view::<3, 3>(3, 3).into(),
+            q: minv.fixed_view::<3, NJ>(3, NB).into(),
+            r: acc.fixed_rows::<3>(3).into(),
+            p_locked: mbb_inv.fixed_view::<3, 3>(3, 3).into(),
+            r_locked: acc_locked.fixed_rows::<3>(3).into(),
+        })
+    }
+
     /// System CoM, linear momentum and angular momenta (base frame) for `(θ, ν)`.
     pub fn momentum(&self, theta: &Vector7, nu: &Vector13) -> Momentum {
         let x = self.placements(theta);
@@ -340,6 +400,15 @@ impl Robot {
             mc += p.rot * i.h + p.trans * i.mass;
         }
         mc / self.total_mass
+    }
+
+    /// Velocity of the system CoM relative to the base frame (m/s, base frame) for joint
+    /// rates `theta_dot` with the base held fixed: `ċ_B = J_c θ̇` (the total linear momentum
+    /// of `ν = [0; 0; θ̇]` divided by the total mass).
+    pub fn center_of_mass_velocity(&self, theta: &Vector7, theta_dot: &Vector7) -> Vector3<f64> {
+        let mut nu = Vector13::zeros();
+        nu.fixed_rows_mut::<NJ>(NB).copy_from(theta_dot);
+        self.momentum(theta, &nu).linear / self.total_mass
     }
 
     /// Kinetic energy `½ νᵀ M ν` (J).

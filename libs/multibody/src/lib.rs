@@ -16,7 +16,7 @@ pub mod kinematics;
 pub mod model;
 pub mod spatial;
 
-pub use dynamics::{Momentum, ReducedArmDynamics};
+pub use dynamics::{BaseAngularDynamics, Momentum, ReducedArmDynamics};
 pub use error::ModelError;
 pub use kinematics::{Kinematics, SphereState};
 pub use model::{CollisionSphere, Frame, JointLimits, Robot};

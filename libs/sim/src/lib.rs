@@ -25,4 +25,4 @@ mod state;
 pub use observation::{Observation, TRAJECTORY_COLUMNS, TrajectoryRow};
 pub use profile::{CommandProfile, PROFILE_COLUMNS, ProfileError};
 pub use report::{ModelReport, ModelState, evaluate_model};
-pub use state::{Command, SimError, SimState, Simulator};
+pub use state::{BarrierState, Command, SimError, SimState, Simulator};

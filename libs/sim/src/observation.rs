@@ -55,6 +55,15 @@ pub struct Observation {
     /// velocity in F_R [m/s].
     pub ee_r: Vector3<f64>,
     pub ee_v_r: Vector3<f64>,
+    /// Servicer system centre of mass (bus + arm) relative to the target CoM, Hill frame
+    /// [m], and its derivative in the rotating Hill frame [m/s]: the point whose motion the
+    /// Clohessy–Wiltshire model describes exactly (internal forces of the arm do not move
+    /// it), so the translational barriers and the line of sight are measured from it.
+    pub com_h: Vector3<f64>,
+    pub com_v_h: Vector3<f64>,
+    /// The same in F_R [m] with its inertial velocity [m/s].
+    pub com_r: Vector3<f64>,
+    pub com_v_r: Vector3<f64>,
 }
 
 impl Observation {
@@ -110,6 +119,12 @@ impl Simulator {
         let ee_rel_v_b = self.robot.ee_jacobian(&kin).fixed_rows::<3>(0) * s.theta_dot;
         let ee_r = r_r + r_rb * ee_b;
         let ee_v_r = v_r + r_rb * (s.w_b.cross(&ee_b) + ee_rel_v_b);
+        let com_b = self.robot.center_of_mass(&s.theta);
+        let com_rel_v_b = self.robot.center_of_mass_velocity(&s.theta, &s.theta_dot);
+        let r_ib = quat::to_matrix(&s.q_ib);
+        let dr_com = s.dr + r_ib * com_b;
+        let dv_com = s.dv + r_ib * (s.w_b.cross(&com_b) + com_rel_v_b);
+        let (com_h, com_v_h) = hill.relative_to_hill(&dr_com, &dv_com);
         Observation {
             step: self.step,
             t: s.t,
@@ -135,6 +150,10 @@ impl Simulator {
             ee_b,
             ee_r,
             ee_v_r,
+            com_h,
+            com_v_h,
+            com_r: r_ri * dr_com,
+            com_v_r: r_ri * dv_com,
         }
     }
 

@@ -53,6 +53,23 @@ pub enum SimError {
     Model(String),
 }
 
+/// The part of the true state every safety barrier depends on (see `sc_cbf::monitor`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BarrierState {
+    /// Time [s].
+    pub t: f64,
+    /// Servicer system CoM relative to the target CoM, in F_R [m].
+    pub com_r: Vector3<f64>,
+    /// `q_RB`: base attitude, rotates F_B vectors into F_R.
+    pub q_rb: Quat,
+    /// Base body rate [rad/s, F_B].
+    pub omega_b: Vector3<f64>,
+    /// Grasping point relative to the target CoM, in F_R [m].
+    pub grasp_r: Vector3<f64>,
+    pub theta: Vector7,
+    pub theta_dot: Vector7,
+}
+
 /// The full simulator state at one instant (inertial frame I, SI units).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SimState {
@@ -277,22 +294,58 @@ impl Simulator {
 
     /// Advances one control period under the zero-order-hold command `cmd`.
     pub fn step(&mut self, cmd: &Command) -> Result<(), SimError> {
+        self.step_with(cmd, |_| {})
+    }
+
+    /// Like [`Self::step`], and calls `at_physics_step` with the [`BarrierState`] after
+    /// every RK4 step of the period (the last call sees the state of the next control
+    /// step): the inter-sample states that a monitor must see too.
+    pub fn step_with(
+        &mut self,
+        cmd: &Command,
+        mut at_physics_step: impl FnMut(&BarrierState),
+    ) -> Result<(), SimError> {
         if !cmd.is_finite() {
             return Err(SimError::NonFiniteCommand { t: self.state.t });
         }
         let u = cmd.as_vector();
         let mut x = self.state.pack();
         let h = self.p.physics_step;
-        for _ in 0..self.p.substeps {
+        let t0 = self.state.t;
+        for j in 0..self.p.substeps {
             x = self
                 .rk4(&x, &u, h)
                 .ok_or(SimError::Diverged { t: self.state.t })?;
+            let s = SimState::unpack(t0 + (j + 1) as f64 * h, &x);
+            at_physics_step(&self.barrier_state_of(&s));
         }
         self.step += 1;
         // time from the step count, so that it never accumulates rounding
         let period = h * self.p.substeps as f64;
         self.state = SimState::unpack(self.step as f64 * period, &x);
         Ok(())
+    }
+
+    /// What the safety barriers depend on, at the current state.
+    pub fn barrier_state(&self) -> BarrierState {
+        self.barrier_state_of(&self.state)
+    }
+
+    fn barrier_state_of(&self, s: &SimState) -> BarrierState {
+        let q_ri = quat::conj(&self.p.q_ir);
+        let r_ri = quat::to_matrix(&q_ri);
+        let com_b = self.robot.center_of_mass(&s.theta);
+        let dr_com = s.dr + quat::to_matrix(&s.q_ib) * com_b;
+        let q_rt = quat::mul(&q_ri, &s.q_it);
+        BarrierState {
+            t: s.t,
+            com_r: r_ri * dr_com,
+            q_rb: quat::mul(&q_ri, &s.q_ib),
+            omega_b: s.w_b,
+            grasp_r: quat::to_matrix(&q_rt) * self.p.grasp_point_t,
+            theta: s.theta,
+            theta_dot: s.theta_dot,
+        }
     }
 
     /// Generalised velocity ν = [v_B; ω_B; θ̇] with the base linear velocity taken
