@@ -1,0 +1,294 @@
+//! The safety QP of every filter (paper eqs. "translation_qp", "attitude_qp",
+//! "robotic_qp"), solved exactly:
+//!
+//! ```text
+//! min_u ‖u − u_nom‖²   s.t.   c_i + a_i·u ≥ 0 (barrier rows),   d_k + g_k·u ≥ 0 (input bounds)
+//! ```
+//!
+//! with the dual active-set solver of `sc-qp` (exact to rounding, allocation-free,
+//! deterministic). Clarabel stays in the product as the independent second opinion
+//! ([`crate::qp::QpEngine`], used by the tests and the verification mode).
+//!
+//! * **Skip path.** A nominal command that satisfies every row and bound is the unique
+//!   minimiser and is returned unchanged.
+//! * **Relaxed problem that cannot be bought.** When the barrier rows cannot all hold
+//!   inside the input bounds, each row's allowed violation is chosen lexicographically,
+//!   independently of `u_nom`, before the command is: first the least achievable violation
+//!   `t₁ = min t` s.t. `c_i + a_i·u + w_i t ≥ 0` for every barrier row, bounds hard (`w_i`
+//!   the row's physical scale, so `t` is a fraction of each barrier's braking authority);
+//!   the rows that make `t₁` necessary (the support of the LP's optimal dual) keep the
+//!   violation `w_i t₁`, every other row must do better: the next round minimises their
+//!   common violation with the first rows fixed, and so on until the remaining rows hold
+//!   exactly (a lexicographic min-max, at most one round per row). Then the command is the
+//!   one nearest `u_nom` among those violating no row by more than its allowance. A large
+//!   nominal cannot buy violation, and one infeasible row does not license the others.
+
+use crate::barrier::Row;
+use nalgebra::SVector;
+use sc_qp::{ActiveSetQp, Settings, Status};
+
+/// How the command of one solve was produced.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// The nominal satisfied every row and bound.
+    Skipped,
+    /// The hard QP was solved.
+    Solved,
+    /// The barrier rows were infeasible: the lexicographic least-violation command.
+    Relaxed,
+    /// The solver failed (invalid data or its iteration limit): no command.
+    Failed,
+}
+
+/// Result of [`Engine::solve`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Outcome<const M: usize> {
+    pub kind: Kind,
+    /// The command (the nominal for `Skipped`, unchanged input for `Failed`).
+    pub u: SVector<f64, M>,
+    /// The least violation `t*` of the relaxed problem (0 otherwise).
+    pub violation: f64,
+    /// Active-set changes (all stages).
+    pub iterations: u32,
+    /// Multipliers of the barrier rows (0 when skipped).
+    pub row_duals: [f64; 64],
+}
+
+/// The QP of one filter: `M` inputs, at most `N` rows (barrier rows + bound rows).
+pub struct Engine<const M: usize, const N: usize> {
+    qp: ActiveSetQp<M, N>,
+    a: [[f64; M]; N],
+    b: [f64; N],
+    w: [f64; N],
+    skip_enabled: bool,
+}
+
+impl<const M: usize, const N: usize> Default for Engine<M, N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const M: usize, const N: usize> Engine<M, N> {
+    pub fn new() -> Self {
+        Self {
+            qp: ActiveSetQp::new(Settings::default()),
+            a: [[0.0; M]; N],
+            b: [0.0; N],
+            w: [0.0; N],
+            skip_enabled: true,
+        }
+    }
+
+    /// Verification only: with `false` the solver runs even for a feasible nominal.
+    pub fn set_skip_enabled(&mut self, on: bool) {
+        self.skip_enabled = on;
+    }
+
+    /// Solves for `u_nom` with barrier `rows` (physical weights `weights`, > 0) and hard
+    /// `bounds`. Never panics: too many rows or non-finite data give [`Kind::Failed`].
+    pub fn solve(
+        &mut self,
+        u_nom: &SVector<f64, M>,
+        rows: &[Row<M>],
+        weights: &[f64],
+        bounds: &[Row<M>],
+    ) -> Outcome<M> {
+        let mut out = Outcome {
+            kind: Kind::Failed,
+            u: *u_nom,
+            violation: 0.0,
+            iterations: 0,
+            row_duals: [0.0; 64],
+        };
+        let nb = rows.len();
+        let n = nb + bounds.len();
+        if n > N || weights.len() != nb || nb > 64 {
+            return out;
+        }
+        let feasible = rows.iter().chain(bounds).all(|r| r.phi(u_nom) >= 0.0);
+        if feasible && self.skip_enabled {
+            out.kind = Kind::Skipped;
+            return out;
+        }
+        for (i, r) in rows.iter().chain(bounds).enumerate() {
+            self.a[i].copy_from_slice(r.a.as_slice());
+            self.b[i] = -r.c;
+            self.w[i] = if i < nb { weights[i] } else { 0.0 };
+        }
+        let x0: [f64; M] = std::array::from_fn(|j| u_nom[j]);
+        let hard = self.qp.solve(&x0, &self.a, &self.b, n);
+        out.iterations = hard.iterations;
+        match hard.status {
+            Status::Optimal => {
+                out.kind = Kind::Solved;
+                out.u = SVector::from(hard.x);
+                out.row_duals[..nb].copy_from_slice(&hard.lambda[..nb]);
+            }
+            Status::Infeasible => {
+                if let Some((sol, t, iters)) = self.relaxed(&x0, nb, n) {
+                    out.kind = Kind::Relaxed;
+                    out.u = SVector::from(sol.x);
+                    out.violation = t;
+                    out.row_duals[..nb].copy_from_slice(&sol.lambda[..nb]);
+                    out.iterations += iters;
+                }
+            }
+            Status::IterationLimit | Status::InvalidInput => {}
+        }
+        if !out.u.iter().all(|x| x.is_finite()) {
+            out.kind = Kind::Failed;
+            out.u = *u_nom;
+        }
+        out
+    }
+}
+
+impl<const M: usize, const N: usize> Engine<M, N> {
+    /// The lexicographic min-max relaxation of the barrier rows `0..nb` (see the module
+    /// documentation): returns the command, the largest allowance `t₁` (the violation
+    /// reported) and the iterations. `None` when a stage fails.
+    fn relaxed(
+        &mut self,
+        x0: &[f64; M],
+        nb: usize,
+        n: usize,
+    ) -> Option<(sc_qp::Solution<M, N>, f64, u32)> {
+        let mut fixed = [false; N];
+        let mut allowance = [0.0; N];
+        let mut b = self.b;
+        let mut w = [0.0; N];
+        let mut iterations = 0;
+        let mut worst = 0.0f64;
+        for _ in 0..nb {
+            for i in 0..n {
+                let soft = i < nb && !fixed[i];
+                w[i] = if soft { self.w[i] } else { 0.0 };
+                b[i] = self.b[i] - if fixed[i] { self.w[i] * allowance[i] } else { 0.0 };
+            }
+            let lv = self.qp.least_violation(&self.a, &b, &w, n);
+            iterations += lv.iterations;
+            if lv.status != Status::Optimal {
+                return None;
+            }
+            if lv.t <= 0.0 {
+                break;
+            }
+            worst = worst.max(lv.t);
+            // rounding must not make the fixed rows' set empty: a relative 1e-9 of room
+            let t = lv.t * (1.0 + 1e-9) + 1e-12;
+            let mut any = false;
+            for i in 0..nb {
+                if !fixed[i] && lv.dual[i] > 0.0 {
+                    fixed[i] = true;
+                    allowance[i] = t;
+                    any = true;
+                }
+            }
+            if !any {
+                // a degenerate dual: give every remaining row the same allowance
+                for i in 0..nb {
+                    if !fixed[i] {
+                        fixed[i] = true;
+                        allowance[i] = t;
+                    }
+                }
+            }
+            if (0..nb).all(|i| fixed[i]) {
+                break;
+            }
+        }
+        for i in 0..n {
+            b[i] = self.b[i] - if fixed[i] { self.w[i] * allowance[i] } else { 0.0 };
+        }
+        let sol = self.qp.solve(x0, &self.a, &b, n);
+        iterations += sol.iterations;
+        (sol.status == Status::Optimal).then_some((sol, worst, iterations))
+    }
+}
+
+/// The last problem a filter handed to its engine and what came out — for `--dump-qp`
+/// and offline checks. The buffers are allocated once, so recording does not allocate.
+#[derive(Debug, Clone)]
+pub struct LastProblem<const M: usize> {
+    pub u_nom: SVector<f64, M>,
+    pub rows: Vec<Row<M>>,
+    pub weights: Vec<f64>,
+    pub hard: Vec<Row<M>>,
+    pub u: SVector<f64, M>,
+    pub kind: Option<Kind>,
+    pub violation: f64,
+    pub iterations: u32,
+    pub row_duals: Vec<f64>,
+}
+
+impl<const M: usize> LastProblem<M> {
+    /// Empty, with room for `rows` barrier rows and `hard` bound rows.
+    pub fn with_capacity(rows: usize, hard: usize) -> Self {
+        Self {
+            u_nom: SVector::zeros(),
+            rows: Vec::with_capacity(rows),
+            weights: Vec::with_capacity(rows),
+            hard: Vec::with_capacity(hard),
+            u: SVector::zeros(),
+            kind: None,
+            violation: 0.0,
+            iterations: 0,
+            row_duals: Vec::with_capacity(rows),
+        }
+    }
+
+    /// Records a solve.
+    pub fn record(
+        &mut self,
+        u_nom: &SVector<f64, M>,
+        rows: &[Row<M>],
+        weights: &[f64],
+        hard: &[Row<M>],
+        out: &Outcome<M>,
+    ) {
+        self.u_nom = *u_nom;
+        self.rows.clear();
+        self.rows.extend_from_slice(rows);
+        self.weights.clear();
+        self.weights.extend_from_slice(weights);
+        self.hard.clear();
+        self.hard.extend_from_slice(hard);
+        self.u = out.u;
+        self.kind = Some(out.kind);
+        self.violation = out.violation;
+        self.iterations = out.iterations;
+        self.row_duals.clear();
+        self.row_duals
+            .extend_from_slice(&out.row_duals[..rows.len().min(64)]);
+    }
+
+    /// As a [`crate::QpDump`] (allocates).
+    pub fn dump(&self) -> crate::QpDump {
+        use crate::QpOutcome;
+        crate::QpDump {
+            u_nom: self.u_nom.iter().copied().collect(),
+            rows_a: self.rows.iter().map(|r| r.a.iter().copied().collect()).collect(),
+            rows_c: self.rows.iter().map(|r| r.c).collect(),
+            bounds_g: self
+                .hard
+                .iter()
+                .map(|r| r.a.iter().map(|x| -x).collect())
+                .collect(),
+            bounds_g_max: self.hard.iter().map(|r| r.c).collect(),
+            solution: self.u.iter().copied().collect(),
+            row_duals: self.row_duals.clone(),
+            bound_duals: vec![0.0; self.hard.len()],
+            slack: self.violation,
+            outcome: self.kind.map(|k| match k {
+                Kind::Skipped => QpOutcome::Skipped,
+                Kind::Solved => QpOutcome::Solved,
+                Kind::Relaxed => QpOutcome::Relaxed,
+                Kind::Failed => QpOutcome::Failed,
+            }),
+            solver_status: "active_set".into(),
+            hard_status: String::new(),
+            iterations: self.iterations,
+        }
+    }
+}

@@ -1,0 +1,321 @@
+//! Sampled-data barrier rows: conditions that hold **between** samples under a
+//! zero-order hold of length `T`, not only at the sampling instants.
+//!
+//! The paper's conditions (eqs. "CBF rel deg 1" and "CBF rel deg 2") constrain the
+//! derivative at the sample only; under a held input the state drifts inside the sample
+//! and ε is the only margin. Here every row is derived from a one-sample prediction with
+//! bounds on how much the barrier's highest derivative can change inside the sample
+//! (after Breeden & Panagou, "Autonomous Spacecraft Attitude Reorientation Using Robust
+//! Sampled-Data CBFs", JGCD 46(10), 2023). docs/SAFETY.md has the derivation; in short:
+//!
+//! **Relative degree two** (`ḧ = a + b·u` at the sample, the paper's position-level
+//! barriers). With `φ = a + b·u` the true `ḧ(t_k + s)` stays in
+//! `[φ − M₂ − M₃ s, φ + M₂ + M₃ s]` for `s ∈ [0, T]`, where `M₂` bounds what the model does
+//! not know at the sample (e.g. a downstream subsystem's reaction) and `M₃` bounds the
+//! rate of change of `ḧ` over everything reachable in one sample. Integrating the lower
+//! bound gives `ḣ(s) ≥ v(s)`, `h(s) ≥ p(s)` and the row requires
+//!
+//! * (C1) `p(s) ≥ 0` for all `s ∈ [0, T]` — the barrier itself holds inside the sample;
+//! * (C2) `H(p(T), v(T)) ≥ e^{−γT} H(h, ḣ)` with the paper's auxiliary (braking) barrier
+//!   `H(h, ḣ) = h + |ḣ| ḣ / (2μ)` — the next sample is again in the braking-safe set, and
+//!   `H` decays at most like the paper's `α(H) = γH`.
+//!
+//! `H` is increasing in both arguments and `p`, `v` increase with `φ`, so both become
+//! `φ ≥ φ_req`: one affine row `b·u ≥ φ_req − a`. Unlike the paper's row (whose input
+//! gain `|ḣ| ∂ḧ/∂u / μ` vanishes at `ḣ = 0`) its gain is `∂ḧ/∂u` itself. It is feasible
+//! wherever the subsystem can brake the barrier at `φ = μ + M₂ + M₃T` (see
+//! [`braking_requirement`]): that command keeps `p ≥ 0` and does not decrease `H`.
+//!
+//! **Relative degree one** (`ḣ = a + b·u`, the rate limits): with the true `ḣ` in
+//! `[φ − D − J s, …]`, `h(T) ≥ h + (φ − D)T − ½JT²`, concave in `s`, so requiring the
+//! exact discretisation of the paper's `ḣ ≥ −γh + ε` at `s = T` keeps `h ≥ 0` on the
+//! whole sample: `φ ≥ D + ½JT + (e^{−γT}(h − ε/γ) + ε/γ − h)/T`.
+
+use crate::barrier::Row;
+use nalgebra::SVector;
+
+/// The paper's auxiliary barrier `H = h + |ḣ| ḣ / (2μ)`.
+pub fn braking_barrier(h: f64, hdot: f64, mu: f64) -> f64 {
+    h + hdot.abs() * hdot / (2.0 * mu)
+}
+
+/// Bounds on the model's error inside one sample of a relative-degree-two barrier.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SampleBounds {
+    /// Sample length `T` [s].
+    pub period: f64,
+    /// `M₂`: bound on the part of `ḧ` unknown at the sample [unit of h / s²].
+    pub m2: f64,
+    /// `M₃`: bound on `|d ḧ / dt|` over one sample [unit of h / s³].
+    pub m3: f64,
+}
+
+/// Terms of a relative-degree-two barrier at the sample: `h`, `ḣ`, and `ḧ = a + b·u`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RelDeg2<const M: usize> {
+    pub h: f64,
+    pub hdot: f64,
+    /// `ḧ` at `u = 0` (drift, explicit time dependence, known coupling ξ).
+    pub a: f64,
+    /// `∂ḧ/∂u`.
+    pub b: SVector<f64, M>,
+}
+
+/// Terms of a relative-degree-one barrier at the sample: `h` and `ḣ = a + b·u`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RelDeg1<const M: usize> {
+    pub h: f64,
+    pub a: f64,
+    pub b: SVector<f64, M>,
+}
+
+impl<const M: usize> From<crate::barrier::RelDegTwo<M>> for RelDeg2<M> {
+    fn from(t: crate::barrier::RelDegTwo<M>) -> Self {
+        Self {
+            h: t.h,
+            hdot: t.hdot,
+            a: t.hddot_drift,
+            b: t.hddot_u,
+        }
+    }
+}
+
+impl<const M: usize> From<crate::barrier::RelDegOne<M>> for RelDeg1<M> {
+    fn from(t: crate::barrier::RelDegOne<M>) -> Self {
+        Self {
+            h: t.h,
+            a: t.hdot_drift,
+            b: t.hdot_u,
+        }
+    }
+}
+
+/// Smallest `a` such that `h + ḣ s + ½ a s² ≥ 0` for all `s ∈ (0, T]`. For `h < 0`
+/// (already outside) only the end of the sample is required (recover within one sample).
+fn c1_requirement(h: f64, hdot: f64, t: f64) -> f64 {
+    let a_end = -2.0 * (h + hdot * t) / (t * t);
+    if h < 0.0 || hdot >= 0.0 || a_end <= 0.0 || -hdot / a_end >= t {
+        return a_end;
+    }
+    if h == 0.0 {
+        // h = 0 while decreasing: outside the braking set, nothing keeps h(s) ≥ 0 just
+        // after the sample; require the end of the sample
+        return a_end;
+    }
+    a_end.max(hdot * hdot / (2.0 * h))
+}
+
+/// Smallest `ψ = φ − M₂` with `H(P0 + ½T²ψ, V0 + Tψ) ≥ κ` (`H` increasing in `ψ`).
+fn c2_requirement(p0: f64, v0: f64, t: f64, mu: f64, kappa: f64) -> f64 {
+    // at v = 0 (ψ0 = −V0/T) H equals P0 − ½T V0
+    let h_at_switch = p0 - 0.5 * t * v0;
+    let c = h_at_switch - kappa;
+    let half_t = 0.5 * t;
+    let w = if c <= 0.0 {
+        // root on the v ≥ 0 branch: w²/(2μ) + (T/2) w + c = 0, w ≥ 0
+        let d = -2.0 * c / mu;
+        mu * d / (half_t + (half_t * half_t + d).sqrt())
+    } else {
+        // root on the v < 0 branch: −w²/(2μ) + (T/2) w + c = 0, w < 0
+        let d = 2.0 * c / mu;
+        -2.0 * c / (half_t + (half_t * half_t + d).sqrt())
+    };
+    (w - v0) / t
+}
+
+impl<const M: usize> RelDeg2<M> {
+    /// `φ_req`: the smallest `ḧ` at the sample for which (C1) and (C2) hold, with braking
+    /// authority `μ` in `H` and class-K gain `γ`.
+    pub fn phi_required(&self, bounds: &SampleBounds, mu: f64, gamma: f64) -> f64 {
+        let t = bounds.period;
+        let (h, hd) = (self.h, self.hdot);
+        let c1 = bounds.m2 + bounds.m3 * t / 3.0 + c1_requirement(h, hd, t);
+        let kappa = (-gamma * t).exp() * braking_barrier(h, hd, mu);
+        let p0 = h + hd * t - bounds.m3 * t * t * t / 6.0;
+        let v0 = hd - 0.5 * bounds.m3 * t * t;
+        let c2 = bounds.m2 + c2_requirement(p0, v0, t, mu, kappa);
+        c1.max(c2)
+    }
+
+    /// The row `b·u + (a − φ_req) ≥ 0`.
+    pub fn row(&self, bounds: &SampleBounds, mu: f64, gamma: f64) -> Row<M> {
+        Row {
+            a: self.b,
+            c: self.a - self.phi_required(bounds, mu, gamma),
+        }
+    }
+}
+
+/// The `ḧ` a command must produce at the sample to brake a relative-degree-two barrier
+/// in every state of the braking-safe set `{h ≥ 0, H ≥ 0}`: `μ + M₂ + M₃T`. A subsystem
+/// whose bounded input can produce it for all its barriers at once keeps every row
+/// feasible (docs/SAFETY.md, "Feasibility").
+pub fn braking_requirement(bounds: &SampleBounds, mu: f64) -> f64 {
+    mu + bounds.m2 + bounds.m3 * bounds.period
+}
+
+/// Bounds inside one sample of a relative-degree-one barrier.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RateBounds {
+    /// Sample length `T` [s].
+    pub period: f64,
+    /// `D`: bound on the part of `ḣ` unknown at the sample [unit of h / s].
+    pub d: f64,
+    /// `J`: bound on `|ḧ|` over one sample [unit of h / s²].
+    pub j: f64,
+}
+
+impl<const M: usize> RelDeg1<M> {
+    /// `ḣ` required at the sample: `D + ½JT + (e^{−γT}(h − ε/γ) + ε/γ − h)/T`.
+    pub fn hdot_required(&self, bounds: &RateBounds, gamma: f64, eps: f64) -> f64 {
+        let t = bounds.period;
+        let e = (-gamma * t).exp();
+        let floor = if gamma > 0.0 { eps / gamma } else { 0.0 };
+        let target = e * (self.h - floor) + floor;
+        bounds.d + 0.5 * bounds.j * t + (target - self.h) / t
+    }
+
+    /// The row `b·u + (a − ḣ_req) ≥ 0`.
+    pub fn row(&self, bounds: &RateBounds, gamma: f64, eps: f64) -> Row<M> {
+        Row {
+            a: self.b,
+            c: self.a - self.hdot_required(bounds, gamma, eps),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector1;
+
+    fn lcg(s: &mut u64) -> f64 {
+        *s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (*s >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// The worst case the row guards against: ḧ(s) = φ − M₂ − M₃ s, integrated exactly.
+    fn worst(x: &RelDeg2<1>, b: &SampleBounds, phi: f64, s: f64) -> (f64, f64) {
+        let a = phi - b.m2;
+        (
+            x.h + x.hdot * s + 0.5 * a * s * s - b.m3 * s * s * s / 6.0,
+            x.hdot + a * s - 0.5 * b.m3 * s * s,
+        )
+    }
+
+    #[test]
+    fn rel_deg_two_row_keeps_h_and_next_braking_barrier_on_the_worst_case() {
+        let mut seed = 1;
+        for _ in 0..20000 {
+            let mut r = || lcg(&mut seed);
+            let mu = 0.001 + r();
+            let b = SampleBounds {
+                period: 0.01 + 0.2 * r(),
+                m2: 0.1 * r(),
+                m3: r() * r(),
+            };
+            let hdot = 2.0 * r() - 1.0;
+            // a state inside {h ≥ 0, H ≥ 0}
+            let h = hdot.min(0.0).powi(2) / (2.0 * mu) + r() * r();
+            let x = RelDeg2 {
+                h,
+                hdot,
+                a: 0.0,
+                b: Vector1::new(1.0),
+            };
+            let gamma = 2.0 * r();
+            let phi = x.phi_required(&b, mu, gamma);
+            assert!(phi.is_finite());
+            for k in 0..=200 {
+                let s = b.period * k as f64 / 200.0;
+                let (p, _) = worst(&x, &b, phi, s);
+                assert!(p >= -1e-12 * (1.0 + h), "h({s}) = {p} (h {h}, hdot {hdot})");
+            }
+            let (p, v) = worst(&x, &b, phi, b.period);
+            let kappa = (-gamma * b.period).exp() * braking_barrier(h, hdot, mu);
+            assert!(
+                braking_barrier(p, v, mu) >= kappa - 1e-9 * (1.0 + kappa.abs()),
+                "H(T) = {} < {kappa}",
+                braking_barrier(p, v, mu)
+            );
+            // feasible by braking: the requirement never exceeds μ + M₂ + M₃T
+            assert!(
+                phi <= braking_requirement(&b, mu) + 1e-9,
+                "phi_req {phi} > braking {}",
+                braking_requirement(&b, mu)
+            );
+        }
+    }
+
+    #[test]
+    fn rel_deg_two_requirement_is_tight_for_the_braking_barrier() {
+        // no margins, γ = 0, moving towards the boundary exactly at the stopping distance:
+        // the row must ask for exactly μ (brake now), and a little less must fail (C2).
+        let mu = 0.5;
+        let hdot: f64 = -0.4;
+        let x = RelDeg2 {
+            h: hdot * hdot / (2.0 * mu),
+            hdot,
+            a: 0.0,
+            b: Vector1::new(1.0),
+        };
+        let b = SampleBounds {
+            period: 0.1,
+            m2: 0.0,
+            m3: 0.0,
+        };
+        let phi = x.phi_required(&b, mu, 0.0);
+        assert!((phi - mu).abs() < 1e-12, "{phi}");
+    }
+
+    #[test]
+    fn row_gain_does_not_vanish_at_zero_rate() {
+        let x = RelDeg2 {
+            h: 0.0,
+            hdot: 0.0,
+            a: -0.3,
+            b: Vector1::new(2.0),
+        };
+        let b = SampleBounds {
+            period: 0.1,
+            m2: 0.01,
+            m3: 0.1,
+        };
+        let row = x.row(&b, 1.0, 1.0);
+        assert_eq!(row.a[0], 2.0);
+        // at rest on the boundary the command must produce at least the margins
+        assert!(row.c <= -0.3 - (0.01 + 0.1 * 0.1 / 3.0) + 1e-15, "{}", row.c);
+    }
+
+    #[test]
+    fn rel_deg_one_row_holds_over_the_sample() {
+        let mut seed = 7;
+        for _ in 0..20000 {
+            let mut r = || lcg(&mut seed);
+            let x = RelDeg1 {
+                h: r() * r(),
+                a: 0.0,
+                b: Vector1::new(1.0),
+            };
+            let b = RateBounds {
+                period: 0.01 + 0.2 * r(),
+                d: 0.1 * r(),
+                j: r(),
+            };
+            let (gamma, eps) = (2.0 * r(), 0.01 * r());
+            let req = x.hdot_required(&b, gamma, eps);
+            // worst case ḣ(s) = req − D − J s
+            for k in 0..=100 {
+                let s = b.period * k as f64 / 100.0;
+                let h = x.h + (req - b.d) * s - 0.5 * b.j * s * s;
+                assert!(h >= -1e-12, "h({s}) = {h}");
+            }
+            let e = (-gamma * b.period).exp();
+            let h_t = x.h + (req - b.d) * b.period - 0.5 * b.j * b.period * b.period;
+            let floor = eps / gamma;
+            assert!(h_t >= e * (x.h - floor) + floor - 1e-12);
+        }
+    }
+}
