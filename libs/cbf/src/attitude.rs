@@ -2,8 +2,16 @@
 //! "attitude_qp").
 //!
 //! State `x_att = [q_RB; ω_B]` (scalar-first quaternion rotating F_B into F_R; body rate in
-//! F_B [rad/s]); dynamics paper eqs. "Attitude kinematics"/"Attitude dynamics"
-//! `I ω̇ = τ_B − ω × (I ω)`; input the body torque `τ_B` [N m] in F_B.
+//! F_B [rad/s]); input the body torque `τ_B` [N m] in F_B. The paper's rigid-body model
+//! `I ω̇ = τ_B − ω × (I ω)` (eq. "Attitude dynamics") is replaced by the base's exact
+//! angular dynamics in the coupled multibody servicer
+//! (`sc_multibody::Robot::base_angular_dynamics`),
+//! `ω̇_B = P_L τ_B + r_L + Q (τ_M − τ_hold)`: `P_L`, `r_L` the base with the arm locked
+//! (its joint rates held; `r_L` carries the velocity products of the moving arm and the
+//! torque of the upstream force about the system CoM, known), and `Q (τ_M − τ_hold)` the
+//! reaction of whatever the downstream arm does beyond holding itself, bounded by a
+//! contract the robotic filter enforces, `|(Q (τ_M − τ_hold))_i| ≤ β_i`
+//! (`arm_reaction_budget_rad_s2`) — the backward coupling the paper leaves uncompensated.
 //!
 //! Coupling `ξ_att`: the line-of-sight barrier depends on where the servicer *is*, so its
 //! second derivative contains the servicer's relative translational acceleration in F_R,
@@ -16,8 +24,10 @@ use crate::common::{
     self, BOX_MARGIN, FilterOutput, FilterReport, FilterStatus, clamp_box, faults, in_range3,
     unit_quat,
 };
-use crate::qp::{QpDump, QpEngine, QpOutcome, SolverParams};
-use nalgebra::{Matrix3, Vector3};
+use crate::engine::{Engine, Kind, LastProblem};
+use crate::sampled::{RateBounds, RelDeg1, RelDeg2, SampleBounds};
+use crate::{Formulation, qp::SolverParams};
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use sc_models::quat::{self, Quat};
 use std::time::Instant;
 
@@ -50,7 +60,7 @@ pub struct AttitudeParams {
     pub boresight_b: Vector3<f64>,
     /// `cos β_ATT`.
     pub cos_beta: f64,
-    /// γ_h [1/s], ε_ATT [1/s], u_max of H_ATT [1/s²].
+    /// γ_h [1/s], ε_ATT [1/s], μ of H_ATT [1/s²] (`u_max_att_per_s2`).
     pub gamma: f64,
     pub eps_att: f64,
     pub u_max_att: f64,
@@ -62,13 +72,31 @@ pub struct AttitudeParams {
     pub eps_omega: f64,
     /// `‖τ_B‖∞ ≤ T` [N m].
     pub torque_max: f64,
-    /// T of the fallback `τ_B = sat(−I (ω_B − ω_T,B)/T)` [s].
+    /// T of the braking law `τ_B = sat(−P⁻¹ (ω_B − ω_T,B)/T)` [s]: the substitute nominal
+    /// and the backup command.
     pub brake_time: f64,
     pub solver: SolverParams,
+    /// Sample length `T` [s].
+    pub period: f64,
+    pub formulation: Formulation,
+    /// The contract with the robotic filter: `|(Q τ_M)_i| ≤ β_i` [rad/s²], the arm's
+    /// reaction on the base's angular acceleration (the robotic filter enforces it).
+    pub arm_reaction_budget: Vector3<f64>,
+    /// The contract with the robotic filter: the joint torque the base wrench may take
+    /// from each joint, `|(K [f_B; τ_B])_j| ≤ κ_j` [N m].
+    pub joint_coupling_budget: SVector<f64, 7>,
+    /// Bound on `‖ω̇_B‖` over the certified set [rad/s²].
+    pub accel_bound: f64,
+    /// Bound on `|ω̈_B,i|` over the certified set [rad/s³].
+    pub jerk_bound: f64,
+    /// The servicer's mass [kg] and force bound [N]: the relative motion of the line of
+    /// sight inside a sample.
+    pub mass: f64,
+    pub force_max: f64,
 }
 
 impl AttitudeParams {
-    pub fn from_scenario(s: &sc_scenario::Scenario) -> Self {
+    pub fn from_scenario(s: &sc_scenario::Scenario, mass: f64) -> Self {
         let a = &s.safety.attitude;
         Self {
             boresight_b: Vector3::from(s.servicer.boresight_body).normalize(),
@@ -83,6 +111,14 @@ impl AttitudeParams {
             torque_max: s.limits.torque_max_nm,
             brake_time: s.safety.fallback.attitude_brake_time_s,
             solver: SolverParams::from_scenario(s),
+            period: s.mission.control_period_s,
+            formulation: s.safety.formulation,
+            arm_reaction_budget: Vector3::from(a.arm_reaction_budget_rad_s2),
+            joint_coupling_budget: SVector::<f64, 7>::from(a.joint_coupling_budget_nm),
+            accel_bound: a.angular_accel_bound_rad_s2,
+            jerk_bound: a.angular_jerk_bound_rad_s3,
+            mass,
+            force_max: s.limits.force_max_n,
         }
     }
 }
@@ -94,13 +130,17 @@ pub struct AttitudeInput {
     pub q_rb: Quat,
     /// `ω_B` [rad/s] in F_B.
     pub omega_b: Vector3<f64>,
-    /// Servicer inertia `I` about its CoM in F_B [kg m²] (symmetric positive definite).
-    pub inertia: Matrix3<f64>,
-    /// Servicer position `r_R` relative to the target CoM, in F_R [m].
+    /// The base's angular dynamics with the arm locked, `ω̇_B = P τ_B + r` (+ the arm's
+    /// reaction beyond holding, bounded by the contract): `P` [1/(kg m²)] and `r` [rad/s²]
+    /// with the upstream safe force acting.
+    pub p: Matrix3<f64>,
+    pub r: Vector3<f64>,
+    /// Servicer system CoM relative to the target CoM, in F_R [m] (the line of sight is
+    /// measured from it).
     pub r_r: Vector3<f64>,
     /// `v_R = ṙ_R` [m/s] (F_R is non-rotating).
     pub v_r: Vector3<f64>,
-    /// Relative drift acceleration of the servicer in F_R without its own thrust [m/s²]
+    /// Relative drift acceleration of the CoM in F_R without its own thrust [m/s²]
     /// (e.g. [`tidal_acceleration`]).
     pub a_drift_r: Vector3<f64>,
     /// Grasping point `R_RT(t) p_G,T` in F_R [m], its first and second time derivative.
@@ -109,8 +149,13 @@ pub struct AttitudeInput {
     pub grasp_acc_r: Vector3<f64>,
     /// `ξ_att = R_RB f_B,SF / m` [m/s²]: the upstream safe force's acceleration, F_R.
     pub xi_r: Vector3<f64>,
-    /// Target angular velocity expressed in F_B [rad/s] (used by the fallback only).
+    /// Target angular velocity expressed in F_B [rad/s].
     pub omega_target_b: Vector3<f64>,
+    /// The joint torque the base wrench takes to hold the arm, `K [f_B; τ_B]`
+    /// (`sc_multibody::ReducedArmDynamics::wrench_map`): its torque columns [N m per N m]
+    /// and the upstream force's share [N m] — the contract rows `|K_j [f_B; τ_B]| ≤ κ_j`.
+    pub joint_coupling: SMatrix<f64, 7, 3>,
+    pub joint_coupling_force: SVector<f64, 7>,
 }
 
 /// `ξ_att = R_RB f_B,SF / m` from the translational filter's actuated safe force.
@@ -153,13 +198,13 @@ pub fn line_of_sight_direction(
 /// Line-of-sight cone, paper eq. "CBF-ATT": `h_ATT = d_Bᵀ R_BR(q) s_R(t) − cos β_ATT`.
 /// With `s_B = R_BR s`, `ṡ_B = R_BR ṡ`, `s̈_B = R_BR s̈`:
 /// `ḣ = (ω×d)ᵀ s_B + dᵀ ṡ_B`,
-/// `ḧ = (ω̇×d + ω×(ω×d))ᵀ s_B + 2 (ω×d)ᵀ ṡ_B + dᵀ s̈_B`, `ω̇ = I⁻¹(τ − ω×Iω)`, so
-/// `∂ḧ/∂τ = I⁻¹ (d × s_B)`. ξ_att is inside `s̈` (through `ρ̈`).
+/// `ḧ = ω̇ᵀ(d × s_B) + (ω×(ω×d))ᵀ s_B + 2 (ω×d)ᵀ ṡ_B + dᵀ s̈_B` with `ω̇ = P τ + r`, so
+/// `∂ḧ/∂τ = Pᵀ (d × s_B)`. ξ_att is inside `s̈` (through `ρ̈`).
 pub fn line_of_sight(
     r_br: &Matrix3<f64>,
     omega: &Vector3<f64>,
-    inertia: &Matrix3<f64>,
-    inertia_inv: &Matrix3<f64>,
+    p: &Matrix3<f64>,
+    r: &Vector3<f64>,
     d_b: &Vector3<f64>,
     los: &LineOfSight,
     cos_beta: f64,
@@ -169,60 +214,44 @@ pub fn line_of_sight(
     let sdd_b = r_br * los.s_ddot;
     let wxd = omega.cross(d_b);
     let dxs = d_b.cross(&s_b);
-    let wdot0 = -(inertia_inv * omega.cross(&(inertia * omega)));
     RelDegTwo {
         h: d_b.dot(&s_b) - cos_beta,
         hdot: wxd.dot(&s_b) + d_b.dot(&sd_b),
-        hddot_drift: wdot0.dot(&dxs)
+        hddot_drift: r.dot(&dxs)
             + omega.cross(&wxd).dot(&s_b)
             + 2.0 * wxd.dot(&sd_b)
             + d_b.dot(&sdd_b),
-        hddot_u: inertia_inv * dxs,
+        hddot_u: p.transpose() * dxs,
     }
 }
 
 /// Angular-rate limits, paper eq. "CBF-omega": `h⁺_i = ω_max,i − ω_i`,
-/// `h⁻_i = ω_i − ω_min,i` [rad/s]; relative degree one with `ω̇ = I⁻¹(τ − ω×Iω)`.
+/// `h⁻_i = ω_i − ω_min,i` [rad/s]; relative degree one with `ω̇ = P τ + r`.
 /// Returns `[h⁺_x, h⁺_y, h⁺_z, h⁻_x, h⁻_y, h⁻_z]`.
 pub fn omega_limits(
     omega: &Vector3<f64>,
-    inertia: &Matrix3<f64>,
-    inertia_inv: &Matrix3<f64>,
+    p: &Matrix3<f64>,
+    r: &Vector3<f64>,
     omega_max: &Vector3<f64>,
     omega_min: &Vector3<f64>,
 ) -> [RelDegOne<3>; 6] {
-    let wdot0 = -(inertia_inv * omega.cross(&(inertia * omega)));
     std::array::from_fn(|k| {
         let i = k % 3;
-        let row: Vector3<f64> = inertia_inv.row(i).transpose();
+        let row: Vector3<f64> = p.row(i).transpose();
         if k < 3 {
             RelDegOne {
                 h: omega_max[i] - omega[i],
-                hdot_drift: -wdot0[i],
+                hdot_drift: -r[i],
                 hdot_u: -row,
             }
         } else {
             RelDegOne {
                 h: omega[i] - omega_min[i],
-                hdot_drift: wdot0[i],
+                hdot_drift: r[i],
                 hdot_u: row,
             }
         }
     })
-}
-
-/// `I` symmetrised and its inverse, if finite, symmetric (1e-9 relative) and positive definite.
-pub fn checked_inertia(i: &Matrix3<f64>) -> Option<(Matrix3<f64>, Matrix3<f64>)> {
-    if !common::finite(i) {
-        return None;
-    }
-    let n = i.norm();
-    if !(n > 0.0 && n < 1e12) || (i - i.transpose()).norm() > 1e-9 * n {
-        return None;
-    }
-    let s = (i + i.transpose()) * 0.5;
-    let inv = s.cholesky()?.inverse();
-    common::finite(&inv).then_some((s, inv))
 }
 
 /// All barrier terms of one step.
@@ -233,9 +262,13 @@ pub struct AttitudeTerms {
 }
 
 struct Prepared {
+    /// `P⁻¹`: the base's articulated inertia [kg m²] (for the braking law).
     inertia: Matrix3<f64>,
     terms: AttitudeTerms,
+    /// Rows valid for any torque in the box ([`NAMES`] order).
     rows: [Row<3>; N],
+    weights: [f64; N],
+    rho: Vector3<f64>,
 }
 
 enum Invalid {
@@ -243,25 +276,143 @@ enum Invalid {
     Coupling,
 }
 
+/// Caps on the body's angular acceleration per axis [rad/s²] that the certificate tries
+/// after the nominal's own; the certified command nearest the nominal wins
+/// (docs/SAFETY.md, "Line of sight").
+pub const ACCEL_CAPS: [f64; 7] = [0.32, 0.16, 0.08, 0.04, 0.02, 0.01, 0.005];
+
+fn p_formulation_sampled(p: &AttitudeParams) -> bool {
+    p.formulation == Formulation::SampledData
+}
+
 /// The attitude CBF-QP safety filter (paper eq. "attitude_qp").
 pub struct AttitudeFilter {
     pub params: AttitudeParams,
-    qp: QpEngine,
+    engine: Engine<3, { N + HARD + 6 }>,
+    bounds: [Row<3>; 6],
+    last: LastProblem<3>,
+}
+
+/// Hard rows: the torque box (6) and the joint-coupling contract (14).
+const HARD: usize = 6 + 14;
+
+/// `P` symmetric positive definite (to 1e-9 relative) with finite inverse: `(P, P⁻¹)`.
+pub fn checked_gain(p: &Matrix3<f64>) -> Option<(Matrix3<f64>, Matrix3<f64>)> {
+    if !common::finite(p) {
+        return None;
+    }
+    let n = p.norm();
+    if !(n > 0.0 && n < 1e12) || (p - p.transpose()).norm() > 1e-9 * n {
+        return None;
+    }
+    let s = (p + p.transpose()) * 0.5;
+    let inv = s.cholesky()?.inverse();
+    common::finite(&inv).then_some((s, inv))
 }
 
 impl AttitudeFilter {
     pub fn new(params: AttitudeParams) -> Self {
-        let qp = QpEngine::new(3, N, 6, params.torque_max, &params.solver);
-        Self { params, qp }
+        let lim = params.torque_max * (1.0 - BOX_MARGIN);
+        let bounds = std::array::from_fn(|i| {
+            let mut a = Vector3::zeros();
+            a[i / 2] = if i % 2 == 0 { -1.0 } else { 1.0 };
+            Row { a, c: lim }
+        });
+        Self {
+            params,
+            engine: Engine::new(),
+            bounds,
+            last: LastProblem::with_capacity(N, HARD + 6),
+        }
     }
 
-    pub fn from_scenario(s: &sc_scenario::Scenario) -> Self {
-        Self::new(AttitudeParams::from_scenario(s))
+    pub fn from_scenario(s: &sc_scenario::Scenario, mass: f64) -> Self {
+        Self::new(AttitudeParams::from_scenario(s, mass))
     }
 
     /// Barrier terms for a valid input (`None` otherwise).
     pub fn constraints(&self, x: &AttitudeInput) -> Option<AttitudeTerms> {
         self.prepare(x).ok().map(|p| p.terms)
+    }
+
+    /// Bounds on the model's error inside one sample for a command whose body angular
+    /// acceleration at the sample is at most `accel = (‖ω̇‖, ‖ω̇ − d(dᵀω̇)‖)` [rad/s²]
+    /// (`None`: any torque in the box): the line of sight's `(M₂, M₃)` and the rate rows'
+    /// `(D, J)` (derivation: docs/SAFETY.md, "Line of sight").
+    ///
+    /// Only the rotation *across* the boresight moves it, so the bound keeps the body rate
+    /// `W` and its part across the boresight `W⊥` apart: with `β` the arm's contract and `j`
+    /// the configured bound on `|ω̈_i|`, `α = ‖ω̇‖ + ‖β‖ + √3 jT`, `α⊥` likewise from the
+    /// part across, `W = ‖ω‖ + αT`, `W⊥ = ‖ω × d‖ + α⊥T`. The line of sight `s = ρ/L` of
+    /// `ρ = p_G − r` changes at most at `σ₁ = V/L`, `σ₂ = A/L + 2V²/L²`,
+    /// `σ₃ = J/L + 6VA/L² + 6V³/L³` with `V, A, J` the bounds on `ρ̇, ρ̈, ρ⃛` over the sample
+    /// (servicer thrust `√3F/m` turning at `W`, grasping point on the target tumbling at
+    /// `ω_T`). With `e₀ = ‖d × s_B‖` at the sample, `ė = σ₁ + W⊥ + We` its rate and
+    /// `e = e₀ + ėT`, differentiating `ḧ = ω̇ᵀ(d × s_B) + 2(ω×d)ᵀṡ_B − (ω×d)ᵀ(ω×s_B) + dᵀs̈_B`:
+    /// `M₂ = e₀‖β‖`,
+    /// `M₃ = ė‖β‖ + √3 j e + α⊥(σ₁ + W⊥ + We) + 2α⊥σ₁ + 2W⊥(σ₂ + Wσ₁)
+    ///       + α⊥(W⊥ + We) + W⊥α + W⊥W(σ₁ + W⊥ + We) + σ₃ + W⊥σ₂`.
+    pub fn sample_bounds(
+        &self,
+        x: &AttitudeInput,
+        rho: &Vector3<f64>,
+        accel: Option<(f64, f64)>,
+    ) -> (SampleBounds, [RateBounds; 6]) {
+        let p = &self.params;
+        let t = p.period;
+        let jerk = p.jerk_bound;
+        let beta = p.arm_reaction_budget.norm();
+        let d = p.boresight_b;
+        let (acc, acc_perp) = accel.unwrap_or_else(|| {
+            // ‖P τ + r‖ over the torque box: ‖P‖₂ ≤ √(‖P‖₁‖P‖∞)
+            let n1 = (0..3).map(|j| x.p.column(j).abs().sum()).fold(0.0, f64::max);
+            let ni = (0..3).map(|i| x.p.row(i).abs().sum()).fold(0.0, f64::max);
+            let a = (n1 * ni).sqrt() * 3f64.sqrt() * p.torque_max + x.r.norm();
+            (a, a)
+        });
+        let grow = beta + 3f64.sqrt() * jerk * t;
+        let alpha = acc + grow;
+        let alpha_p = acc_perp + grow;
+        let w = x.omega_b.norm() + alpha * t;
+        let w_p = x.omega_b.cross(&d).norm() + alpha_p * t;
+        // relative motion of the line of sight
+        let wt = x.omega_target_b.norm();
+        let pg = x.grasp_r.norm();
+        let f_acc = 3f64.sqrt() * p.force_max / p.mass;
+        let a_rel = f_acc + x.a_drift_r.norm() + 2.0 * wt * wt * pg;
+        let v_rel = (x.grasp_vel_r - x.v_r).norm() + a_rel * t;
+        let j_rel = f_acc * w + 3.0 * wt * wt * wt * pg;
+        let l = (rho.norm() - v_rel * t).max(1e-3);
+        let s1 = v_rel / l;
+        let s2 = a_rel / l + 2.0 * v_rel * v_rel / (l * l);
+        let s3 = j_rel / l + 6.0 * v_rel * a_rel / (l * l) + 6.0 * v_rel.powi(3) / l.powi(3);
+        let r_br = quat::to_matrix(&x.q_rb).transpose();
+        let s_b = r_br * (rho / rho.norm());
+        let e0 = d.cross(&s_b).norm();
+        let e_dot = s1 + w_p + w * e0;
+        let e = (e0 + e_dot * t).min(1.0);
+        let e_dot = s1 + w_p + w * e;
+        let m3 = e_dot * beta
+            + 3f64.sqrt() * jerk * e
+            + alpha_p * (s1 + w_p + w * e)
+            + 2.0 * alpha_p * s1
+            + 2.0 * w_p * (s2 + w * s1)
+            + alpha_p * (w_p + w * e)
+            + w_p * alpha
+            + w_p * w * (s1 + w_p + w * e)
+            + s3
+            + w_p * s2;
+        let los = SampleBounds {
+            period: t,
+            m2: e0 * beta,
+            m3,
+        };
+        let rate = std::array::from_fn(|k| RateBounds {
+            period: t,
+            d: p.arm_reaction_budget[k % 3],
+            j: jerk,
+        });
+        (los, rate)
     }
 
     fn prepare(&self, x: &AttitudeInput) -> Result<Prepared, Invalid> {
@@ -273,12 +424,15 @@ impl AttitudeFilter {
             && in_range3(&x.v_r, MAX_SPEED_M_S)
             && in_range3(&x.grasp_vel_r, MAX_SPEED_M_S)
             && in_range3(&x.a_drift_r, MAX_ACCEL_M_S2)
-            && in_range3(&x.grasp_acc_r, MAX_ACCEL_M_S2);
+            && in_range3(&x.grasp_acc_r, MAX_ACCEL_M_S2)
+            && in_range3(&x.r, MAX_ACCEL_M_S2)
+            && common::finite(&x.joint_coupling)
+            && common::finite(&x.joint_coupling_force);
         if !ok {
             return Err(Invalid::State);
         }
         let q = unit_quat(&x.q_rb).ok_or(Invalid::State)?;
-        let (inertia, inertia_inv) = checked_inertia(&x.inertia).ok_or(Invalid::State)?;
+        let (gain, inertia) = checked_gain(&x.p).ok_or(Invalid::State)?;
         let rho = x.grasp_r - x.r_r;
         if rho.norm() < MIN_LOS_M {
             return Err(Invalid::State);
@@ -293,55 +447,110 @@ impl AttitudeFilter {
         let los = line_of_sight(
             &r_br,
             &x.omega_b,
-            &inertia,
-            &inertia_inv,
+            &gain,
+            &x.r,
             &p.boresight_b,
             &los_dir,
             p.cos_beta,
         );
-        let omega = omega_limits(
-            &x.omega_b,
-            &inertia,
-            &inertia_inv,
-            &p.omega_max,
-            &p.omega_min,
-        );
-        let mut rows = [los.row(p.gamma, p.eps_att, p.u_max_att); N];
-        for (k, o) in omega.iter().enumerate() {
-            rows[1 + k] = o.row(p.gamma_omega, p.eps_omega);
-        }
+        let omega = omega_limits(&x.omega_b, &gain, &x.r, &p.omega_max, &p.omega_min);
+        let terms = AttitudeTerms { los, omega };
+        let rows: [Row<3>; N] = match p.formulation {
+            Formulation::SampledData => self.sampled_rows(x, &rho, &terms, None),
+            Formulation::Paper => {
+                let mut rows = [los.row(p.gamma, p.eps_att, p.u_max_att); N];
+                for (k, o) in omega.iter().enumerate() {
+                    rows[1 + k] = o.row(p.gamma_omega, p.eps_omega);
+                }
+                rows
+            }
+        };
         if !rows.iter().all(Row::is_finite) {
             return Err(Invalid::State);
         }
+        let mut weights = [p.accel_bound; N];
+        weights[0] = p.u_max_att;
         Ok(Prepared {
             inertia,
-            terms: AttitudeTerms { los, omega },
+            terms,
             rows,
+            weights,
+            rho,
         })
     }
 
-    /// Bounded fallback `τ_B = sat(−I (ω_B − ω_T,B)/T)` (direction kept), zero when the
-    /// state is invalid.
-    pub fn fallback(&self, x: &AttitudeInput) -> Vector3<f64> {
-        match checked_inertia(&x.inertia) {
-            Some((i, _))
+    /// The sampled-data rows ([`NAMES`] order) for commands with body acceleration at most
+    /// `accel` (`None`: any torque in the box).
+    fn sampled_rows(
+        &self,
+        x: &AttitudeInput,
+        rho: &Vector3<f64>,
+        t: &AttitudeTerms,
+        accel: Option<(f64, f64)>,
+    ) -> [Row<3>; N] {
+        let p = &self.params;
+        let (b_los, b_rate) = self.sample_bounds(x, rho, accel);
+        let mut rows = [RelDeg2::from(t.los).row(&b_los, p.u_max_att, p.gamma); N];
+        for (k, o) in t.omega.iter().enumerate() {
+            rows[1 + k] = RelDeg1::from(*o).row(&b_rate[k], p.gamma_omega, p.eps_omega);
+        }
+        rows
+    }
+
+    /// The braking law `τ_B = sat(−P⁻¹ (ω_B − ω_T,B)/T)` (direction kept): hold the
+    /// target's rate. The substitute nominal and the backup when the solver fails; zero
+    /// when the state is invalid.
+    pub fn brake(&self, x: &AttitudeInput) -> Vector3<f64> {
+        match checked_gain(&x.p) {
+            Some((_, i))
                 if in_range3(&x.omega_b, MAX_RATE_RAD_S)
                     && in_range3(&x.omega_target_b, MAX_RATE_RAD_S) =>
             {
-                self.fallback_with(&i, x)
+                self.brake_with(&i, x)
             }
             _ => Vector3::zeros(),
         }
     }
 
-    fn fallback_with(&self, inertia: &Matrix3<f64>, x: &AttitudeInput) -> Vector3<f64> {
+    /// The torque box and the contract rows `κ_j ∓ (K_f f_B + K_τ τ_B)_j ≥ 0`.
+    fn hard_rows(&self, x: &AttitudeInput) -> [Row<3>; HARD] {
+        std::array::from_fn(|k| {
+            if k < 6 {
+                self.bounds[k]
+            } else {
+                let j = (k - 6) / 2;
+                let sign = if k % 2 == 0 { -1.0 } else { 1.0 };
+                Row {
+                    a: x.joint_coupling.row(j).transpose() * sign,
+                    c: self.params.joint_coupling_budget[j] + sign * x.joint_coupling_force[j],
+                }
+            }
+        })
+    }
+
+    fn brake_with(&self, inertia: &Matrix3<f64>, x: &AttitudeInput) -> Vector3<f64> {
         let t = -(inertia * (x.omega_b - x.omega_target_b)) / self.params.brake_time;
         common::sat_inf(&t, self.params.torque_max * (1.0 - BOX_MARGIN))
     }
 
-    /// One filter step: safe `τ_B` closest to `tau_nom` subject to `Φ_ATT ≥ 0`,
-    /// `φ⁺_ω,i ≥ 0`, `φ⁻_ω,i ≥ 0` and `‖τ_B‖∞ ≤ T`.
+    /// The filter's command when its nominal is missing: the safety QP on the substitute
+    /// nominal (the braking law).
+    pub fn backup(&mut self, x: &AttitudeInput) -> FilterOutput<3, N> {
+        self.filter_with(x, None)
+    }
+
+    /// One filter step: safe `τ_B` closest to `tau_nom` subject to the line-of-sight and
+    /// rate rows and `‖τ_B‖∞ ≤ T`. An invalid nominal is replaced by the substitute.
     pub fn filter(&mut self, x: &AttitudeInput, tau_nom: &Vector3<f64>) -> FilterOutput<3, N> {
+        self.filter_with(x, Some(tau_nom))
+    }
+
+    /// [`Self::filter`] with the nominal possibly missing.
+    pub fn filter_with(
+        &mut self,
+        x: &AttitudeInput,
+        tau_nom: Option<&Vector3<f64>>,
+    ) -> FilterOutput<3, N> {
         let t0 = Instant::now();
         let mut report = FilterReport::<N>::default();
         let u = self.filter_inner(x, tau_nom, &mut report);
@@ -356,7 +565,7 @@ impl AttitudeFilter {
     fn filter_inner(
         &mut self,
         x: &AttitudeInput,
-        tau_nom: &Vector3<f64>,
+        tau_nom: Option<&Vector3<f64>>,
         report: &mut FilterReport<N>,
     ) -> Vector3<f64> {
         let tmax = self.params.torque_max;
@@ -364,85 +573,116 @@ impl AttitudeFilter {
             Ok(p) => p,
             Err(Invalid::State) => {
                 report.faults |= faults::INVALID_STATE;
-                return Vector3::zeros();
+                return clamp_box(&self.brake(x), tmax).0;
             }
             Err(Invalid::Coupling) => {
                 report.faults |= faults::INVALID_COUPLING;
-                let u = self.fallback(x);
-                return clamp_box(&u, tmax).0;
+                return clamp_box(&self.brake(x), tmax).0;
             }
         };
         report.h[0] = p.terms.los.h;
         for (k, o) in p.terms.omega.iter().enumerate() {
             report.h[1 + k] = o.h;
         }
-        let mut tau;
-        if !common::nominal_valid(tau_nom, tmax) {
-            report.faults |= faults::INVALID_NOMINAL;
-            report.status = FilterStatus::Fallback;
-            tau = self.fallback_with(&p.inertia, x);
-        } else {
-            let mut rows_a = [0.0; 3 * N];
-            let mut rows_c = [0.0; N];
-            for (i, r) in p.rows.iter().enumerate() {
-                rows_a[3 * i..3 * i + 3].copy_from_slice(r.a.as_slice());
-                rows_c[i] = r.c;
+        let (u_nom, flag) =
+            common::resolve_nominal(tau_nom, tmax, || self.brake_with(&p.inertia, x));
+        report.faults |= flag;
+        // The certificate: rows whose in-sample bounds hold for commands that accelerate
+        // the body by at most `cap` per axis, solved together with the rows that keep the
+        // command's acceleration within `cap` — any solution is certified. The caps tried:
+        // the nominal's own acceleration (the nearest command), then smaller ones (easier
+        // for the barrier rows); last, the rows valid for any torque in the box.
+        let sampled = p_formulation_sampled(&self.params);
+        let accel_inf = |u: &Vector3<f64>| (x.p * u + x.r).amax();
+        let hard = self.hard_rows(x);
+        let mut res = None;
+        let mut rows = p.rows;
+        if sampled {
+            let first = accel_inf(&u_nom);
+            let floor = x.r.amax();
+            let mut best: Option<(f64, crate::engine::Outcome<3>, [Row<3>; N])> = None;
+            for (k, cap) in std::iter::once(first).chain(ACCEL_CAPS).enumerate() {
+                if cap < floor || (k > 0 && cap >= first) {
+                    continue;
+                }
+                let c = 3f64.sqrt() * cap;
+                let r_cap = self.sampled_rows(x, &p.rho, &p.terms, Some((c, c)));
+                let mut with_cap = [Row::<3> {
+                    a: Vector3::zeros(),
+                    c: 0.0,
+                }; HARD + 6];
+                with_cap[..HARD].copy_from_slice(&hard);
+                for i in 0..3 {
+                    let row: Vector3<f64> = x.p.row(i).transpose();
+                    with_cap[HARD + 2 * i] = Row {
+                        a: -row,
+                        c: cap - x.r[i],
+                    };
+                    with_cap[HARD + 2 * i + 1] = Row {
+                        a: row,
+                        c: cap + x.r[i],
+                    };
+                }
+                let out = self.engine.solve(&u_nom, &r_cap, &p.weights, &with_cap);
+                if matches!(out.kind, Kind::Skipped | Kind::Solved) {
+                    if k == 0 {
+                        best = Some((0.0, out, r_cap));
+                        break;
+                    }
+                    let dist = (out.u - u_nom).norm();
+                    if best.as_ref().is_none_or(|b| dist < b.0) {
+                        best = Some((dist, out, r_cap));
+                    }
+                }
             }
-            let (g, g_max) = box_rows::<3, 18, 6>(tmax);
-            let mut u = [0.0; 3];
-            let res = self
-                .qp
-                .solve(tau_nom.as_slice(), &rows_a, &rows_c, &g, &g_max, &mut u);
-            report.iterations = res.iterations;
-            report.slack = res.slack;
-            tau = Vector3::from(u);
-            match res.outcome {
-                QpOutcome::Skipped => report.status = FilterStatus::Skipped,
-                QpOutcome::Solved => report.status = FilterStatus::Solved,
-                QpOutcome::Relaxed => {
-                    report.status = FilterStatus::Relaxed;
-                    report.faults |= faults::QP_INFEASIBLE_RELAXED;
-                }
-                QpOutcome::Failed => {
-                    report.status = FilterStatus::Fallback;
-                    report.faults |= faults::QP_FAILED_FALLBACK;
-                    tau = self.fallback_with(&p.inertia, x);
-                }
+            if let Some((_, out, r_cap)) = best {
+                res = Some(out);
+                rows = r_cap;
+            }
+        }
+        let res = match res {
+            Some(r) => r,
+            None => self.engine.solve(&u_nom, &p.rows, &p.weights, &hard),
+        };
+        self.last.record(&u_nom, &rows, &p.weights, &hard, &res);
+        report.iterations = res.iterations;
+        report.violation = res.violation;
+        let mut tau = res.u;
+        match res.kind {
+            Kind::Skipped => report.status = FilterStatus::Skipped,
+            Kind::Solved => report.status = FilterStatus::Solved,
+            Kind::Relaxed => {
+                report.status = FilterStatus::Relaxed;
+                report.faults |= faults::QP_INFEASIBLE_RELAXED;
+            }
+            Kind::Failed => {
+                report.status = FilterStatus::Fallback;
+                report.faults |= faults::QP_FAILED_FALLBACK;
+                tau = self.brake_with(&p.inertia, x);
             }
         }
         let (tau, clamped) = clamp_box(&tau, tmax);
         if clamped {
             report.faults |= faults::OUTPUT_CLAMPED;
         }
-        common::evaluate_rows(&p.rows, &tau, report);
+        common::evaluate_rows(&rows, &tau, report);
         tau
     }
 
     /// Verification only: force the solver even when the nominal is feasible.
     pub fn set_skip_enabled(&mut self, on: bool) {
-        self.qp.set_skip_enabled(on);
+        self.engine.set_skip_enabled(on);
     }
 
-    /// Multipliers λ_i ≥ 0 of the barrier rows of the last solve, in [`NAMES`] order.
-    pub fn row_duals(&self) -> &[f64] {
-        self.qp.row_duals()
+    /// The last QP handed to the engine (for `--dump-qp`).
+    pub fn dump_qp(&self) -> crate::QpDump {
+        self.last.dump()
     }
 
-    /// The last QP handed to the solver (for `--dump-qp`).
-    pub fn dump_qp(&self) -> QpDump {
-        self.qp.dump()
+    /// The barrier rows ([`NAMES`] order), their weights and the hard rows (torque box,
+    /// joint-coupling contract) at `x`.
+    pub fn rows(&self, x: &AttitudeInput) -> Option<(Vec<Row<3>>, Vec<f64>, Vec<Row<3>>)> {
+        let p = self.prepare(x).ok()?;
+        Some((p.rows.to_vec(), p.weights.to_vec(), self.hard_rows(x).to_vec()))
     }
-}
-
-/// Box rows `[I; −I] u ≤ limit (1 − BOX_MARGIN)` for `M` inputs (`G` is `2M × M`
-/// row-major, `GM = 2M·M`, `G2 = 2M`).
-pub(crate) fn box_rows<const M: usize, const GM: usize, const G2: usize>(
-    limit: f64,
-) -> ([f64; GM], [f64; G2]) {
-    let mut g = [0.0; GM];
-    for k in 0..M {
-        g[k * M + k] = 1.0;
-        g[(M + k) * M + k] = -1.0;
-    }
-    (g, [limit * (1.0 - BOX_MARGIN); G2])
 }

@@ -8,29 +8,35 @@ use serde::{Deserialize, Serialize};
 
 /// Fault flags (`FilterReport::faults`, a `u32` bitset). Stable: telemetry stores them.
 pub mod faults {
-    /// The state (or a parameter carried with it, e.g. the inertia) is non-finite or out of
-    /// its documented range; the fallback command is used (zero when the state itself
-    /// cannot be trusted).
+    /// The state (or a parameter carried with it, e.g. the inertia) is non-finite or
+    /// cannot be evaluated; the backup command is used (zero when the state itself cannot
+    /// be trusted).
     pub const INVALID_STATE: u32 = 1 << 0;
-    /// The nominal command is non-finite or beyond `NOMINAL_RANGE × bound`; fallback used.
+    /// The nominal command was non-finite or beyond `NOMINAL_RANGE × bound`: the QP ran on
+    /// the subsystem's substitute nominal.
     pub const INVALID_NOMINAL: u32 = 1 << 1;
-    /// The upstream coupling ξ is non-finite or out of range; fallback used (the
-    /// certificate cannot be computed without the coupling).
+    /// The upstream coupling ξ is non-finite or out of range; the backup command is used
+    /// (the certificate cannot be computed without the coupling).
     pub const INVALID_COUPLING: u32 = 1 << 2;
-    /// The CBF-QP was infeasible or failed; the relaxed QP (one slack on the barrier rows,
-    /// bounds hard) produced the command.
+    /// The barrier rows could not all hold inside the input bounds: the lexicographic
+    /// least-violation command (`FilterReport::violation` > 0). The state is outside the
+    /// certified set (docs/SAFETY.md).
     pub const QP_INFEASIBLE_RELAXED: u32 = 1 << 3;
-    /// The relaxed QP failed too (or no solver could be built); the bounded fallback was used.
+    /// The solver failed (invalid data, iteration limit): the backup braking law was used.
     pub const QP_FAILED_FALLBACK: u32 = 1 << 4;
-    /// Set by callers: the upstream safe command was missing (ξ assumed zero or stale).
+    /// Set by callers: the upstream safe command was missing (the upstream backup command
+    /// was used as ξ).
     pub const UPSTREAM_MISSING: u32 = 1 << 5;
     /// The last-line clamp to the input bounds changed the command by more than 1e-9.
     pub const OUTPUT_CLAMPED: u32 = 1 << 6;
+    /// No nominal command arrived (silent, dead or late controller): the QP ran on the
+    /// subsystem's substitute nominal.
+    pub const NOMINAL_MISSING: u32 = 1 << 7;
     /// All flags, for masks.
-    pub const ALL: u32 = (1 << 7) - 1;
+    pub const ALL: u32 = (1 << 8) - 1;
 
     /// Names of the flags in bit order.
-    pub const NAMES: [&str; 7] = [
+    pub const NAMES: [&str; 8] = [
         "invalid_state",
         "invalid_nominal",
         "invalid_coupling",
@@ -38,6 +44,7 @@ pub mod faults {
         "qp_failed_fallback",
         "upstream_missing",
         "output_clamped",
+        "nominal_missing",
     ];
 }
 
@@ -80,14 +87,15 @@ pub struct FilterReport<const N: usize> {
     /// Bit `i` set when constraint `i` is active (`Φ_i ≤ ACTIVE_TOL·max(1,‖∂Φ_i/∂u‖)`).
     pub active: u64,
     pub status: FilterStatus,
-    /// Interior-point iterations (hard + relaxed QP).
+    /// Solver iterations (active-set changes, all stages).
     pub iterations: u32,
     /// Wall time of the whole filter call [ns] — the only nondeterministic output.
     pub solve_time_ns: u64,
     /// [`faults`] bitset.
     pub faults: u32,
-    /// Slack of the relaxed QP (0 otherwise), in units of the normalised rows.
-    pub slack: f64,
+    /// Least violation `t*` of the relaxed problem (0 otherwise), as a fraction of each
+    /// barrier's braking authority (docs/SAFETY.md).
+    pub violation: f64,
 }
 
 impl<const N: usize> Default for FilterReport<N> {
@@ -100,7 +108,7 @@ impl<const N: usize> Default for FilterReport<N> {
             iterations: 0,
             solve_time_ns: 0,
             faults: 0,
-            slack: 0.0,
+            violation: 0.0,
         }
     }
 }
@@ -115,7 +123,7 @@ impl<const N: usize> FilterReport<N> {
             self.status as u64,
             self.iterations as u64,
             self.faults as u64,
-            self.slack.to_bits(),
+            self.violation.to_bits(),
         ]);
         v
     }
@@ -189,6 +197,34 @@ pub fn unit_quat(q: &Quat) -> Option<Quat> {
 /// A nominal command is valid when finite and `‖u‖∞ ≤ NOMINAL_RANGE × bound`.
 pub fn nominal_valid<const M: usize>(u: &SVector<f64, M>, bound: f64) -> bool {
     finite(u) && u.amax() <= NOMINAL_RANGE * bound
+}
+
+/// The nominal the QP runs on: the given one when valid, else `substitute`, with the flag
+/// saying why ([`faults::INVALID_NOMINAL`], [`faults::NOMINAL_MISSING`]).
+pub fn resolve_nominal<const M: usize>(
+    given: Option<&SVector<f64, M>>,
+    bound: f64,
+    substitute: impl FnOnce() -> SVector<f64, M>,
+) -> (SVector<f64, M>, u32) {
+    match given {
+        Some(u) if nominal_valid(u, bound) => (*u, 0),
+        Some(_) => (substitute(), faults::INVALID_NOMINAL),
+        None => (substitute(), faults::NOMINAL_MISSING),
+    }
+}
+
+/// Input-bound rows `limit (1 − BOX_MARGIN) ∓ u_k ≥ 0` of a box `‖u‖∞ ≤ limit`.
+pub fn box_rows<const M: usize>(limit: f64) -> Vec<Row<M>> {
+    let l = limit * (1.0 - BOX_MARGIN);
+    let mut v = Vec::with_capacity(2 * M);
+    for k in 0..M {
+        for sign in [-1.0, 1.0] {
+            let mut a = SVector::<f64, M>::zeros();
+            a[k] = sign;
+            v.push(Row { a, c: l });
+        }
+    }
+    v
 }
 
 /// Fills `h`, `phi` and the active mask from the rows at the returned command.

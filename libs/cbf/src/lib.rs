@@ -18,14 +18,20 @@
 pub mod attitude;
 pub mod barrier;
 pub mod common;
+pub mod engine;
+pub mod envelope;
+pub mod monitor;
 pub mod qp;
 pub mod robotic;
+pub mod sampled;
 pub mod translational;
 
 pub use attitude::{AttitudeFilter, AttitudeInput, AttitudeParams};
+pub use sc_scenario::Formulation;
 pub use barrier::{RelDegOne, RelDegTwo, Row};
 pub use common::{FilterOutput, FilterReport, FilterStatus, faults};
 pub use qp::{QpDump, QpOutcome, SolverParams};
+pub use sampled::{RateBounds, RelDeg1, RelDeg2, SampleBounds};
 pub use robotic::{RoboticFilter, RoboticInput, RoboticParams, robotic_input_from_model};
 pub use translational::{TranslationalFilter, TranslationalInput, TranslationalParams};
 
@@ -44,12 +50,13 @@ pub struct SafetyLayer {
 }
 
 impl SafetyLayer {
-    /// All three filters from the scenario; `mass` is the servicer's total mass [kg].
-    pub fn from_scenario(s: &sc_scenario::Scenario, mass: f64) -> Self {
+    /// All three filters from the scenario and the servicer model.
+    pub fn from_scenario(s: &sc_scenario::Scenario, robot: std::sync::Arc<sc_multibody::Robot>) -> Self {
+        let mass = robot.total_mass();
         Self {
             translational: TranslationalFilter::from_scenario(s, mass),
-            attitude: AttitudeFilter::from_scenario(s),
-            robotic: RoboticFilter::from_scenario(s),
+            attitude: AttitudeFilter::from_scenario(s, mass),
+            robotic: RoboticFilter::from_scenario(s, robot),
         }
     }
 }

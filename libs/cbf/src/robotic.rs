@@ -1,9 +1,8 @@
 //! Robotic safety filter (paper Sec. "CBFs for the Robotic Subsystem", QP eq.
 //! "robotic_qp").
 //!
-//! State `x_rob = [θ; θ̇]` (rad, rad/s); input the joint torques `τ_M` [N m]. The filter
-//! core is IPC- and model-free: it takes the *precomputed* reduced free-floating arm
-//! dynamics in control-affine form
+//! State `x_rob = [θ; θ̇]` (rad, rad/s); input the joint torques `τ_M` [N m]. The rows take
+//! the *precomputed* reduced free-floating arm dynamics in control-affine form
 //!
 //! ```text
 //! θ̈ = A τ_M + b + ξ_rob,    A = M_eff⁻¹,  b = −M_eff⁻¹ c_free,  ξ_rob = −M_eff⁻¹ K [f_B; τ_B]
@@ -13,15 +12,29 @@
 //! upstream safe force and torque (`K` the wrench map of the Schur-reduced dynamics), and per
 //! collision sphere its centre `p_i`, Jacobian `J_i` and `J̇_i θ̇` in the base frame F_B.
 //! [`robotic_input_from_model`] computes all of these from `sc_multibody`.
+//!
+//! **Sampled data at 10 Hz.** The arm's light distal links make its joint accelerations
+//! change by tens of rad/s² inside one 0.1 s sample (docs/SAFETY.md, "The arm at 10 Hz"),
+//! so the analytic bounds of [`crate::sampled`] — with the joint jerk bounded over the
+//! envelope (`joint_jerk_bound_rad_s3`) — certify a command cheaply only away from the
+//! limits. Where they cannot, the filter **verifies** its command: with the servicer model
+//! it integrates the sample exactly as the simulator does (RK4 at the physics step, the
+//! upstream force and torque held) and checks every barrier at every physics step and the
+//! braking barrier at the next sample; a row whose prediction fell short gets the shortfall
+//! as a margin and the QP is solved again.
+//!
+//! **Contract with the attitude filter.** The command keeps the reaction on the base
+//! angular acceleration of what the arm does beyond holding its joint rates within the
+//! budget the attitude filter assumes, `|(Q (τ_M − τ_hold))_i| ≤ β_i` (six hard rows).
 
-use crate::attitude::box_rows;
 use crate::barrier::{RelDegOne, RelDegTwo, Row};
-use crate::common::{
-    self, BOX_MARGIN, FilterOutput, FilterReport, FilterStatus, clamp_box, faults,
-};
-use crate::qp::{QpDump, QpEngine, QpOutcome, SolverParams};
+use crate::common::{self, BOX_MARGIN, FilterOutput, FilterReport, FilterStatus, clamp_box, faults};
+use crate::engine::{Engine, Kind, LastProblem, Outcome};
+use crate::sampled::{RateBounds, RelDeg1, RelDeg2, SampleBounds, braking_barrier};
+use crate::{Formulation, qp::SolverParams};
 use nalgebra::{SMatrix, SVector, Vector3, Vector6};
-use sc_multibody::Robot;
+use sc_multibody::{Robot, Vector13};
+use std::sync::Arc;
 
 /// Joint-space vector and matrix.
 pub type Vector7 = SVector<f64, 7>;
@@ -81,10 +94,9 @@ pub const NAMES: [&str; N] = [
     "link_base_7_3",
 ];
 
-/// Accepted ranges: `|θ_i| ≤ MAX_ANGLE_RAD`, `|θ̇_i| ≤ MAX_RATE_RAD_S`, drift and coupling
-/// accelerations `≤ MAX_ACCEL`, `A` entries `≤ MAX_GAIN`, sphere centres `≤ MAX_REACH_M`.
-pub const MAX_ANGLE_RAD: f64 = 100.0;
-pub const MAX_RATE_RAD_S: f64 = 100.0;
+/// Accepted ranges of the model terms (any finite joint angle and rate is accepted: the
+/// filter never switches itself off): drift and coupling accelerations `≤ MAX_ACCEL`, `A`
+/// entries `≤ MAX_GAIN`, sphere centres `≤ MAX_REACH_M`. Beyond them the braking law applies.
 pub const MAX_ACCEL: f64 = 1e6;
 pub const MAX_GAIN: f64 = 1e6;
 pub const MAX_REACH_M: f64 = 100.0;
@@ -109,7 +121,7 @@ pub struct RoboticInput {
     pub theta_dot: Vector7,
     /// `A = M_eff⁻¹` (the reduced free-floating joint-space inverse inertia) [1/(kg m²)].
     pub a: Matrix7,
-    /// `M_eff` [kg m²] (used by the fallback `τ_M = sat(−M θ̇/T)`).
+    /// `M_eff` [kg m²] (the braking law `τ_M = sat(−M θ̇/T)`).
     pub m_eff: Matrix7,
     /// `b = −M_eff⁻¹ c_free` [rad/s²]: velocity-product drift.
     pub drift: Vector7,
@@ -120,6 +132,13 @@ pub struct RoboticInput {
     /// Base collision zone `c_base` [m] (F_B) and `R_base` [m].
     pub base_center: Vector3<f64>,
     pub base_radius: f64,
+    /// `Q = ∂ω̇_B/∂τ_M` [1/(kg m²)]: the arm's reaction on the base (the contract rows).
+    pub reaction: Matrix3x7,
+    /// Base body rate [rad/s, F_B] and the upstream safe force [N] and torque [N m] (F_B)
+    /// held over the sample: what the verification integrates with.
+    pub omega_b: Vector3<f64>,
+    pub force_b: Vector3<f64>,
+    pub torque_b: Vector3<f64>,
 }
 
 /// Parameters of the robotic filter.
@@ -129,21 +148,31 @@ pub struct RoboticParams {
     pub theta_max: Vector7,
     /// Symmetric `|θ̇_i| ≤ θ̇_max,i` [rad/s].
     pub theta_dot_max: Vector7,
-    /// γ_h [1/s], ε_θ [rad²/s], u_max of H_θ [rad²/s²].
+    /// γ_h [1/s], ε_θ [rad²/s], μ of H_θ [rad²/s²].
     pub gamma: f64,
     pub eps_theta: f64,
     pub u_max_theta: f64,
     /// γ_θ̇ [1/s], ε_θ̇ [rad/s²].
     pub gamma_theta_dot: f64,
     pub eps_theta_dot: f64,
-    /// ε_LB [m²/s], u_max of H_LB [m²/s²].
+    /// ε_LB [m²/s], μ of H_LB [m²/s²].
     pub eps_lb: f64,
     pub u_max_lb: f64,
     /// `‖τ_M‖∞ ≤ T_M` [N m].
     pub torque_max: f64,
-    /// T of the fallback `τ_M = sat(−M θ̇ / T)` [s].
+    /// T of the braking law `τ_M = sat(−M θ̇ / T)` [s]: the substitute nominal.
     pub brake_time: f64,
     pub solver: SolverParams,
+    /// Sample length `T` [s] and the simulator's physics step [s] (the verification's).
+    pub period: f64,
+    pub physics_step: f64,
+    pub formulation: Formulation,
+    /// Bound on `|θ⃛_i|` over the certified envelope [rad/s³].
+    pub joint_jerk_bound: Vector7,
+    /// Bound on the jerk of the centres of each link's spheres [m/s³] (link 1..7).
+    pub sphere_jerk_bound: Vector7,
+    /// The contract with the attitude filter, `|(Q τ_M)_i| ≤ β_i` [rad/s²].
+    pub arm_reaction_budget: Vector3<f64>,
 }
 
 impl RoboticParams {
@@ -163,6 +192,12 @@ impl RoboticParams {
             torque_max: s.limits.joint_torque_max_nm,
             brake_time: s.safety.fallback.robotic_brake_time_s,
             solver: SolverParams::from_scenario(s),
+            period: s.mission.control_period_s,
+            physics_step: s.mission.physics_step_s,
+            formulation: s.safety.formulation,
+            joint_jerk_bound: Vector7::from(r.joint_jerk_bound_rad_s3),
+            sphere_jerk_bound: Vector7::from(r.link_sphere_jerk_bound_m_s3),
+            arm_reaction_budget: Vector3::from(s.safety.attitude.arm_reaction_budget_rad_s2),
         }
     }
 }
@@ -241,15 +276,50 @@ impl RoboticTerms {
     }
 }
 
+
 enum Invalid {
     State,
     Coupling,
 }
 
+/// Rounds of the a-posteriori certificate before the verification path.
+pub const CERTIFY_ROUNDS: usize = 2;
+/// Rows of the verification path: at most this many QP + verification rounds.
+pub const MAX_VERIFY_ROUNDS: usize = 4;
+/// A row whose verified shortfall is `s` gets the margin `VERIFY_GAIN · s` on the next round.
+pub const VERIFY_GAIN: f64 = 1.5;
+/// Upper bound on the distance of any sphere centre from any joint axis [m] (the arm's
+/// reach plus its sphere offsets): the lever of the joints' motion in the link-base bounds.
+pub const LEVER_BOUND_M: f64 = 2.0;
+
+/// Which bounds the rows carry.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Level {
+    /// Bounds valid for every command whose joint accelerations at the sample are at most
+    /// the given ones (the a-posteriori certificate).
+    Certified(Vector7),
+    /// No in-sample bounds (the sample's own prediction); the verification adds margins.
+    Local,
+}
+
+/// The outcome of verifying one command over one sample.
+#[derive(Debug, Clone, Copy)]
+struct Verdict {
+    /// Every barrier ≥ 0 at every physics step and every next-sample condition held.
+    ok: bool,
+    /// Per row, how much larger its `ḧ` (or `ḣ`) needed to be [row units].
+    shortfall: [f64; N],
+    /// The smallest barrier value over the sample, each divided by its weight.
+    worst: f64,
+}
+
 /// The robotic CBF-QP safety filter (paper eq. "robotic_qp").
 pub struct RoboticFilter {
     pub params: RoboticParams,
-    qp: QpEngine,
+    engine: Engine<NJ, { N + 6 + 2 * NJ }>,
+    /// The servicer model for the verification path (without it, the envelope rows only).
+    robot: Option<Arc<Robot>>,
+    last: LastProblem<NJ>,
 }
 
 fn finite_in<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>, max: f64) -> bool {
@@ -258,20 +328,40 @@ fn finite_in<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>, max: f64) -
 
 impl RoboticFilter {
     pub fn new(params: RoboticParams) -> Self {
-        let qp = QpEngine::new(NJ, N, 2 * NJ, params.torque_max, &params.solver);
-        Self { params, qp }
+        Self {
+            params,
+            engine: Engine::new(),
+            robot: None,
+            last: LastProblem::with_capacity(N, 2 * NJ + 6),
+        }
     }
 
-    pub fn from_scenario(s: &sc_scenario::Scenario) -> Self {
-        Self::new(RoboticParams::from_scenario(s))
+    /// The filter with the servicer model, so that it can verify its commands.
+    pub fn with_model(params: RoboticParams, robot: Arc<Robot>) -> Self {
+        Self {
+            params,
+            engine: Engine::new(),
+            robot: Some(robot),
+            last: LastProblem::with_capacity(N, 2 * NJ + 6),
+        }
     }
 
+    pub fn from_scenario(s: &sc_scenario::Scenario, robot: Arc<Robot>) -> Self {
+        Self::with_model(RoboticParams::from_scenario(s), robot)
+    }
+
+    /// A state the filter can work with: everything finite and the dynamics
+    /// non-degenerate. Large angles and rates are not refused (the filter keeps filtering).
     fn state_valid(x: &RoboticInput) -> bool {
-        finite_in(&x.theta, MAX_ANGLE_RAD)
-            && finite_in(&x.theta_dot, MAX_RATE_RAD_S)
+        common::finite(&x.theta)
+            && common::finite(&x.theta_dot)
             && finite_in(&x.a, MAX_GAIN)
             && finite_in(&x.m_eff, MAX_GAIN)
             && finite_in(&x.drift, MAX_ACCEL)
+            && common::finite(&x.reaction)
+            && common::finite(&x.omega_b)
+            && common::finite(&x.force_b)
+            && common::finite(&x.torque_b)
             && (0..NJ).all(|i| x.a[(i, i)] > 0.0 && x.m_eff[(i, i)] > 0.0)
             && finite_in(&x.base_center, MAX_REACH_M)
             && x.base_radius.is_finite()
@@ -286,10 +376,10 @@ impl RoboticFilter {
 
     /// Barrier terms for a valid input (`None` otherwise).
     pub fn constraints(&self, x: &RoboticInput) -> Option<RoboticTerms> {
-        self.prepare(x).ok().map(|(t, _)| t)
+        self.terms(x).ok()
     }
 
-    fn prepare(&self, x: &RoboticInput) -> Result<(RoboticTerms, [Row<NJ>; N]), Invalid> {
+    fn terms(&self, x: &RoboticInput) -> Result<RoboticTerms, Invalid> {
         if !Self::state_valid(x) {
             return Err(Invalid::State);
         }
@@ -297,43 +387,167 @@ impl RoboticFilter {
             return Err(Invalid::Coupling);
         }
         let p = &self.params;
-        let terms = RoboticTerms {
+        Ok(RoboticTerms {
             theta: std::array::from_fn(|i| joint_angle(i, x, p.theta_min[i], p.theta_max[i])),
             theta_dot_max: std::array::from_fn(|i| joint_velocity(i, x, p.theta_dot_max[i])[0]),
             theta_dot_min: std::array::from_fn(|i| joint_velocity(i, x, p.theta_dot_max[i])[1]),
             link_base: std::array::from_fn(|k| link_base(&x.spheres[k], x)),
-        };
-        let rows: [Row<NJ>; N] = std::array::from_fn(|j| {
-            if j < NJ {
-                terms.theta[j].row(p.gamma, p.eps_theta, p.u_max_theta)
-            } else if j < 2 * NJ {
-                terms.theta_dot_max[j - NJ].row(p.gamma_theta_dot, p.eps_theta_dot)
-            } else if j < 3 * NJ {
-                terms.theta_dot_min[j - 2 * NJ].row(p.gamma_theta_dot, p.eps_theta_dot)
-            } else {
-                terms.link_base[j - 3 * NJ].row(p.gamma, p.eps_lb, p.u_max_lb)
-            }
-        });
-        if rows.iter().all(Row::is_finite) {
-            Ok((terms, rows))
-        } else {
-            Err(Invalid::State)
-        }
+        })
     }
 
-    /// Bounded fallback `τ_M = sat(−M_eff θ̇ / T)` (direction kept); zero when the state is
-    /// invalid.
-    pub fn fallback(&self, x: &RoboticInput) -> Vector7 {
-        if !(finite_in(&x.theta_dot, MAX_RATE_RAD_S) && finite_in(&x.m_eff, MAX_GAIN)) {
+    /// Weights of the rows in the relaxed problem: `μ_θ` [rad²/s²], 1 rad/s² for the rates,
+    /// `μ_LB` [m²/s²].
+    fn weights(&self) -> [f64; N] {
+        let p = &self.params;
+        std::array::from_fn(|j| {
+            if j < NJ {
+                p.u_max_theta
+            } else if j < 3 * NJ {
+                1.0
+            } else {
+                p.u_max_lb
+            }
+        })
+    }
+
+    /// The in-sample bounds of every row for a command whose joint accelerations at the
+    /// sample are `qdd` (docs/SAFETY.md, "The arm at 10 Hz"): with the configured jerk
+    /// bounds `J_i` (joints) and `J_k` (sphere centres), the accelerations inside the sample
+    /// stay within `ā_i = |θ̈_i| + J_i T`, the rates within `v̄_i = |θ̇_i| + ā_i T`; then
+    /// * joint angle (`ḧ = kθ̈ − 2θ̇²`): `M₃ = |k|_max J_i + 6 v̄_i ā_i`;
+    /// * joint rate: `J = J_i`;
+    /// * link sphere (`ḧ = 2‖ṗ‖² + 2dᵀp̈`): `M₃ = 6 V A + 2 D J_k` with the centre's
+    ///   acceleration `A = ‖p̈‖ + J_k T`, speed `V = ‖ṗ‖ + A T`, distance `D = ‖d‖ + V T`.
+    fn certified_bounds(&self, x: &RoboticInput, qdd: &Vector7) -> ([SampleBounds; NJ], [RateBounds; NJ], [SampleBounds; NS]) {
+        let p = &self.params;
+        let t = p.period;
+        let acc = Vector7::from_fn(|i, _| qdd[i].abs() + p.joint_jerk_bound[i] * t);
+        let vel = Vector7::from_fn(|i, _| x.theta_dot[i].abs() + acc[i] * t);
+        let theta = std::array::from_fn(|i| {
+            let k = (p.theta_max[i] + p.theta_min[i] - 2.0 * x.theta[i]).abs() + 2.0 * vel[i] * t;
+            SampleBounds {
+                period: t,
+                m2: 0.0,
+                m3: k * p.joint_jerk_bound[i] + 6.0 * vel[i] * acc[i],
+            }
+        });
+        let rate = std::array::from_fn(|i| RateBounds {
+            period: t,
+            d: 0.0,
+            j: p.joint_jerk_bound[i],
+        });
+        let lb = std::array::from_fn(|k| {
+            let s = &x.spheres[k];
+            let jk = p.sphere_jerk_bound[k / 3];
+            let a = (s.jacobian * qdd + s.jdot_qdot).norm() + jk * t;
+            let v = (s.jacobian * x.theta_dot).norm() + a * t;
+            let d = (s.center - x.base_center).norm() + v * t;
+            SampleBounds {
+                period: t,
+                m2: 0.0,
+                m3: 6.0 * v * a + 2.0 * d * jk,
+            }
+        });
+        (theta, rate, lb)
+    }
+
+    /// The 42 barrier rows at `level`, each tightened by `margin[j]` [row units].
+    fn barrier_rows(&self, x: &RoboticInput, t: &RoboticTerms, level: Level, margin: &[f64; N]) -> [Row<NJ>; N] {
+        let p = &self.params;
+        let mut rows: [Row<NJ>; N] = match p.formulation {
+            Formulation::Paper => std::array::from_fn(|j| {
+                if j < NJ {
+                    t.theta[j].row(p.gamma, p.eps_theta, p.u_max_theta)
+                } else if j < 2 * NJ {
+                    t.theta_dot_max[j - NJ].row(p.gamma_theta_dot, p.eps_theta_dot)
+                } else if j < 3 * NJ {
+                    t.theta_dot_min[j - 2 * NJ].row(p.gamma_theta_dot, p.eps_theta_dot)
+                } else {
+                    t.link_base[j - 3 * NJ].row(p.gamma, p.eps_lb, p.u_max_lb)
+                }
+            }),
+            Formulation::SampledData => {
+                let (bt, br, blb) = match level {
+                    Level::Certified(qdd) => self.certified_bounds(x, &qdd),
+                    Level::Local => {
+                        let z = SampleBounds {
+                            period: p.period,
+                            m2: 0.0,
+                            m3: 0.0,
+                        };
+                        let zr = RateBounds {
+                            period: p.period,
+                            d: 0.0,
+                            j: 0.0,
+                        };
+                        ([z; NJ], [zr; NJ], [z; NS])
+                    }
+                };
+                std::array::from_fn(|j| {
+                    if j < NJ {
+                        RelDeg2::from(t.theta[j]).row(&bt[j], p.u_max_theta, p.gamma)
+                    } else if j < 2 * NJ {
+                        RelDeg1::from(t.theta_dot_max[j - NJ]).row(&br[j - NJ], p.gamma_theta_dot, p.eps_theta_dot)
+                    } else if j < 3 * NJ {
+                        RelDeg1::from(t.theta_dot_min[j - 2 * NJ]).row(&br[j - 2 * NJ], p.gamma_theta_dot, p.eps_theta_dot)
+                    } else {
+                        RelDeg2::from(t.link_base[j - 3 * NJ]).row(&blb[j - 3 * NJ], p.u_max_lb, p.gamma)
+                    }
+                })
+            }
+        };
+        for (r, m) in rows.iter_mut().zip(margin) {
+            r.c -= m;
+        }
+        rows
+    }
+
+    /// Input bounds and the contract rows `β_i ∓ (Q (τ_M − τ_hold))_i ≥ 0`, with
+    /// `τ_hold = c_eff = −M_eff (b + ξ)` the torque that holds the joint rates.
+    fn hard_rows(&self, x: &RoboticInput) -> [Row<NJ>; 2 * NJ + 6] {
+        let p = &self.params;
+        let lim = p.torque_max * (1.0 - BOX_MARGIN);
+        let hold = -(x.m_eff * (x.drift + x.xi));
+        let q_hold = x.reaction * hold;
+        std::array::from_fn(|k| {
+            if k < 2 * NJ {
+                let mut a = Vector7::zeros();
+                a[k / 2] = if k % 2 == 0 { -1.0 } else { 1.0 };
+                Row { a, c: lim }
+            } else {
+                let i = (k - 2 * NJ) / 2;
+                let sign = if k % 2 == 0 { -1.0 } else { 1.0 };
+                Row {
+                    a: x.reaction.row(i).transpose() * sign,
+                    c: p.arm_reaction_budget[i] - sign * q_hold[i],
+                }
+            }
+        })
+    }
+
+    /// The braking law `τ_M = sat(−M_eff θ̇ / T)` (direction kept) — the substitute nominal,
+    /// and the backup when the solver fails; zero when the state is invalid.
+    pub fn brake(&self, x: &RoboticInput) -> Vector7 {
+        if !(common::finite(&x.theta_dot) && finite_in(&x.m_eff, MAX_GAIN)) {
             return Vector7::zeros();
         }
         let t = -(x.m_eff * x.theta_dot) / self.params.brake_time;
         common::sat_inf(&t, self.params.torque_max * (1.0 - BOX_MARGIN))
     }
 
-    /// One filter step: safe `τ_M` closest to `tau_nom` subject to the 42 CBF rows and
-    /// `‖τ_M‖∞ ≤ T_M`.
+    /// The filter's command when its nominal is missing: the safety QP on the substitute.
+    pub fn backup(&mut self, x: &RoboticInput) -> FilterOutput<NJ, N> {
+        self.filter_with(x, None)
+    }
+
+    /// One filter step: safe `τ_M` closest to `tau_nom` subject to the 42 barrier rows, the
+    /// contract rows and `‖τ_M‖∞ ≤ T_M`.
     pub fn filter(&mut self, x: &RoboticInput, tau_nom: &Vector7) -> FilterOutput<NJ, N> {
+        self.filter_with(x, Some(tau_nom))
+    }
+
+    /// [`Self::filter`] with the nominal possibly missing.
+    pub fn filter_with(&mut self, x: &RoboticInput, tau_nom: Option<&Vector7>) -> FilterOutput<NJ, N> {
         let t0 = std::time::Instant::now();
         let mut report = FilterReport::<N>::default();
         let u = self.filter_inner(x, tau_nom, &mut report);
@@ -345,88 +559,310 @@ impl RoboticFilter {
         }
     }
 
-    fn filter_inner(
-        &mut self,
-        x: &RoboticInput,
-        tau_nom: &Vector7,
-        report: &mut FilterReport<N>,
-    ) -> Vector7 {
+    fn filter_inner(&mut self, x: &RoboticInput, tau_nom: Option<&Vector7>, report: &mut FilterReport<N>) -> Vector7 {
         let tmax = self.params.torque_max;
-        let (terms, rows) = match self.prepare(x) {
-            Ok(p) => p,
+        let terms = match self.terms(x) {
+            Ok(t) => t,
             Err(Invalid::State) => {
                 report.faults |= faults::INVALID_STATE;
-                return Vector7::zeros();
+                return clamp_box(&self.brake(x), tmax).0;
             }
             Err(Invalid::Coupling) => {
                 report.faults |= faults::INVALID_COUPLING;
-                return clamp_box(&self.fallback(x), tmax).0;
+                return clamp_box(&self.brake(x), tmax).0;
             }
         };
         report.h = terms.h();
-        let mut tau;
-        if !common::nominal_valid(tau_nom, tmax) {
-            report.faults |= faults::INVALID_NOMINAL;
-            tau = self.fallback(x);
-        } else {
-            let mut rows_a = [0.0; NJ * N];
-            let mut rows_c = [0.0; N];
-            for (i, r) in rows.iter().enumerate() {
-                rows_a[NJ * i..NJ * (i + 1)].copy_from_slice(r.a.as_slice());
-                rows_c[i] = r.c;
-            }
-            let (g, g_max) = box_rows::<NJ, { 2 * NJ * NJ }, { 2 * NJ }>(tmax);
-            let mut u = [0.0; NJ];
-            let res = self
-                .qp
-                .solve(tau_nom.as_slice(), &rows_a, &rows_c, &g, &g_max, &mut u);
-            report.iterations = res.iterations;
-            report.slack = res.slack;
-            tau = Vector7::from(u);
-            match res.outcome {
-                QpOutcome::Skipped => report.status = FilterStatus::Skipped,
-                QpOutcome::Solved => report.status = FilterStatus::Solved,
-                QpOutcome::Relaxed => {
-                    report.status = FilterStatus::Relaxed;
-                    report.faults |= faults::QP_INFEASIBLE_RELAXED;
+        let (u_nom, flag) = common::resolve_nominal(tau_nom, tmax, || self.brake(x));
+        report.faults |= flag;
+        let weights = self.weights();
+        let hard = self.hard_rows(x);
+        let zero = [0.0; N];
+        // 1. the a-posteriori certificate: solve with the sample's own prediction, then
+        // check the command against rows whose in-sample bounds are valid for its own
+        // accelerations; if it falls short, solve with those rows and check again.
+        let accel = |u: &Vector7| x.a * u + x.drift + x.xi;
+        let local = self.barrier_rows(x, &terms, Level::Local, &zero);
+        let mut res = self.engine.solve(&u_nom, &local, &weights, &hard);
+        report.iterations = res.iterations;
+        let mut final_rows = local;
+        let mut certified = false;
+        if matches!(res.kind, Kind::Skipped | Kind::Solved) {
+            for _ in 0..CERTIFY_ROUNDS {
+                let rows = self.barrier_rows(x, &terms, Level::Certified(accel(&res.u)), &zero);
+                if rows.iter().all(|r| r.phi(&res.u) >= 0.0) {
+                    certified = true;
+                    final_rows = rows;
+                    break;
                 }
-                QpOutcome::Failed => {
-                    report.status = FilterStatus::Fallback;
-                    report.faults |= faults::QP_FAILED_FALLBACK;
-                    tau = self.fallback(x);
+                // the next candidate may accelerate more; bound it by the larger of both
+                let grown = accel(&res.u).abs() * 2.0;
+                let rows = self.barrier_rows(x, &terms, Level::Certified(grown), &zero);
+                let next = self.engine.solve(&u_nom, &rows, &weights, &hard);
+                report.iterations += next.iterations;
+                if !matches!(next.kind, Kind::Skipped | Kind::Solved) {
+                    break;
+                }
+                res = next;
+                let a = accel(&res.u).abs();
+                if (0..NJ).all(|i| a[i] <= grown[i]) {
+                    // the rows' bounds cover the new command's accelerations
+                    certified = true;
+                    final_rows = rows;
+                    break;
                 }
             }
         }
+        let mut tau = res.u;
+        if certified {
+            report.status = if res.kind == Kind::Skipped {
+                FilterStatus::Skipped
+            } else {
+                FilterStatus::Solved
+            };
+        } else {
+            // 2. verification path (paper rows are never verified: comparison only)
+            let verified = if self.params.formulation == Formulation::SampledData {
+                self.verified(x, &terms, &u_nom, &weights, &hard, report)
+            } else {
+                None
+            };
+            match verified {
+                Some((u, rows, relaxed_violation)) => {
+                    tau = u;
+                    final_rows = rows;
+                    if relaxed_violation > 0.0 {
+                        report.status = FilterStatus::Relaxed;
+                        report.faults |= faults::QP_INFEASIBLE_RELAXED;
+                        report.violation = relaxed_violation;
+                    } else {
+                        report.status = FilterStatus::Solved;
+                    }
+                }
+                None => match res.kind {
+                    Kind::Skipped => report.status = FilterStatus::Skipped,
+                    Kind::Solved => report.status = FilterStatus::Solved,
+                    Kind::Relaxed => {
+                        report.status = FilterStatus::Relaxed;
+                        report.faults |= faults::QP_INFEASIBLE_RELAXED;
+                        report.violation = res.violation;
+                    }
+                    Kind::Failed => {
+                        report.status = FilterStatus::Fallback;
+                        report.faults |= faults::QP_FAILED_FALLBACK;
+                        tau = self.brake(x);
+                    }
+                },
+            }
+        }
+        let kind = match report.status {
+            FilterStatus::Skipped => Kind::Skipped,
+            FilterStatus::Solved => Kind::Solved,
+            FilterStatus::Relaxed => Kind::Relaxed,
+            FilterStatus::Fallback => Kind::Failed,
+        };
+        let outcome = Outcome {
+            kind,
+            u: tau,
+            violation: report.violation,
+            iterations: report.iterations,
+            row_duals: [0.0; 64],
+        };
+        self.last.record(&u_nom, &final_rows, &weights, &hard, &outcome);
         let (tau, clamped) = clamp_box(&tau, tmax);
         if clamped {
             report.faults |= faults::OUTPUT_CLAMPED;
         }
-        common::evaluate_rows(&rows, &tau, report);
+        common::evaluate_rows(&final_rows, &tau, report);
         tau
+    }
+
+    /// The verification path: solve with the sample's own prediction, simulate the sample,
+    /// tighten the rows that fell short, repeat. Returns the first verified command (with its
+    /// rows and, if it came from the relaxed problem, its violation), or — when none verifies
+    /// within [`MAX_VERIFY_ROUNDS`] — the candidate whose worst barrier over the sample is
+    /// best, flagged as relaxed. `None` without a model or when every solve failed.
+    fn verified(
+        &mut self,
+        x: &RoboticInput,
+        terms: &RoboticTerms,
+        u_nom: &Vector7,
+        weights: &[f64; N],
+        hard: &[Row<NJ>; 2 * NJ + 6],
+        report: &mut FilterReport<N>,
+    ) -> Option<(Vector7, [Row<NJ>; N], f64)> {
+        let robot = self.robot.clone()?;
+        let mut margin = [0.0; N];
+        let mut best: Option<(f64, Vector7, [Row<NJ>; N])> = None;
+        for _ in 0..MAX_VERIFY_ROUNDS {
+            let rows = self.barrier_rows(x, terms, Level::Local, &margin);
+            let res = self.engine.solve(u_nom, &rows, weights, hard);
+            report.iterations += res.iterations;
+            if res.kind == Kind::Failed {
+                break;
+            }
+            let v = self.verify(&robot, x, terms, &res.u, weights);
+            report.iterations += 1;
+            if v.ok {
+                let violation = if res.kind == Kind::Relaxed { res.violation } else { 0.0 };
+                return Some((res.u, rows, violation));
+            }
+            if best.as_ref().is_none_or(|b| v.worst > b.0) {
+                best = Some((v.worst, res.u, rows));
+            }
+            for (m, s) in margin.iter_mut().zip(&v.shortfall) {
+                *m += VERIFY_GAIN * s;
+            }
+        }
+        best.map(|(worst, u, rows)| (u, rows, (-worst).max(f64::MIN_POSITIVE)))
+    }
+
+    /// Integrates one sample under `tau` with the servicer model exactly as the simulator
+    /// does (RK4 at the physics step; base force and torque held in the body frame) and
+    /// checks every row's conditions on the true trajectory.
+    fn verify(&self, robot: &Robot, x: &RoboticInput, t0: &RoboticTerms, tau: &Vector7, weights: &[f64; N]) -> Verdict {
+        let p = &self.params;
+        let mut verdict = Verdict {
+            ok: true,
+            shortfall: [0.0; N],
+            worst: f64::INFINITY,
+        };
+        let mut u = Vector13::zeros();
+        u.fixed_rows_mut::<3>(0).copy_from(&x.force_b);
+        u.fixed_rows_mut::<3>(3).copy_from(&x.torque_b);
+        u.fixed_rows_mut::<NJ>(6).copy_from(tau);
+        let h = p.physics_step;
+        let steps = ((p.period / h).round() as usize).max(1);
+        let (mut th, mut thd, mut w) = (x.theta, x.theta_dot, x.omega_b);
+        let Some(base) = robot.base_sphere() else {
+            verdict.ok = false;
+            verdict.worst = f64::NEG_INFINITY;
+            return verdict;
+        };
+        let fail = |v: &mut Verdict, j: usize, short: f64| {
+            v.ok = false;
+            v.shortfall[j] = v.shortfall[j].max(short);
+        };
+        for step in 1..=steps {
+            let Some((th1, thd1, w1)) = rk4_internal(robot, &th, &thd, &w, &u, h) else {
+                verdict.ok = false;
+                verdict.worst = f64::NEG_INFINITY;
+                return verdict;
+            };
+            th = th1;
+            thd = thd1;
+            w = w1;
+            let s = step as f64 * h;
+            let kin = robot.kinematics_vel(&th, &thd);
+            let mut hv = [0.0; N];
+            let mut hd = [0.0; N];
+            for i in 0..NJ {
+                let k = p.theta_max[i] + p.theta_min[i] - 2.0 * th[i];
+                hv[i] = (th[i] - p.theta_min[i]) * (p.theta_max[i] - th[i]);
+                hd[i] = thd[i] * k;
+                hv[NJ + i] = p.theta_dot_max[i] - thd[i];
+                hv[2 * NJ + i] = thd[i] + p.theta_dot_max[i];
+            }
+            for (k, (idx, _)) in robot.arm_spheres().take(NS).enumerate() {
+                if let Some(sp) = robot.sphere_state(&kin, idx) {
+                    let d = sp.center - base.center;
+                    let rr = sp.radius + base.radius;
+                    hv[3 * NJ + k] = d.dot(&d) - rr * rr;
+                    hd[3 * NJ + k] = 2.0 * d.dot(&(sp.jacobian * thd));
+                }
+            }
+            for j in 0..N {
+                verdict.worst = verdict.worst.min(hv[j] / weights[j]);
+                let rel2 = j < NJ || j >= 3 * NJ;
+                if hv[j] < 0.0 {
+                    // C1: the barrier inside the sample
+                    let short = if rel2 { 2.0 * -hv[j] / (s * s) } else { -hv[j] / s };
+                    fail(&mut verdict, j, short);
+                }
+                if step == steps {
+                    // the next-sample conditions of the rows
+                    if rel2 {
+                        let (h0, hd0) = if j < NJ {
+                            (t0.theta[j].h, t0.theta[j].hdot)
+                        } else {
+                            (t0.link_base[j - 3 * NJ].h, t0.link_base[j - 3 * NJ].hdot)
+                        };
+                        let mu = if j < NJ { p.u_max_theta } else { p.u_max_lb };
+                        let kappa = (-p.gamma * p.period).exp() * braking_barrier(h0, hd0, mu);
+                        let got = braking_barrier(hv[j], hd[j], mu);
+                        if got < kappa {
+                            let gain = 0.5 * s * s + hd[j].abs() * s / mu;
+                            fail(&mut verdict, j, (kappa - got) / gain);
+                        }
+                    } else {
+                        let h0 = if j < 2 * NJ {
+                            t0.theta_dot_max[j - NJ].h
+                        } else {
+                            t0.theta_dot_min[j - 2 * NJ].h
+                        };
+                        let g = p.gamma_theta_dot;
+                        let floor = p.eps_theta_dot / g;
+                        let target = (-g * p.period).exp() * (h0 - floor) + floor;
+                        if hv[j] < target {
+                            fail(&mut verdict, j, (target - hv[j]) / s);
+                        }
+                    }
+                }
+            }
+        }
+        verdict
     }
 
     /// Verification only: force the solver even when the nominal is feasible.
     pub fn set_skip_enabled(&mut self, on: bool) {
-        self.qp.set_skip_enabled(on);
+        self.engine.set_skip_enabled(on);
     }
 
-    /// Multipliers λ_i ≥ 0 of the barrier rows of the last solve, in [`NAMES`] order.
-    pub fn row_duals(&self) -> &[f64] {
-        self.qp.row_duals()
+    /// The certified barrier rows for a command that does not accelerate the joints
+    /// ([`NAMES`] order), their weights and the hard rows
+    /// (input bounds, then the contract) at `x` — for verification and inspection.
+    pub fn rows(&self, x: &RoboticInput) -> Option<(Vec<Row<NJ>>, Vec<f64>, Vec<Row<NJ>>)> {
+        let t = self.terms(x).ok()?;
+        let rows = self.barrier_rows(x, &t, Level::Certified(Vector7::zeros()), &[0.0; N]);
+        Some((rows.to_vec(), self.weights().to_vec(), self.hard_rows(x).to_vec()))
     }
 
-    /// The last QP handed to the solver (for `--dump-qp`).
-    pub fn dump_qp(&self) -> QpDump {
-        self.qp.dump()
+    /// The last QP (the rows the command was finally solved with) for `--dump-qp`.
+    pub fn dump_qp(&self) -> crate::QpDump {
+        self.last.dump()
     }
+}
+
+/// One RK4 step of the servicer's internal state `(θ, θ̇, ω_B)` under the held input `u`,
+/// with exactly the simulator's arithmetic (`sc_sim`'s RK4 on these components).
+pub fn rk4_internal(
+    robot: &Robot,
+    th: &Vector7,
+    thd: &Vector7,
+    w: &Vector3<f64>,
+    u: &Vector13,
+    h: f64,
+) -> Option<(Vector7, Vector7, Vector3<f64>)> {
+    let f = |th: &Vector7, thd: &Vector7, w: &Vector3<f64>| -> Option<(Vector7, Vector7, Vector3<f64>)> {
+        let a = robot.forward_dynamics_sim(th, w, thd, u)?;
+        Some((*thd, a.fixed_rows::<NJ>(6).into(), a.fixed_rows::<3>(3).into()))
+    };
+    let (k1t, k1d, k1w) = f(th, thd, w)?;
+    let (k2t, k2d, k2w) = f(&(th + k1t * (h / 2.0)), &(thd + k1d * (h / 2.0)), &(w + k1w * (h / 2.0)))?;
+    let (k3t, k3d, k3w) = f(&(th + k2t * (h / 2.0)), &(thd + k2d * (h / 2.0)), &(w + k2w * (h / 2.0)))?;
+    let (k4t, k4d, k4w) = f(&(th + k3t * h), &(thd + k3d * h), &(w + k3w * h))?;
+    let th1 = th + (k1t + k2t * 2.0 + k3t * 2.0 + k4t) * (h / 6.0);
+    let thd1 = thd + (k1d + k2d * 2.0 + k3d * 2.0 + k4d) * (h / 6.0);
+    let w1 = w + (k1w + k2w * 2.0 + k3w * 2.0 + k4w) * (h / 6.0);
+    (common::finite(&th1) && common::finite(&thd1) && common::finite(&w1)).then_some((th1, thd1, w1))
 }
 
 /// Computes the filter's precomputed terms from the servicer model for joint state
 /// `(θ, θ̇)`, base angular velocity `omega_b` [rad/s, F_B] and the upstream safe base wrench
 /// `[f_B,SF; τ_B,SF]` [N, N m; F_B, about the base origin]: `A = M_eff⁻¹`,
-/// `b = −A c_free`, `ξ_rob = −A K [f_B; τ_B]`, and the 21 arm spheres with `J`, `J̇θ̇`.
-/// `None` when the model has no base sphere, not exactly 21 arm spheres, or the dynamics
-/// are singular / non-finite.
+/// `b = −A c_free`, `ξ_rob = −A K [f_B; τ_B]`, the 21 arm spheres with `J`, `J̇θ̇`, and the
+/// arm's reaction `Q` on the base. `None` when the model has no base sphere, not exactly 21
+/// arm spheres, or the dynamics are singular / non-finite.
 pub fn robotic_input_from_model(
     robot: &Robot,
     theta: &Vector7,
@@ -448,6 +884,7 @@ pub fn robotic_input_from_model(
     );
     let red = robot.reduced_arm_dynamics(theta, theta_dot, omega_b, &wrench)?;
     let a = red.m_eff.cholesky()?.inverse();
+    let reaction = robot.base_angular_dynamics(theta, theta_dot, omega_b, f_b_sf)?.q;
     let base = robot.base_sphere()?;
     let kin = robot.kinematics_vel(theta, theta_dot);
     let mut spheres = [SphereTerms::default(); NS];
@@ -478,5 +915,9 @@ pub fn robotic_input_from_model(
         spheres,
         base_center: base.center,
         base_radius: base.radius,
+        reaction,
+        omega_b: *omega_b,
+        force_b: *f_b_sf,
+        torque_b: *tau_b_sf,
     })
 }

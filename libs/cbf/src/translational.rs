@@ -1,21 +1,30 @@
 //! Translational safety filter (paper Sec. "CBFs for the Translational Subsystem",
 //! QP eq. "translation_qp").
 //!
-//! State `x_tr = [r_H; v_H]`: servicer base origin relative to the target CoM in the Hill
-//! frame `F_H` [m, m/s]; Clohessy–Wiltshire dynamics (paper eq. "rel motion system")
-//! `r̈_H = a_CW(r_H, v_H) + f_H/m` with mean motion `n` and servicer mass `m`; input the
-//! force `f_H` [N] in `F_H`. First in the causal order: `ξ_tr = 0`.
+//! State `x_tr = [r_H; v_H]`: the servicer's system centre of mass relative to the target
+//! CoM in the Hill frame `F_H` [m, m/s] — the point whose motion the Clohessy–Wiltshire
+//! model (paper eq. "rel motion system") `r̈_H = a_CW(r_H, v_H) + f_H/m` describes exactly
+//! (the arm's internal forces do not move it), with mean motion `n` and the servicer's total
+//! mass `m`; input the force `f_H` [N] in `F_H`. First in the causal order: `ξ_tr = 0`.
+//!
+//! Rows: the sampled-data rows of [`crate::sampled`] (default), or the paper's
+//! continuous-time rows (`safety.formulation = "paper"`, for comparison). The bounds on
+//! the model's error inside one sample ([`TranslationalFilter::sample_bounds`]) come from
+//! the CW model, the force bound and the body rate: the force is held in the body frame,
+//! which turns by at most `Ω T` inside the sample.
 //!
 //! Input bounds: the safe force is actuated in the body frame, `f_B,SF = R_BH f_H,SF`. To
 //! guarantee the paper's `‖f_B‖∞ ≤ F` the box is imposed on `f_B` itself, i.e. the six
 //! rows `±R_BH f_H ≤ F` (not a box on `f_H`, which would allow `‖f_B‖∞` up to √3 F).
 
-use crate::barrier::{RelDegTwo, Row};
+use crate::barrier::{RelDegOne, RelDegTwo, Row};
 use crate::common::{
     self, BOX_MARGIN, FilterOutput, FilterReport, FilterStatus, clamp_box, faults, in_range3,
     unit_quat,
 };
-use crate::qp::{QpDump, QpEngine, QpOutcome, SolverParams};
+use crate::engine::{Engine, Kind, LastProblem};
+use crate::sampled::{RateBounds, RelDeg1, RelDeg2, SampleBounds};
+use crate::{Formulation, qp::SolverParams};
 use nalgebra::{Matrix3, Vector3};
 use sc_models::quat::{self, Quat};
 use std::time::Instant;
@@ -55,9 +64,19 @@ pub struct TranslationalParams {
     pub u_max_caz: f64,
     /// `F` of `‖f_B‖∞ ≤ F` [N].
     pub force_max: f64,
-    /// T of the fallback brake `f_H = sat(−m v_H / T)` [s].
+    /// T of the braking law `f_H = sat(−m v_H / T)` [s]: the substitute nominal and the
+    /// backup command.
     pub brake_time: f64,
     pub solver: SolverParams,
+    /// Sample length `T` of the zero-order hold [s].
+    pub period: f64,
+    /// Which rows: the sampled-data rows or the paper's.
+    pub formulation: Formulation,
+    /// Bound on the base body rate `‖ω_B‖` inside the certified set [rad/s] (the attitude
+    /// filter keeps `|ω_i| ≤ ω_max,i` between samples): how far the body-fixed force turns.
+    pub omega_bound: f64,
+    /// Radius of the target's circular orbit [m] (bounds the CW linearisation error).
+    pub orbit_radius: f64,
 }
 
 impl TranslationalParams {
@@ -80,6 +99,13 @@ impl TranslationalParams {
             force_max: s.limits.force_max_n,
             brake_time: s.safety.fallback.translational_brake_time_s,
             solver: SolverParams::from_scenario(s),
+            period: s.mission.control_period_s,
+            formulation: s.safety.formulation,
+            omega_bound: Vector3::from(s.safety.attitude.omega_max_rad_s)
+                .abs()
+                .sup(&Vector3::from(s.safety.attitude.omega_min_rad_s).abs())
+                .norm(),
+            orbit_radius: a,
         }
     }
 }
@@ -99,10 +125,12 @@ pub struct TranslationalInput {
     pub omega_dot_h: Vector3<f64>,
     /// `q_RB`: servicer attitude (rotates F_B into F_R); gives `R_BH` for the force box.
     pub q_rb: Quat,
+    /// Base body rate ω_B [rad/s, F_B]: how fast the body-fixed force turns.
+    pub omega_b: Vector3<f64>,
 }
 
 impl TranslationalInput {
-    /// Input on a circular orbit: `ω_H = [0, 0, n]`, `ω̇_H = 0`.
+    /// Input on a circular orbit: `ω_H = [0, 0, n]`, `ω̇_H = 0`, base at rest.
     pub fn circular(r_h: Vector3<f64>, v_h: Vector3<f64>, q_hr: Quat, n: f64, q_rb: Quat) -> Self {
         Self {
             r_h,
@@ -111,6 +139,7 @@ impl TranslationalInput {
             omega_h: Vector3::new(0.0, 0.0, n),
             omega_dot_h: Vector3::zeros(),
             q_rb,
+            omega_b: Vector3::zeros(),
         }
     }
 }
@@ -192,23 +221,69 @@ pub fn collision_avoidance_zone(
     }
 }
 
+/// Share of the corridor's braking authority at the wall (`sin ψ F/m − μ_AC`) that the
+/// cone's curvature may take; the rest stays for the sampled-data margins.
+pub const CURVATURE_SHARE: f64 = 0.5;
+
+/// The tangential-speed coefficient `c_t` [m/s²] of [`tangential_speed`]: the servicer's
+/// speed across the line to the target may not exceed `√(c_t ‖r‖)`, so that the cone's
+/// curvature `cos ψ ‖v_⊥‖²/‖r‖` never takes more than [`CURVATURE_SHARE`] of the braking
+/// authority `sin ψ F/m − μ_AC` that keeps it inside the corridor. Non-positive when
+/// `μ_AC` exceeds the authority (a configuration error).
+pub fn tangential_coefficient(p: &TranslationalParams) -> f64 {
+    let sin_psi = (1.0 - p.cos_psi * p.cos_psi).max(0.0).sqrt();
+    CURVATURE_SHARE * (sin_psi * p.force_max / p.mass - p.u_max_ac) / p.cos_psi
+}
+
+/// Tangential-speed limit, a constraint of the certified set (not one of the paper's
+/// barriers; docs/SAFETY.md, "The corridor's curvature"): `h_t = c_t ‖r‖ − ‖v_⊥‖² ≥ 0` in the
+/// inertially fixed F_R, `v_⊥ = v − r̂ (r̂ᵀv)` the velocity across the line to the target.
+/// Relative degree one: `ḣ_t = c_t r̂ᵀv − 2 v_⊥ᵀ a + 2 (r̂ᵀv) ‖v_⊥‖²/‖r‖` with
+/// `a = a_drift + R_RH f_H / m`, so `∂ḣ_t/∂f_H = −2 R_HR v_⊥ / m`.
+pub fn tangential_speed(
+    r: &Vector3<f64>,
+    v: &Vector3<f64>,
+    a_drift: &Vector3<f64>,
+    r_hr: &Matrix3<f64>,
+    mass: f64,
+    c_t: f64,
+) -> RelDegOne<3> {
+    let rn = r.norm();
+    let rhat = r / rn;
+    let rv = rhat.dot(v);
+    let v_perp = v - rhat * rv;
+    let vp2 = v_perp.dot(&v_perp);
+    RelDegOne {
+        h: c_t * rn - vp2,
+        hdot_drift: c_t * rv + 2.0 * rv * vp2 / rn - 2.0 * v_perp.dot(a_drift),
+        hdot_u: r_hr * v_perp * (-2.0 / mass),
+    }
+}
+
 /// Validated, preprocessed input.
 struct Prepared {
     r_bh: Matrix3<f64>,
     terms: [RelDegTwo<3>; N],
-    rows: [Row<3>; N],
+    /// The barrier rows ([`NAMES`] order) and the tangential-speed row.
+    rows: [Row<3>; N + 1],
+    weights: [f64; N + 1],
+    bounds: [Row<3>; 6],
 }
 
 /// The translational CBF-QP safety filter (paper eq. "translation_qp").
 pub struct TranslationalFilter {
     pub params: TranslationalParams,
-    qp: QpEngine,
+    engine: Engine<3, { N + 1 + 6 }>,
+    last: LastProblem<3>,
 }
 
 impl TranslationalFilter {
     pub fn new(params: TranslationalParams) -> Self {
-        let qp = QpEngine::new(3, N, 6, 3f64.sqrt() * params.force_max, &params.solver);
-        Self { params, qp }
+        Self {
+            params,
+            engine: Engine::new(),
+            last: LastProblem::with_capacity(N + 1, 6),
+        }
     }
 
     /// Filter for servicer mass `mass` [kg] with the scenario's parameters.
@@ -222,6 +297,81 @@ impl TranslationalFilter {
         self.prepare(x).map(|p| p.terms)
     }
 
+    /// The bounds on the model's error inside one sample, per barrier ([`NAMES`] order),
+    /// for a state `(r, v)` with body rate `ω_B` (derivation: docs/SAFETY.md).
+    ///
+    /// With `A` the largest acceleration (CW drift + `√3 F/m`, the box's corner), speeds
+    /// `V ≤ ‖v‖ + AT`, distances in `[R_min, R]` over the sample, and the jerk
+    /// `J = 3n²V + 2nA + (√3F/m)(Ω + n)` (`Ω = max(‖ω_B‖, ω_bound)`: the held body-fixed
+    /// force turns with the body relative to F_H):
+    /// * CAZ (`ḧ = 2‖v‖² + 2rᵀa`): `M₃ = 6VA + 2RJ`;
+    /// * corridor (`ḧ = d̈ᵀr + 2ḋᵀv + gᵀa − cos ψ ‖v_⊥‖²/‖r‖`, `g = d − r̂ cos ψ`):
+    ///   `M₃ = n³R + 3n²V + 3nA + (n + V/R_min)A + G J + cos ψ (2VA/R_min + 3V³/R_min²)`;
+    /// * `M₂`: the CW linearisation of gravity, `≤ 3n²R²/a` in acceleration, times the
+    ///   barrier's gradient.
+    pub fn sample_bounds(
+        &self,
+        r: &Vector3<f64>,
+        v: &Vector3<f64>,
+        omega_b: &Vector3<f64>,
+        axis: &CorridorAxis,
+    ) -> ([SampleBounds; N], RateBounds) {
+        let p = &self.params;
+        let t = p.period;
+        let n = p.mean_motion;
+        let f_acc = 3f64.sqrt() * p.force_max / p.mass;
+        let (rn, vn) = (r.norm(), v.norm());
+        // fixed point of A(R, V), V(A), R(A): n is tiny, two passes are plenty
+        let mut a = f_acc + 3.0 * n * n * rn + 2.0 * n * vn;
+        let (mut vv, mut rr) = (vn, rn);
+        for _ in 0..2 {
+            vv = vn + a * t;
+            rr = rn + vn * t + 0.5 * a * t * t;
+            a = f_acc + 3.0 * n * n * rr + 2.0 * n * vv;
+        }
+        let r_min = (rn - vn * t - 0.5 * a * t * t).max(1e-3);
+        let omega = omega_b.norm().max(p.omega_bound) + n;
+        let jerk = 3.0 * n * n * vv + 2.0 * n * a + f_acc * omega;
+        let grav = 3.0 * n * n * rr * rr / p.orbit_radius;
+        let rhat = r / rn.max(1e-12);
+        let g_now = (axis.d - rhat * p.cos_psi).norm();
+        let g_max = (1.0 + p.cos_psi).min(g_now + t * (n + vv / r_min));
+        let m3_ac = n * n * n * rr
+            + 3.0 * n * n * vv
+            + 3.0 * n * a
+            + (n + vv / r_min) * a
+            + g_max * jerk
+            + p.cos_psi * (2.0 * vv * a / r_min + 3.0 * vv * vv * vv / (r_min * r_min));
+        let m3_caz = 6.0 * vv * a + 2.0 * rr * jerk;
+        // tangential speed: |ḧ_t| ≤ c_t(A + V²/R) + 2A(A + V²/R) + 2VJ + 6AV²/R + 4V⁴/R²
+        let c_t = tangential_coefficient(p).max(0.0);
+        let curv = a + vv * vv / r_min;
+        let j_t = c_t * curv
+            + 2.0 * a * curv
+            + 2.0 * vv * jerk
+            + 6.0 * a * vv * vv / r_min
+            + 4.0 * vv.powi(4) / (r_min * r_min);
+        (
+            [
+                SampleBounds {
+                    period: t,
+                    m2: g_max * grav,
+                    m3: m3_ac,
+                },
+                SampleBounds {
+                    period: t,
+                    m2: 2.0 * rr * grav,
+                    m3: m3_caz,
+                },
+            ],
+            RateBounds {
+                period: t,
+                d: 2.0 * vv * grav,
+                j: j_t,
+            },
+        )
+    }
+
     fn prepare(&self, x: &TranslationalInput) -> Option<Prepared> {
         let p = &self.params;
         let rn = x.r_h.norm();
@@ -230,6 +380,7 @@ impl TranslationalFilter {
             || !in_range3(&x.v_h, MAX_SPEED_M_S)
             || !in_range3(&x.omega_h, MAX_FRAME_RATE)
             || !in_range3(&x.omega_dot_h, MAX_FRAME_RATE)
+            || !common::finite(&x.omega_b)
         {
             return None;
         }
@@ -243,39 +394,98 @@ impl TranslationalFilter {
             approach_corridor(&x.r_h, &x.v_h, &axis, &a0, p.mass, p.cos_psi),
             collision_avoidance_zone(&x.r_h, &x.v_h, &a0, p.mass, p.r_caz),
         ];
-        let rows = [
-            terms[0].row(p.gamma, p.eps_ac, p.u_max_ac),
-            terms[1].row(p.gamma, p.eps_caz, p.u_max_caz),
+        let mu = [p.u_max_ac, p.u_max_caz];
+        let c_t = tangential_coefficient(p);
+        // the tangential speed in the inertially fixed F_R (where the corridor is fixed)
+        let r_rh = r_hr.transpose();
+        let r_r = r_rh * x.r_h;
+        let v_r = r_rh * (x.v_h + x.omega_h.cross(&x.r_h));
+        let radial = r_rh * Vector3::x();
+        let tidal = (radial * (3.0 * radial.dot(&r_r)) - r_r) * (p.mean_motion * p.mean_motion);
+        let tangential = tangential_speed(&r_r, &v_r, &tidal, &r_hr, p.mass, c_t);
+        let rows: [Row<3>; N + 1] = match p.formulation {
+            Formulation::SampledData => {
+                let (b, bt) = self.sample_bounds(&x.r_h, &x.v_h, &x.omega_b, &axis);
+                [
+                    RelDeg2::from(terms[0]).row(&b[0], mu[0], p.gamma),
+                    RelDeg2::from(terms[1]).row(&b[1], mu[1], p.gamma),
+                    RelDeg1::from(tangential).row(&bt, p.gamma, 0.0),
+                ]
+            }
+            Formulation::Paper => [
+                terms[0].row(p.gamma, p.eps_ac, p.u_max_ac),
+                terms[1].row(p.gamma, p.eps_caz, p.u_max_caz),
+                // the paper has no tangential limit: a row that never binds
+                Row {
+                    a: Vector3::zeros(),
+                    c: 1.0,
+                },
+            ],
+        };
+        let weights = [
+            p.u_max_ac,
+            p.u_max_caz,
+            2.0 * (c_t.max(0.0) * p.r_caz).sqrt() * p.force_max / p.mass,
         ];
-        if rows.iter().all(Row::is_finite) && common::finite(&r_bh) {
-            Some(Prepared { r_bh, terms, rows })
+        // ‖f_B‖∞ ≤ F on the body-frame force f_B = R_BH f_H: rows F(1 − margin) ∓ (R_BH f_H)_k
+        let lim = p.force_max * (1.0 - BOX_MARGIN);
+        let bounds: [Row<3>; 6] = std::array::from_fn(|i| {
+            let k = i / 2;
+            let sign = if i % 2 == 0 { -1.0 } else { 1.0 };
+            Row {
+                a: r_bh.row(k).transpose() * sign,
+                c: lim,
+            }
+        });
+        if rows.iter().chain(&bounds).all(Row::is_finite) && common::finite(&r_bh) {
+            Some(Prepared {
+                r_bh,
+                terms,
+                rows,
+                weights,
+                bounds,
+            })
         } else {
             None
         }
     }
 
-    /// Bounded fallback `f_H = sat(−m v_H / T)`, saturated so that `‖R_BH f_H‖∞ ≤ F`
-    /// (direction kept); zero when the state is invalid.
-    pub fn fallback(&self, x: &TranslationalInput) -> (Vector3<f64>, Vector3<f64>) {
+    /// The braking law `f_H = sat(−m v_H / T)`, saturated so that `‖R_BH f_H‖∞ ≤ F`
+    /// (direction kept): the substitute nominal, and the backup command when the solver
+    /// fails. Zero when the state is invalid.
+    pub fn brake(&self, x: &TranslationalInput) -> (Vector3<f64>, Vector3<f64>) {
         match self.prepare(x) {
-            Some(p) => self.fallback_prepared(x, &p),
+            Some(p) => self.brake_prepared(x, &p),
             None => (Vector3::zeros(), Vector3::zeros()),
         }
     }
 
-    fn fallback_prepared(
-        &self,
-        x: &TranslationalInput,
-        p: &Prepared,
-    ) -> (Vector3<f64>, Vector3<f64>) {
+    fn brake_prepared(&self, x: &TranslationalInput, p: &Prepared) -> (Vector3<f64>, Vector3<f64>) {
         let f_b = p.r_bh * (-self.params.mass * x.v_h / self.params.brake_time);
         let f_b = common::sat_inf(&f_b, self.params.force_max * (1.0 - BOX_MARGIN));
         (p.r_bh.transpose() * f_b, f_b)
     }
 
+    /// The filter's command when its nominal is missing: the safety QP on the substitute
+    /// nominal (the braking law) — what the partition applies for a dead nominal or filter.
+    pub fn backup(&mut self, x: &TranslationalInput) -> FilterOutput<3, N> {
+        self.filter_with(x, None)
+    }
+
     /// One filter step: safe `f_H` (and `f_B = R_BH f_H` in `actuated`) closest to
-    /// `f_nom_h` subject to `Φ_AC ≥ 0`, `Φ_CAZ ≥ 0` and `‖f_B‖∞ ≤ F`.
+    /// `f_nom_h` subject to the corridor and zone rows and `‖f_B‖∞ ≤ F`. An invalid
+    /// nominal is replaced by the substitute (flagged).
     pub fn filter(&mut self, x: &TranslationalInput, f_nom_h: &Vector3<f64>) -> FilterOutput<3, N> {
+        self.filter_with(x, Some(f_nom_h))
+    }
+
+    /// [`Self::filter`] with the nominal possibly missing (`None`: silent, dead or late
+    /// controller), then the QP runs on the substitute nominal (flagged).
+    pub fn filter_with(
+        &mut self,
+        x: &TranslationalInput,
+        f_nom_h: Option<&Vector3<f64>>,
+    ) -> FilterOutput<3, N> {
         let t0 = Instant::now();
         let mut report = FilterReport::<N>::default();
         let out = self.filter_inner(x, f_nom_h, &mut report);
@@ -290,7 +500,7 @@ impl TranslationalFilter {
     fn filter_inner(
         &mut self,
         x: &TranslationalInput,
-        f_nom_h: &Vector3<f64>,
+        f_nom_h: Option<&Vector3<f64>>,
         report: &mut FilterReport<N>,
     ) -> (Vector3<f64>, Vector3<f64>) {
         let fmax = self.params.force_max;
@@ -302,45 +512,26 @@ impl TranslationalFilter {
         for (i, t) in p.terms.iter().enumerate() {
             report.h[i] = t.h;
         }
-        let mut f_h;
-        if !common::nominal_valid(f_nom_h, fmax) {
-            report.faults |= faults::INVALID_NOMINAL;
-            report.status = FilterStatus::Fallback;
-            f_h = self.fallback_prepared(x, &p).0;
-        } else {
-            let mut rows_a = [0.0; 3 * N];
-            let mut rows_c = [0.0; N];
-            for (i, r) in p.rows.iter().enumerate() {
-                rows_a[3 * i..3 * i + 3].copy_from_slice(r.a.as_slice());
-                rows_c[i] = r.c;
+        let (u_nom, flag) =
+            common::resolve_nominal(f_nom_h, fmax, || self.brake_prepared(x, &p).0);
+        report.faults |= flag;
+        let res = self.engine.solve(&u_nom, &p.rows, &p.weights, &p.bounds);
+        self.last
+            .record(&u_nom, &p.rows, &p.weights, &p.bounds, &res);
+        report.iterations = res.iterations;
+        report.violation = res.violation;
+        let mut f_h = res.u;
+        match res.kind {
+            Kind::Skipped => report.status = FilterStatus::Skipped,
+            Kind::Solved => report.status = FilterStatus::Solved,
+            Kind::Relaxed => {
+                report.status = FilterStatus::Relaxed;
+                report.faults |= faults::QP_INFEASIBLE_RELAXED;
             }
-            let mut g = [0.0; 18];
-            for k in 0..3 {
-                for j in 0..3 {
-                    g[3 * k + j] = p.r_bh[(k, j)];
-                    g[9 + 3 * k + j] = -p.r_bh[(k, j)];
-                }
-            }
-            let g_max = [fmax * (1.0 - BOX_MARGIN); 6];
-            let mut u = [0.0; 3];
-            let res = self
-                .qp
-                .solve(f_nom_h.as_slice(), &rows_a, &rows_c, &g, &g_max, &mut u);
-            report.iterations = res.iterations;
-            report.slack = res.slack;
-            f_h = Vector3::from(u);
-            match res.outcome {
-                QpOutcome::Skipped => report.status = FilterStatus::Skipped,
-                QpOutcome::Solved => report.status = FilterStatus::Solved,
-                QpOutcome::Relaxed => {
-                    report.status = FilterStatus::Relaxed;
-                    report.faults |= faults::QP_INFEASIBLE_RELAXED;
-                }
-                QpOutcome::Failed => {
-                    report.status = FilterStatus::Fallback;
-                    report.faults |= faults::QP_FAILED_FALLBACK;
-                    f_h = self.fallback_prepared(x, &p).0;
-                }
+            Kind::Failed => {
+                report.status = FilterStatus::Fallback;
+                report.faults |= faults::QP_FAILED_FALLBACK;
+                f_h = self.brake_prepared(x, &p).0;
             }
         }
         // Last line of defence: the actuated force must be finite and inside the box.
@@ -350,22 +541,26 @@ impl TranslationalFilter {
             report.faults |= faults::OUTPUT_CLAMPED;
             f_h = p.r_bh.transpose() * f_b_c;
         }
-        common::evaluate_rows(&p.rows, &f_h, report);
+        let barrier_rows: [Row<3>; N] = [p.rows[0], p.rows[1]];
+        common::evaluate_rows(&barrier_rows, &f_h, report);
         (f_h, f_b_c)
     }
 
     /// Verification only: force the solver even when the nominal is feasible.
     pub fn set_skip_enabled(&mut self, on: bool) {
-        self.qp.set_skip_enabled(on);
+        self.engine.set_skip_enabled(on);
     }
 
-    /// Multipliers λ_i ≥ 0 of the barrier rows of the last solve, in [`NAMES`] order.
-    pub fn row_duals(&self) -> &[f64] {
-        self.qp.row_duals()
+    /// The last QP handed to the engine (for `--dump-qp`).
+    pub fn dump_qp(&self) -> crate::QpDump {
+        self.last.dump()
     }
 
-    /// The last QP handed to the solver (for `--dump-qp`).
-    pub fn dump_qp(&self) -> QpDump {
-        self.qp.dump()
+    /// The rows (barrier rows in [`NAMES`] order, then the tangential-speed row), their
+    /// weights in the relaxed problem, and the six bound rows at state `x` — for
+    /// verification and `--dump-qp`.
+    pub fn rows(&self, x: &TranslationalInput) -> Option<(Vec<Row<3>>, Vec<f64>, Vec<Row<3>>)> {
+        let p = self.prepare(x)?;
+        Some((p.rows.to_vec(), p.weights.to_vec(), p.bounds.to_vec()))
     }
 }

@@ -163,10 +163,25 @@ pub struct Limits {
     pub joint_torque_max_nm: f64,
 }
 
+/// Which barrier rows the filters build.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Formulation {
+    /// Rows that hold between samples under the zero-order hold (docs/SAFETY.md).
+    #[default]
+    SampledData,
+    /// The paper's continuous-time rows (eqs. "CBF rel deg 1/2"), which hold at the
+    /// samples only; kept for comparison.
+    Paper,
+}
+
 /// Parameters of the three safety filters.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Safety {
+    /// `sampled_data` (default) or `paper`.
+    #[serde(default)]
+    pub formulation: Formulation,
     /// γ_h of α(H) = γ_h H [1/s].
     pub gamma_per_s: f64,
     pub translational: SafetyTranslational,
@@ -224,6 +239,16 @@ pub struct SafetyAttitude {
     pub gamma_omega_per_s: f64,
     /// u_max of the line-of-sight auxiliary barrier [1/s²].
     pub u_max_att_per_s2: f64,
+    /// Contract with the robotic filter: the arm's reaction on the base angular
+    /// acceleration, `|(Q τ_M)_i| ≤ β_i` per body axis [rad/s²].
+    pub arm_reaction_budget_rad_s2: V3,
+    /// Contract with the robotic filter: the joint torque the base wrench may take to
+    /// hold the arm, `|(K [f_B; τ_B])_j| ≤ κ_j` per joint [N m].
+    pub joint_coupling_budget_nm: J7,
+    /// Bound on ‖ω̇_B‖ over the certified set [rad/s²] (derived: `safe-capture bounds`).
+    pub angular_accel_bound_rad_s2: f64,
+    /// Bound on |ω̈_B,i| over the certified set [rad/s³] (derived: `safe-capture bounds`).
+    pub angular_jerk_bound_rad_s3: f64,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -245,6 +270,12 @@ pub struct SafetyRobotic {
     pub u_max_theta_rad2_s2: f64,
     /// u_max of the link–base auxiliary barriers [m²/s²].
     pub u_max_lb_m2_s2: f64,
+    /// Bound on |θ⃛_i| over the certified set [rad/s³] per joint (derived:
+    /// `safe-capture bounds`).
+    pub joint_jerk_bound_rad_s3: J7,
+    /// Bound on the jerk of each link's collision-sphere centres in the base frame
+    /// [m/s³], links 1..7 (derived: `safe-capture bounds`).
+    pub link_sphere_jerk_bound_m_s3: J7,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -279,6 +279,27 @@ impl Scenario {
         positive("safety.attitude.gamma_omega_per_s", at.gamma_omega_per_s)?;
         positive("safety.attitude.u_max_att_per_s2", at.u_max_att_per_s2)?;
 
+        for i in 0..3 {
+            non_negative(
+                &format!("safety.attitude.arm_reaction_budget_rad_s2[{i}]"),
+                at.arm_reaction_budget_rad_s2[i],
+            )?;
+        }
+        for i in 0..7 {
+            non_negative(
+                &format!("safety.attitude.joint_coupling_budget_nm[{i}]"),
+                at.joint_coupling_budget_nm[i],
+            )?;
+        }
+        positive(
+            "safety.attitude.angular_accel_bound_rad_s2",
+            at.angular_accel_bound_rad_s2,
+        )?;
+        non_negative(
+            "safety.attitude.angular_jerk_bound_rad_s3",
+            at.angular_jerk_bound_rad_s3,
+        )?;
+
         let rb = &sf.robotic;
         finite_all("safety.robotic.theta_min_rad", &rb.theta_min_rad)?;
         finite_all("safety.robotic.theta_max_rad", &rb.theta_max_rad)?;
@@ -315,6 +336,16 @@ impl Scenario {
         )?;
         positive("safety.robotic.u_max_theta_rad2_s2", rb.u_max_theta_rad2_s2)?;
         positive("safety.robotic.u_max_lb_m2_s2", rb.u_max_lb_m2_s2)?;
+        for i in 0..7 {
+            non_negative(
+                &format!("safety.robotic.joint_jerk_bound_rad_s3[{i}]"),
+                rb.joint_jerk_bound_rad_s3[i],
+            )?;
+            non_negative(
+                &format!("safety.robotic.link_sphere_jerk_bound_m_s3[{i}]"),
+                rb.link_sphere_jerk_bound_m_s3[i],
+            )?;
+        }
 
         let so = &sf.solver;
         if so.max_iterations == 0 {
