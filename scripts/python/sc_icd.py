@@ -26,6 +26,7 @@ N_JOINTS = 7
 N_CONSTRAINTS_TRANSLATIONAL = 2
 N_CONSTRAINTS_ATTITUDE = 7
 N_CONSTRAINTS_ROBOTIC = 42
+N_BARRIERS = N_CONSTRAINTS_TRANSLATIONAL + N_CONSTRAINTS_ATTITUDE + N_CONSTRAINTS_ROBOTIC
 
 
 def _vec(n):
@@ -131,11 +132,17 @@ class SimState(ctypes.Structure):
         ("ee_b", _vec(3)),  # F_B [m]
         ("ee_r", _vec(3)),  # F_R [m]
         ("ee_v_r", _vec(3)),  # F_R [m/s]
+        ("com_h", _vec(3)),  # servicer CoM, F_H [m]
+        ("com_v_h", _vec(3)),  # F_H [m/s]
+        ("com_r", _vec(3)),  # servicer CoM, F_R [m]
+        ("com_v_r", _vec(3)),  # F_R [m/s]
+        ("barriers", _vec(N_BARRIERS)),  # every barrier from the true state
+        ("barriers_between", _vec(N_BARRIERS)),  # minima since the previous state
     ]
 
     @staticmethod
     def type_name():
-        return "safe_capture::v2::SimState"
+        return "safe_capture::v3::SimState"
 
 
 _NOMINAL_HEAD = [

@@ -34,6 +34,9 @@ pub const N_CONSTRAINTS_TRANSLATIONAL: usize = 2;
 pub const N_CONSTRAINTS_ATTITUDE: usize = 7;
 /// Number of robotic safety constraints: θ limits 7, θ̇ upper 7, θ̇ lower 7, link-base 21.
 pub const N_CONSTRAINTS_ROBOTIC: usize = 42;
+/// Number of barriers of the whole safety layer (translational, attitude, robotic).
+pub const N_BARRIERS: usize =
+    N_CONSTRAINTS_TRANSLATIONAL + N_CONSTRAINTS_ATTITUDE + N_CONSTRAINTS_ROBOTIC;
 
 /// Monotonic clock stamp in ns (`CLOCK_MONOTONIC` of this machine, shared by all processes).
 pub fn monotonic_ns() -> u64 {
@@ -206,7 +209,7 @@ pub struct Tick {
 /// that the stages compute exactly what they compute in one process.
 #[derive(Debug, Clone, Copy, ZeroCopySend, PartialEq)]
 #[repr(C)]
-#[type_name("safe_capture::v2::SimState")]
+#[type_name("safe_capture::v3::SimState")]
 pub struct SimState {
     /// Tick index this state answers (= simulator step count at the base rate) [-].
     pub tick: u64,
@@ -268,6 +271,20 @@ pub struct SimState {
     pub ee_r: [f64; 3],
     /// End-effector inertial velocity, F_R [m/s].
     pub ee_v_r: [f64; 3],
+    /// Servicer system centre of mass relative to the target CoM, Hill frame F_H [m].
+    pub com_h: [f64; 3],
+    /// Its derivative in the rotating Hill frame F_H [m/s].
+    pub com_v_h: [f64; 3],
+    /// Servicer system centre of mass relative to the target CoM, F_R [m].
+    pub com_r: [f64; 3],
+    /// Its inertial velocity, F_R [m/s].
+    pub com_v_r: [f64; 3],
+    /// Every barrier at this state, from the simulator's own state (the safety monitor),
+    /// in telemetry order (units per barrier, docs/ICD.md) [-].
+    pub barriers: [f64; N_BARRIERS],
+    /// The smallest value of every barrier over the physics steps since the previous
+    /// state message (this state included) [-].
+    pub barriers_between: [f64; N_BARRIERS],
 }
 
 macro_rules! nominal_msg {
@@ -458,7 +475,7 @@ pub fn type_name_of<T: ZeroCopySend>() -> &'static str {
 
 // Size guards: change them only together with scripts/python/sc_icd.py and docs/ICD.md.
 const _: () = assert!(core::mem::size_of::<Tick>() == 40);
-const _: () = assert!(core::mem::size_of::<SimState>() == 656);
+const _: () = assert!(core::mem::size_of::<SimState>() == 1568);
 const _: () = assert!(core::mem::size_of::<NominalTranslational>() == 64);
 const _: () = assert!(core::mem::size_of::<NominalAttitude>() == 64);
 const _: () = assert!(core::mem::size_of::<NominalRobotic>() == 96);

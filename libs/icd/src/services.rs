@@ -78,7 +78,7 @@ pub const HANDSHAKE: ServiceName = ServiceName("safe_capture/handshake");
 pub const ALL: &[(ServiceName, &str)] = &[
     (TICK, "safe_capture::v2::Tick"),
     (CONTROL, "safe_capture::v2::Tick"),
-    (SIM_STATE, "safe_capture::v2::SimState"),
+    (SIM_STATE, "safe_capture::v3::SimState"),
     (
         NOMINAL_TRANSLATIONAL,
         "safe_capture::v2::NominalTranslational",

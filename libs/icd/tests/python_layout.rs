@@ -71,7 +71,13 @@ fn rust_layouts() -> Vec<Layout> {
             grasp_b,
             ee_b,
             ee_r,
-            ee_v_r
+            ee_v_r,
+            com_h,
+            com_v_h,
+            com_r,
+            com_v_r,
+            barriers,
+            barriers_between
         }),
         layout!(NominalTranslational {
             tick,

@@ -6,12 +6,14 @@
 //! [`stages`], so its results are bit-for-bit those of [`Mission`].
 
 pub mod mission;
+pub mod nominal_source;
 pub mod record;
 pub mod setup;
 pub mod stages;
 pub mod summary;
 
-pub use mission::{Mission, MissionEnd, RunOptions, capture_check, timeout_check};
+pub use mission::{Mission, MissionEnd, RunOptions, all_hold, capture_check, timeout_check};
+pub use nominal_source::{NominalCommand, NominalCommands, NominalOverride};
 pub use record::{StepRecord, TelemetryWriter, parse_telemetry, telemetry_columns, timing_columns};
 pub use setup::{Setup, SetupError};
 pub use summary::{Summary, summarize};

@@ -2,7 +2,9 @@
 
 use crate::record::StepRecord;
 use crate::setup::{Setup, SetupError};
+use crate::nominal_source::{NominalCommands, NominalOverride};
 use crate::stages;
+use sc_cbf::monitor::{Barriers, Monitor, min_into};
 use sc_cbf::{QpDump, SafetyLayer};
 use sc_nominal::NominalControllers;
 use sc_sim::{Command, Simulator};
@@ -60,6 +62,13 @@ impl MissionEnd {
     }
 }
 
+/// The three QPs of one step, for `--dump-qp`.
+pub struct StepQps {
+    pub translational: QpDump,
+    pub attitude: QpDump,
+    pub robotic: QpDump,
+}
+
 /// Simulator + nominal controllers + safety layer, stepped at the control period.
 pub struct Mission {
     pub setup: Setup,
@@ -67,14 +76,13 @@ pub struct Mission {
     pub nominal: NominalControllers,
     pub safety: SafetyLayer,
     pub options: RunOptions,
+    /// Every barrier from the true state, at control and physics steps.
+    pub monitor: Monitor,
+    /// Barrier minima over the physics steps since the last control step.
+    between: Option<Barriers>,
+    /// Replaces nominal commands (a partner's controller or a red-team adversary).
+    pub nominal_override: Option<Box<dyn NominalOverride>>,
     end: Option<MissionEnd>,
-}
-
-/// The three QPs of one step, for `--dump-qp`.
-pub struct StepQps {
-    pub translational: QpDump,
-    pub attitude: QpDump,
-    pub robotic: QpDump,
 }
 
 impl Mission {
@@ -84,13 +92,17 @@ impl Mission {
             .map_err(|e| SetupError::Other(e.to_string()))?;
         let nominal = NominalControllers::new(&setup.scenario, (*setup.robot).clone())
             .map_err(|e| SetupError::Other(e.to_string()))?;
-        let safety = SafetyLayer::from_scenario(&setup.scenario, setup.mass());
+        let safety = SafetyLayer::from_scenario(&setup.scenario, setup.robot.clone());
+        let monitor = Monitor::from_scenario(&setup.scenario, setup.robot.clone());
         Ok(Self {
             setup,
             sim,
             nominal,
             safety,
             options,
+            monitor,
+            between: None,
+            nominal_override: None,
             end: None,
         })
     }
@@ -104,25 +116,37 @@ impl Mission {
     /// robotic filter), without advancing the simulator.
     pub fn compute(&mut self) -> StepRecord {
         let o = self.sim.observe();
+        let barriers = self.monitor.evaluate(&stages::monitor_state(&o));
+        let barriers_between = self.between.unwrap_or(barriers);
         let robot = self.setup.robot.clone();
         let limits = &self.setup.scenario.limits;
         let nom = self.nominal.command(&stages::nominal_input(&o));
+        let cmds = match self.nominal_override.as_mut() {
+            Some(src) => src.commands(&o, &nom),
+            None => NominalCommands::REFERENCE,
+        };
+        let f_h_nom = cmds.translational.resolve(nom.f_h);
+        let tau_b_nom = cmds.attitude.resolve(nom.tau_b);
+        let tau_m_nom = cmds.robotic.resolve(nom.tau_m);
         let tr = self
             .safety
             .translational
-            .filter(&stages::translational_input(&o), &nom.f_h);
+            .filter_with(&stages::translational_input(&o), f_h_nom.as_ref());
         // what acts on the base: the safe force, or the saturated nominal without filters
         let f_b = if self.options.no_filter {
-            stages::saturate(&stages::hill_to_body(&o, &nom.f_h), limits.force_max_n)
+            stages::saturate(
+                &stages::hill_to_body(&o, &f_h_nom.unwrap_or_default()),
+                limits.force_max_n,
+            )
         } else {
             tr.actuated
         };
         let at = self
             .safety
             .attitude
-            .filter(&stages::attitude_input(&o, &robot, &f_b), &nom.tau_b);
+            .filter_with(&stages::attitude_input(&o, &robot, &f_b), tau_b_nom.as_ref());
         let tau_b = if self.options.no_filter {
-            stages::saturate(&nom.tau_b, limits.torque_max_nm)
+            stages::saturate(&tau_b_nom.unwrap_or_default(), limits.torque_max_nm)
         } else {
             at.u
         };
@@ -132,21 +156,24 @@ impl Mission {
             &robot,
             &f_b,
             &tau_b,
-            &nom.tau_m,
+            tau_m_nom.as_ref(),
         );
         let tau_m = if self.options.no_filter {
-            stages::saturate(&nom.tau_m, limits.joint_torque_max_nm)
+            stages::saturate(&tau_m_nom.unwrap_or_default(), limits.joint_torque_max_nm)
         } else {
             rb.u
         };
+        let nan3 = nalgebra::Vector3::from_element(f64::NAN);
         StepRecord {
             step: o.step,
             t: o.t,
-            phase: nom.phase,
+            // the phase comes from the mission's own schedule, never from a controller
+            phase: self.setup.scenario.phase_index(o.t),
             obs: o,
-            f_h_nom: nom.f_h,
-            tau_b_nom: nom.tau_b,
-            tau_m_nom: nom.tau_m,
+            // a missing nominal is recorded as NaN
+            f_h_nom: f_h_nom.unwrap_or(nan3),
+            tau_b_nom: tau_b_nom.unwrap_or(nan3),
+            tau_m_nom: tau_m_nom.unwrap_or(sc_multibody::Vector7::from_element(f64::NAN)),
             translational: tr,
             attitude: at,
             robotic: rb,
@@ -155,6 +182,8 @@ impl Mission {
                 torque_b: tau_b,
                 tau: tau_m,
             },
+            barriers,
+            barriers_between,
         }
     }
 
@@ -168,9 +197,12 @@ impl Mission {
     }
 
     /// True if the record shows a capture: grasping phase, end-effector on the grasping
-    /// point within the configured distance and relative-speed tolerances.
+    /// point within the configured distance and relative-speed tolerances, and every
+    /// barrier ≥ 0 at this step and since the previous one (true state).
     pub fn is_capture(&self, r: &StepRecord) -> bool {
         capture_check(&self.setup.scenario, r.phase, &r.obs)
+            && all_hold(&r.barriers)
+            && all_hold(&r.barriers_between)
     }
 
     /// One control step: compute, then advance the simulator under the applied command.
@@ -194,7 +226,16 @@ impl Mission {
             self.end = Some(MissionEnd::Timeout { t: r.t });
             return;
         }
-        if let Err(e) = self.sim.step(&r.applied) {
+        let monitor = &self.monitor;
+        let mut between: Barriers = [f64::INFINITY; sc_cbf::monitor::N_ALL];
+        let stepped = self.sim.step_with(&r.applied, |b| {
+            min_into(
+                &mut between,
+                &monitor.evaluate(&stages::monitor_state_between(b)),
+            )
+        });
+        self.between = Some(between);
+        if let Err(e) = stepped {
             self.end = Some(MissionEnd::SimulatorFailed {
                 t: r.t,
                 message: e.to_string(),
@@ -226,6 +267,11 @@ pub fn capture_check(
     grasping
         && o.grasp_distance() <= m.capture_tolerance_m
         && o.grasp_speed() <= m.capture_speed_tolerance_m_s
+}
+
+/// True if every barrier value is ≥ 0 (a NaN fails).
+pub fn all_hold(h: &Barriers) -> bool {
+    h.iter().all(|v| *v >= 0.0)
 }
 
 /// True if the step starting at `t` is the last one of the configured duration.

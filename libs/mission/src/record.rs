@@ -5,6 +5,7 @@
 //! * `timing.csv` — wall-clock solve times of the filters (not reproducible by nature).
 
 use nalgebra::Vector3;
+use sc_cbf::monitor::Barriers;
 use sc_cbf::{AttitudeOutput, RoboticOutput, TranslationalOutput};
 use sc_multibody::Vector7;
 use sc_sim::{Command, Observation};
@@ -27,16 +28,19 @@ pub struct StepRecord {
     pub robotic: RoboticOutput,
     /// The command applied to the simulator over the next control period.
     pub applied: Command,
+    /// Every barrier at this step, from the true state ([`sc_cbf::monitor`]), in
+    /// [`crate::constraint_names`] order — never from a filter's report.
+    pub barriers: Barriers,
+    /// The smallest value of every barrier over the physics steps since the previous
+    /// control step (the state of this step included); at step 0 the values of this step.
+    pub barriers_between: Barriers,
 }
 
 impl StepRecord {
-    /// All barrier values in [`crate::constraint_names`] order.
+    /// All barrier values at this step, from the true state, in
+    /// [`crate::constraint_names`] order.
     pub fn h(&self) -> Vec<f64> {
-        let mut v = Vec::with_capacity(51);
-        v.extend(self.translational.report.h);
-        v.extend(self.attitude.report.h);
-        v.extend(self.robotic.report.h);
-        v
+        self.barriers.to_vec()
     }
 
     /// Total safety-layer solve time of this step [µs].
@@ -62,6 +66,10 @@ pub fn telemetry_columns() -> Vec<String> {
     push3(&mut c, "v_h", "_m_s");
     push3(&mut c, "r_r", "_m");
     push3(&mut c, "v_r", "_m_s");
+    push3(&mut c, "com_r", "_m");
+    push3(&mut c, "com_v_r", "_m_s");
+    push3(&mut c, "com_h", "_m");
+    push3(&mut c, "com_v_h", "_m_s");
     for i in 0..4 {
         c.push(format!("q{i}_rb"));
     }
@@ -94,11 +102,15 @@ pub fn telemetry_columns() -> Vec<String> {
     for n in crate::constraint_names() {
         c.push(format!("h_{n}"));
     }
+    for n in crate::constraint_names() {
+        c.push(format!("hmin_{n}"));
+    }
     for f in ["translational", "attitude", "robotic"] {
         c.push(format!("{f}_status"));
         c.push(format!("{f}_iterations"));
         c.push(format!("{f}_active"));
         c.push(format!("{f}_faults"));
+        c.push(format!("{f}_violation"));
     }
     c
 }
@@ -127,6 +139,10 @@ pub fn telemetry_line(r: &StepRecord) -> String {
     o.v_h.iter().for_each(|x| f(*x));
     o.r_r.iter().for_each(|x| f(*x));
     o.v_r.iter().for_each(|x| f(*x));
+    o.com_r.iter().for_each(|x| f(*x));
+    o.com_v_r.iter().for_each(|x| f(*x));
+    o.com_h.iter().for_each(|x| f(*x));
+    o.com_v_h.iter().for_each(|x| f(*x));
     o.q_rb.iter().for_each(|x| f(*x));
     o.omega_b.iter().for_each(|x| f(*x));
     o.theta.iter().for_each(|x| f(*x));
@@ -144,31 +160,36 @@ pub fn telemetry_line(r: &StepRecord) -> String {
     r.applied.force_b.iter().for_each(|x| f(*x));
     r.applied.torque_b.iter().for_each(|x| f(*x));
     r.applied.tau.iter().for_each(|x| f(*x));
-    r.h().into_iter().for_each(&mut f);
-    for (status, iters, active, faults) in [
+    r.barriers.iter().for_each(|x| f(*x));
+    r.barriers_between.iter().for_each(|x| f(*x));
+    for (status, iters, active, faults, violation) in [
         (
             r.translational.report.status,
             r.translational.report.iterations,
             r.translational.report.active,
             r.translational.report.faults,
+            r.translational.report.violation,
         ),
         (
             r.attitude.report.status,
             r.attitude.report.iterations,
             r.attitude.report.active,
             r.attitude.report.faults,
+            r.attitude.report.violation,
         ),
         (
             r.robotic.report.status,
             r.robotic.report.iterations,
             r.robotic.report.active,
             r.robotic.report.faults,
+            r.robotic.report.violation,
         ),
     ] {
         v.push((status as u8).to_string());
         v.push(iters.to_string());
         v.push(active.to_string());
         v.push(faults.to_string());
+        v.push(violation.to_string());
     }
     v.join(",")
 }
@@ -324,7 +345,8 @@ fn status_of(v: u8, file: &'static str, line: usize) -> Result<sc_cbf::FilterSta
 /// `obs.grasp_b` is recomputed from the attitude and positions
 /// ([`Observation::grasp_in_base`]), the derived columns (synchronisation error, grasp
 /// distance) are checked against the state they come from. Not in the files, so NaN:
-/// the CBF conditions φ and the relaxed-QP slack, the Hill frame's attitude and rates,
+/// the filters' own barrier values and CBF conditions (the records' barriers are the
+/// monitor's, which the files hold), the Hill frame's attitude and rates,
 /// the mean motion, the target's angular acceleration, the grasping point's velocity
 /// and acceleration, the end-effector in F_B and its velocity.
 pub fn parse_telemetry(
@@ -354,6 +376,10 @@ pub fn parse_telemetry(
         let v_h = c.v3()?;
         let r_r = c.v3()?;
         let v_r = c.v3()?;
+        let com_r = c.v3()?;
+        let com_v_r = c.v3()?;
+        let com_h = c.v3()?;
+        let com_v_h = c.v3()?;
         let q_rb = c.array::<4>()?;
         let omega_b = c.v3()?;
         let theta = c.v7()?;
@@ -389,6 +415,10 @@ pub fn parse_telemetry(
             ee_b: nan3,
             ee_r,
             ee_v_r: nan3,
+            com_h,
+            com_v_h,
+            com_r,
+            com_v_r,
         };
         let s = obs.sync_error();
         c.check(
@@ -424,13 +454,12 @@ pub fn parse_telemetry(
             actuated: if filtered { applied.tau } else { nan7 },
             report: Default::default(),
         };
-        for h in translational.report.h.iter_mut() {
+        let mut barriers = [0.0; sc_cbf::monitor::N_ALL];
+        for h in barriers.iter_mut() {
             *h = c.f()?;
         }
-        for h in attitude.report.h.iter_mut() {
-            *h = c.f()?;
-        }
-        for h in robotic.report.h.iter_mut() {
+        let mut barriers_between = [0.0; sc_cbf::monitor::N_ALL];
+        for h in barriers_between.iter_mut() {
             *h = c.f()?;
         }
         macro_rules! report {
@@ -439,7 +468,7 @@ pub fn parse_telemetry(
                 $r.iterations = c.parse("an iteration count")?;
                 $r.active = c.parse("an active-set bitset")?;
                 $r.faults = c.parse("a fault bitset")?;
-                $r.slack = f64::NAN;
+                $r.violation = c.f()?;
             }};
         }
         report!(translational.report);
@@ -479,6 +508,8 @@ pub fn parse_telemetry(
             attitude,
             robotic,
             applied,
+            barriers,
+            barriers_between,
         });
     }
     if tim.next().is_some_and(|l| !l.is_empty()) {

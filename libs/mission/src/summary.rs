@@ -37,16 +37,22 @@ impl TimeStats {
     }
 }
 
-/// Minimum of one barrier over the run.
+/// Minimum of one barrier over the run, from the true state (the safety monitor), never
+/// from a filter's report.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ConstraintSummary {
-    /// Smallest h over the run (NaN samples excluded; see `nan_samples`).
+    /// Smallest h over every physics step of the run (the control steps and the states
+    /// between them; NaN samples excluded, see `nan_samples`).
     pub min_h: f64,
-    /// True if any sample was < 0 (or NaN).
+    /// Smallest h over the control steps only (the samples the filters see).
+    pub min_h_at_control_steps: f64,
+    /// True if any sample, at a control or a physics step, was < 0 or NaN.
     pub violated: bool,
+    /// Time of the control step at (or, for an inter-sample minimum, just after) the minimum.
     pub t_of_min_s: f64,
+    /// Samples that could not be evaluated (non-finite state); each counts as a violation.
     pub nan_samples: usize,
-    /// Smallest h per mission phase (by phase name).
+    /// Smallest h per mission phase (by phase name), over every physics step.
     pub min_h_per_phase: BTreeMap<String, f64>,
 }
 
@@ -121,6 +127,7 @@ pub fn summarize(
             n.to_string(),
             ConstraintSummary {
                 min_h: f64::INFINITY,
+                min_h_at_control_steps: f64::INFINITY,
                 violated: false,
                 t_of_min_s: 0.0,
                 nan_samples: 0,
@@ -136,22 +143,28 @@ pub fn summarize(
     let mut fault_count = 0;
     for r in records {
         let pn = phase_name(r.phase);
-        for (n, h) in names.iter().zip(r.h()) {
+        for (i, n) in names.iter().enumerate() {
             let c = constraints.get_mut(*n).expect("constraint present");
-            if h.is_nan() {
-                c.nan_samples += 1;
-                c.violated = true;
-                continue;
+            let at_step = r.barriers[i];
+            if !at_step.is_nan() {
+                c.min_h_at_control_steps = c.min_h_at_control_steps.min(at_step);
             }
-            if h < c.min_h {
-                c.min_h = h;
-                c.t_of_min_s = r.t;
+            for h in [at_step, r.barriers_between[i]] {
+                if h.is_nan() {
+                    c.nan_samples += 1;
+                    c.violated = true;
+                    continue;
+                }
+                if h < c.min_h {
+                    c.min_h = h;
+                    c.t_of_min_s = r.t;
+                }
+                if h < 0.0 {
+                    c.violated = true;
+                }
+                let e = c.min_h_per_phase.entry(pn.clone()).or_insert(f64::INFINITY);
+                *e = e.min(h);
             }
-            if h < 0.0 {
-                c.violated = true;
-            }
-            let e = c.min_h_per_phase.entry(pn.clone()).or_insert(f64::INFINITY);
-            *e = e.min(h);
         }
         let t = r.solve_time_us();
         for i in 0..4 {

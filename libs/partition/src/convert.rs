@@ -53,6 +53,10 @@ pub fn sim_state(o: &Observation) -> SimState {
         ee_b: a3(&o.ee_b),
         ee_r: a3(&o.ee_r),
         ee_v_r: a3(&o.ee_v_r),
+        com_h: a3(&o.com_h),
+        com_v_h: a3(&o.com_v_h),
+        com_r: a3(&o.com_r),
+        com_v_r: a3(&o.com_v_r),
         ..SimState::default()
     }
 }
@@ -84,6 +88,10 @@ pub fn observation(s: &SimState) -> Observation {
         ee_b: v3(&s.ee_b),
         ee_r: v3(&s.ee_r),
         ee_v_r: v3(&s.ee_v_r),
+        com_h: v3(&s.com_h),
+        com_v_h: v3(&s.com_v_h),
+        com_r: v3(&s.com_r),
+        com_v_r: v3(&s.com_v_r),
     }
 }
 
@@ -184,7 +192,7 @@ pub fn safe_msg<T: SafeMsg, const M: usize, const N: usize>(
         *h.fault_flags = out.report.faults;
         *h.n_constraints = N as u32;
         *h.phase = phase as u32;
-        *h.slack = out.report.slack;
+        *h.slack = out.report.violation;
         h.h.copy_from_slice(&out.report.h);
         h.phi.copy_from_slice(&out.report.phi);
         h.u.copy_from_slice(out.u.as_slice());
@@ -205,7 +213,7 @@ pub fn filter_output<T: SafeMsg, const M: usize, const N: usize>(msg: &T) -> Fil
     report.iterations = *h.iterations;
     report.solve_time_ns = *h.solve_ns;
     report.faults = *h.fault_flags;
-    report.slack = *h.slack;
+    report.violation = *h.slack;
     FilterOutput {
         u: SVector::<f64, M>::from_column_slice(&h.u[..M]),
         actuated: SVector::<f64, M>::from_column_slice(&h.actuated[..M]),

@@ -90,7 +90,7 @@ pub fn recorder() -> anyhow::Result<i32> {
         "tick,tick_send_ns,sim_recv_ns,state_publish_ns,nom_t_publish_ns,nom_a_publish_ns,nom_r_publish_ns,safe_t_recv_ns,safe_t_publish_ns,safe_a_recv_ns,safe_a_publish_ns,safe_r_recv_ns,safe_r_publish_ns,sim_safe_recv_ns,result_publish_ns,fallback_mask,held_mask,upstream_missing_mask"
     )?;
     let mut mcap = crate::mcap_out::McapOut::create(&p.out.join("recording.mcap"))?;
-    let layer = SafetyLayer::from_scenario(&p.setup.scenario, p.setup.mass());
+    let mut layer = SafetyLayer::from_scenario(&p.setup.scenario, p.setup.robot.clone());
     let robot = p.setup.robot.clone();
     let phase_names: Vec<String> = p
         .setup
@@ -275,11 +275,11 @@ pub fn recorder() -> anyhow::Result<i32> {
                     convert::filter_output(&m)
                 }
                 None if r.fallback_mask & due::TRANSLATIONAL != 0 => {
-                    fallback::translational(&layer, &o)
+                    fallback::translational(&mut layer, &o)
                 }
                 None => {
                     h.st.map(|m| convert::filter_output(&m))
-                        .unwrap_or_else(|| fallback::translational(&layer, &o))
+                        .unwrap_or_else(|| fallback::translational(&mut layer, &o))
                 }
             };
             let at: AttitudeOutput = match set.sa {
@@ -288,11 +288,11 @@ pub fn recorder() -> anyhow::Result<i32> {
                     convert::filter_output(&m)
                 }
                 None if r.fallback_mask & due::ATTITUDE != 0 => {
-                    fallback::attitude(&layer, &o, &robot, &applied.force_b)
+                    fallback::attitude(&mut layer, &o, &robot, &applied.force_b)
                 }
                 None => {
                     h.sa.map(|m| convert::filter_output(&m))
-                        .unwrap_or_else(|| fallback::attitude(&layer, &o, &robot, &applied.force_b))
+                        .unwrap_or_else(|| fallback::attitude(&mut layer, &o, &robot, &applied.force_b))
                 }
             };
             let rb: RoboticOutput = match set.sr {
@@ -301,23 +301,14 @@ pub fn recorder() -> anyhow::Result<i32> {
                     convert::filter_output(&m)
                 }
                 None if r.fallback_mask & due::ROBOTIC != 0 => {
-                    fallback::robotic(&layer, &o, &robot, &applied.force_b, &applied.torque_b)
+                    fallback::robotic(&mut layer, &o, &robot, &applied.force_b, &applied.torque_b)
                 }
                 None => h.sr.map(|m| convert::filter_output(&m)).unwrap_or_else(|| {
-                    fallback::robotic(&layer, &o, &robot, &applied.force_b, &applied.torque_b)
+                    fallback::robotic(&mut layer, &o, &robot, &applied.force_b, &applied.torque_b)
                 }),
             };
-            let phase =
-                h.nt.map(|m| m.phase)
-                    .or(h.na.map(|m| m.phase))
-                    .or(h.nr.map(|m| m.phase))
-                    .unwrap_or(0) as usize;
-            let phase = match (set.nt, set.na, set.nr) {
-                (Some(m), _, _) => m.phase as usize,
-                (_, Some(m), _) => m.phase as usize,
-                (_, _, Some(m)) => m.phase as usize,
-                _ => phase,
-            };
+            // the mission's own schedule, as the simulator decides it
+            let phase = p.setup.scenario.phase_index(o.t);
             let rec = StepRecord {
                 step: o.step,
                 t: o.t,
@@ -339,6 +330,8 @@ pub fn recorder() -> anyhow::Result<i32> {
                 attitude: at,
                 robotic: rb,
                 applied,
+                barriers: state.barriers,
+                barriers_between: state.barriers_between,
             };
             writer.write(&rec)?;
             writer.flush()?;

@@ -360,8 +360,10 @@ pub fn simulator() -> anyhow::Result<i32> {
     let scenario = p.scenario_with_period(p.schedule.base_period_s);
     let mut sim =
         Simulator::new(&scenario, p.setup.robot.clone()).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let layer = SafetyLayer::from_scenario(&scenario, p.setup.mass());
+    let mut layer = SafetyLayer::from_scenario(&scenario, p.setup.robot.clone());
     let robot = p.setup.robot.clone();
+    let monitor = sc_cbf::monitor::Monitor::from_scenario(&scenario, robot.clone());
+    let mut between: Option<sc_cbf::monitor::Barriers> = None;
     let deadline = p.deadline(p.cfg.deadlines.simulator_ms);
     let keep_going = p.cfg.max_ticks > 0;
     p.handshake()?;
@@ -374,7 +376,6 @@ pub fn simulator() -> anyhow::Result<i32> {
     let mut absent = [false; 3];
     let mut held = Command::zero();
     let mut held_f_h = Vector3::zeros();
-    let mut phase: usize = 0;
     let mut ended = false;
     let mut misses = 0u64;
     loop {
@@ -412,6 +413,11 @@ pub fn simulator() -> anyhow::Result<i32> {
         let recv_ns = now();
         let o = sim.observe();
         let mut msg = convert::sim_state(&o);
+        let barriers = monitor.evaluate(&stages::monitor_state(&o));
+        msg.barriers = barriers;
+        msg.barriers_between = between.unwrap_or(barriers);
+        // the phase is the mission's own schedule, never a partner's report
+        let phase = scenario.phase_index(o.t);
         msg.tick = tick.tick;
         msg.due_mask = tick.due_mask;
         msg.tick_send_ns = tick.send_ns;
@@ -483,9 +489,8 @@ pub fn simulator() -> anyhow::Result<i32> {
             if let Some(m) = fresh_t {
                 held.force_b = convert::vec3(&m.actuated);
                 held_f_h = convert::vec3(&m.u);
-                phase = m.phase as usize;
             } else {
-                let f = fallback::translational(&layer, &o);
+                let f = fallback::translational(&mut layer, &o);
                 held.force_b = f.actuated;
                 held_f_h = f.u;
                 fallback_mask |= due::TRANSLATIONAL;
@@ -505,9 +510,8 @@ pub fn simulator() -> anyhow::Result<i32> {
         if due & due::ATTITUDE != 0 || absent[1] {
             if let Some(m) = fresh_a {
                 held.torque_b = convert::vec3(&m.u);
-                phase = m.phase as usize;
             } else {
-                held.torque_b = fallback::attitude(&layer, &o, &robot, &held.force_b).u;
+                held.torque_b = fallback::attitude(&mut layer, &o, &robot, &held.force_b).u;
                 fallback_mask |= due::ATTITUDE;
                 if !absent[1] {
                     eprintln!(
@@ -524,9 +528,8 @@ pub fn simulator() -> anyhow::Result<i32> {
         if due & due::ROBOTIC != 0 || absent[2] {
             if let Some(m) = fresh_r {
                 held.tau = convert::vec7(&m.u);
-                phase = m.phase as usize;
             } else {
-                held.tau = fallback::robotic(&layer, &o, &robot, &held.force_b, &held.torque_b).u;
+                held.tau = fallback::robotic(&mut layer, &o, &robot, &held.force_b, &held.torque_b).u;
                 fallback_mask |= due::ROBOTIC;
                 if !absent[2] {
                     eprintln!(
@@ -549,7 +552,10 @@ pub fn simulator() -> anyhow::Result<i32> {
             ..Default::default()
         };
         convert::set_applied(&mut res, &held);
-        res.end = if sc_mission::capture_check(&scenario, phase, &o) {
+        let captured = sc_mission::capture_check(&scenario, phase, &o)
+            && sc_mission::all_hold(&msg.barriers)
+            && sc_mission::all_hold(&msg.barriers_between);
+        res.end = if captured {
             end::CAPTURED
         } else if sc_mission::timeout_check(&scenario, o.t) {
             end::TIMEOUT
@@ -558,11 +564,19 @@ pub fn simulator() -> anyhow::Result<i32> {
         };
         // with max_ticks (benchmarks, soak runs) the physics goes on after the end
         // and the scheduler stops after exactly max_ticks
-        if (res.end == end::RUNNING || keep_going)
-            && let Err(e) = sim.step(&held)
-        {
-            eprintln!("simulator: {e}");
-            res.end = end::SIMULATOR_FAILED;
+        if res.end == end::RUNNING || keep_going {
+            let mut min: sc_cbf::monitor::Barriers = [f64::INFINITY; sc_cbf::monitor::N_ALL];
+            let stepped = sim.step_with(&held, |b| {
+                sc_cbf::monitor::min_into(
+                    &mut min,
+                    &monitor.evaluate(&stages::monitor_state_between(b)),
+                )
+            });
+            between = Some(min);
+            if let Err(e) = stepped {
+                eprintln!("simulator: {e}");
+                res.end = end::SIMULATOR_FAILED;
+            }
         }
         ended = res.end == end::SIMULATOR_FAILED || (res.end != end::RUNNING && !keep_going);
         res.publish_ns = now();
@@ -794,7 +808,7 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
             }
         }};
     }
-    let mut layer = SafetyLayer::from_scenario(&p.setup.scenario, p.setup.mass());
+    let mut layer = SafetyLayer::from_scenario(&p.setup.scenario, p.setup.robot.clone());
     let robot = p.setup.robot.clone();
     let d = &p.cfg.deadlines;
     let deadline = p.deadline(
@@ -814,7 +828,6 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
     let mut up_a: Option<SafeAttitude> = None;
     // inputs found missing at a deadline are not waited for again until they reappear
     let mut absent = [false; 3]; // nominal, upstream translational, upstream attitude
-    let mut phase = 0u32;
     let mut misses = 0u64;
     let mut stop = false;
     let mut last_state: Option<SimState> = None;
@@ -907,18 +920,18 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
                     match which {
                         0 => {
                             if let Some(n) = nom_t {
-                                std::hint::black_box(layer.translational.filter(
+                                std::hint::black_box(layer.translational.filter_with(
                                     &stages::translational_input(&o),
-                                    &convert::vec3(&n.f_h),
+                                    Some(&convert::vec3(&n.f_h)),
                                 ));
                             }
                             tx_t.as_ref().context("publisher")?.warm()?;
                         }
                         1 => {
                             if let Some(n) = nom_a {
-                                std::hint::black_box(layer.attitude.filter(
+                                std::hint::black_box(layer.attitude.filter_with(
                                     &stages::attitude_input(&o, &robot, &f_b),
-                                    &convert::vec3(&n.tau_b),
+                                    Some(&convert::vec3(&n.tau_b)),
                                 ));
                             }
                             tx_a.as_ref().context("publisher")?.warm()?;
@@ -931,7 +944,7 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
                                     &robot,
                                     &f_b,
                                     &tau_b,
-                                    &convert::vec7(&n.tau_m),
+                                    Some(&convert::vec7(&n.tau_m)),
                                 ));
                             }
                             tx_r.as_ref().context("publisher")?.warm()?;
@@ -1000,6 +1013,8 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
         }
         let recv_ns = now();
         let o = convert::observation(&s);
+        // the mission's own schedule (a nominal's report of its phase is not trusted)
+        let phase = p.setup.scenario.phase_index(o.t);
         // upstream safe commands: this tick's, the held one of a slower group, or
         // (missing / dead upstream) the upstream fallback, which is what the simulator applies
         let mut upstream_missing = false;
@@ -1008,7 +1023,7 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
                 Some(m) => convert::vec3(&m.actuated),
                 None => {
                     upstream_missing = true;
-                    fallback::translational(&layer, &o).actuated
+                    fallback::translational(&mut layer, &o).actuated
                 }
             }
         } else {
@@ -1019,7 +1034,7 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
                 Some(m) => convert::vec3(&m.u),
                 None => {
                     upstream_missing = true;
-                    fallback::attitude(&layer, &o, &robot, &f_b).u
+                    fallback::attitude(&mut layer, &o, &robot, &f_b).u
                 }
             }
         } else {
@@ -1028,16 +1043,13 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
         let publish_ns;
         match which {
             0 => {
-                let nom = nom_t.filter(|m| m.tick == k);
-                let mut out = match nom {
-                    Some(n) => {
-                        phase = n.phase;
-                        layer
-                            .translational
-                            .filter(&stages::translational_input(&o), &convert::vec3(&n.f_h))
-                    }
-                    None => fallback::translational(&layer, &o),
-                };
+                // a command for another tick, or one its sender marks invalid, is no
+                // command: the filter runs its QP on the substitute nominal
+                let nom = nom_t.filter(|m| m.tick == k && m.valid != 0);
+                let f = nom.map(|n| convert::vec3(&n.f_h));
+                let mut out = layer
+                    .translational
+                    .filter_with(&stages::translational_input(&o), f.as_ref());
                 if upstream_missing {
                     out = fallback::flag_missing(out);
                 }
@@ -1048,17 +1060,11 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
                 send(tx_t.as_ref().context("publisher")?, &m)?;
             }
             1 => {
-                let nom = nom_a.filter(|m| m.tick == k);
-                let mut out = match nom {
-                    Some(n) => {
-                        phase = n.phase;
-                        layer.attitude.filter(
-                            &stages::attitude_input(&o, &robot, &f_b),
-                            &convert::vec3(&n.tau_b),
-                        )
-                    }
-                    None => fallback::attitude(&layer, &o, &robot, &f_b),
-                };
+                let nom = nom_a.filter(|m| m.tick == k && m.valid != 0);
+                let t = nom.map(|n| convert::vec3(&n.tau_b));
+                let mut out = layer
+                    .attitude
+                    .filter_with(&stages::attitude_input(&o, &robot, &f_b), t.as_ref());
                 if upstream_missing {
                     out = fallback::flag_missing(out);
                 }
@@ -1069,21 +1075,16 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
                 send(tx_a.as_ref().context("publisher")?, &m)?;
             }
             _ => {
-                let nom = nom_r.filter(|m| m.tick == k);
-                let mut out = match nom {
-                    Some(n) => {
-                        phase = n.phase;
-                        stages::robotic_step(
-                            &mut layer.robotic,
-                            &o,
-                            &robot,
-                            &f_b,
-                            &tau_b,
-                            &convert::vec7(&n.tau_m),
-                        )
-                    }
-                    None => fallback::robotic(&layer, &o, &robot, &f_b, &tau_b),
-                };
+                let nom = nom_r.filter(|m| m.tick == k && m.valid != 0);
+                let t = nom.map(|n| convert::vec7(&n.tau_m));
+                let mut out = stages::robotic_step(
+                    &mut layer.robotic,
+                    &o,
+                    &robot,
+                    &f_b,
+                    &tau_b,
+                    t.as_ref(),
+                );
                 if upstream_missing {
                     out = fallback::flag_missing(out);
                 }
