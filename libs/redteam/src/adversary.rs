@@ -1,0 +1,333 @@
+//! The adversarial nominal controller: replaces the nominal commands of its target
+//! subsystem(s) with those of its [`Strategy`], step by step. It knows everything the
+//! safety layer knows (the scenario, the servicer model, the true state) — a hostile
+//! partner is assumed to.
+
+use crate::strategy::{STALE_LAG, Strategy, Target};
+use nalgebra::{SVector, Vector3};
+use rand_chacha::ChaCha8Rng;
+use rand_chacha::rand_core::{Rng, SeedableRng};
+use sc_cbf::monitor::{Barriers, Monitor};
+use sc_cbf::{attitude, robotic, translational};
+use sc_mission::{NominalCommand, NominalCommands, NominalOverride, stages};
+use sc_models::quat;
+use sc_multibody::{Robot, Vector7};
+use sc_nominal::NominalOutput;
+use sc_scenario::Scenario;
+use sc_sim::Observation;
+use std::collections::VecDeque;
+use std::sync::Arc;
+
+/// Factor on the input bound of every saturating adversarial command: beyond the bound,
+/// so the filters' input bounds are exercised too.
+pub const OVERDRIVE: f64 = 1.5;
+
+/// The three subsystems' raw commands of one step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Raw {
+    f_h: Vector3<f64>,
+    tau_b: Vector3<f64>,
+    tau_m: Vector7,
+}
+
+/// An adversarial nominal controller.
+pub struct Adversary {
+    target: Target,
+    strategy: Strategy,
+    geometry: Geometry,
+    monitor: Monitor,
+    rng: ChaCha8Rng,
+    frozen: Option<Raw>,
+    history: VecDeque<Observation>,
+    step: u64,
+}
+
+/// What the adversary needs to aim at each boundary.
+struct Geometry {
+    axis_r: Vector3<f64>,
+    cos_psi: f64,
+    boresight_b: Vector3<f64>,
+    theta_mid: Vector7,
+    force_max: f64,
+    torque_max: f64,
+    joint_torque_max: f64,
+    /// Distance-like scale of every barrier (for the greedy choice).
+    scale: Barriers,
+    robot: Arc<Robot>,
+}
+
+impl Adversary {
+    /// An adversary for `target` playing `strategy` in the scenario `s`.
+    pub fn new(s: &Scenario, robot: Arc<Robot>, target: Target, strategy: Strategy) -> Self {
+        let t = &s.safety.translational;
+        let a = &s.safety.attitude;
+        let r = &s.safety.robotic;
+        let psi = t.corridor_half_angle_deg.to_radians();
+        let beta = a.los_half_angle_deg.to_radians();
+        let mut scale = [1.0; sc_cbf::monitor::N_ALL];
+        scale[0] = 1.0 - psi.cos();
+        scale[1] = t.caz_radius_m * t.caz_radius_m;
+        let o = translational::N;
+        scale[o] = 1.0 - beta.cos();
+        for i in 0..3 {
+            scale[o + 1 + i] = a.omega_max_rad_s[i] - a.omega_min_rad_s[i];
+            scale[o + 4 + i] = a.omega_max_rad_s[i] - a.omega_min_rad_s[i];
+        }
+        let o = translational::N + attitude::N;
+        let nj = robotic::NJ;
+        for i in 0..nj {
+            let half = 0.5 * (r.theta_max_rad[i] - r.theta_min_rad[i]);
+            scale[o + i] = half * half;
+            scale[o + nj + i] = 2.0 * r.theta_dot_max_rad_s[i];
+            scale[o + 2 * nj + i] = 2.0 * r.theta_dot_max_rad_s[i];
+        }
+        if let Some(base) = robot.base_sphere() {
+            for (k, (_, sp)) in robot.arm_spheres().take(robotic::NS).enumerate() {
+                let rr = sp.radius + base.radius;
+                scale[o + 3 * nj + k] = rr * rr;
+            }
+        }
+        let seed = match strategy {
+            Strategy::Random(s) => s,
+            _ => 0,
+        };
+        Self {
+            target,
+            strategy,
+            geometry: Geometry {
+                axis_r: Vector3::from(t.corridor_axis).normalize(),
+                cos_psi: psi.cos(),
+                boresight_b: Vector3::from(s.servicer.boresight_body).normalize(),
+                theta_mid: Vector7::from_fn(|i, _| 0.5 * (r.theta_max_rad[i] + r.theta_min_rad[i])),
+                force_max: s.limits.force_max_n,
+                torque_max: s.limits.torque_max_nm,
+                joint_torque_max: s.limits.joint_torque_max_nm,
+                scale,
+                robot: robot.clone(),
+            },
+            monitor: Monitor::from_scenario(s, robot),
+            rng: ChaCha8Rng::seed_from_u64(seed),
+            frozen: None,
+            history: VecDeque::new(),
+            step: 0,
+        }
+    }
+
+    /// The command of every subsystem pushing towards barrier `i` of that subsystem
+    /// (indices into the subsystem's constraint names).
+    fn toward(&self, o: &Observation, which: [usize; 3]) -> Raw {
+        let g = &self.geometry;
+        // translational: the CoM out of the corridor / into the zone (Hill frame)
+        let r = o.com_h;
+        let rhat = r / r.norm().max(1e-9);
+        let f_h = if which[0] == 0 {
+            let d_h = quat::rotate(&o.q_hr, &g.axis_r);
+            let grad = d_h - rhat * g.cos_psi;
+            -unit_or(&grad, &perpendicular(&rhat)) * (OVERDRIVE * g.force_max)
+        } else {
+            -rhat * (OVERDRIVE * g.force_max)
+        };
+        // attitude: the boresight off the line of sight, or spin about an axis
+        let tmax = OVERDRIVE * g.torque_max;
+        let tau_b = match which[1] {
+            0 => {
+                let rho = o.grasp_r - o.com_r;
+                let s_b = quat::to_matrix(&o.q_rb).transpose() * rho;
+                let axis = g.boresight_b.cross(&s_b);
+                -unit_or(&axis, &perpendicular(&g.boresight_b)) * tmax
+            }
+            k => {
+                let mut t = Vector3::zeros();
+                let axis = (k - 1) % 3;
+                t[axis] = if k <= 3 { tmax } else { -tmax };
+                t
+            }
+        };
+        // robotic: a joint to its nearer limit, a joint rate up or down, a link sphere
+        // into the base
+        let nj = robotic::NJ;
+        let tm = OVERDRIVE * g.joint_torque_max;
+        let k = which[2];
+        let tau_m = if k < nj {
+            let mut t = Vector7::zeros();
+            t[k] = tm * (o.theta[k] - g.theta_mid[k]).signum();
+            t
+        } else if k < 2 * nj {
+            let mut t = Vector7::zeros();
+            t[k - nj] = tm;
+            t
+        } else if k < 3 * nj {
+            let mut t = Vector7::zeros();
+            t[k - 2 * nj] = -tm;
+            t
+        } else {
+            self.sphere_into_base(o, k - 3 * nj)
+                .map(|d| d.map(|x| -tm * x.signum()))
+                .unwrap_or_else(Vector7::zeros)
+        };
+        Raw { f_h, tau_b, tau_m }
+    }
+
+    /// `∂ḧ_LB/∂τ_M = 2 Aᵀ Jᵀ d` of link sphere `k` (A = M_eff⁻¹).
+    fn sphere_into_base(&self, o: &Observation, k: usize) -> Option<Vector7> {
+        let robot = &self.geometry.robot;
+        let red = robot.reduced_arm_dynamics(
+            &o.theta,
+            &o.theta_dot,
+            &o.omega_b,
+            &nalgebra::Vector6::zeros(),
+        )?;
+        let a = red.m_eff.cholesky()?.inverse();
+        let kin = robot.kinematics(&o.theta);
+        let base = robot.base_sphere()?;
+        let (idx, _) = robot.arm_spheres().nth(k)?;
+        let sp = robot.sphere_state(&kin, idx)?;
+        let d = sp.center - base.center;
+        Some(a.transpose() * (sp.jacobian.transpose() * d) * 2.0)
+    }
+
+    /// The index, per subsystem, of the barrier closest to its boundary (distance-normalised).
+    fn greedy_choice(&self, o: &Observation) -> [usize; 3] {
+        let h = self.monitor.evaluate(&stages::monitor_state(o));
+        let argmin = |from: usize, n: usize| {
+            (0..n)
+                .min_by(|&a, &b| {
+                    let va = h[from + a] / self.geometry.scale[from + a];
+                    let vb = h[from + b] / self.geometry.scale[from + b];
+                    va.total_cmp(&vb)
+                })
+                .unwrap_or(0)
+        };
+        [
+            argmin(0, translational::N),
+            argmin(translational::N, attitude::N),
+            argmin(translational::N + attitude::N, robotic::N),
+        ]
+    }
+
+    fn greedy(&self, o: &Observation) -> Raw {
+        self.toward(o, self.greedy_choice(o))
+    }
+
+    fn random(&mut self) -> Raw {
+        let g = &self.geometry;
+        let (f, t, tm) = (
+            OVERDRIVE * g.force_max,
+            OVERDRIVE * g.torque_max,
+            OVERDRIVE * g.joint_torque_max,
+        );
+        let mut sign = || {
+            if self.rng.next_u64() & 1 == 0 {
+                1.0
+            } else {
+                -1.0
+            }
+        };
+        Raw {
+            f_h: Vector3::from_fn(|_, _| f * sign()),
+            tau_b: Vector3::from_fn(|_, _| t * sign()),
+            tau_m: Vector7::from_fn(|_, _| tm * sign()),
+        }
+    }
+
+    fn raw(&mut self, o: &Observation) -> Option<Raw> {
+        Some(match self.strategy {
+            Strategy::Toward(i) => self.toward(o, [i.min(1), i.min(6), i.min(41)]),
+            Strategy::Greedy => self.greedy(o),
+            Strategy::Random(_) => self.random(),
+            Strategy::NonFinite => {
+                let v = match self.step % 4 {
+                    0 => f64::NAN,
+                    1 => f64::INFINITY,
+                    2 => f64::NEG_INFINITY,
+                    _ => 0.0,
+                };
+                let mut r = Raw {
+                    f_h: Vector3::repeat(v),
+                    tau_b: Vector3::repeat(v),
+                    tau_m: Vector7::repeat(v),
+                };
+                if self.step % 4 == 3 {
+                    r.f_h[1] = f64::NAN;
+                    r.tau_b[2] = f64::NAN;
+                    r.tau_m[6] = f64::NAN;
+                }
+                r
+            }
+            Strategy::Huge => {
+                let g = self.greedy(o);
+                let k = match self.step % 3 {
+                    0 => 1e300 / OVERDRIVE,
+                    1 => 1000.0 / OVERDRIVE,
+                    _ => -1e300 / OVERDRIVE,
+                };
+                Raw {
+                    f_h: scale(&g.f_h, k),
+                    tau_b: scale(&g.tau_b, k),
+                    tau_m: scale(&g.tau_m, k),
+                }
+            }
+            Strategy::Frozen => match self.frozen {
+                Some(r) => r,
+                None => {
+                    let r = self.greedy(o);
+                    self.frozen = Some(r);
+                    r
+                }
+            },
+            Strategy::Stale => {
+                self.history.push_back(*o);
+                while self.history.len() > STALE_LAG + 1 {
+                    self.history.pop_front();
+                }
+                let old = self.history.front().copied().unwrap_or(*o);
+                self.greedy(&old)
+            }
+            Strategy::Silent => return None,
+        })
+    }
+}
+
+impl NominalOverride for Adversary {
+    fn commands(&mut self, o: &Observation, _reference: &NominalOutput) -> NominalCommands {
+        let raw = self.raw(o);
+        self.step += 1;
+        let pick = |i: usize| self.target.covers(i);
+        NominalCommands {
+            translational: command(pick(0), raw.map(|r| r.f_h)),
+            attitude: command(pick(1), raw.map(|r| r.tau_b)),
+            robotic: command(pick(2), raw.map(|r| r.tau_m)),
+        }
+    }
+}
+
+/// The command of one subsystem: the reference when not attacked, else the adversary's
+/// (or missing).
+fn command<T>(attacked: bool, v: Option<T>) -> NominalCommand<T> {
+    match (attacked, v) {
+        (false, _) => NominalCommand::Reference,
+        (true, Some(u)) => NominalCommand::Given(u),
+        (true, None) => NominalCommand::Missing,
+    }
+}
+
+/// `v · k` keeping the direction (a zero vector stays zero; 1e300 × a unit component
+/// overflows to ±∞ only where the component is large, as a real partner's would).
+fn scale<const M: usize>(v: &SVector<f64, M>, k: f64) -> SVector<f64, M> {
+    v.map(|x| x * k)
+}
+
+fn unit_or(v: &Vector3<f64>, fallback: &Vector3<f64>) -> Vector3<f64> {
+    let n = v.norm();
+    if n > 1e-12 { v / n } else { *fallback }
+}
+
+/// A unit vector perpendicular to `v`.
+fn perpendicular(v: &Vector3<f64>) -> Vector3<f64> {
+    let pick = if v.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    unit_or(&v.cross(&pick), &Vector3::z())
+}

@@ -1,0 +1,153 @@
+//! The red-team campaign: every case (a strategy against a target) runs the whole mission
+//! in one process with the adversary in place of the nominal controller(s), and the result
+//! is measured from the simulator's true state at every physics step (the safety monitor),
+//! never from a filter's report.
+
+use crate::adversary::Adversary;
+use crate::strategy::Case;
+use rayon::prelude::*;
+use sc_cbf::faults;
+use sc_mission::summary::TimeStats;
+use sc_mission::{Mission, MissionEnd, RunOptions, Setup, StepRecord, summarize};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// What one case measured.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CaseResult {
+    /// `<target>/<strategy>`.
+    pub case: String,
+    pub target: String,
+    pub strategy: String,
+    /// How the mission ended ("captured", "timeout", "simulator_failed").
+    pub end: String,
+    pub final_time_s: f64,
+    pub steps: usize,
+    /// Smallest value of every barrier over every physics step (true state).
+    pub min_h: BTreeMap<String, f64>,
+    /// Barriers that went below zero (or could not be evaluated) at any physics step.
+    pub violated: Vec<String>,
+    /// Applied commands with a non-finite component.
+    pub nonfinite_applied: usize,
+    /// Applied commands outside the input bounds (`‖f_B‖∞ ≤ F`, `‖τ_B‖∞ ≤ T`,
+    /// `‖τ_M‖∞ ≤ T_M`).
+    pub out_of_bounds_applied: usize,
+    /// Per filter (translational, attitude, robotic): steps on the substitute nominal
+    /// (invalid or missing), on the relaxed problem, on the backup law.
+    pub substituted_steps: [usize; 3],
+    pub relaxed_steps: [usize; 3],
+    pub backup_steps: [usize; 3],
+    /// Safety-layer time per step (wall clock) [µs].
+    pub solve_time_us: TimeStats,
+}
+
+impl CaseResult {
+    /// True if every barrier held at every physics step and every applied command was
+    /// finite and inside its bounds.
+    pub fn safe(&self) -> bool {
+        self.violated.is_empty() && self.nonfinite_applied == 0 && self.out_of_bounds_applied == 0
+    }
+}
+
+/// Runs one case to the end of its mission.
+pub fn run_case(setup: &Setup, case: &Case) -> Result<CaseResult, String> {
+    let adversary = Adversary::new(
+        &setup.scenario,
+        setup.robot.clone(),
+        case.target,
+        case.strategy,
+    );
+    let mut mission =
+        Mission::new(setup.clone(), RunOptions::default()).map_err(|e| e.to_string())?;
+    mission.nominal_override = Some(Box::new(adversary));
+    let mut records: Vec<StepRecord> = Vec::new();
+    let end = mission.run(|_, r| records.push(*r));
+    Ok(measure(setup, case, &records, &end))
+}
+
+/// The result of a case from its records.
+pub fn measure(setup: &Setup, case: &Case, records: &[StepRecord], end: &MissionEnd) -> CaseResult {
+    let phases: Vec<String> = setup
+        .scenario
+        .mission
+        .phases
+        .iter()
+        .map(|p| p.name.clone())
+        .collect();
+    let summary = summarize(records, end, &phases, true);
+    let lim = &setup.scenario.limits;
+    let mut r = CaseResult {
+        case: case.name(),
+        target: case.target.name().into(),
+        strategy: case.strategy.name(case.target),
+        end: end.name().into(),
+        final_time_s: end.t(),
+        steps: records.len(),
+        min_h: summary
+            .constraints
+            .iter()
+            .map(|(n, c)| (n.clone(), if c.nan_samples > 0 { f64::NAN } else { c.min_h }))
+            .collect(),
+        violated: summary.violated_constraints.clone(),
+        nonfinite_applied: 0,
+        out_of_bounds_applied: 0,
+        substituted_steps: [0; 3],
+        relaxed_steps: [0; 3],
+        backup_steps: [0; 3],
+        solve_time_us: summary
+            .solve_time_us
+            .get("total")
+            .copied()
+            .unwrap_or_default(),
+    };
+    for rec in records {
+        let a = &rec.applied;
+        if !a.is_finite() {
+            r.nonfinite_applied += 1;
+        } else if a.force_b.amax() > lim.force_max_n
+            || a.torque_b.amax() > lim.torque_max_nm
+            || a.tau.amax() > lim.joint_torque_max_nm
+        {
+            r.out_of_bounds_applied += 1;
+        }
+        let flags = [
+            rec.translational.report.faults,
+            rec.attitude.report.faults,
+            rec.robotic.report.faults,
+        ];
+        for (i, f) in flags.iter().enumerate() {
+            if f & (faults::INVALID_NOMINAL | faults::NOMINAL_MISSING) != 0 {
+                r.substituted_steps[i] += 1;
+            }
+            if f & faults::QP_INFEASIBLE_RELAXED != 0 {
+                r.relaxed_steps[i] += 1;
+            }
+            if f & (faults::QP_FAILED_FALLBACK | faults::INVALID_STATE) != 0 {
+                r.backup_steps[i] += 1;
+            }
+        }
+    }
+    r
+}
+
+/// Runs every case in parallel (rayon), calling `progress(done, total, result)` as cases
+/// finish (from worker threads). Results come back in the order of `cases`; a case whose
+/// mission cannot be set up is an `Err` with the reason.
+pub fn run_campaign(
+    setup: &Setup,
+    cases: &[Case],
+    progress: &(dyn Fn(usize, usize, &Result<CaseResult, String>) + Sync),
+) -> Vec<Result<CaseResult, String>> {
+    let done = AtomicUsize::new(0);
+    let total = cases.len();
+    cases
+        .par_iter()
+        .map(|c| {
+            let r = run_case(setup, c);
+            let k = done.fetch_add(1, Ordering::SeqCst) + 1;
+            progress(k, total, &r);
+            r
+        })
+        .collect()
+}

@@ -1,0 +1,11 @@
+//! The red team of the safety layer: adversarial nominal controllers
+//! ([`Adversary`], one [`Strategy`] against one [`Target`]) and the campaign that runs
+//! them against the filters and measures every barrier from the simulator's true state.
+
+pub mod adversary;
+pub mod campaign;
+pub mod strategy;
+
+pub use adversary::Adversary;
+pub use campaign::{CaseResult, run_campaign, run_case};
+pub use strategy::{Case, Strategy, Target};
