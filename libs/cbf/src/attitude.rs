@@ -468,8 +468,14 @@ impl AttitudeFilter {
         if !rows.iter().all(Row::is_finite) {
             return Err(Invalid::State);
         }
-        let mut weights = [p.accel_bound; N];
+        // the relaxed problem's weights: each row's violation is measured against the
+        // deceleration the formulation budgets for it — μ (u_max of H) for the line of
+        // sight, the paper's ε_ω for a rate row
+        let mut weights = [0.0; N];
         weights[0] = p.u_max_att;
+        for w in weights.iter_mut().skip(1) {
+            *w = p.eps_omega;
+        }
         Ok(Prepared {
             inertia,
             terms,

@@ -395,15 +395,16 @@ impl RoboticFilter {
         })
     }
 
-    /// Weights of the rows in the relaxed problem: `μ_θ` [rad²/s²], 1 rad/s² for the rates,
-    /// `μ_LB` [m²/s²].
+    /// Weights of the rows in the relaxed problem — the deceleration the formulation budgets
+    /// for each row: `μ_θ` [rad²/s²], the paper's `ε_θ̇` for the rates [rad/s²], `μ_LB`
+    /// [m²/s²].
     fn weights(&self) -> [f64; N] {
         let p = &self.params;
         std::array::from_fn(|j| {
             if j < NJ {
                 p.u_max_theta
             } else if j < 3 * NJ {
-                1.0
+                p.eps_theta_dot
             } else {
                 p.u_max_lb
             }
