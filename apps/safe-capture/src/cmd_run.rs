@@ -41,6 +41,11 @@ pub struct Args {
     /// Write no figures.
     #[arg(long)]
     no_figures: bool,
+    /// Replace nominal controllers by a red-team adversary, `<target>/<strategy>`
+    /// (`safe-capture redteam --list` lists them), e.g. `all/random:3` or
+    /// `robotic/toward:theta_dot_max_7`.
+    #[arg(long, value_name = "CASE")]
+    redteam: Option<String>,
 }
 
 /// Runs one mission, writing telemetry into `out`; returns the records and how it ended.
@@ -50,6 +55,7 @@ pub fn run_mission(
     out: &Path,
     dump_qp: Option<&Path>,
     quiet: bool,
+    nominal_override: Option<Box<dyn sc_mission::NominalOverride>>,
 ) -> anyhow::Result<(Vec<StepRecord>, MissionEnd)> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let open = |name: &str| -> anyhow::Result<std::io::BufWriter<std::fs::File>> {
@@ -67,6 +73,7 @@ pub fn run_mission(
     };
     let duration = setup.scenario.mission.duration_s;
     let mut mission = Mission::new(setup, options)?;
+    mission.nominal_override = nominal_override;
     let mut records = Vec::new();
     let mut io_err: Option<std::io::Error> = None;
     let mut last_print = 0.0;
@@ -126,7 +133,21 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let started = std::time::Instant::now();
     let scenario = setup.scenario.clone();
     let compare_setup = setup.clone();
-    let (records, end) = run_mission(setup, options, &a.out, a.dump_qp.as_deref(), a.quiet)?;
+    let case = a
+        .redteam
+        .as_deref()
+        .map(sc_redteam::Case::parse)
+        .transpose()
+        .map_err(|e| anyhow::anyhow!("--redteam: {e}"))?;
+    let adversary = case.map(|c| adversary(&setup, c));
+    let (records, end) = run_mission(
+        setup,
+        options,
+        &a.out,
+        a.dump_qp.as_deref(),
+        a.quiet,
+        adversary,
+    )?;
     let summary = summarize(&records, &end, &phase_names, !a.no_filter);
     let path = a.out.join("summary.json");
     std::fs::write(&path, serde_json::to_string_pretty(&summary)? + "\n")
@@ -138,15 +159,17 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             &records,
             compare_setup,
             a.no_filter || a.no_compare,
+            case,
         )?;
     }
     let safe = summary.violated_constraints.is_empty() && summary.fault_count == 0;
     println!(
         "{}: {} at t = {:.1} s; min margin {} = {:.3e}; violated: [{}]; faults: {}; total solve time geomean {:.1} us, max {:.1} us; wall {:.2} s -> {}",
-        if a.no_filter {
-            "nominal only"
-        } else {
-            "filtered"
+        match (&a.redteam, a.no_filter) {
+            (Some(c), true) => format!("red team {c}, nominal only"),
+            (Some(c), false) => format!("red team {c}, filtered"),
+            (None, true) => "nominal only".into(),
+            (None, false) => "filtered".into(),
         },
         summary.end,
         summary.final_time_s,
@@ -166,6 +189,16 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     })
 }
 
+/// A red-team adversary for `case` in `setup`'s scenario.
+fn adversary(setup: &Setup, case: sc_redteam::Case) -> Box<dyn sc_mission::NominalOverride> {
+    Box::new(sc_redteam::Adversary::new(
+        &setup.scenario,
+        setup.robot.clone(),
+        case.target,
+        case.strategy,
+    ))
+}
+
 /// Writes the run's figures into `out/figures`; unless `alone`, first runs the nominal
 /// controllers alone into `out/nominal` and draws that run dashed.
 fn write_figures(
@@ -174,6 +207,7 @@ fn write_figures(
     records: &[StepRecord],
     setup: Setup,
     alone: bool,
+    case: Option<sc_redteam::Case>,
 ) -> anyhow::Result<()> {
     let nominal = if alone {
         None
@@ -185,7 +219,10 @@ fn write_figures(
             .iter()
             .map(|p| p.name.clone())
             .collect();
-        let (recs, end) = run_mission(setup, RunOptions { no_filter: true }, &dir, None, true)?;
+        // the same nominal (or adversary) without the filters
+        let adv = case.map(|c| adversary(&setup, c));
+        let (recs, end) =
+            run_mission(setup, RunOptions { no_filter: true }, &dir, None, true, adv)?;
         let summary = summarize(&recs, &end, &phase_names, false);
         let path = dir.join("summary.json");
         std::fs::write(&path, serde_json::to_string_pretty(&summary)? + "\n")

@@ -8,6 +8,7 @@ mod cmd_bench_latency;
 mod cmd_launch;
 mod cmd_model;
 mod cmd_montecarlo;
+mod cmd_redteam;
 mod cmd_run;
 mod cmd_simulate;
 // `montecarlo --mode partition`: runs through the process partition
@@ -42,6 +43,9 @@ enum Command {
     /// Monte Carlo campaigns: dispersed runs in parallel (in-process or through the
     /// process partition), shards, merge, rerun.
     Montecarlo(cmd_montecarlo::Args),
+    /// Red team: adversarial nominal controllers against the safety layer, measured from
+    /// the simulator's true state.
+    Redteam(cmd_redteam::Args),
 }
 
 /// Default scenario path (relative to the working directory).
@@ -58,6 +62,7 @@ fn main() -> ExitCode {
         Command::Launch(a) => cmd_launch::run(a),
         Command::Bench(a) => cmd_bench::run(a),
         Command::Montecarlo(a) => cmd_montecarlo::run(a),
+        Command::Redteam(a) => cmd_redteam::run(a),
     };
     match result {
         Ok(code) => code,

@@ -9,6 +9,7 @@
 //!   against the line-of-sight cone coloured by synchronisation error, joint-torque norm vs
 //!   peak synchronisation error coloured by tumbling rate, distributions of every barrier's
 //!   minimum.
+//! * [`redteam_margins`] — every red-team case against every barrier.
 //!
 //! SVG text is written as `<text>` elements, so no system fonts are needed. Output is a
 //! pure function of the input data (no timestamps), so identical data give identical
@@ -18,12 +19,14 @@
 mod campaign;
 mod chart;
 mod colour;
+mod redteam;
 mod run;
 
 pub use campaign::{
     BarrierMinima, CampaignFigures, RunPoint, RuntimeBar, TracePoint, campaign_figures,
 };
 pub use colour::viridis;
+pub use redteam::{RedTeamMargins, redteam_margins};
 pub use run::{los_angles_deg, run_figures};
 
 use nalgebra::Vector3;

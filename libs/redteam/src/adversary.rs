@@ -60,33 +60,9 @@ impl Adversary {
     /// An adversary for `target` playing `strategy` in the scenario `s`.
     pub fn new(s: &Scenario, robot: Arc<Robot>, target: Target, strategy: Strategy) -> Self {
         let t = &s.safety.translational;
-        let a = &s.safety.attitude;
         let r = &s.safety.robotic;
         let psi = t.corridor_half_angle_deg.to_radians();
-        let beta = a.los_half_angle_deg.to_radians();
-        let mut scale = [1.0; sc_cbf::monitor::N_ALL];
-        scale[0] = 1.0 - psi.cos();
-        scale[1] = t.caz_radius_m * t.caz_radius_m;
-        let o = translational::N;
-        scale[o] = 1.0 - beta.cos();
-        for i in 0..3 {
-            scale[o + 1 + i] = a.omega_max_rad_s[i] - a.omega_min_rad_s[i];
-            scale[o + 4 + i] = a.omega_max_rad_s[i] - a.omega_min_rad_s[i];
-        }
-        let o = translational::N + attitude::N;
-        let nj = robotic::NJ;
-        for i in 0..nj {
-            let half = 0.5 * (r.theta_max_rad[i] - r.theta_min_rad[i]);
-            scale[o + i] = half * half;
-            scale[o + nj + i] = 2.0 * r.theta_dot_max_rad_s[i];
-            scale[o + 2 * nj + i] = 2.0 * r.theta_dot_max_rad_s[i];
-        }
-        if let Some(base) = robot.base_sphere() {
-            for (k, (_, sp)) in robot.arm_spheres().take(robotic::NS).enumerate() {
-                let rr = sp.radius + base.radius;
-                scale[o + 3 * nj + k] = rr * rr;
-            }
-        }
+        let scale = crate::scales::barrier_scales(s, &robot);
         let seed = match strategy {
             Strategy::Random(s) => s,
             _ => 0,

@@ -87,7 +87,12 @@ pub fn measure(setup: &Setup, case: &Case, records: &[StepRecord], end: &Mission
         min_h: summary
             .constraints
             .iter()
-            .map(|(n, c)| (n.clone(), if c.nan_samples > 0 { f64::NAN } else { c.min_h }))
+            .map(|(n, c)| {
+                (
+                    n.clone(),
+                    if c.nan_samples > 0 { f64::NAN } else { c.min_h },
+                )
+            })
             .collect(),
         violated: summary.violated_constraints.clone(),
         nonfinite_applied: 0,

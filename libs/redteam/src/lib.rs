@@ -4,6 +4,8 @@
 
 pub mod adversary;
 pub mod campaign;
+pub mod report;
+pub mod scales;
 pub mod strategy;
 
 pub use adversary::Adversary;

@@ -1,0 +1,245 @@
+//! The red-team campaign's outputs: `cases.csv` (one line per case), `min_h.csv` (every
+//! case's smallest value of every barrier), `summary.json`, `report.md` and
+//! `figures/redteam_margins.svg`.
+
+use crate::campaign::CaseResult;
+use crate::scales::barrier_scales;
+use crate::strategy::Case;
+use sc_mission::Setup;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// The campaign's verdict (`summary.json`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CampaignSummary {
+    pub cases: usize,
+    pub safe: usize,
+    /// Cases with a barrier below zero at some physics step, or a non-finite or
+    /// out-of-bound applied command.
+    pub unsafe_cases: Vec<String>,
+    /// Cases whose mission could not be set up, with the reason.
+    pub errors: Vec<String>,
+    pub nonfinite_applied: usize,
+    pub out_of_bounds_applied: usize,
+    /// Per barrier: the smallest value over all cases and the case it came from.
+    pub worst: BTreeMap<String, (f64, String)>,
+    /// Safety-layer time per step over all cases [µs]: the largest geometric mean of a
+    /// case and the largest single step (wall clock, so the maximum includes preemption
+    /// by the other cases running in parallel).
+    pub solve_time_geomean_max_us: f64,
+    pub solve_time_max_us: f64,
+    pub wall_s: f64,
+}
+
+/// Writes every output into `dir`; returns the summary.
+pub fn write(
+    dir: &Path,
+    setup: &Setup,
+    cases: &[Case],
+    results: &[Result<CaseResult, String>],
+    wall_s: f64,
+) -> Result<CampaignSummary, String> {
+    let io = |p: &Path, e: std::io::Error| format!("cannot write {}: {e}", p.display());
+    std::fs::create_dir_all(dir.join("figures")).map_err(|e| io(dir, e))?;
+    let names = sc_mission::constraint_names();
+    let scales = barrier_scales(&setup.scenario, &setup.robot);
+    let mut summary = CampaignSummary {
+        cases: cases.len(),
+        safe: 0,
+        unsafe_cases: Vec::new(),
+        errors: Vec::new(),
+        nonfinite_applied: 0,
+        out_of_bounds_applied: 0,
+        worst: BTreeMap::new(),
+        solve_time_geomean_max_us: 0.0,
+        solve_time_max_us: 0.0,
+        wall_s,
+    };
+    let mut cases_csv = String::from(
+        "case,target,strategy,end,final_time_s,steps,safe,violated,nonfinite_applied,out_of_bounds_applied,\
+substituted_translational,substituted_attitude,substituted_robotic,relaxed_translational,relaxed_attitude,relaxed_robotic,\
+backup_translational,backup_attitude,backup_robotic,worst_barrier,worst_normalised_margin,solve_geomean_us,solve_max_us\n",
+    );
+    let mut min_csv = format!("case,{}\n", names.join(","));
+    let mut rows: Vec<String> = Vec::new();
+    let mut values: Vec<Vec<f64>> = Vec::new();
+    for (case, r) in cases.iter().zip(results) {
+        let r = match r {
+            Ok(r) => r,
+            Err(e) => {
+                summary.errors.push(format!("{}: {e}", case.name()));
+                continue;
+            }
+        };
+        if r.safe() {
+            summary.safe += 1;
+        } else {
+            summary.unsafe_cases.push(r.case.clone());
+        }
+        summary.nonfinite_applied += r.nonfinite_applied;
+        summary.out_of_bounds_applied += r.out_of_bounds_applied;
+        summary.solve_time_geomean_max_us = summary
+            .solve_time_geomean_max_us
+            .max(r.solve_time_us.geomean);
+        summary.solve_time_max_us = summary.solve_time_max_us.max(r.solve_time_us.max);
+        let normalised: Vec<f64> = names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| r.min_h.get(*n).copied().unwrap_or(f64::NAN) / scales[i])
+            .collect();
+        let (wi, wv) = normalised
+            .iter()
+            .enumerate()
+            .min_by(|a, b| a.1.total_cmp(b.1))
+            .map(|(i, v)| (i, *v))
+            .unwrap_or((0, f64::NAN));
+        for n in &names {
+            let h = r.min_h.get(*n).copied().unwrap_or(f64::NAN);
+            let e = summary
+                .worst
+                .entry(n.to_string())
+                .or_insert((f64::INFINITY, String::new()));
+            if h.is_nan() || h < e.0 {
+                *e = (h, r.case.clone());
+            }
+        }
+        let _ = writeln!(
+            cases_csv,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            r.case,
+            r.target,
+            r.strategy,
+            r.end,
+            r.final_time_s,
+            r.steps,
+            r.safe(),
+            r.violated.join(" "),
+            r.nonfinite_applied,
+            r.out_of_bounds_applied,
+            r.substituted_steps[0],
+            r.substituted_steps[1],
+            r.substituted_steps[2],
+            r.relaxed_steps[0],
+            r.relaxed_steps[1],
+            r.relaxed_steps[2],
+            r.backup_steps[0],
+            r.backup_steps[1],
+            r.backup_steps[2],
+            names[wi],
+            wv,
+            r.solve_time_us.geomean,
+            r.solve_time_us.max,
+        );
+        let _ = writeln!(
+            min_csv,
+            "{},{}",
+            r.case,
+            names
+                .iter()
+                .map(|n| r.min_h.get(*n).copied().unwrap_or(f64::NAN).to_string())
+                .collect::<Vec<_>>()
+                .join(",")
+        );
+        rows.push(r.case.clone());
+        values.push(normalised);
+    }
+    let write = |name: &str, text: &str| {
+        let p = dir.join(name);
+        std::fs::write(&p, text).map_err(|e| io(&p, e))
+    };
+    write("cases.csv", &cases_csv)?;
+    write("min_h.csv", &min_csv)?;
+    write(
+        "summary.json",
+        &(serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())? + "\n"),
+    )?;
+    write("report.md", &markdown(&summary, cases, results, &scales))?;
+    let barrier_names: Vec<String> = names.iter().map(|s| s.to_string()).collect();
+    sc_plots::redteam_margins(
+        &dir.join("figures/redteam_margins.svg"),
+        &sc_plots::RedTeamMargins {
+            cases: &rows,
+            barriers: &barrier_names,
+            values: &values,
+        },
+    )
+    .map_err(|e| e.to_string())?;
+    Ok(summary)
+}
+
+fn markdown(
+    s: &CampaignSummary,
+    cases: &[Case],
+    results: &[Result<CaseResult, String>],
+    scales: &sc_cbf::monitor::Barriers,
+) -> String {
+    let names = sc_mission::constraint_names();
+    let mut m = String::new();
+    let _ = writeln!(m, "# Red team of the safety layer\n");
+    let _ = writeln!(
+        m,
+        "**{} of {} cases safe**: every barrier ≥ 0 at every physics step (computed from the simulator's true state, never from a filter's report) and every applied command finite and within its bounds. {} non-finite and {} out-of-bound applied commands; wall time {:.1} s.\n",
+        s.safe, s.cases, s.nonfinite_applied, s.out_of_bounds_applied, s.wall_s
+    );
+    if !s.unsafe_cases.is_empty() {
+        let _ = writeln!(m, "Unsafe: {}\n", s.unsafe_cases.join(", "));
+    }
+    if !s.errors.is_empty() {
+        let _ = writeln!(m, "Could not run: {}\n", s.errors.join("; "));
+    }
+    let _ = writeln!(
+        m,
+        "Each case replaces the nominal controller of its target (`all`: all three) by the adversary for the whole mission. Columns: how the mission ended, the barrier closest to its boundary (value / barrier scale, `figures/redteam_margins.svg`), and per filter (translational/attitude/robotic) the steps on the substitute nominal, on the relaxed problem and on the backup law.\n"
+    );
+    let mut target = "";
+    for (case, r) in cases.iter().zip(results) {
+        if case.target.name() != target {
+            target = case.target.name();
+            let _ = writeln!(
+                m,
+                "\n## {target}\n\n| strategy | end | safe | closest barrier | margin / scale | substituted | relaxed | backup | solve geomean / max [µs] |\n|---|---|---|---|---|---|---|---|---|"
+            );
+        }
+        match r {
+            Ok(r) => {
+                let (wn, wv) = names
+                    .iter()
+                    .enumerate()
+                    .map(|(i, n)| (*n, r.min_h.get(*n).copied().unwrap_or(f64::NAN) / scales[i]))
+                    .min_by(|a, b| a.1.total_cmp(&b.1))
+                    .unwrap_or(("", f64::NAN));
+                let _ = writeln!(
+                    m,
+                    "| {} | {} | {} | {} | {:.3e} | {:?} | {:?} | {:?} | {:.1} / {:.0} |",
+                    r.strategy,
+                    r.end,
+                    if r.safe() { "yes" } else { "**NO**" },
+                    wn,
+                    wv,
+                    r.substituted_steps,
+                    r.relaxed_steps,
+                    r.backup_steps,
+                    r.solve_time_us.geomean,
+                    r.solve_time_us.max
+                );
+            }
+            Err(e) => {
+                let _ = writeln!(
+                    m,
+                    "| {} | error: {e} | | | | | | | |",
+                    case.strategy.name(case.target)
+                );
+            }
+        }
+    }
+    let _ = writeln!(
+        m,
+        "\n## Smallest value of every barrier over all cases\n\n| barrier | min h | case |\n|---|---|---|"
+    );
+    for (n, (v, c)) in &s.worst {
+        let _ = writeln!(m, "| {n} | {v:.3e} | {c} |");
+    }
+    m
+}
