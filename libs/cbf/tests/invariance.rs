@@ -1,187 +1,457 @@
-//! Closed-loop forward invariance per subsystem on its own model, with adversarial nominal
-//! commands held over the 0.1 s control period and the plant integrated at 0.01 s: every
-//! barrier stays ≥ 0 over a long run (checked at every physics step).
+//! Closed-loop forward invariance per subsystem on its own plant, at the paper's 10 Hz:
+//! adversarial nominal commands go through the filter once per 0.1 s sample, the safe
+//! command is held (zero-order hold) and the plant is integrated with RK4 at 0.01 s; every
+//! barrier is checked at every physics step, not only at the samples. Each test also
+//! checks that the nominal really was unsafe (the filter intervened, the nominal alone
+//! would have left the safe set), so none can pass vacuously.
 
 mod common;
 use common::*;
-use nalgebra::{Vector3, Vector6};
-use sc_cbf::robotic::Vector7;
-use sc_cbf::{AttitudeFilter, FilterStatus, RoboticFilter, TranslationalFilter};
-use sc_models::cw::ClohessyWiltshire;
+use nalgebra::{SMatrix, Vector3, Vector6};
+use sc_cbf::robotic::{Vector7, rk4_internal};
+use sc_cbf::translational::cw_drift;
+use sc_cbf::{
+    AttitudeFilter, AttitudeInput, FilterStatus, RoboticFilter, TranslationalFilter,
+    TranslationalInput,
+};
 use sc_models::quat;
+use sc_multibody::Vector13;
 
+/// Control period [s] and physics sub-steps per period.
 const TS: f64 = 0.1;
 const SUB: usize = 10;
-/// Control period and sub-steps of the robotic loop. At the paper's 0.1 s the light wrist
-/// (M_eff⁻¹ ≈ 400 1/(kg m²) on joint 7: 2 N m ≈ 800 rad/s²) moves too far within one
-/// held sample for the continuous-time conditions to hold; the robotic filter needs to
-/// run at ≥ 100 Hz (reported to the integrator).
-const ROB_TS: f64 = 0.01;
-const ROB_SUB: usize = 2;
 
-/// KNOWN FAILURE (reported): with the scenario's parameters h_AC reaches ≈ −1e-2 m. Two
-/// causes, both outside this crate's code: (1) `u_max_ac_m_s2 = 0.02` exceeds the braking
-/// authority along the corridor barrier, `‖∂ḧ_AC/∂f‖·F ≈ sin ψ·F/m ≈ 0.0023 m/s²`; (2) the
-/// auxiliary barrier's input gain `|ḣ|/u_max` vanishes at `ḣ = 0`, so once sampling lets h
-/// dip below `ε_AC/γ` while sliding along the wall the QP is infeasible whatever the
-/// actuators (the relaxed QP then takes over). Run with `--ignored`, optionally
-/// `U_MAX_AC=0.002 EPS_AC=5e-3`, to reproduce.
-#[test]
-#[ignore = "known: corridor u_max/ε tuning and the |ḣ|-gain of H at the wall; see doc"]
-fn translational_corridor_and_caz_invariant_under_adversarial_nominal() {
+// ------------------------------------------------------------------ translational
+
+/// What a closed-loop run saw.
+#[derive(Debug, Default)]
+struct Run {
+    min: Vec<f64>,
+    interventions: usize,
+    relaxed: usize,
+    steps: usize,
+}
+
+/// A nominal force `f_H(t, r_H, v_H)`.
+type ForceNominal<'a> = dyn FnMut(f64, &Vector3<f64>, &Vector3<f64>) -> Vector3<f64> + 'a;
+
+/// The servicer CoM on the CW model (F_H), the safe force held in the **body** frame over
+/// each sample while the body turns at a constant rate `omega_b` (so the force turns in
+/// F_H inside the sample, as on the real servicer), `steps` samples. Returns the smallest
+/// corridor and CAZ barriers over every physics step, and the final CoM distance.
+fn translational_run(
+    omega_b: Vector3<f64>,
+    steps: usize,
+    filtered: bool,
+    nominal: &mut ForceNominal,
+) -> (Run, f64) {
     let s = scenario();
     let n = mean_motion(&s);
-    let mut params = sc_cbf::TranslationalParams::from_scenario(&s, MASS);
-    if let Ok(v) = std::env::var("U_MAX_AC") {
-        params.u_max_ac = v.parse().unwrap();
-    }
-    if let Ok(v) = std::env::var("EPS_AC") {
-        params.eps_ac = v.parse().unwrap();
-    }
-    let mut f = TranslationalFilter::new(params);
+    let mut f = TranslationalFilter::from_scenario(&s, mass());
     let p = f.params.clone();
-    let cw = ClohessyWiltshire { n, mass: MASS };
-    let (ad, bd) = cw.discretize(TS / SUB as f64);
     let q_hr0 = s.reference_frame.attitude_in_hill;
-    let q_hr = |t: f64| quat::mul(&quat::from_axis_angle(&Vector3::z(), -n * t), &q_hr0);
     let r_r0 = Vector3::from(s.servicer.initial_position_m);
-    let r_h0 = quat::rotate(&q_hr0, &r_r0);
-    let v_h0 = quat::rotate(&q_hr0, &Vector3::from(s.servicer.initial_velocity_m_s))
-        - Vector3::new(0.0, 0.0, n).cross(&r_h0);
-    let mut x = nalgebra::Vector6::new(r_h0.x, r_h0.y, r_h0.z, v_h0.x, v_h0.y, v_h0.z);
-    let (mut min_ac, mut min_caz) = (f64::INFINITY, f64::INFINITY);
-    let mut interventions = 0;
-    for k in 0..4000 {
+    let v_r0 = Vector3::from(s.servicer.initial_velocity_m_s);
+    let mut r = quat::rotate(&q_hr0, &r_r0);
+    let mut v = quat::rotate(&q_hr0, &v_r0) - Vector3::new(0.0, 0.0, n).cross(&r);
+    let mut q_rb = quat::IDENTITY;
+    let mut run = Run {
+        min: vec![f64::INFINITY; 2],
+        ..Run::default()
+    };
+    let h = TS / SUB as f64;
+    let barriers = |t: f64, r: &Vector3<f64>| {
+        let d = quat::rotate(&q_hr_at(&s, n, t), &p.axis_r);
+        [
+            d.dot(r) - r.norm() * p.cos_psi,
+            r.norm_squared() - p.r_caz * p.r_caz,
+        ]
+    };
+    let b0 = barriers(0.0, &r);
+    assert!(b0[0] > 0.0 && b0[1] > 0.0, "the run starts safe: {b0:?}");
+    for k in 0..steps {
         let t = k as f64 * TS;
-        let r: Vector3<f64> = x.fixed_rows::<3>(0).into();
-        let v: Vector3<f64> = x.fixed_rows::<3>(3).into();
-        // adversarial: full thrust towards the target, sweeping sideways
-        let f_r =
-            Vector3::new(1.0, 0.8 * (0.05 * t).sin(), 0.8 * (0.031 * t).cos()).normalize() * 9.0;
-        let f_nom = quat::rotate(&q_hr(t), &f_r);
-        let input = sc_cbf::TranslationalInput::circular(r, v, q_hr(t), n, quat::IDENTITY);
-        let out = f.filter(&input, &f_nom);
-        assert!(
-            out.report.status != FilterStatus::Fallback,
-            "step {k}: {:?}",
-            out.report
-        );
-        if out.report.status != FilterStatus::Skipped {
-            interventions += 1;
-        }
-        for j in 1..=SUB {
-            x = ad * x + bd * out.u;
-            let tt = t + j as f64 * TS / SUB as f64;
-            let r: Vector3<f64> = x.fixed_rows::<3>(0).into();
-            let d = quat::rotate(&q_hr(tt), &p.axis_r);
-            let hac = d.dot(&r) - r.norm() * p.cos_psi;
-            min_ac = min_ac.min(hac);
-            min_caz = min_caz.min(r.norm_squared() - p.r_caz * p.r_caz);
+        let mut x = TranslationalInput::circular(r, v, q_hr_at(&s, n, t), n, q_rb);
+        x.omega_b = omega_b;
+        let f_nom = nominal(t, &r, &v);
+        run.steps += 1;
+        let f_b = if filtered {
+            let out = f.filter(&x, &f_nom);
+            assert_ne!(
+                out.report.status,
+                FilterStatus::Fallback,
+                "step {k}: {:?}",
+                out.report
+            );
+            assert!(out.actuated.amax() <= p.force_max);
+            if out.report.status != FilterStatus::Skipped {
+                run.interventions += 1;
+            }
+            if out.report.status == FilterStatus::Relaxed {
+                run.relaxed += 1;
+            }
+            out.actuated
+        } else {
+            // the nominal alone, saturated by the thrusters (body-frame box)
+            let r_bh = (quat::to_matrix(&q_hr_at(&s, n, t)) * quat::to_matrix(&q_rb)).transpose();
+            (r_bh * f_nom).map(|c| c.clamp(-p.force_max, p.force_max))
+        };
+        // RK4 with the body-fixed force turning with the body and the frame
+        let force_h = |tt: f64, q: &quat::Quat| {
+            quat::to_matrix(&q_hr_at(&s, n, tt)) * quat::to_matrix(q) * f_b
+        };
+        for j in 0..SUB {
+            let t0 = t + j as f64 * h;
+            let q0 = q_rb;
+            let qm = quat::integrate_body_rate(&q0, &omega_b, h / 2.0);
+            let q1 = quat::integrate_body_rate(&q0, &omega_b, h);
+            let acc = |tt: f64, q: &quat::Quat, r: &Vector3<f64>, v: &Vector3<f64>| {
+                cw_drift(n, r, v) + force_h(tt, q) / p.mass
+            };
+            let (k1r, k1v) = (v, acc(t0, &q0, &r, &v));
+            let (r2, v2) = (r + k1r * (h / 2.0), v + k1v * (h / 2.0));
+            let (k2r, k2v) = (v2, acc(t0 + h / 2.0, &qm, &r2, &v2));
+            let (r3, v3) = (r + k2r * (h / 2.0), v + k2v * (h / 2.0));
+            let (k3r, k3v) = (v3, acc(t0 + h / 2.0, &qm, &r3, &v3));
+            let (r4, v4) = (r + k3r * h, v + k3v * h);
+            let (k4r, k4v) = (v4, acc(t0 + h, &q1, &r4, &v4));
+            r += (k1r + k2r * 2.0 + k3r * 2.0 + k4r) * (h / 6.0);
+            v += (k1v + k2v * 2.0 + k3v * 2.0 + k4v) * (h / 6.0);
+            q_rb = q1;
+            let b = barriers(t0 + h, &r);
+            for (m, bi) in run.min.iter_mut().zip(b) {
+                *m = m.min(bi);
+            }
         }
     }
-    let r: Vector3<f64> = x.fixed_rows::<3>(0).into();
+    (run, r.norm())
+}
+
+/// The old known failure, now fixed by the sampled-data rows: full thrust (9 N > F)
+/// towards the target, sweeping sideways into the corridor's wall (≈ 5.7° off the axis) —
+/// into the corner of the corridor and the CAZ. Alone it leaves the corridor and enters
+/// the CAZ.
+#[test]
+fn translational_corridor_and_caz_invariant_under_a_nominal_pushing_into_the_corner() {
+    let s = scenario();
+    let n = mean_motion(&s);
+    let mut nominal = |t: f64, _: &Vector3<f64>, _: &Vector3<f64>| {
+        let f_r =
+            Vector3::new(1.0, 0.1 * (0.05 * t).sin(), 0.1 * (0.031 * t).cos()).normalize() * 9.0;
+        quat::rotate(&q_hr_at(&s, n, t), &f_r)
+    };
+    let w = Vector3::new(0.02, -0.03, 0.05);
+    let (open, _) = translational_run(w, 4000, false, &mut nominal);
+    let (run, dist) = translational_run(w, 4000, true, &mut nominal);
     println!(
-        "min h_AC = {min_ac:e}, min h_CAZ = {min_caz:e}, final |r| = {}, interventions {interventions}",
-        r.norm()
+        "{run:?}, final |r| = {dist}; the nominal alone: {:?}",
+        open.min
     );
-    assert!(min_ac >= 0.0 && min_caz >= 0.0);
-    assert!(interventions > 100, "the nominal must actually be unsafe");
     assert!(
-        r.norm() < 2.5,
-        "the servicer still approached the CAZ boundary"
+        open.min[0] < 0.0 && open.min[1] < 0.0,
+        "the nominal alone must violate both: {open:?}"
+    );
+    assert!(
+        run.min[0] >= 0.0,
+        "approach corridor: min h = {:e}",
+        run.min[0]
+    );
+    assert!(
+        run.min[1] >= 0.0,
+        "collision avoidance zone: min h = {:e}",
+        run.min[1]
+    );
+    assert_eq!(run.relaxed, 0, "the state left the certified set");
+    assert!(
+        run.interventions > 1000,
+        "the nominal must actually be unsafe: {run:?}"
+    );
+    assert!(
+        dist < 2.0,
+        "the servicer was pushed to the CAZ boundary ({dist} m)"
     );
 }
 
+/// A random saturating nominal: a new direction (biased towards the target) every 3 s at
+/// 1.5 F, with the body turning at 0.15 rad/s.
 #[test]
-fn attitude_cone_and_rates_invariant_under_adversarial_nominal() {
+fn translational_corridor_and_caz_invariant_under_a_random_saturating_nominal() {
     let s = scenario();
-    let mut f = AttitudeFilter::from_scenario(&s);
+    let n = mean_motion(&s);
+    let mut nominal = |t: f64, _: &Vector3<f64>, _: &Vector3<f64>| {
+        // the direction of each 3 s slot from its own seed
+        let mut rng = Lcg(77 + 1000 * (t / 3.0) as u64);
+        rng.next();
+        let dir = (Vector3::new(0.6, 0.0, 0.0) + rng.v3(1.0)).normalize();
+        quat::rotate(&q_hr_at(&s, n, t), &(dir * 1.5 * s.limits.force_max_n))
+    };
+    let w = Vector3::new(-0.1, 0.05, 0.1);
+    let (run, dist) = translational_run(w, 4000, true, &mut nominal);
+    let (open, _) = translational_run(w, 4000, false, &mut nominal);
+    println!(
+        "{run:?}, final |r| = {dist}; the nominal alone: {:?}",
+        open.min
+    );
+    assert!(
+        open.min[0] < 0.0 || open.min[1] < 0.0,
+        "the nominal alone must be unsafe: {open:?}"
+    );
+    assert!(
+        run.min[0] >= 0.0,
+        "approach corridor: min h = {:e}",
+        run.min[0]
+    );
+    assert!(
+        run.min[1] >= 0.0,
+        "collision avoidance zone: min h = {:e}",
+        run.min[1]
+    );
+    assert_eq!(run.relaxed, 0, "the state left the certified set");
+    assert!(
+        run.interventions > 500,
+        "the nominal must actually be unsafe: {run:?}"
+    );
+}
+
+// ------------------------------------------------------------------ attitude
+
+/// What an attitude run saw.
+#[derive(Debug, Default)]
+struct AttitudeRun {
+    min_los: f64,
+    min_rate: f64,
+    interventions: usize,
+    relaxed: usize,
+    /// Largest least violation `t*` of the relaxed steps (fraction of the braking
+    /// authority), and the first time it happened.
+    worst_violation: f64,
+    first_relaxed_s: Option<f64>,
+}
+
+/// A rigid body with the servicer's locked inertia at the stowed configuration, `ω̇ = P τ
+/// + r(ω)` with `P = I⁻¹`, `r = −I⁻¹ (ω × I ω)` — the attitude input's model, exactly (the
+/// contract rows from the model's wrench map) — pointing at the tumbling target's grasping
+/// point from a fixed CoM, under saturating adversarial torques; the line of sight and the
+/// rate limits at every physics step. `filtered = false`: the nominal alone (saturated).
+fn attitude_run(filtered: bool, steps: usize) -> AttitudeRun {
+    let s = scenario();
+    let robot = robot();
+    let mut f = AttitudeFilter::from_scenario(&s, mass());
     let p = f.params.clone();
-    let i = inertia();
-    let ii = i.try_inverse().unwrap();
-    let r_r = Vector3::new(-2.5, 0.0, 0.0);
-    // start pointing at the grasping point
-    let x0 = att_input(r_r, quat::IDENTITY, Vector3::zeros(), 0.0);
-    let s0 = (x0.grasp_r - r_r).normalize();
-    let axis = p.boresight_b.cross(&s0);
-    let mut q = quat::from_axis_angle(&axis, axis.norm().asin());
-    let mut w = Vector3::zeros();
-    let (mut min_los, mut min_rate) = (f64::INFINITY, f64::INFINITY);
-    let mut interventions = 0;
-    for k in 0..4000 {
-        let t = k as f64 * TS;
-        let mut x = att_input(r_r, q, w, t);
-        x.v_r = Vector3::zeros();
-        x.a_drift_r = Vector3::zeros();
-        x.xi_r = Vector3::zeros();
-        let tau_nom = Vector3::new(10.0 * (0.02 * t).sin(), 10.0, -10.0 * (0.013 * t).cos());
-        let out = f.filter(&x, &tau_nom);
-        assert!(
-            out.report.status != FilterStatus::Fallback,
-            "step {k}: {:?}",
-            out.report
-        );
-        if out.report.status != FilterStatus::Skipped {
-            interventions += 1;
+    let th0 = theta0(&s);
+    let pl = robot
+        .base_angular_dynamics(
+            &th0,
+            &Vector7::zeros(),
+            &Vector3::zeros(),
+            &Vector3::zeros(),
+        )
+        .unwrap()
+        .p_locked;
+    let inertia = pl.try_inverse().unwrap();
+    let k_tau: SMatrix<f64, 7, 3> = robot
+        .reduced_arm_dynamics(
+            &th0,
+            &Vector7::zeros(),
+            &Vector3::zeros(),
+            &Vector6::zeros(),
+        )
+        .unwrap()
+        .wrench_map
+        .fixed_columns::<3>(3)
+        .into();
+    let com = Vector3::new(-2.5, 0.0, 0.0);
+    let mut q = pointing(&s, &com, 0.0, &Vector3::z(), 0.0);
+    let mut w = Vector3::<f64>::zeros();
+    let input = |t: f64, q: &quat::Quat, w: &Vector3<f64>| {
+        let (g, gv, ga, w_t) = grasp_at(&s, t);
+        AttitudeInput {
+            q_rb: *q,
+            omega_b: *w,
+            p: pl,
+            r: -(pl * w.cross(&(inertia * w))),
+            r_r: com,
+            v_r: Vector3::zeros(),
+            a_drift_r: Vector3::zeros(),
+            grasp_r: g,
+            grasp_vel_r: gv,
+            grasp_acc_r: ga,
+            xi_r: Vector3::zeros(),
+            omega_target_b: quat::to_matrix(q).transpose() * w_t,
+            joint_coupling: k_tau,
+            joint_coupling_force: nalgebra::SVector::zeros(),
         }
-        let tau = out.u;
-        let h = TS / SUB as f64;
-        for j in 1..=SUB {
-            let fdyn = |q: &quat::Quat, w: &Vector3<f64>| {
-                (quat::kinematics(q, w), ii * (tau - w.cross(&(i * w))))
-            };
-            let add = |q: &quat::Quat, d: &quat::Quat, s: f64| {
-                [
-                    q[0] + d[0] * s,
-                    q[1] + d[1] * s,
-                    q[2] + d[2] * s,
-                    q[3] + d[3] * s,
-                ]
-            };
-            let (k1q, k1w) = fdyn(&q, &w);
-            let (k2q, k2w) = fdyn(&add(&q, &k1q, h / 2.0), &(w + k1w * h / 2.0));
-            let (k3q, k3w) = fdyn(&add(&q, &k2q, h / 2.0), &(w + k2w * h / 2.0));
-            let (k4q, k4w) = fdyn(&add(&q, &k3q, h), &(w + k3w * h));
-            for c in 0..4 {
-                q[c] += h / 6.0 * (k1q[c] + 2.0 * k2q[c] + 2.0 * k3q[c] + k4q[c]);
+    };
+    let los = |t: f64, q: &quat::Quat| {
+        let s_b = quat::to_matrix(q).transpose() * (grasp_at(&s, t).0 - com).normalize();
+        p.boresight_b.dot(&s_b) - p.cos_beta
+    };
+    let wdot = |tau: &Vector3<f64>, w: &Vector3<f64>| pl * (tau - w.cross(&(inertia * w)));
+    let mut run = AttitudeRun {
+        min_los: los(0.0, &q),
+        min_rate: f64::INFINITY,
+        ..AttitudeRun::default()
+    };
+    let h = TS / SUB as f64;
+    for k in 0..steps {
+        let t = k as f64 * TS;
+        let tau_nom = Vector3::new(10.0 * (0.02 * t).sin(), 10.0, -10.0 * (0.013 * t).cos());
+        let tau = if filtered {
+            let out = f.filter(&input(t, &q, &w), &tau_nom);
+            assert_ne!(
+                out.report.status,
+                FilterStatus::Fallback,
+                "step {k}: {:?}",
+                out.report
+            );
+            assert!(out.u.amax() <= p.torque_max);
+            if out.report.status != FilterStatus::Skipped {
+                run.interventions += 1;
             }
-            q = quat::normalized(&q).unwrap();
-            w += (k1w + 2.0 * k2w + 2.0 * k3w + k4w) * (h / 6.0);
-            let xs = att_input(r_r, q, w, t + j as f64 * h);
-            let s_b = quat::to_matrix(&q).transpose() * (xs.grasp_r - r_r).normalize();
-            min_los = min_los.min(p.boresight_b.dot(&s_b) - p.cos_beta);
+            if out.report.status == FilterStatus::Relaxed {
+                run.relaxed += 1;
+                run.worst_violation = run.worst_violation.max(out.report.violation);
+                run.first_relaxed_s.get_or_insert(t);
+            }
+            out.u
+        } else {
+            tau_nom.map(|c| c.clamp(-p.torque_max, p.torque_max))
+        };
+        for j in 0..SUB {
+            (q, w) = rigid_rk4(&q, &w, h, &|w| wdot(&tau, w));
+            run.min_los = run.min_los.min(los(t + (j + 1) as f64 * h, &q));
             for a in 0..3 {
-                min_rate = min_rate
+                run.min_rate = run
+                    .min_rate
                     .min(p.omega_max[a] - w[a])
                     .min(w[a] - p.omega_min[a]);
             }
         }
     }
-    println!("min h_ATT = {min_los:e}, min h_omega = {min_rate:e}, interventions {interventions}");
-    assert!(min_los >= 0.0 && min_rate >= 0.0);
-    assert!(interventions > 100);
+    run
 }
 
 #[test]
-fn robotic_limits_and_link_base_invariant_under_adversarial_nominal() {
+fn attitude_cone_and_rates_invariant_under_adversarial_nominal() {
+    let open = attitude_run(false, 3000);
+    let run = attitude_run(true, 3000);
+    println!("{run:?}; the nominal alone: {open:?}");
+    assert!(
+        open.min_los < 0.0 && open.min_rate < 0.0,
+        "the nominal alone must be unsafe: {open:?}"
+    );
+    assert!(
+        run.min_los >= 0.0,
+        "line of sight: min h = {:e}",
+        run.min_los
+    );
+    assert!(
+        run.min_rate >= 0.0,
+        "rate limits: min h = {:e}",
+        run.min_rate
+    );
+    assert!(run.interventions > 1000, "{run:?}");
+}
+
+/// KNOWN SRC/DESIGN ISSUE (reported): under the same adversarial nominal the attitude
+/// filter lets the body roll about the boresight at its rate rows' equilibrium
+/// (0.136 rad/s) while coning near the cone's edge; there the line-of-sight row needs
+/// `ḧ ≥ φ_req ≈ 2–6e-3 rad/s²` but the torque box can only add `‖Pᵀ(d × s_B)‖₁ T ≈
+/// 9e-3` to a drift of `≈ −7.5e-3` (the braking requirement `μ + M₂ + M₃T ≈ 0.034` is
+/// ~3.5× the authority): 9 relaxed steps in 300 s, `t*` up to 1.06. The barriers still
+/// hold (previous test) but the certificate is lost.
+#[test]
+#[ignore = "src issue: the attitude certified set is not forward invariant (LOS row infeasible while coning)"]
+fn attitude_certified_set_is_forward_invariant_under_adversarial_nominal() {
+    let run = attitude_run(true, 3000);
+    assert_eq!(run.relaxed, 0, "{run:?}");
+}
+
+/// One RK4 step of `q̇ = ½ q ⊗ ω`, `ω̇ = f(ω)` (quaternion renormalised).
+fn rigid_rk4(
+    q: &quat::Quat,
+    w: &Vector3<f64>,
+    h: f64,
+    f: &dyn Fn(&Vector3<f64>) -> Vector3<f64>,
+) -> (quat::Quat, Vector3<f64>) {
+    let add = |q: &quat::Quat, d: &quat::Quat, s: f64| {
+        [
+            q[0] + d[0] * s,
+            q[1] + d[1] * s,
+            q[2] + d[2] * s,
+            q[3] + d[3] * s,
+        ]
+    };
+    let (k1q, k1w) = (quat::kinematics(q, w), f(w));
+    let (q2, w2) = (add(q, &k1q, h / 2.0), w + k1w * (h / 2.0));
+    let (k2q, k2w) = (quat::kinematics(&q2, &w2), f(&w2));
+    let (q3, w3) = (add(q, &k2q, h / 2.0), w + k2w * (h / 2.0));
+    let (k3q, k3w) = (quat::kinematics(&q3, &w3), f(&w3));
+    let (q4, w4) = (add(q, &k3q, h), w + k3w * h);
+    let (k4q, k4w) = (quat::kinematics(&q4, &w4), f(&w4));
+    let mut qn = *q;
+    for c in 0..4 {
+        qn[c] += h / 6.0 * (k1q[c] + 2.0 * k2q[c] + 2.0 * k3q[c] + k4q[c]);
+    }
+    (
+        quat::normalized(&qn).unwrap(),
+        w + (k1w + k2w * 2.0 + k3w * 2.0 + k4w) * (h / 6.0),
+    )
+}
+
+// ------------------------------------------------------------------ robotic
+
+/// What a robotic run saw.
+#[derive(Debug)]
+struct RoboticRun {
+    /// Smallest barrier over every physics step and its name.
+    min_h: f64,
+    worst: &'static str,
+    interventions: usize,
+    relaxed: usize,
+    /// Sample times of the relaxed steps [s].
+    relaxed_at: Vec<f64>,
+}
+
+/// The arm on the free-floating base at the paper's 10 Hz, with the servicer model: the
+/// filter's input from the model at every sample, the plant integrated exactly as the
+/// simulator does (`rk4_internal`, the base free to turn), every joint-angle, joint-rate
+/// and link–base barrier checked at every physics step. The nominal (a PD on the arm's
+/// inertia) drives the joints beyond their limits, then towards the pitch joints'
+/// singular band and the bus, then across the whole range. `filtered = false`: the
+/// nominal alone (saturated).
+fn robotic_run(filtered: bool) -> RoboticRun {
     let s = scenario();
     let robot = robot();
-    let mut f = RoboticFilter::from_scenario(&s);
+    let mut f = RoboticFilter::from_scenario(&s, robot.clone());
     let p = f.params.clone();
+    assert!((p.period - TS).abs() < 1e-12, "the paper's 10 Hz");
     let base = robot.base_sphere().unwrap().clone();
     let arm: Vec<usize> = robot.arm_spheres().map(|(i, _)| i).collect();
-    let mut th = theta0(&s);
-    let mut thd = Vector7::zeros();
-    let acc = |th: &Vector7, thd: &Vector7, tau: &Vector7| {
-        let red = robot
-            .reduced_arm_dynamics(th, thd, &Vector3::zeros(), &Vector6::zeros())
-            .unwrap();
-        red.m_eff.cholesky().unwrap().solve(&(tau - red.c_eff))
+    let barriers = |th: &Vector7, thd: &Vector7| {
+        let mut h = [0.0; sc_cbf::robotic::N];
+        for i in 0..7 {
+            h[i] = (th[i] - p.theta_min[i]) * (p.theta_max[i] - th[i]);
+            h[7 + i] = p.theta_dot_max[i] - thd[i];
+            h[14 + i] = thd[i] + p.theta_dot_max[i];
+        }
+        let kin = robot.kinematics(th);
+        for (c, &idx) in arm.iter().enumerate() {
+            let st = robot.sphere_state(&kin, idx).unwrap();
+            h[21 + c] =
+                (st.center - base.center).norm_squared() - (st.radius + base.radius).powi(2);
+        }
+        h
     };
-    let mut min_h = f64::INFINITY;
-    let mut worst = "";
-    let mut interventions = 0;
-    // two adversarial goals: beyond the joint limits, then folded back onto the bus
+    let (mut th, mut thd, mut w) = (theta0(&s), Vector7::zeros(), Vector3::zeros());
+    let mut min_h = [f64::INFINITY; sc_cbf::robotic::N];
+    let mut run = RoboticRun {
+        min_h: 0.0,
+        worst: "",
+        interventions: 0,
+        relaxed: 0,
+        relaxed_at: Vec::new(),
+    };
     let goals = [
         Vector7::from_fn(|i, _| {
             if i % 2 == 0 {
@@ -190,75 +460,78 @@ fn robotic_limits_and_link_base_invariant_under_adversarial_nominal() {
                 p.theta_min[i] - 1.0
             }
         }),
-        Vector7::from([2.0, -2.6, 0.0, -0.5, 0.0, 2.5, 0.0]),
+        Vector7::from([2.0, -0.2, 0.0, 0.2, 0.0, -0.2, 0.0]),
+        Vector7::from([-2.0, -1.9, 2.5, 2.7, -2.5, -1.9, 2.5]),
     ];
-    let ts = ROB_TS;
-    let steps = (60.0 / ts) as usize;
+    let steps = 900;
+    let h = p.physics_step;
     for k in 0..steps {
-        let goal = goals[(2 * k / steps) % 2];
-        let x = rob_input_zero(&robot, th, thd);
+        let goal = goals[(k * goals.len()) / steps];
+        let x = sc_cbf::robotic_input_from_model(
+            &robot,
+            &th,
+            &thd,
+            &w,
+            &Vector3::zeros(),
+            &Vector3::zeros(),
+        )
+        .expect("model terms");
         let tau_nom: Vector7 = x.m_eff * ((goal - th) * 4.0 - thd * 1.0);
-        let out = f.filter(&x, &tau_nom);
-        assert!(
-            out.report.status != FilterStatus::Fallback,
-            "step {k}: {:?}",
-            out.report
-        );
-        if out.report.status != FilterStatus::Skipped {
-            interventions += 1;
+        let tau = if filtered {
+            let out = f.filter(&x, &tau_nom);
+            assert_ne!(
+                out.report.status,
+                FilterStatus::Fallback,
+                "step {k}: {:?}",
+                out.report
+            );
+            assert!(out.u.amax() <= p.torque_max);
+            if out.report.status != FilterStatus::Skipped {
+                run.interventions += 1;
+            }
+            if out.report.status == FilterStatus::Relaxed {
+                run.relaxed += 1;
+                run.relaxed_at.push(k as f64 * TS);
+            }
+            out.u
+        } else {
+            tau_nom.map(|c| c.clamp(-p.torque_max, p.torque_max))
+        };
+        let mut u = Vector13::zeros();
+        u.fixed_rows_mut::<7>(6).copy_from(&tau);
+        for _ in 0..SUB {
+            (th, thd, w) = rk4_internal(&robot, &th, &thd, &w, &u, h).expect("finite");
+            for (m, b) in min_h.iter_mut().zip(barriers(&th, &thd)) {
+                *m = m.min(b);
+            }
         }
-        let tau = out.u;
-        let h = ts / ROB_SUB as f64;
-        for _ in 0..ROB_SUB {
-            let k1 = acc(&th, &thd, &tau);
-            let (t2, d2) = (th + thd * (h / 2.0), thd + k1 * (h / 2.0));
-            let k2 = acc(&t2, &d2, &tau);
-            let (t3, d3) = (th + d2 * (h / 2.0), thd + k2 * (h / 2.0));
-            let k3 = acc(&t3, &d3, &tau);
-            let (t4, d4) = (th + d3 * h, thd + k3 * h);
-            let k4 = acc(&t4, &d4, &tau);
-            th += (thd + d2 * 2.0 + d3 * 2.0 + d4) * (h / 6.0);
-            thd += (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (h / 6.0);
-            let kin = robot.kinematics(&th);
-            for i in 0..7 {
-                for (v, name) in [
-                    (
-                        (th[i] - p.theta_min[i]) * (p.theta_max[i] - th[i]),
-                        sc_cbf::names::ROBOTIC[i],
-                    ),
-                    (p.theta_dot_max[i] - thd[i], sc_cbf::names::ROBOTIC[7 + i]),
-                    (thd[i] + p.theta_dot_max[i], sc_cbf::names::ROBOTIC[14 + i]),
-                ] {
-                    if v < min_h {
-                        min_h = v;
-                        worst = name;
-                    }
-                }
-            }
-            for (c, &idx) in arm.iter().enumerate() {
-                let st = robot.sphere_state(&kin, idx).unwrap();
-                let v =
-                    (st.center - base.center).norm_squared() - (st.radius + base.radius).powi(2);
-                if v < min_h {
-                    min_h = v;
-                    worst = sc_cbf::names::ROBOTIC[21 + c];
-                }
-            }
+        if !filtered && min_h.iter().any(|h| *h < 0.0) {
+            break; // the nominal alone has left the safe set
         }
     }
-    println!("min h = {min_h:e} ({worst}), interventions {interventions}");
-    assert!(min_h >= 0.0, "{worst}: {min_h}");
-    assert!(interventions > 100);
+    let (worst, value) =
+        min_h.iter().enumerate().fold(
+            (0, f64::INFINITY),
+            |a, (i, v)| if *v < a.1 { (i, *v) } else { a },
+        );
+    run.min_h = value;
+    run.worst = sc_cbf::names::ROBOTIC[worst];
+    run
 }
 
-fn rob_input_zero(robot: &sc_multibody::Robot, th: Vector7, thd: Vector7) -> sc_cbf::RoboticInput {
-    sc_cbf::robotic_input_from_model(
-        robot,
-        &th,
-        &thd,
-        &Vector3::zeros(),
-        &Vector3::zeros(),
-        &Vector3::zeros(),
-    )
-    .unwrap()
+#[test]
+fn robotic_limits_and_link_base_invariant_at_10_hz_under_adversarial_nominal() {
+    let open = robotic_run(false);
+    let run = robotic_run(true);
+    println!(
+        "{run:?}; the nominal alone: min h = {:e} ({})",
+        open.min_h, open.worst
+    );
+    assert!(open.min_h < 0.0, "the nominal alone must be unsafe");
+    assert!(run.min_h >= 0.0, "{}: {:e}", run.worst, run.min_h);
+    assert!(
+        run.interventions > 300,
+        "the nominal must actually be unsafe ({})",
+        run.interventions
+    );
 }

@@ -1,80 +1,175 @@
-//! Shared fixtures of the sc-cbf integration tests.
+//! Shared fixtures of the sc-cbf integration tests: the default scenario, the servicer
+//! model, realistic filter inputs built from the model (the way `sc-mission` builds them —
+//! replicated here, sc-mission is not a dependency), deterministic random numbers and an
+//! independent QP toolbox (KKT multipliers, brute-force active sets, Clarabel references).
 #![allow(dead_code)]
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{DMatrix, DVector, SMatrix, SVector, Vector3, Vector6};
+use sc_cbf::attitude::{tidal_acceleration, xi_att_from_force};
+use sc_cbf::barrier::Row;
+use sc_cbf::qp::{QpEngine, QpOutcome, SolverParams};
 use sc_cbf::robotic::{Vector7, robotic_input_from_model};
 use sc_cbf::{AttitudeInput, RoboticInput, TranslationalInput};
-use sc_models::quat;
+use sc_models::quat::{self, Quat};
 use sc_multibody::Robot;
 use sc_scenario::Scenario;
 use std::path::PathBuf;
+use std::sync::{Arc, OnceLock};
 
 pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
 pub fn scenario() -> Scenario {
-    Scenario::load(&root().join(sc_scenario::DEFAULT_SCENARIO)).expect("scenario loads")
+    static S: OnceLock<Scenario> = OnceLock::new();
+    S.get_or_init(|| {
+        Scenario::load(&root().join(sc_scenario::DEFAULT_SCENARIO)).expect("scenario loads")
+    })
+    .clone()
 }
 
-pub fn robot() -> Robot {
-    Robot::from_urdf_file(&scenario().urdf_path()).expect("URDF loads")
+/// The servicer model of the default scenario (loaded once).
+pub fn robot() -> Arc<Robot> {
+    static R: OnceLock<Arc<Robot>> = OnceLock::new();
+    R.get_or_init(|| Arc::new(Robot::from_urdf_file(&scenario().urdf_path()).expect("URDF loads")))
+        .clone()
 }
 
-/// Servicer mass used by the translational tests [kg].
-pub const MASS: f64 = 270.0;
+/// The servicer's total mass [kg] (what `SafetyLayer::from_scenario` gives the filters).
+pub fn mass() -> f64 {
+    robot().total_mass()
+}
 
 pub fn mean_motion(s: &Scenario) -> f64 {
     let a = s.orbit.earth_radius_m + s.orbit.altitude_m;
     (s.orbit.earth_mu_m3_s2 / (a * a * a)).sqrt()
 }
 
-/// Translational input with the servicer at `r_r` (F_R) moving at `v_r` (F_R components
-/// of the Hill-frame rate), attitude `q_rb`.
+/// `q_HR` at time `t` on the circular orbit: F_H turns at `ω_H = n ẑ_H` relative to the
+/// inertially fixed F_R, so `R_HR(t) = R_z(−n t) R_HR(0)`.
+pub fn q_hr_at(s: &Scenario, n: f64, t: f64) -> Quat {
+    quat::mul(
+        &quat::from_axis_angle(&Vector3::z(), -n * t),
+        &s.reference_frame.attitude_in_hill,
+    )
+}
+
+/// Translational input for the servicer CoM at `r_r` moving at `v_r` (both in the
+/// inertially fixed F_R), attitude `q_rb`, body rate `omega_b`, at t = 0 of the circular
+/// orbit: `r_H = R_HR r_R`, `v_H = R_HR v_R − ω_H × r_H`.
 pub fn tr_input(
     s: &Scenario,
     r_r: Vector3<f64>,
     v_r: Vector3<f64>,
-    q_rb: quat::Quat,
+    q_rb: Quat,
+    omega_b: Vector3<f64>,
 ) -> TranslationalInput {
+    let n = mean_motion(s);
     let q_hr = s.reference_frame.attitude_in_hill;
     let r_hr = quat::to_matrix(&q_hr);
-    TranslationalInput::circular(r_hr * r_r, r_hr * v_r, q_hr, mean_motion(s), q_rb)
+    let r_h = r_hr * r_r;
+    let w = Vector3::new(0.0, 0.0, n);
+    let mut x = TranslationalInput::circular(r_h, r_hr * v_r - w.cross(&r_h), q_hr, n, q_rb);
+    x.omega_b = omega_b;
+    x
 }
 
-pub fn inertia() -> Matrix3<f64> {
-    Matrix3::new(55.2, 1.2, -0.8, 1.2, 46.0, 0.5, -0.8, 0.5, 50.8)
+/// The target's tumbling motion: grasping point `R_RT(t) p_G,T` in F_R and its first two
+/// derivatives, and `ω_T` in F_R (the default target spins about a principal axis, so
+/// `ω_T` is constant and `R_RT(t) = exp(t [ω_T]×)`).
+pub fn grasp_at(s: &Scenario, t: f64) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+    let wt = Vector3::from(s.target.initial_omega_rad_s);
+    let q_rt0 = s.target.initial_attitude;
+    let w_r = quat::to_matrix(&q_rt0) * wt;
+    let q = quat::mul(&quat::from_axis_angle(&w_r, w_r.norm() * t), &q_rt0);
+    let p = quat::to_matrix(&q) * Vector3::from(s.target.grasp_point_m);
+    let v = w_r.cross(&p);
+    (p, v, w_r.cross(&v), w_r)
 }
 
-/// Attitude input: servicer at `r_r`, attitude `q_rb`, rate `w`; target tumbling about
-/// -x_R at 0.08 rad/s, grasping point at angle `phase`.
-pub fn att_input(
-    r_r: Vector3<f64>,
-    q_rb: quat::Quat,
-    w: Vector3<f64>,
-    phase: f64,
-) -> AttitudeInput {
-    let wt = Vector3::new(-0.08, 0.0, 0.0);
-    let p_t = Vector3::new(-0.55, 0.12, 0.0);
-    let r_rt = quat::to_matrix(&quat::from_axis_angle(&wt, wt.norm() * phase));
-    let p = r_rt * p_t;
-    let pd = wt.cross(&p);
-    let pdd = wt.cross(&pd);
-    AttitudeInput {
-        q_rb,
-        omega_b: w,
-        inertia: inertia(),
-        r_r,
-        v_r: Vector3::new(0.01, -0.002, 0.001),
-        a_drift_r: Vector3::new(1e-6, -2e-6, 0.0),
-        grasp_r: p,
-        grasp_vel_r: pd,
-        grasp_acc_r: pdd,
-        xi_r: Vector3::new(0.004, -0.01, 0.003),
-        omega_target_b: quat::to_matrix(&q_rb).transpose() * (r_rt * wt),
+/// The part of the servicer's state the attitude filter's input is built from.
+#[derive(Debug, Clone, Copy)]
+pub struct ServicerState {
+    pub theta: Vector7,
+    pub theta_dot: Vector7,
+    pub omega_b: Vector3<f64>,
+    pub q_rb: Quat,
+    /// System CoM relative to the target CoM, F_R [m], and its velocity [m/s].
+    pub com_r: Vector3<f64>,
+    pub com_v_r: Vector3<f64>,
+    /// Time of the target's tumbling motion [s].
+    pub t: f64,
+    /// Upstream safe force, F_B [N].
+    pub f_b: Vector3<f64>,
+}
+
+impl ServicerState {
+    pub fn rest(s: &Scenario, com_r: Vector3<f64>, q_rb: Quat) -> Self {
+        Self {
+            theta: theta0(s),
+            theta_dot: Vector7::zeros(),
+            omega_b: Vector3::zeros(),
+            q_rb,
+            com_r,
+            com_v_r: Vector3::zeros(),
+            t: 0.0,
+            f_b: Vector3::zeros(),
+        }
     }
 }
 
+/// The attitude filter's input from the model, as `sc_mission::stages::attitude_input`
+/// builds it: the base with the arm locked (`P_L`, `r_L` under the upstream force), the
+/// wrench map's torque columns and the force's share for the contract rows, the tidal
+/// drift of the CoM, `ξ_att = R_RB f_B / m`.
+pub fn att_input(s: &Scenario, robot: &Robot, x: &ServicerState) -> AttitudeInput {
+    let m = robot.total_mass();
+    let bd = robot
+        .base_angular_dynamics(&x.theta, &x.theta_dot, &x.omega_b, &x.f_b)
+        .expect("base dynamics");
+    let wrench = Vector6::new(x.f_b.x, x.f_b.y, x.f_b.z, 0.0, 0.0, 0.0);
+    let red = robot
+        .reduced_arm_dynamics(&x.theta, &x.theta_dot, &x.omega_b, &wrench)
+        .expect("reduced dynamics");
+    let radial_r = quat::to_matrix(&quat::conj(&s.reference_frame.attitude_in_hill)) * Vector3::x();
+    let (g, gv, ga, w_t) = grasp_at(s, x.t);
+    let k_tau: SMatrix<f64, 7, 3> = red.wrench_map.fixed_columns::<3>(3).into();
+    AttitudeInput {
+        q_rb: x.q_rb,
+        omega_b: x.omega_b,
+        p: bd.p_locked,
+        r: bd.r_locked,
+        r_r: x.com_r,
+        v_r: x.com_v_r,
+        a_drift_r: tidal_acceleration(mean_motion(s), &radial_r, &x.com_r),
+        grasp_r: g,
+        grasp_vel_r: gv,
+        grasp_acc_r: ga,
+        xi_r: xi_att_from_force(&x.f_b, &x.q_rb, m),
+        omega_target_b: quat::to_matrix(&x.q_rb).transpose() * w_t,
+        joint_coupling: k_tau,
+        joint_coupling_force: red.xi,
+    }
+}
+
+/// The attitude `q_RB` that points the boresight `d_B` exactly at the grasping point from
+/// `com_r` (shortest rotation from F_R), then turned by `err` [rad] about the body axis
+/// `axis` made perpendicular to the boresight (so the pointing error is `|err|`).
+pub fn pointing(s: &Scenario, com_r: &Vector3<f64>, t: f64, axis: &Vector3<f64>, err: f64) -> Quat {
+    let d = Vector3::from(s.servicer.boresight_body).normalize();
+    let los = (grasp_at(s, t).0 - com_r).normalize();
+    let c = d.cross(&los);
+    let q0 = quat::from_axis_angle(&c, c.norm().atan2(d.dot(&los)));
+    let perp = axis - d * d.dot(axis);
+    let perp = if perp.norm() > 1e-9 {
+        perp
+    } else {
+        d.cross(&Vector3::z()) + d.cross(&Vector3::y())
+    };
+    quat::mul(&q0, &quat::from_axis_angle(&perp, err))
+}
+
+/// Robotic input from the model with a small base rate and upstream wrench.
 pub fn rob_input(robot: &Robot, theta: Vector7, theta_dot: Vector7) -> RoboticInput {
     robotic_input_from_model(
         robot,
@@ -89,6 +184,16 @@ pub fn rob_input(robot: &Robot, theta: Vector7, theta_dot: Vector7) -> RoboticIn
 
 pub fn theta0(s: &Scenario) -> Vector7 {
     Vector7::from(s.servicer.initial_theta_rad)
+}
+
+/// Joint angles uniformly inside the safety limits, `margin` [rad] from them.
+pub fn theta_inside(s: &Scenario, rng: &mut Lcg, margin: f64) -> Vector7 {
+    let lo = Vector7::from(s.safety.robotic.theta_min_rad);
+    let hi = Vector7::from(s.safety.robotic.theta_max_rad);
+    Vector7::from_fn(|i, _| {
+        let (a, b) = (lo[i] + margin, hi[i] - margin);
+        0.5 * (a + b) + 0.5 * (b - a) * rng.next()
+    })
 }
 
 /// Deterministic pseudo-random numbers in [-1, 1] (no rand dependence in tests).
@@ -107,4 +212,434 @@ impl Lcg {
     pub fn v7(&mut self, s: f64) -> Vector7 {
         Vector7::from_fn(|_, _| self.next() * s)
     }
+    pub fn unit_quat(&mut self) -> Quat {
+        let q = [self.next(), self.next(), self.next(), self.next()];
+        quat::normalized(&q).unwrap_or(quat::IDENTITY)
+    }
+}
+
+// ------------------------------------------------------------------ QP toolbox
+
+/// A QP `min ‖u − u_nom‖²  s.t.  c_i + a_i·u ≥ 0` (barrier rows first, then the hard rows),
+/// in plain vectors.
+#[derive(Debug, Clone)]
+pub struct Qp {
+    pub u_nom: DVector<f64>,
+    pub a: Vec<DVector<f64>>,
+    pub c: Vec<f64>,
+    /// Number of barrier rows (the first `nb`).
+    pub nb: usize,
+}
+
+impl Qp {
+    pub fn from_rows<const M: usize>(
+        u_nom: &SVector<f64, M>,
+        rows: &[Row<M>],
+        hard: &[Row<M>],
+    ) -> Self {
+        Self {
+            u_nom: DVector::from_column_slice(u_nom.as_slice()),
+            a: rows
+                .iter()
+                .chain(hard)
+                .map(|r| DVector::from_column_slice(r.a.as_slice()))
+                .collect(),
+            c: rows.iter().chain(hard).map(|r| r.c).collect(),
+            nb: rows.len(),
+        }
+    }
+
+    /// From a filter's `dump_qp()`: barrier rows `c + a·u ≥ 0`, bounds `g·u ≤ g_max`.
+    pub fn from_dump(d: &sc_cbf::QpDump) -> Self {
+        let mut a: Vec<DVector<f64>> = d
+            .rows_a
+            .iter()
+            .map(|r| DVector::from_column_slice(r))
+            .collect();
+        let mut c = d.rows_c.clone();
+        for (g, gm) in d.bounds_g.iter().zip(&d.bounds_g_max) {
+            a.push(-DVector::from_column_slice(g));
+            c.push(*gm);
+        }
+        Self {
+            u_nom: DVector::from_column_slice(&d.u_nom),
+            a,
+            c,
+            nb: d.rows_a.len(),
+        }
+    }
+
+    pub fn m(&self) -> usize {
+        self.u_nom.len()
+    }
+
+    pub fn phi(&self, i: usize, u: &DVector<f64>) -> f64 {
+        self.c[i] + self.a[i].dot(u)
+    }
+
+    /// Rows with allowances: `c_i + w_i t_i` for the first rows.
+    pub fn relaxed(&self, allowance: &[f64]) -> Self {
+        let mut q = self.clone();
+        for (i, t) in allowance.iter().enumerate() {
+            q.c[i] += t;
+        }
+        q
+    }
+}
+
+/// Non-negative least squares `min ‖A λ − b‖, λ ≥ 0` (Lawson–Hanson).
+pub fn nnls(a: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {
+    let n = a.ncols();
+    let mut x = DVector::zeros(n);
+    let mut passive = vec![false; n];
+    for _outer in 0..3 * n + 10 {
+        let w = a.transpose() * (b - a * &x);
+        let cand = (0..n)
+            .filter(|&j| !passive[j])
+            .max_by(|&i, &j| w[i].partial_cmp(&w[j]).unwrap());
+        let Some(j) = cand else { break };
+        if w[j] <= 1e-14 * (1.0 + b.norm()) * (1.0 + a.norm()) {
+            break;
+        }
+        passive[j] = true;
+        for _inner in 0..3 * n + 10 {
+            let idx: Vec<usize> = (0..n).filter(|&k| passive[k]).collect();
+            let ap = DMatrix::from_fn(a.nrows(), idx.len(), |r, c| a[(r, idx[c])]);
+            let Some(z) = ap.clone().svd(true, true).solve(b, 1e-14).ok() else {
+                return x;
+            };
+            if z.iter().all(|v| *v > 0.0) {
+                for (k, &i) in idx.iter().enumerate() {
+                    x[i] = z[k];
+                }
+                for k in 0..n {
+                    if !passive[k] {
+                        x[k] = 0.0;
+                    }
+                }
+                break;
+            }
+            let mut alpha = 1.0f64;
+            for (k, &i) in idx.iter().enumerate() {
+                if z[k] <= 0.0 {
+                    alpha = alpha.min(x[i] / (x[i] - z[k]));
+                }
+            }
+            for (k, &i) in idx.iter().enumerate() {
+                x[i] += alpha * (z[k] - x[i]);
+                if x[i] <= 1e-300 {
+                    x[i] = 0.0;
+                    passive[i] = false;
+                }
+            }
+        }
+    }
+    x
+}
+
+/// KKT residuals of `u` for `qp`, with multipliers computed here (NNLS over the rows
+/// active within `act_tol` in distance): `(max row violation in distance, stationarity
+/// residual ‖(u − u_nom) − Σ λ_i a_i‖, multipliers)`. The multipliers are those of the ½
+/// cost `½‖u − u_nom‖²`.
+pub fn kkt(qp: &Qp, u: &DVector<f64>, act_tol: f64) -> (f64, f64, Vec<f64>) {
+    let mut viol = 0.0f64;
+    let mut act = Vec::new();
+    for i in 0..qp.a.len() {
+        let n = qp.a[i].norm();
+        let d = if n > 0.0 { qp.phi(i, u) / n } else { qp.c[i] };
+        viol = viol.max(-d);
+        if n > 0.0 && d <= act_tol {
+            act.push(i);
+        }
+    }
+    let g = u - &qp.u_nom;
+    let mut lam = vec![0.0; qp.a.len()];
+    if act.is_empty() {
+        return (viol, g.norm(), lam);
+    }
+    let a = DMatrix::from_fn(qp.m(), act.len(), |r, c| qp.a[act[c]][r]);
+    let l = nnls(&a, &g);
+    for (k, &i) in act.iter().enumerate() {
+        lam[i] = l[k];
+    }
+    ((viol), (a * l - g).norm(), lam)
+}
+
+/// The exact minimiser by enumerating active sets of at most `M` rows (the unique KKT
+/// point of the strictly convex QP); `None` when infeasible. Exponential: small problems only.
+pub fn brute_force(qp: &Qp) -> Option<DVector<f64>> {
+    let m = qp.m();
+    let n = qp.a.len();
+    let un = &qp.u_nom;
+    let scale = 1.0 + un.amax();
+    let feasible =
+        |u: &DVector<f64>| (0..n).all(|i| qp.phi(i, u) >= -1e-11 * scale * (1.0 + qp.a[i].norm()));
+    let mut best: Option<(f64, DVector<f64>)> = None;
+    let mut set = Vec::with_capacity(m);
+    fn rec(start: usize, set: &mut Vec<usize>, m: usize, n: usize, f: &mut dyn FnMut(&[usize])) {
+        f(set);
+        if set.len() == m {
+            return;
+        }
+        for i in start..n {
+            set.push(i);
+            rec(i + 1, set, m, n, f);
+            set.pop();
+        }
+    }
+    let mut consider = |set: &[usize]| {
+        let k = set.len();
+        let u = if k == 0 {
+            un.clone()
+        } else {
+            let a = DMatrix::from_fn(k, m, |r, c| qp.a[set[r]][c]);
+            let b = DVector::from_fn(k, |r, _| -qp.c[set[r]]);
+            let aat = &a * a.transpose();
+            let Some(ch) = aat.clone().cholesky() else {
+                return;
+            };
+            // reject (nearly) dependent sets
+            let an: f64 = set.iter().map(|&i| qp.a[i].norm_squared()).product();
+            if aat.determinant() <= 1e-12 * an {
+                return;
+            }
+            let lam = ch.solve(&(&b - &a * un));
+            if lam.iter().any(|l| *l < -1e-12) {
+                return;
+            }
+            un + a.transpose() * lam
+        };
+        if feasible(&u) {
+            let c = (&u - un).norm_squared();
+            if best.as_ref().is_none_or(|(bc, _)| c < *bc) {
+                best = Some((c, u));
+            }
+        }
+    };
+    rec(0, &mut set, m, n, &mut consider);
+    best.map(|b| b.1)
+}
+
+/// Clarabel's solution of `qp` through the crate's independent reference engine
+/// [`QpEngine`] (barrier rows as rows, hard rows as bounds; tight tolerances). `u_inf`
+/// bounds `‖u‖∞` on the hard rows' feasible set.
+pub fn clarabel(qp: &Qp, u_inf: f64) -> Option<DVector<f64>> {
+    let m = qp.m();
+    let (nb, ng) = (qp.nb, qp.a.len() - qp.nb);
+    let params = SolverParams {
+        max_iterations: 200,
+        tolerance: 1e-11,
+        slack_weight: 1e6,
+    };
+    let mut eng = QpEngine::new(m, nb, ng, u_inf, &params);
+    eng.set_skip_enabled(false);
+    let rows_a: Vec<f64> = qp.a[..nb].iter().flat_map(|a| a.iter().copied()).collect();
+    let g: Vec<f64> = qp.a[nb..]
+        .iter()
+        .flat_map(|a| a.iter().map(|x| -x))
+        .collect();
+    let mut u = vec![0.0; m];
+    let r = eng.solve(
+        qp.u_nom.as_slice(),
+        &rows_a,
+        &qp.c[..nb],
+        &g,
+        &qp.c[nb..],
+        &mut u,
+    );
+    (r.outcome == QpOutcome::Solved).then(|| DVector::from_vec(u))
+}
+
+/// The reference solution of the lexicographic relaxed problem.
+#[derive(Debug, Clone)]
+pub struct Lexicographic {
+    /// The first round's least violation `t₁`.
+    pub t1: f64,
+    /// The allowance `w_i t_i` (incl. the engine's rounding room) of every barrier row.
+    pub allowance: Vec<f64>,
+    /// Largest relative deviation of Clarabel's raw LP values from the exact vertex values
+    /// (small problems only; 0 otherwise).
+    pub clarabel_lp_deviation: f64,
+}
+
+/// The lexicographic min-max relaxation of the barrier rows (the first `nb`, weights `w`),
+/// solved independently of `Engine`: each round's LP with Clarabel — whose duals give the
+/// rows that make the round's violation necessary — and, for up to 3 inputs, its exact
+/// value by vertex enumeration (for more inputs Clarabel's value, refined to the exact
+/// vertex of the supporting rows when that vertex is feasible). The command is then the
+/// projection of the nominal onto `qp.relaxed(&allowance)`. Independent of `qp.u_nom`.
+pub fn lexicographic(qp: &Qp, w: &[f64]) -> Result<Lexicographic, String> {
+    use clarabel::algebra::CscMatrix;
+    use clarabel::solver::{
+        DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
+    };
+    let m = qp.m();
+    let n = qp.a.len();
+    let nb = qp.nb;
+    let mut fixed = vec![false; nb];
+    let mut allow = vec![0.0; nb];
+    let mut t1 = 0.0f64;
+    let mut deviation = 0.0f64;
+    let settings = |tol: f64| {
+        let mut st = DefaultSettingsBuilder::<f64>::default().build().unwrap();
+        st.verbose = false;
+        st.max_iter = 500;
+        st.tol_gap_abs = tol;
+        st.tol_gap_rel = tol;
+        st.tol_feas = tol;
+        st
+    };
+    for round in 0..nb {
+        // variables [u; t]: min t  s.t.  −a_i u − w_i t ≤ c_i (soft), −a_i u ≤ c_i + w_i t_i
+        // (fixed), −g u ≤ c (hard), −t ≤ 0
+        let cols = m + 1;
+        let rows = n + 1;
+        let mut dense = vec![vec![0.0; cols]; rows];
+        let mut b = vec![0.0; rows];
+        for i in 0..n {
+            for (j, d) in dense[i].iter_mut().enumerate().take(m) {
+                *d = -qp.a[i][j];
+            }
+            b[i] = qp.c[i];
+            if i < nb {
+                if fixed[i] {
+                    b[i] += w[i] * allow[i];
+                } else {
+                    dense[i][m] = -w[i];
+                }
+            }
+        }
+        dense[n][m] = -1.0;
+        let a = CscMatrix::from(&dense);
+        let p = CscMatrix::<f64>::zeros((cols, cols));
+        let mut q = vec![0.0; cols];
+        q[m] = 1.0;
+        let cones = [SupportedConeT::NonnegativeConeT(rows)];
+        // tight tolerances first, looser ones if Clarabel stalls on an ill-conditioned LP
+        let mut solved = None;
+        for tol in [1e-12, 1e-10, 1e-8] {
+            let mut s = DefaultSolver::new(&p, &q, &a, &b, &cones, settings(tol))
+                .map_err(|e| format!("{e:?}"))?;
+            s.solve();
+            if matches!(
+                s.solution.status,
+                SolverStatus::Solved | SolverStatus::AlmostSolved
+            ) {
+                solved = Some(s);
+                break;
+            }
+        }
+        let s = solved.ok_or(format!("LP round {round}: Clarabel failed"))?;
+        let t_clarabel = s.solution.x[m];
+        let z = &s.solution.z;
+        let zmax = z[..n].iter().cloned().fold(0.0, f64::max);
+        let mut t = t_clarabel;
+        if cols <= 4 {
+            let (exact, _) =
+                exact_lp_min_last(&dense, &b).ok_or(format!("LP round {round}: no vertex"))?;
+            deviation = deviation.max((t_clarabel - exact).abs() / exact.abs().max(1e-9));
+            t = exact;
+        } else if t > 1e-9 {
+            // crossover: the vertex of the supporting rows, accepted only when feasible and
+            // close to Clarabel's value (an incomplete support gives some other point)
+            let support: Vec<usize> = (0..n).filter(|&i| z[i] > 1e-6 * zmax).collect();
+            let am = DMatrix::from_fn(support.len(), cols, |r, c| dense[support[r]][c]);
+            let bv = DVector::from_fn(support.len(), |r, _| b[support[r]]);
+            if let Ok(sol) = am.clone().svd(true, true).solve(&bv, 1e-13) {
+                let res = (&am * &sol - &bv).amax();
+                let feasible = (0..rows).all(|i| {
+                    let lhs: f64 = (0..cols).map(|j| dense[i][j] * sol[j]).sum();
+                    lhs <= b[i] + 1e-12 * (1.0 + b[i].abs())
+                });
+                if feasible && res <= 1e-12 * (1.0 + bv.amax()) && (sol[m] - t).abs() <= 1e-7 * t {
+                    t = sol[m];
+                }
+            }
+        }
+        if t <= 1e-10 {
+            break;
+        }
+        if round == 0 {
+            t1 = t;
+        }
+        // the engine's documented rounding room on every allowance: t (1 + 1e-9) + 1e-12
+        // (it enters the later rounds, and rows can be ill-conditioned enough for it to
+        // matter)
+        let t_allow = t * (1.0 + 1e-9) + 1e-12;
+        let mut any = false;
+        for i in 0..nb {
+            if !fixed[i] && z[i] > 1e-6 * zmax {
+                fixed[i] = true;
+                allow[i] = t_allow;
+                any = true;
+            }
+        }
+        if !any || fixed.iter().all(|f| *f) {
+            for i in 0..nb {
+                if !fixed[i] {
+                    fixed[i] = true;
+                    allow[i] = t_allow;
+                }
+            }
+            break;
+        }
+    }
+    let allowance: Vec<f64> = (0..nb).map(|i| w[i] * allow[i]).collect();
+    Ok(Lexicographic {
+        t1,
+        allowance,
+        clarabel_lp_deviation: deviation,
+    })
+}
+
+/// `min x_last  s.t.  G x ≤ h` by enumerating vertices (small dimensions only): the exact
+/// LP optimum `(value, supporting rows)`.
+pub fn exact_lp_min_last(g: &[Vec<f64>], h: &[f64]) -> Option<(f64, Vec<usize>)> {
+    let d = g[0].len();
+    // unit rows: the tolerances below are distances
+    let norms: Vec<f64> = g
+        .iter()
+        .map(|r| r.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-300))
+        .collect();
+    let g: Vec<Vec<f64>> = g
+        .iter()
+        .zip(&norms)
+        .map(|(r, n)| r.iter().map(|x| x / n).collect())
+        .collect();
+    let h: Vec<f64> = h.iter().zip(&norms).map(|(x, n)| x / n).collect();
+    let n = g.len();
+    let mut best: Option<(f64, Vec<usize>)> = None;
+    let mut idx: Vec<usize> = (0..d).collect();
+    loop {
+        let a = DMatrix::from_fn(d, d, |r, c| g[idx[r]][c]);
+        let b = DVector::from_fn(d, |r, _| h[idx[r]]);
+        if a.determinant().abs() > 1e-12
+            && let Some(x) = a.clone().lu().solve(&b)
+        {
+            let ok = (0..n).all(|i| {
+                let lhs: f64 = (0..d).map(|j| g[i][j] * x[j]).sum();
+                lhs <= h[i] + 1e-11 * (1.0 + h[i].abs())
+            });
+            if ok && best.as_ref().is_none_or(|(t, _)| x[d - 1] < *t) {
+                best = Some((x[d - 1], idx.clone()));
+            }
+        }
+        // next combination
+        let mut k = d;
+        while k > 0 && idx[k - 1] == n - d + k - 1 {
+            k -= 1;
+        }
+        if k == 0 {
+            break;
+        }
+        idx[k - 1] += 1;
+        for j in k..d {
+            idx[j] = idx[j - 1] + 1;
+        }
+    }
+    best
+}
+
+pub fn dvec<const M: usize>(v: &SVector<f64, M>) -> DVector<f64> {
+    DVector::from_column_slice(v.as_slice())
 }

