@@ -7,7 +7,7 @@ use common::*;
 use std::path::Path;
 
 /// Steps in which `filter` reported upstream_missing (telemetry.csv `<filter>_faults`).
-fn flagged_steps(out: &Path, filter: &str) -> Vec<u64> {
+fn flagged_steps(out: &Path, filter: &str, mask: u32) -> Vec<u64> {
     let text = std::fs::read_to_string(out.join("telemetry.csv")).unwrap();
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -15,20 +15,20 @@ fn flagged_steps(out: &Path, filter: &str) -> Vec<u64> {
         .iter()
         .position(|c| *c == format!("{filter}_faults"))
         .unwrap();
-    let upstream_missing = sc_cbf_upstream_missing();
     lines
         .filter_map(|l| {
             let v: Vec<&str> = l.split(',').collect();
             let flags: u32 = v[col].parse().unwrap();
-            (flags & upstream_missing != 0).then(|| v[0].parse().unwrap())
+            (flags & mask != 0).then(|| v[0].parse().unwrap())
         })
         .collect()
 }
 
-/// `sc_cbf::faults::UPSTREAM_MISSING` (bit 5, documented in docs/ICD.md).
-fn sc_cbf_upstream_missing() -> u32 {
-    1 << 5
-}
+/// `sc_cbf::faults::UPSTREAM_MISSING` (bit 5, documented in docs/ICD.md): the filter's
+/// command is the backup the simulator applied, or its upstream command was.
+const UPSTREAM_MISSING: u32 = 1 << 5;
+/// `sc_cbf::faults::NOMINAL_MISSING` (bit 7): the filter ran its QP on the substitute nominal.
+const NOMINAL_MISSING: u32 = 1 << 7;
 
 /// Runs a shortened mission (60 s, lock-step) and SIGKILLs `exec` after 100 steps.
 fn kill_run(
@@ -57,18 +57,19 @@ fn kill_run(
     (rep, dir, out)
 }
 
-fn degraded(exec: &str, filter: &str) {
+fn degraded(exec: &str, filter: &str, mask: u32) {
     let (_, dir, out) = kill_run(exec, exec);
     // the mission went on to its end, every step recorded
     let n = contiguous_steps(&out);
     assert_eq!(n, 601, "all steps 0..=600 of the 60 s mission recorded");
     let s = summary(&out);
     assert_eq!(s["end"], "timeout");
-    // from the kill on, the subsystem runs on its fallback, flagged
-    let f = flagged_steps(&out, filter);
+    // from the kill on, the subsystem runs on its substitute nominal (a dead nominal) or
+    // on the backup the simulator applies (a dead filter), flagged
+    let f = flagged_steps(&out, filter, mask);
     let first = *f
         .first()
-        .unwrap_or_else(|| panic!("{filter}: no step flagged upstream_missing"));
+        .unwrap_or_else(|| panic!("{filter}: no step flagged {mask:#x}"));
     assert!(
         first >= 100,
         "{filter}: flagged before the kill (step {first})"
@@ -112,29 +113,29 @@ fn degraded(exec: &str, filter: &str) {
 }
 
 #[test]
-fn killed_nominal_translational_gives_translational_fallback() {
-    degraded("sc-nominal-translational", "translational");
+fn killed_nominal_translational_gives_the_qp_on_the_substitute_nominal() {
+    degraded("sc-nominal-translational", "translational", NOMINAL_MISSING);
 }
 
 #[test]
-fn killed_nominal_robotic_gives_robotic_fallback() {
-    degraded("sc-nominal-robotic", "robotic");
+fn killed_nominal_robotic_gives_the_qp_on_the_substitute_nominal() {
+    degraded("sc-nominal-robotic", "robotic", NOMINAL_MISSING);
 }
 
 #[test]
-fn killed_translational_filter_gives_fallback_applied_by_simulator() {
-    degraded("sc-safety-translational", "translational");
-    // (the attitude and robotic filters use the translational fallback as coupling)
+fn killed_translational_filter_gives_backup_applied_by_simulator() {
+    degraded("sc-safety-translational", "translational", UPSTREAM_MISSING);
+    // (the attitude and robotic filters use the translational backup as coupling)
 }
 
 #[test]
-fn killed_attitude_filter_gives_fallback_applied_by_simulator() {
-    degraded("sc-safety-attitude", "attitude");
+fn killed_attitude_filter_gives_backup_applied_by_simulator() {
+    degraded("sc-safety-attitude", "attitude", UPSTREAM_MISSING);
 }
 
 #[test]
-fn killed_robotic_filter_gives_fallback_applied_by_simulator() {
-    degraded("sc-safety-robotic", "robotic");
+fn killed_robotic_filter_gives_backup_applied_by_simulator() {
+    degraded("sc-safety-robotic", "robotic", UPSTREAM_MISSING);
 }
 
 fn aborted(exec: &str, peer: &str) {
@@ -218,7 +219,7 @@ fn hung_robotic_filter_is_detected_by_deadlines() {
     assert_clean(&rep, &out);
     assert_eq!(rep.code, 3, "{rep:?}");
     assert_eq!(contiguous_steps(&out), 601);
-    let f = flagged_steps(&out, "robotic");
+    let f = flagged_steps(&out, "robotic", UPSTREAM_MISSING);
     let first = *f.first().expect("robotic steps flagged");
     assert_eq!(f, (first..=600).collect::<Vec<u64>>());
     let rec: serde_json::Value =
@@ -254,7 +255,7 @@ fn hung_nominal_is_caught_by_the_stage_deadline_watchdog() {
     let rep = h.join().unwrap();
     assert_clean(&rep, &out);
     assert_eq!(contiguous_steps(&out), 601);
-    let f = flagged_steps(&out, "translational");
+    let f = flagged_steps(&out, "translational", NOMINAL_MISSING);
     let first = *f.first().expect("translational steps flagged");
     assert!(first >= 100, "flagged before the stop (step {first})");
     assert_eq!(f, (first..=600).collect::<Vec<u64>>());

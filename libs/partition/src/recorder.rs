@@ -171,8 +171,9 @@ pub fn recorder() -> anyhow::Result<i32> {
             let complete = pending.get(&r.tick).is_some_and(|set| {
                 let Some(st) = set.state else { return false };
                 // due subsystem: its safe command (unless the simulator used the
-                // fallback) and its nominal command (unless the filter flagged it missing)
-                let missing_flag = sc_cbf::faults::UPSTREAM_MISSING;
+                // backup) and its nominal command (unless the filter flagged it missing)
+                let missing_flag =
+                    sc_cbf::faults::UPSTREAM_MISSING | sc_cbf::faults::NOMINAL_MISSING;
                 let need = |bit: u32, nom: bool, safe: Option<u32>| {
                     st.due_mask & bit == 0
                         || r.fallback_mask & bit != 0
@@ -347,8 +348,11 @@ pub fn recorder() -> anyhow::Result<i32> {
             }
             let ns = |o: Option<u64>| o.map(|x| x.to_string()).unwrap_or_default();
             // the filters that used a fallback for an input missing at their deadline
+            // a filter that ran without its nominal or its upstream command at a deadline
             let missing = |faults: u32, bit: u32| {
-                if faults & sc_cbf::faults::UPSTREAM_MISSING != 0 {
+                if faults & (sc_cbf::faults::UPSTREAM_MISSING | sc_cbf::faults::NOMINAL_MISSING)
+                    != 0
+                {
                     bit
                 } else {
                     0
