@@ -603,10 +603,18 @@ impl AttitudeFilter {
         let hard = self.hard_rows(x);
         let mut res = None;
         let mut rows = p.rows;
+        // the hard rows the command was solved with (the cap's rows added when certified)
+        let mut solved_hard = [Row::<3> {
+            a: Vector3::zeros(),
+            c: 1.0,
+        }; HARD + 6];
+        solved_hard[..HARD].copy_from_slice(&hard);
+        let mut n_hard = HARD;
         if sampled {
             let first = accel_inf(&u_nom);
             let floor = x.r.amax();
-            let mut best: Option<(f64, crate::engine::Outcome<3>, [Row<3>; N])> = None;
+            let mut best: Option<(f64, crate::engine::Outcome<3>, [Row<3>; N], [Row<3>; HARD + 6])> =
+                None;
             for (k, cap) in std::iter::once(first).chain(ACCEL_CAPS).enumerate() {
                 if cap < floor || (k > 0 && cap >= first) {
                     continue;
@@ -632,25 +640,28 @@ impl AttitudeFilter {
                 let out = self.engine.solve(&u_nom, &r_cap, &p.weights, &with_cap);
                 if matches!(out.kind, Kind::Skipped | Kind::Solved) {
                     if k == 0 {
-                        best = Some((0.0, out, r_cap));
+                        best = Some((0.0, out, r_cap, with_cap));
                         break;
                     }
                     let dist = (out.u - u_nom).norm();
                     if best.as_ref().is_none_or(|b| dist < b.0) {
-                        best = Some((dist, out, r_cap));
+                        best = Some((dist, out, r_cap, with_cap));
                     }
                 }
             }
-            if let Some((_, out, r_cap)) = best {
+            if let Some((_, out, r_cap, with_cap)) = best {
                 res = Some(out);
                 rows = r_cap;
+                solved_hard = with_cap;
+                n_hard = HARD + 6;
             }
         }
         let res = match res {
             Some(r) => r,
             None => self.engine.solve(&u_nom, &p.rows, &p.weights, &hard),
         };
-        self.last.record(&u_nom, &rows, &p.weights, &hard, &res);
+        self.last
+            .record(&u_nom, &rows, &p.weights, &solved_hard[..n_hard], &res);
         report.iterations = res.iterations;
         report.violation = res.violation;
         let mut tau = res.u;

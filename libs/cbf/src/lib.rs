@@ -2,12 +2,17 @@
 //! (Sec. "Method"): translational → attitude → robotic, in causal order, each downstream
 //! filter taking the upstream safe commands as its known coupling ξ.
 //!
-//! * [`barrier`]: the generic rows — relative degree one `ḣ + γh − ε ≥ 0` and relative
-//!   degree two through the auxiliary barrier `H = h + |ḣ|ḣ/(2u_max)`.
+//! * [`barrier`]: the paper's rows — relative degree one `ḣ + γh − ε ≥ 0` and relative
+//!   degree two through the auxiliary barrier `H = h + |ḣ|ḣ/(2u_max)` — kept for the
+//!   `paper` formulation.
+//! * [`sampled`]: the sampled-data rows (the default): conditions that hold between
+//!   samples under the zero-order hold (docs/SAFETY.md).
 //! * [`translational`], [`attitude`], [`robotic`]: every constraint as its own function
-//!   citing its paper equation, and the filter.
-//! * [`qp`]: the Clarabel-based QP engine (built once, updated in place, skip path,
-//!   relaxed problem).
+//!   citing its paper equation, the in-sample bounds, and the filter.
+//! * [`engine`]: the filters' QP on the exact dual active-set solver of `sc-qp`, with the
+//!   lexicographic relaxation; [`qp`]: the Clarabel engine, the independent reference.
+//! * [`monitor`]: every barrier from the true state; [`envelope`]: the model's bounds over
+//!   the certified envelope.
 //! * [`common`]: outputs, reports, [`faults`] flags.
 //!
 //! Every filter call is deterministic: the same input sequence gives bit-identical commands

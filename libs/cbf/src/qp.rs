@@ -1,5 +1,7 @@
-//! The CBF-QP engine shared by the three filters (paper eqs. "translation_qp",
-//! "attitude_qp", "robotic_qp"):
+//! The Clarabel (interior-point) engine for the filters' QP (paper eqs. "translation_qp",
+//! "attitude_qp", "robotic_qp"): the independent second opinion the tests and the
+//! verification compare the exact engine ([`crate::engine`]) with. Its settings are
+//! `[safety.solver]`; its relaxed problem is the older single-slack one:
 //!
 //! ```text
 //! min_u ‖u − u_nom‖²   s.t.   c_i + a_i·u ≥ 0 (barrier rows),   G u ≤ g (input bounds)
@@ -89,30 +91,36 @@ impl SolverParams {
     }
 }
 
-/// The last QP a filter handed to the solver, in the filter's own (unscaled) form —
-/// for `--dump-qp` and offline checks.
+/// The last QP a filter handed to its solver, in the filter's own (unscaled) form —
+/// for `--dump-qp` and offline checks. Filled by the filters' exact engine
+/// ([`crate::engine::LastProblem::dump`]) or by the Clarabel reference engine
+/// ([`QpEngine::dump`]); the two differ in the multipliers' convention and in `slack`,
+/// as noted per field.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct QpDump {
-    /// Cost `‖u − u_nom‖²`: `P = 2I`, `q = −2 u_nom`.
+    /// Cost `‖u − u_nom‖²` (`P = 2I`, `q = −2 u_nom`).
     pub u_nom: Vec<f64>,
     /// Barrier rows `c_i + a_i·u ≥ 0`: `a_i` (row-major).
     pub rows_a: Vec<Vec<f64>>,
     pub rows_c: Vec<f64>,
-    /// Input bounds `G u ≤ g`.
+    /// Hard rows (input bounds, contracts) as `G u ≤ g`.
     pub bounds_g: Vec<Vec<f64>>,
     pub bounds_g_max: Vec<f64>,
     /// Returned solution (before the filter's last-line clamp).
     pub solution: Vec<f64>,
-    /// Multipliers λ_i ≥ 0 of the barrier rows (`2(u − u_nom) = Σλ_i a_i − Gᵀμ`).
+    /// Multipliers λ_i ≥ 0 of the barrier rows. Exact engine: `u − u_nom = Σλ_i a_i −
+    /// Σμ_k g_k` (the cost `½‖u − u_nom‖²`); Clarabel engine: `2(u − u_nom) = Σλ_i a_i − Gᵀμ`.
     pub row_duals: Vec<f64>,
-    /// Multipliers μ_k ≥ 0 of the bounds.
+    /// Multipliers μ_k ≥ 0 of the hard rows (Clarabel engine only; zero from the exact
+    /// engine, which does not record them).
     pub bound_duals: Vec<f64>,
-    /// Slack of the relaxed problem (0 otherwise).
+    /// Exact engine: the largest allowance `t*` of the relaxed problem (a fraction of the
+    /// rows' weights); Clarabel engine: the slack of its relaxed problem. 0 otherwise.
     pub slack: f64,
     pub outcome: Option<QpOutcome>,
-    /// Clarabel status of the last solver call (the relaxed one if it ran).
+    /// "active_set" (exact engine) or Clarabel's status of the last solver call.
     pub solver_status: String,
-    /// Clarabel status of the hard QP of the last solve ("" when skipped).
+    /// Clarabel's status of the hard QP ("" from the exact engine or when skipped).
     pub hard_status: String,
     pub iterations: u32,
 }

@@ -98,6 +98,10 @@ pub const NAMES: [&str; N] = [
 /// filter never switches itself off): drift and coupling accelerations `≤ MAX_ACCEL`, `A`
 /// entries `≤ MAX_GAIN`, sphere centres `≤ MAX_REACH_M`. Beyond them the braking law applies.
 pub const MAX_ACCEL: f64 = 1e6;
+/// Accepted range of the upstream state the verification integrates with: base rate
+/// `≤ MAX_BASE_RATE_RAD_S`, base force and torque components `≤ MAX_WRENCH` (N, N m).
+pub const MAX_BASE_RATE_RAD_S: f64 = 10.0;
+pub const MAX_WRENCH: f64 = 1e4;
 pub const MAX_GAIN: f64 = 1e6;
 pub const MAX_REACH_M: f64 = 100.0;
 
@@ -383,7 +387,11 @@ impl RoboticFilter {
         if !Self::state_valid(x) {
             return Err(Invalid::State);
         }
-        if !finite_in(&x.xi, MAX_ACCEL) {
+        if !finite_in(&x.xi, MAX_ACCEL)
+            || !finite_in(&x.omega_b, MAX_BASE_RATE_RAD_S)
+            || !finite_in(&x.force_b, MAX_WRENCH)
+            || !finite_in(&x.torque_b, MAX_WRENCH)
+        {
             return Err(Invalid::Coupling);
         }
         let p = &self.params;
@@ -588,16 +596,23 @@ impl RoboticFilter {
         report.iterations = res.iterations;
         let mut final_rows = local;
         let mut certified = false;
+        // the accelerations the rows `res` was solved with were built for (None: the
+        // sample's own prediction, the loosest rows); the bounds grow with them joint by
+        // joint, so rows built for the larger of both are tighter than those
+        let mut solved_cap: Option<Vector7> = None;
         if matches!(res.kind, Kind::Skipped | Kind::Solved) {
             for _ in 0..CERTIFY_ROUNDS {
-                let rows = self.barrier_rows(x, &terms, Level::Certified(accel(&res.u)), &zero);
+                let own = accel(&res.u).abs();
+                let cap = solved_cap.map_or(own, |c| c.sup(&own));
+                let rows = self.barrier_rows(x, &terms, Level::Certified(cap), &zero);
                 if rows.iter().all(|r| r.phi(&res.u) >= 0.0) {
+                    // inside tighter rows than it was solved with: still their minimiser
                     certified = true;
                     final_rows = rows;
                     break;
                 }
-                // the next candidate may accelerate more; bound it by the larger of both
-                let grown = accel(&res.u).abs() * 2.0;
+                // the next candidate may accelerate more; bound it by twice as much
+                let grown = cap * 2.0;
                 let rows = self.barrier_rows(x, &terms, Level::Certified(grown), &zero);
                 let next = self.engine.solve(&u_nom, &rows, &weights, &hard);
                 report.iterations += next.iterations;
@@ -605,8 +620,8 @@ impl RoboticFilter {
                     break;
                 }
                 res = next;
-                let a = accel(&res.u).abs();
-                if (0..NJ).all(|i| a[i] <= grown[i]) {
+                solved_cap = Some(grown);
+                if accel(&res.u).abs().iter().zip(grown.iter()).all(|(a, g)| a <= g) {
                     // the rows' bounds cover the new command's accelerations
                     certified = true;
                     final_rows = rows;
@@ -715,7 +730,12 @@ impl RoboticFilter {
                 *m += VERIFY_GAIN * s;
             }
         }
-        best.map(|(worst, u, rows)| (u, rows, (-worst).max(f64::MIN_POSITIVE)))
+        // a sample whose integration failed reports a full violation (the command itself
+        // is still inside the box: the relaxed problem's hard rows hold)
+        best.map(|(worst, u, rows)| {
+            let v = if worst.is_finite() { (-worst).max(f64::MIN_POSITIVE) } else { 1.0 };
+            (u, rows, v)
+        })
     }
 
     /// Integrates one sample under `tau` with the servicer model exactly as the simulator

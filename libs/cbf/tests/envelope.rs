@@ -20,7 +20,6 @@ fn envelope_bounds_cover_the_model() {
 /// 1.34, 1.21, 1.38, 1.18× the maxima and the sphere bounds of links 2–7 1.21–1.44×, not
 /// 1.5×. About 7 s.
 #[test]
-#[ignore = "config issue: joint/sphere jerk bounds < 1.5 × the maxima of 200k samples"]
 fn envelope_bounds_cover_the_model_with_200k_samples() {
     check_bounds(200_000, 11);
 }

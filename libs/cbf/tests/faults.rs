@@ -391,7 +391,6 @@ fn all_nan_inf_or_huge_inputs_give_a_flagged_bounded_command() {
 /// bounded. Expected: such inputs flagged (`INVALID_COUPLING`/`INVALID_STATE`), the report
 /// finite.
 #[test]
-#[ignore = "src issue: the robotic filter accepts an absurd base rate / upstream wrench"]
 fn robotic_filter_refuses_an_absurd_upstream_wrench_or_rate() {
     let s = scenario();
     let mut f = RoboticFilter::from_scenario(&s, robot());

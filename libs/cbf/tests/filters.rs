@@ -309,7 +309,6 @@ fn attitude_solved_qps_are_kkt_points_and_match_brute_force_and_clarabel() {
 /// solved one when a cap row is active (16 of 111 solved cases here; the test above
 /// reconstructs the caps).
 #[test]
-#[ignore = "src issue: the attitude filter's dump_qp() omits its acceleration-cap rows"]
 fn attitude_dump_qp_is_the_solved_qp() {
     let s = scenario();
     let tmax = s.limits.torque_max_nm;
@@ -382,7 +381,6 @@ fn robotic_solved_commands_hold_their_dumped_certificate_and_match_clarabel() {
 /// QP's minimiser (more invasive than needed; the dump does not replay). 5 of 109 solved
 /// cases here, stationarity residuals 1.3–4.4 N m.
 #[test]
-#[ignore = "src issue: robotic certify round 2 records rows the command was not solved with"]
 fn robotic_solved_commands_are_minimisers_of_their_dumped_qp() {
     let s = scenario();
     let tmax = s.limits.joint_torque_max_nm;
