@@ -43,6 +43,12 @@ pub const NAMES: [&str; 7] = [
 ];
 /// Number of constraints.
 pub const N: usize = 7;
+/// Rows of the QP: the [`NAMES`] rows, then the four boresight-rate rows of the certified
+/// set ([`boresight_rate`]).
+pub const ROWS: usize = N + 4;
+/// Priority tiers of the rows in the relaxed problem ([`crate::engine`]): the rates
+/// (the six limits and the boresight's rate) first, the line of sight after them.
+pub const TIERS: [u8; ROWS] = [1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0];
 
 /// Accepted ranges: `‖ω_B‖, ‖ω_T,B‖ ≤ MAX_RATE_RAD_S`; positions `≤ MAX_RANGE_M`,
 /// velocities `≤ MAX_SPEED_M_S`, accelerations (incl. ξ) `≤ MAX_ACCEL_M_S2`; the LOS
@@ -70,6 +76,10 @@ pub struct AttitudeParams {
     /// γ_ω [1/s], ε_ω [rad/s²].
     pub gamma_omega: f64,
     pub eps_omega: f64,
+    /// Certified set: `|e_kᵀω_B| ≤ w̄` across the boresight [rad/s] ([`boresight_rate`])
+    /// and its γ [1/s].
+    pub boresight_rate_max: f64,
+    pub gamma_boresight: f64,
     /// `‖τ_B‖∞ ≤ T` [N m].
     pub torque_max: f64,
     /// T of the braking law `τ_B = sat(−P⁻¹ (ω_B − ω_T,B)/T)` [s]: the substitute nominal
@@ -108,6 +118,8 @@ impl AttitudeParams {
             omega_min: Vector3::from(a.omega_min_rad_s),
             gamma_omega: a.gamma_omega_per_s,
             eps_omega: a.eps_omega,
+            boresight_rate_max: a.boresight_rate_max_rad_s,
+            gamma_boresight: a.gamma_boresight_rate_per_s,
             torque_max: s.limits.torque_max_nm,
             brake_time: s.safety.fallback.attitude_brake_time_s,
             solver: SolverParams::from_scenario(s),
@@ -254,20 +266,56 @@ pub fn omega_limits(
     })
 }
 
+/// Two unit axes across the boresight `d` (unit): `e₁ ⊥ d`, `e₂ = d × e₁`.
+pub fn across_boresight(d: &Vector3<f64>) -> [Vector3<f64>; 2] {
+    // the body axis least aligned with d, made orthogonal to it
+    let k = d.iamin();
+    let mut e = Vector3::zeros();
+    e[k] = 1.0;
+    let e1 = (e - d * d.dot(&e)).normalize();
+    [e1, d.cross(&e1)]
+}
+
+/// The boresight's rate across itself, constraints of the certified set (not among the
+/// paper's barriers; docs/SAFETY.md, "Line of sight"): `h = w̄ ∓ e_kᵀω ≥ 0` for the two
+/// axes `e_k` across the boresight ([`across_boresight`]), so that the boresight's tip
+/// moves at most `√2 w̄`. Rate limits like [`omega_limits`] on rotated axes: relative
+/// degree one, `ḣ = ∓e_kᵀ(P τ + r)`. Order `[+e₁, +e₂, −e₁, −e₂]`.
+pub fn boresight_rate(
+    omega: &Vector3<f64>,
+    p: &Matrix3<f64>,
+    r: &Vector3<f64>,
+    d: &Vector3<f64>,
+    w_max: f64,
+) -> [RelDegOne<3>; 4] {
+    let e = across_boresight(d);
+    std::array::from_fn(|k| {
+        let sign = if k < 2 { 1.0 } else { -1.0 };
+        let ek = e[k % 2] * sign;
+        RelDegOne {
+            h: w_max - ek.dot(omega),
+            hdot_drift: -ek.dot(r),
+            hdot_u: -(p.transpose() * ek),
+        }
+    })
+}
+
 /// All barrier terms of one step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AttitudeTerms {
     pub los: RelDegTwo<3>,
     pub omega: [RelDegOne<3>; 6],
+    /// The certified set's boresight-rate limits ([`boresight_rate`]).
+    pub boresight: [RelDegOne<3>; 4],
 }
 
 struct Prepared {
     /// `P⁻¹`: the base's articulated inertia [kg m²] (for the braking law).
     inertia: Matrix3<f64>,
     terms: AttitudeTerms,
-    /// Rows valid for any torque in the box ([`NAMES`] order).
-    rows: [Row<3>; N],
-    weights: [f64; N],
+    /// Rows valid for any torque in the box ([`NAMES`] order, then the boresight rate).
+    rows: [Row<3>; ROWS],
+    weights: [f64; ROWS],
     rho: Vector3<f64>,
 }
 
@@ -288,7 +336,7 @@ fn p_formulation_sampled(p: &AttitudeParams) -> bool {
 /// The attitude CBF-QP safety filter (paper eq. "attitude_qp").
 pub struct AttitudeFilter {
     pub params: AttitudeParams,
-    engine: Engine<3, { N + HARD + 6 }>,
+    engine: Engine<3, { ROWS + HARD + 6 }>,
     bounds: [Row<3>; 6],
     last: LastProblem<3>,
 }
@@ -322,7 +370,7 @@ impl AttitudeFilter {
             params,
             engine: Engine::new(),
             bounds,
-            last: LastProblem::with_capacity(N, HARD + 6),
+            last: LastProblem::with_capacity(ROWS, HARD + 6),
         }
     }
 
@@ -357,7 +405,7 @@ impl AttitudeFilter {
         x: &AttitudeInput,
         rho: &Vector3<f64>,
         accel: Option<(f64, f64)>,
-    ) -> (SampleBounds, [RateBounds; 6]) {
+    ) -> (SampleBounds, [RateBounds; 6], [RateBounds; 4]) {
         let p = &self.params;
         let t = p.period;
         let jerk = p.jerk_bound;
@@ -365,7 +413,9 @@ impl AttitudeFilter {
         let d = p.boresight_b;
         let (acc, acc_perp) = accel.unwrap_or_else(|| {
             // ‖P τ + r‖ over the torque box: ‖P‖₂ ≤ √(‖P‖₁‖P‖∞)
-            let n1 = (0..3).map(|j| x.p.column(j).abs().sum()).fold(0.0, f64::max);
+            let n1 = (0..3)
+                .map(|j| x.p.column(j).abs().sum())
+                .fold(0.0, f64::max);
             let ni = (0..3).map(|i| x.p.row(i).abs().sum()).fold(0.0, f64::max);
             let a = (n1 * ni).sqrt() * 3f64.sqrt() * p.torque_max + x.r.norm();
             (a, a)
@@ -412,7 +462,18 @@ impl AttitudeFilter {
             d: p.arm_reaction_budget[k % 3],
             j: jerk,
         });
-        (los, rate)
+        // the boresight rates: e_kᵀω̇ has the arm's reaction Σ|e_k,i|β_i unknown, and
+        // |e_kᵀω̈| ≤ Σ|e_k,i| j
+        let e = across_boresight(&d);
+        let boresight = std::array::from_fn(|k| {
+            let l1 = e[k % 2].abs();
+            RateBounds {
+                period: t,
+                d: l1.dot(&p.arm_reaction_budget),
+                j: l1.sum() * jerk,
+            }
+        });
+        (los, rate, boresight)
     }
 
     fn prepare(&self, x: &AttitudeInput) -> Result<Prepared, Invalid> {
@@ -454,13 +515,31 @@ impl AttitudeFilter {
             p.cos_beta,
         );
         let omega = omega_limits(&x.omega_b, &gain, &x.r, &p.omega_max, &p.omega_min);
-        let terms = AttitudeTerms { los, omega };
-        let rows: [Row<3>; N] = match p.formulation {
+        let boresight = boresight_rate(
+            &x.omega_b,
+            &gain,
+            &x.r,
+            &p.boresight_b,
+            p.boresight_rate_max,
+        );
+        let terms = AttitudeTerms {
+            los,
+            omega,
+            boresight,
+        };
+        let rows: [Row<3>; ROWS] = match p.formulation {
             Formulation::SampledData => self.sampled_rows(x, &rho, &terms, None),
             Formulation::Paper => {
-                let mut rows = [los.row(p.gamma, p.eps_att, p.u_max_att); N];
+                let mut rows = [los.row(p.gamma, p.eps_att, p.u_max_att); ROWS];
                 for (k, o) in omega.iter().enumerate() {
                     rows[1 + k] = o.row(p.gamma_omega, p.eps_omega);
+                }
+                // the paper has no boresight-rate limit: rows that never bind
+                for r in rows.iter_mut().skip(N) {
+                    *r = Row {
+                        a: Vector3::zeros(),
+                        c: 1.0,
+                    };
                 }
                 rows
             }
@@ -471,7 +550,7 @@ impl AttitudeFilter {
         // the relaxed problem's weights: each row's violation is measured against the
         // deceleration the formulation budgets for it — μ (u_max of H) for the line of
         // sight, the paper's ε_ω for a rate row
-        let mut weights = [0.0; N];
+        let mut weights = [0.0; ROWS];
         weights[0] = p.u_max_att;
         for w in weights.iter_mut().skip(1) {
             *w = p.eps_omega;
@@ -493,12 +572,15 @@ impl AttitudeFilter {
         rho: &Vector3<f64>,
         t: &AttitudeTerms,
         accel: Option<(f64, f64)>,
-    ) -> [Row<3>; N] {
+    ) -> [Row<3>; ROWS] {
         let p = &self.params;
-        let (b_los, b_rate) = self.sample_bounds(x, rho, accel);
-        let mut rows = [RelDeg2::from(t.los).row(&b_los, p.u_max_att, p.gamma); N];
+        let (b_los, b_rate, b_w) = self.sample_bounds(x, rho, accel);
+        let mut rows = [RelDeg2::from(t.los).row(&b_los, p.u_max_att, p.gamma); ROWS];
         for (k, o) in t.omega.iter().enumerate() {
             rows[1 + k] = RelDeg1::from(*o).row(&b_rate[k], p.gamma_omega, p.eps_omega);
+        }
+        for (k, o) in t.boresight.iter().enumerate() {
+            rows[N + k] = RelDeg1::from(*o).row(&b_w[k], p.gamma_boresight, p.eps_omega);
         }
         rows
     }
@@ -613,10 +695,14 @@ impl AttitudeFilter {
         if sampled {
             let first = accel_inf(&u_nom);
             let floor = x.r.amax();
-            let mut best: Option<(f64, crate::engine::Outcome<3>, [Row<3>; N], [Row<3>; HARD + 6])> =
-                None;
+            let mut best: Option<(
+                f64,
+                crate::engine::Outcome<3>,
+                [Row<3>; ROWS],
+                [Row<3>; HARD + 6],
+            )> = None;
             for (k, cap) in std::iter::once(first).chain(ACCEL_CAPS).enumerate() {
-                if cap < floor || (k > 0 && cap >= first) {
+                if cap < floor || (k > 0 && cap == first) {
                     continue;
                 }
                 let c = 3f64.sqrt() * cap;
@@ -637,7 +723,9 @@ impl AttitudeFilter {
                         c: cap + x.r[i],
                     };
                 }
-                let out = self.engine.solve(&u_nom, &r_cap, &p.weights, &with_cap);
+                let out = self
+                    .engine
+                    .solve_tiered(&u_nom, &r_cap, &p.weights, &TIERS, &with_cap);
                 if matches!(out.kind, Kind::Skipped | Kind::Solved) {
                     if k == 0 {
                         best = Some((0.0, out, r_cap, with_cap));
@@ -658,7 +746,9 @@ impl AttitudeFilter {
         }
         let res = match res {
             Some(r) => r,
-            None => self.engine.solve(&u_nom, &p.rows, &p.weights, &hard),
+            None => self
+                .engine
+                .solve_tiered(&u_nom, &p.rows, &p.weights, &TIERS, &hard),
         };
         self.last
             .record(&u_nom, &rows, &p.weights, &solved_hard[..n_hard], &res);
@@ -682,7 +772,8 @@ impl AttitudeFilter {
         if clamped {
             report.faults |= faults::OUTPUT_CLAMPED;
         }
-        common::evaluate_rows(&rows, &tau, report);
+        let barrier_rows: [Row<3>; N] = std::array::from_fn(|i| rows[i]);
+        common::evaluate_rows(&barrier_rows, &tau, report);
         tau
     }
 
@@ -696,10 +787,14 @@ impl AttitudeFilter {
         self.last.dump()
     }
 
-    /// The barrier rows ([`NAMES`] order), their weights and the hard rows (torque box,
+    /// The rows ([`NAMES`] order, then the boresight rate), their weights and the hard rows (torque box,
     /// joint-coupling contract) at `x`.
     pub fn rows(&self, x: &AttitudeInput) -> Option<(Vec<Row<3>>, Vec<f64>, Vec<Row<3>>)> {
         let p = self.prepare(x).ok()?;
-        Some((p.rows.to_vec(), p.weights.to_vec(), self.hard_rows(x).to_vec()))
+        Some((
+            p.rows.to_vec(),
+            p.weights.to_vec(),
+            self.hard_rows(x).to_vec(),
+        ))
     }
 }

@@ -22,6 +22,13 @@
 //!   exactly (a lexicographic min-max, at most one round per row). Then the command is the
 //!   one nearest `u_nom` among those violating no row by more than its allowance. A large
 //!   nominal cannot buy violation, and one infeasible row does not license the others.
+//! * **Priorities.** Rows may carry a priority tier ([`Engine::solve_tiered`], 0 first):
+//!   the lexicographic relaxation then runs tier by tier, each tier's allowances chosen
+//!   with the earlier tiers' fixed and the later tiers ignored, so a row of a later tier
+//!   never makes one of an earlier tier give way. The filters put the rate limits first
+//!   (they bound every other row's in-sample motion, and braking the rates is always
+//!   possible inside the input box), the positions (line of sight, joint angles, link
+//!   spheres) after them: a lost line of sight cannot drag the body rates with it.
 
 use crate::barrier::Row;
 use nalgebra::SVector;
@@ -60,6 +67,7 @@ pub struct Engine<const M: usize, const N: usize> {
     a: [[f64; M]; N],
     b: [f64; N],
     w: [f64; N],
+    tier: [u8; N],
     skip_enabled: bool,
 }
 
@@ -76,6 +84,7 @@ impl<const M: usize, const N: usize> Engine<M, N> {
             a: [[0.0; M]; N],
             b: [0.0; N],
             w: [0.0; N],
+            tier: [0; N],
             skip_enabled: true,
         }
     }
@@ -94,6 +103,19 @@ impl<const M: usize, const N: usize> Engine<M, N> {
         weights: &[f64],
         bounds: &[Row<M>],
     ) -> Outcome<M> {
+        self.solve_tiered(u_nom, rows, weights, &[], bounds)
+    }
+
+    /// [`Self::solve`] with a priority tier per barrier row (0 first; `tiers` empty: all
+    /// rows in tier 0). Only the relaxed problem depends on the tiers.
+    pub fn solve_tiered(
+        &mut self,
+        u_nom: &SVector<f64, M>,
+        rows: &[Row<M>],
+        weights: &[f64],
+        tiers: &[u8],
+        bounds: &[Row<M>],
+    ) -> Outcome<M> {
         let mut out = Outcome {
             kind: Kind::Failed,
             u: *u_nom,
@@ -103,7 +125,7 @@ impl<const M: usize, const N: usize> Engine<M, N> {
         };
         let nb = rows.len();
         let n = nb + bounds.len();
-        if n > N || weights.len() != nb || nb > 64 {
+        if n > N || weights.len() != nb || nb > 64 || !(tiers.is_empty() || tiers.len() == nb) {
             return out;
         }
         let feasible = rows.iter().chain(bounds).all(|r| r.phi(u_nom) >= 0.0);
@@ -115,6 +137,11 @@ impl<const M: usize, const N: usize> Engine<M, N> {
             self.a[i].copy_from_slice(r.a.as_slice());
             self.b[i] = -r.c;
             self.w[i] = if i < nb { weights[i] } else { 0.0 };
+            self.tier[i] = if i < nb {
+                tiers.get(i).copied().unwrap_or(0)
+            } else {
+                0
+            };
         }
         let x0: [f64; M] = std::array::from_fn(|j| u_nom[j]);
         let hard = self.qp.solve(&x0, &self.a, &self.b, n);
@@ -156,50 +183,75 @@ impl<const M: usize, const N: usize> Engine<M, N> {
     ) -> Option<(sc_qp::Solution<M, N>, f64, u32)> {
         let mut fixed = [false; N];
         let mut allowance = [0.0; N];
+        let mut a = self.a;
         let mut b = self.b;
         let mut w = [0.0; N];
         let mut iterations = 0;
         let mut worst = 0.0f64;
-        for _ in 0..nb {
-            for i in 0..n {
-                let soft = i < nb && !fixed[i];
-                w[i] = if soft { self.w[i] } else { 0.0 };
-                b[i] = self.b[i] - if fixed[i] { self.w[i] * allowance[i] } else { 0.0 };
+        let last_tier = (0..nb).map(|i| self.tier[i]).max().unwrap_or(0);
+        for tier in 0..=last_tier {
+            let in_tier = |i: usize| i < nb && self.tier[i] == tier;
+            if !(0..nb).any(in_tier) {
+                continue;
             }
-            let lv = self.qp.least_violation(&self.a, &b, &w, n);
-            iterations += lv.iterations;
-            if lv.status != Status::Optimal {
-                return None;
-            }
-            if lv.t <= 0.0 {
-                break;
-            }
-            worst = worst.max(lv.t);
-            // rounding must not make the fixed rows' set empty: a relative 1e-9 of room
-            let t = lv.t * (1.0 + 1e-9) + 1e-12;
-            let mut any = false;
-            for i in 0..nb {
-                if !fixed[i] && lv.dual[i] > 0.0 {
-                    fixed[i] = true;
-                    allowance[i] = t;
-                    any = true;
+            for _ in 0..nb {
+                for i in 0..n {
+                    // rows of later tiers are left out (a row that always holds)
+                    let later = i < nb && self.tier[i] > tier;
+                    a[i] = if later { [0.0; M] } else { self.a[i] };
+                    let soft = in_tier(i) && !fixed[i];
+                    w[i] = if soft { self.w[i] } else { 0.0 };
+                    b[i] = if later {
+                        -1.0
+                    } else {
+                        self.b[i]
+                            - if fixed[i] {
+                                self.w[i] * allowance[i]
+                            } else {
+                                0.0
+                            }
+                    };
                 }
-            }
-            if !any {
-                // a degenerate dual: give every remaining row the same allowance
+                let lv = self.qp.least_violation(&a, &b, &w, n);
+                iterations += lv.iterations;
+                if lv.status != Status::Optimal {
+                    return None;
+                }
+                if lv.t <= 0.0 {
+                    break;
+                }
+                worst = worst.max(lv.t);
+                // rounding must not make the fixed rows' set empty: a relative 1e-9 of room
+                let t = lv.t * (1.0 + 1e-9) + 1e-12;
+                let mut any = false;
                 for i in 0..nb {
-                    if !fixed[i] {
+                    if in_tier(i) && !fixed[i] && lv.dual[i] > 0.0 {
                         fixed[i] = true;
                         allowance[i] = t;
+                        any = true;
                     }
                 }
-            }
-            if (0..nb).all(|i| fixed[i]) {
-                break;
+                if !any {
+                    // a degenerate dual: give every remaining row of the tier the same allowance
+                    for i in 0..nb {
+                        if in_tier(i) && !fixed[i] {
+                            fixed[i] = true;
+                            allowance[i] = t;
+                        }
+                    }
+                }
+                if (0..nb).filter(|i| in_tier(*i)).all(|i| fixed[i]) {
+                    break;
+                }
             }
         }
         for i in 0..n {
-            b[i] = self.b[i] - if fixed[i] { self.w[i] * allowance[i] } else { 0.0 };
+            b[i] = self.b[i]
+                - if fixed[i] {
+                    self.w[i] * allowance[i]
+                } else {
+                    0.0
+                };
         }
         let sol = self.qp.solve(x0, &self.a, &b, n);
         iterations += sol.iterations;
@@ -268,7 +320,11 @@ impl<const M: usize> LastProblem<M> {
         use crate::QpOutcome;
         crate::QpDump {
             u_nom: self.u_nom.iter().copied().collect(),
-            rows_a: self.rows.iter().map(|r| r.a.iter().copied().collect()).collect(),
+            rows_a: self
+                .rows
+                .iter()
+                .map(|r| r.a.iter().copied().collect())
+                .collect(),
             rows_c: self.rows.iter().map(|r| r.c).collect(),
             bounds_g: self
                 .hard

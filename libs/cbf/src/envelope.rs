@@ -43,7 +43,12 @@ fn lcg(s: &mut u64) -> f64 {
 }
 
 /// Samples the envelope of scenario `s` with the servicer model `robot`.
-pub fn sample(s: &sc_scenario::Scenario, robot: &Robot, samples: usize, seed: u64) -> EnvelopeMaxima {
+pub fn sample(
+    s: &sc_scenario::Scenario,
+    robot: &Robot,
+    samples: usize,
+    seed: u64,
+) -> EnvelopeMaxima {
     let rb = &s.safety.robotic;
     let at = &s.safety.attitude;
     let lim = &s.limits;
@@ -59,7 +64,8 @@ pub fn sample(s: &sc_scenario::Scenario, robot: &Robot, samples: usize, seed: u6
     let mut rng = seed.max(1);
     for _ in 0..samples {
         let mut r = || lcg(&mut rng);
-        let th = Vector7::from_fn(|i, _| 0.5 * (tmin[i] + tmax[i]) + 0.5 * (tmax[i] - tmin[i]) * r());
+        let th =
+            Vector7::from_fn(|i, _| 0.5 * (tmin[i] + tmax[i]) + 0.5 * (tmax[i] - tmin[i]) * r());
         let thd = Vector7::from_fn(|i, _| tdmax[i] * r());
         let w = Vector3::from_fn(|i, _| wmax[i] * r());
         let f = Vector3::from_fn(|_, _| lim.force_max_n * r());
@@ -82,10 +88,17 @@ pub fn sample(s: &sc_scenario::Scenario, robot: &Robot, samples: usize, seed: u6
         let mut delta = Vector7::from_fn(|_, _| lim.joint_torque_max_nm * r()) - hold;
         let qt = bd.q * delta;
         let k = (0..3)
-            .map(|i| if beta[i] > 0.0 { qt[i].abs() / beta[i] } else { 0.0 })
+            .map(|i| {
+                if beta[i] > 0.0 {
+                    qt[i].abs() / beta[i]
+                } else {
+                    0.0
+                }
+            })
             .fold(1.0f64, f64::max);
         delta /= k;
-        let mut tm = (hold + delta).map(|t| t.clamp(-lim.joint_torque_max_nm, lim.joint_torque_max_nm));
+        let mut tm =
+            (hold + delta).map(|t| t.clamp(-lim.joint_torque_max_nm, lim.joint_torque_max_nm));
         let admitted = |t: &Vector7| {
             let qdd = a * (t - red.c_eff);
             (0..7).all(|i| qdd[i].abs() <= 2.0 * tdmax[i] / period)
@@ -119,7 +132,9 @@ pub fn sample(s: &sc_scenario::Scenario, robot: &Robot, samples: usize, seed: u6
         // d/dt along the state's own motion, central differences (the body-fixed base
         // force and torque and the joint torques are held, as in a sample)
         let d = 1e-5;
-        let at_ = |e: f64| robot.forward_dynamics_sim(&(th + thd * e), &(w + wd * e), &(thd + qdd * e), &u);
+        let at_ = |e: f64| {
+            robot.forward_dynamics_sim(&(th + thd * e), &(w + wd * e), &(thd + qdd * e), &u)
+        };
         let qdd_at = |_e: f64| qdd;
         let (Some(p), Some(m)) = (at_(d), at_(-d)) else {
             continue;

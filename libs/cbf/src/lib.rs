@@ -32,12 +32,12 @@ pub mod sampled;
 pub mod translational;
 
 pub use attitude::{AttitudeFilter, AttitudeInput, AttitudeParams};
-pub use sc_scenario::Formulation;
 pub use barrier::{RelDegOne, RelDegTwo, Row};
 pub use common::{FilterOutput, FilterReport, FilterStatus, faults};
 pub use qp::{QpDump, QpOutcome, SolverParams};
-pub use sampled::{RateBounds, RelDeg1, RelDeg2, SampleBounds};
 pub use robotic::{RoboticFilter, RoboticInput, RoboticParams, robotic_input_from_model};
+pub use sampled::{RateBounds, RelDeg1, RelDeg2, SampleBounds};
+pub use sc_scenario::Formulation;
 pub use translational::{TranslationalFilter, TranslationalInput, TranslationalParams};
 
 /// Output of the translational filter: `u = f_H`, `actuated = f_B` (2 constraints).
@@ -56,7 +56,10 @@ pub struct SafetyLayer {
 
 impl SafetyLayer {
     /// All three filters from the scenario and the servicer model.
-    pub fn from_scenario(s: &sc_scenario::Scenario, robot: std::sync::Arc<sc_multibody::Robot>) -> Self {
+    pub fn from_scenario(
+        s: &sc_scenario::Scenario,
+        robot: std::sync::Arc<sc_multibody::Robot>,
+    ) -> Self {
         let mass = robot.total_mass();
         Self {
             translational: TranslationalFilter::from_scenario(s, mass),

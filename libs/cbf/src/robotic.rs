@@ -28,7 +28,9 @@
 //! budget the attitude filter assumes, `|(Q (τ_M − τ_hold))_i| ≤ β_i` (six hard rows).
 
 use crate::barrier::{RelDegOne, RelDegTwo, Row};
-use crate::common::{self, BOX_MARGIN, FilterOutput, FilterReport, FilterStatus, clamp_box, faults};
+use crate::common::{
+    self, BOX_MARGIN, FilterOutput, FilterReport, FilterStatus, clamp_box, faults,
+};
 use crate::engine::{Engine, Kind, LastProblem, Outcome};
 use crate::sampled::{RateBounds, RelDeg1, RelDeg2, SampleBounds, braking_barrier};
 use crate::{Formulation, qp::SolverParams};
@@ -280,7 +282,6 @@ impl RoboticTerms {
     }
 }
 
-
 enum Invalid {
     State,
     Coupling,
@@ -427,7 +428,11 @@ impl RoboticFilter {
     /// * joint rate: `J = J_i`;
     /// * link sphere (`ḧ = 2‖ṗ‖² + 2dᵀp̈`): `M₃ = 6 V A + 2 D J_k` with the centre's
     ///   acceleration `A = ‖p̈‖ + J_k T`, speed `V = ‖ṗ‖ + A T`, distance `D = ‖d‖ + V T`.
-    fn certified_bounds(&self, x: &RoboticInput, qdd: &Vector7) -> ([SampleBounds; NJ], [RateBounds; NJ], [SampleBounds; NS]) {
+    fn certified_bounds(
+        &self,
+        x: &RoboticInput,
+        qdd: &Vector7,
+    ) -> ([SampleBounds; NJ], [RateBounds; NJ], [SampleBounds; NS]) {
         let p = &self.params;
         let t = p.period;
         let acc = Vector7::from_fn(|i, _| qdd[i].abs() + p.joint_jerk_bound[i] * t);
@@ -461,7 +466,13 @@ impl RoboticFilter {
     }
 
     /// The 42 barrier rows at `level`, each tightened by `margin[j]` [row units].
-    fn barrier_rows(&self, x: &RoboticInput, t: &RoboticTerms, level: Level, margin: &[f64; N]) -> [Row<NJ>; N] {
+    fn barrier_rows(
+        &self,
+        x: &RoboticInput,
+        t: &RoboticTerms,
+        level: Level,
+        margin: &[f64; N],
+    ) -> [Row<NJ>; N] {
         let p = &self.params;
         let mut rows: [Row<NJ>; N] = match p.formulation {
             Formulation::Paper => std::array::from_fn(|j| {
@@ -496,11 +507,23 @@ impl RoboticFilter {
                     if j < NJ {
                         RelDeg2::from(t.theta[j]).row(&bt[j], p.u_max_theta, p.gamma)
                     } else if j < 2 * NJ {
-                        RelDeg1::from(t.theta_dot_max[j - NJ]).row(&br[j - NJ], p.gamma_theta_dot, p.eps_theta_dot)
+                        RelDeg1::from(t.theta_dot_max[j - NJ]).row(
+                            &br[j - NJ],
+                            p.gamma_theta_dot,
+                            p.eps_theta_dot,
+                        )
                     } else if j < 3 * NJ {
-                        RelDeg1::from(t.theta_dot_min[j - 2 * NJ]).row(&br[j - 2 * NJ], p.gamma_theta_dot, p.eps_theta_dot)
+                        RelDeg1::from(t.theta_dot_min[j - 2 * NJ]).row(
+                            &br[j - 2 * NJ],
+                            p.gamma_theta_dot,
+                            p.eps_theta_dot,
+                        )
                     } else {
-                        RelDeg2::from(t.link_base[j - 3 * NJ]).row(&blb[j - 3 * NJ], p.u_max_lb, p.gamma)
+                        RelDeg2::from(t.link_base[j - 3 * NJ]).row(
+                            &blb[j - 3 * NJ],
+                            p.u_max_lb,
+                            p.gamma,
+                        )
                     }
                 })
             }
@@ -556,7 +579,11 @@ impl RoboticFilter {
     }
 
     /// [`Self::filter`] with the nominal possibly missing.
-    pub fn filter_with(&mut self, x: &RoboticInput, tau_nom: Option<&Vector7>) -> FilterOutput<NJ, N> {
+    pub fn filter_with(
+        &mut self,
+        x: &RoboticInput,
+        tau_nom: Option<&Vector7>,
+    ) -> FilterOutput<NJ, N> {
         let t0 = std::time::Instant::now();
         let mut report = FilterReport::<N>::default();
         let u = self.filter_inner(x, tau_nom, &mut report);
@@ -568,7 +595,12 @@ impl RoboticFilter {
         }
     }
 
-    fn filter_inner(&mut self, x: &RoboticInput, tau_nom: Option<&Vector7>, report: &mut FilterReport<N>) -> Vector7 {
+    fn filter_inner(
+        &mut self,
+        x: &RoboticInput,
+        tau_nom: Option<&Vector7>,
+        report: &mut FilterReport<N>,
+    ) -> Vector7 {
         let tmax = self.params.torque_max;
         let terms = match self.terms(x) {
             Ok(t) => t,
@@ -621,7 +653,12 @@ impl RoboticFilter {
                 }
                 res = next;
                 solved_cap = Some(grown);
-                if accel(&res.u).abs().iter().zip(grown.iter()).all(|(a, g)| a <= g) {
+                if accel(&res.u)
+                    .abs()
+                    .iter()
+                    .zip(grown.iter())
+                    .all(|(a, g)| a <= g)
+                {
                     // the rows' bounds cover the new command's accelerations
                     certified = true;
                     final_rows = rows;
@@ -684,7 +721,8 @@ impl RoboticFilter {
             iterations: report.iterations,
             row_duals: [0.0; 64],
         };
-        self.last.record(&u_nom, &final_rows, &weights, &hard, &outcome);
+        self.last
+            .record(&u_nom, &final_rows, &weights, &hard, &outcome);
         let (tau, clamped) = clamp_box(&tau, tmax);
         if clamped {
             report.faults |= faults::OUTPUT_CLAMPED;
@@ -720,7 +758,11 @@ impl RoboticFilter {
             let v = self.verify(&robot, x, terms, &res.u, weights);
             report.iterations += 1;
             if v.ok {
-                let violation = if res.kind == Kind::Relaxed { res.violation } else { 0.0 };
+                let violation = if res.kind == Kind::Relaxed {
+                    res.violation
+                } else {
+                    0.0
+                };
                 return Some((res.u, rows, violation));
             }
             if best.as_ref().is_none_or(|b| v.worst > b.0) {
@@ -733,7 +775,11 @@ impl RoboticFilter {
         // a sample whose integration failed reports a full violation (the command itself
         // is still inside the box: the relaxed problem's hard rows hold)
         best.map(|(worst, u, rows)| {
-            let v = if worst.is_finite() { (-worst).max(f64::MIN_POSITIVE) } else { 1.0 };
+            let v = if worst.is_finite() {
+                (-worst).max(f64::MIN_POSITIVE)
+            } else {
+                1.0
+            };
             (u, rows, v)
         })
     }
@@ -741,7 +787,14 @@ impl RoboticFilter {
     /// Integrates one sample under `tau` with the servicer model exactly as the simulator
     /// does (RK4 at the physics step; base force and torque held in the body frame) and
     /// checks every row's conditions on the true trajectory.
-    fn verify(&self, robot: &Robot, x: &RoboticInput, t0: &RoboticTerms, tau: &Vector7, weights: &[f64; N]) -> Verdict {
+    fn verify(
+        &self,
+        robot: &Robot,
+        x: &RoboticInput,
+        t0: &RoboticTerms,
+        tau: &Vector7,
+        weights: &[f64; N],
+    ) -> Verdict {
         let p = &self.params;
         let mut verdict = Verdict {
             ok: true,
@@ -794,10 +847,14 @@ impl RoboticFilter {
             }
             for j in 0..N {
                 verdict.worst = verdict.worst.min(hv[j] / weights[j]);
-                let rel2 = j < NJ || j >= 3 * NJ;
+                let rel2 = !(NJ..3 * NJ).contains(&j);
                 if hv[j] < 0.0 {
                     // C1: the barrier inside the sample
-                    let short = if rel2 { 2.0 * -hv[j] / (s * s) } else { -hv[j] / s };
+                    let short = if rel2 {
+                        2.0 * -hv[j] / (s * s)
+                    } else {
+                        -hv[j] / s
+                    };
                     fail(&mut verdict, j, short);
                 }
                 if step == steps {
@@ -845,7 +902,11 @@ impl RoboticFilter {
     pub fn rows(&self, x: &RoboticInput) -> Option<(Vec<Row<NJ>>, Vec<f64>, Vec<Row<NJ>>)> {
         let t = self.terms(x).ok()?;
         let rows = self.barrier_rows(x, &t, Level::Certified(Vector7::zeros()), &[0.0; N]);
-        Some((rows.to_vec(), self.weights().to_vec(), self.hard_rows(x).to_vec()))
+        Some((
+            rows.to_vec(),
+            self.weights().to_vec(),
+            self.hard_rows(x).to_vec(),
+        ))
     }
 
     /// The last QP (the rows the command was finally solved with) for `--dump-qp`.
@@ -864,18 +925,34 @@ pub fn rk4_internal(
     u: &Vector13,
     h: f64,
 ) -> Option<(Vector7, Vector7, Vector3<f64>)> {
-    let f = |th: &Vector7, thd: &Vector7, w: &Vector3<f64>| -> Option<(Vector7, Vector7, Vector3<f64>)> {
+    let f = |th: &Vector7,
+             thd: &Vector7,
+             w: &Vector3<f64>|
+     -> Option<(Vector7, Vector7, Vector3<f64>)> {
         let a = robot.forward_dynamics_sim(th, w, thd, u)?;
-        Some((*thd, a.fixed_rows::<NJ>(6).into(), a.fixed_rows::<3>(3).into()))
+        Some((
+            *thd,
+            a.fixed_rows::<NJ>(6).into(),
+            a.fixed_rows::<3>(3).into(),
+        ))
     };
     let (k1t, k1d, k1w) = f(th, thd, w)?;
-    let (k2t, k2d, k2w) = f(&(th + k1t * (h / 2.0)), &(thd + k1d * (h / 2.0)), &(w + k1w * (h / 2.0)))?;
-    let (k3t, k3d, k3w) = f(&(th + k2t * (h / 2.0)), &(thd + k2d * (h / 2.0)), &(w + k2w * (h / 2.0)))?;
+    let (k2t, k2d, k2w) = f(
+        &(th + k1t * (h / 2.0)),
+        &(thd + k1d * (h / 2.0)),
+        &(w + k1w * (h / 2.0)),
+    )?;
+    let (k3t, k3d, k3w) = f(
+        &(th + k2t * (h / 2.0)),
+        &(thd + k2d * (h / 2.0)),
+        &(w + k2w * (h / 2.0)),
+    )?;
     let (k4t, k4d, k4w) = f(&(th + k3t * h), &(thd + k3d * h), &(w + k3w * h))?;
     let th1 = th + (k1t + k2t * 2.0 + k3t * 2.0 + k4t) * (h / 6.0);
     let thd1 = thd + (k1d + k2d * 2.0 + k3d * 2.0 + k4d) * (h / 6.0);
     let w1 = w + (k1w + k2w * 2.0 + k3w * 2.0 + k4w) * (h / 6.0);
-    (common::finite(&th1) && common::finite(&thd1) && common::finite(&w1)).then_some((th1, thd1, w1))
+    (common::finite(&th1) && common::finite(&thd1) && common::finite(&w1))
+        .then_some((th1, thd1, w1))
 }
 
 /// Computes the filter's precomputed terms from the servicer model for joint state
@@ -905,7 +982,9 @@ pub fn robotic_input_from_model(
     );
     let red = robot.reduced_arm_dynamics(theta, theta_dot, omega_b, &wrench)?;
     let a = red.m_eff.cholesky()?.inverse();
-    let reaction = robot.base_angular_dynamics(theta, theta_dot, omega_b, f_b_sf)?.q;
+    let reaction = robot
+        .base_angular_dynamics(theta, theta_dot, omega_b, f_b_sf)?
+        .q;
     let base = robot.base_sphere()?;
     let kin = robot.kinematics_vel(theta, theta_dot);
     let mut spheres = [SphereTerms::default(); NS];

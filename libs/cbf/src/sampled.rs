@@ -286,7 +286,11 @@ mod tests {
         let row = x.row(&b, 1.0, 1.0);
         assert_eq!(row.a[0], 2.0);
         // at rest on the boundary the command must produce at least the margins
-        assert!(row.c <= -0.3 - (0.01 + 0.1 * 0.1 / 3.0) + 1e-15, "{}", row.c);
+        assert!(
+            row.c <= -0.3 - (0.01 + 0.1 * 0.1 / 3.0) + 1e-15,
+            "{}",
+            row.c
+        );
     }
 
     #[test]

@@ -512,8 +512,7 @@ impl TranslationalFilter {
         for (i, t) in p.terms.iter().enumerate() {
             report.h[i] = t.h;
         }
-        let (u_nom, flag) =
-            common::resolve_nominal(f_nom_h, fmax, || self.brake_prepared(x, &p).0);
+        let (u_nom, flag) = common::resolve_nominal(f_nom_h, fmax, || self.brake_prepared(x, &p).0);
         report.faults |= flag;
         let res = self.engine.solve(&u_nom, &p.rows, &p.weights, &p.bounds);
         self.last

@@ -488,11 +488,13 @@ struct RelaxedStats {
 /// the same bits for all of them and equals the reference's; the command is the
 /// projection of the nominal onto the rows with the reference's allowances (KKT with
 /// multipliers of our own, and Clarabel's own solution where it resolves it).
+#[allow(clippy::too_many_arguments)] // a test helper: each argument is one axis of the check
 fn check_relaxed<const M: usize>(
     what: &str,
     bound: f64,
     u_inf: f64,
     rows: &(Vec<Row<M>>, Vec<f64>, Vec<Row<M>>),
+    tiers: &[u8],
     dir: &SVector<f64, M>,
     stats: &mut RelaxedStats,
     mut run: impl FnMut(&SVector<f64, M>) -> (SVector<f64, M>, FilterStatus, f64, u32),
@@ -501,7 +503,7 @@ fn check_relaxed<const M: usize>(
     let mut t_ref = None;
     stats.cases += 1;
     // the allowances do not depend on the nominal (that is the point): computed once
-    let lex = lexicographic(&Qp::from_rows(dir, barrier, hard), w)
+    let lex = lexicographic_tiered(&Qp::from_rows(dir, barrier, hard), w, tiers)
         .unwrap_or_else(|e| panic!("{what}: {e}"));
     stats.lp_deviation = stats.lp_deviation.max(lex.clarabel_lp_deviation);
     for k in SCALES {
@@ -596,6 +598,7 @@ fn translational_relaxed_command_is_the_lexicographic_least_violation_and_ignore
             fmax,
             3f64.sqrt() * fmax,
             &rows,
+            &[],
             &dir,
             &mut stats,
             |un| {
@@ -648,6 +651,7 @@ fn attitude_relaxed_command_is_the_lexicographic_least_violation_and_ignores_the
             tmax,
             tmax,
             &rows,
+            &sc_cbf::attitude::TIERS,
             &dir,
             &mut stats,
             |un| {
@@ -691,7 +695,13 @@ fn engine_relaxation_matches_clarabel_on_random_infeasible_problems() {
                 })
                 .collect();
             let dir = SVector::<f64, M>::from_fn(|_, _| rng.next());
-            let first = eng.solve(&dir, &barrier, &w, &hard);
+            // every third problem with two priority tiers
+            let tiers: Vec<u8> = if stats.cases % 3 == 2 {
+                (0..nb).map(|i| (i % 2) as u8).collect()
+            } else {
+                Vec::new()
+            };
+            let first = eng.solve_tiered(&dir, &barrier, &w, &tiers, &hard);
             if first.kind != Kind::Relaxed {
                 continue;
             }
@@ -700,10 +710,11 @@ fn engine_relaxation_matches_clarabel_on_random_infeasible_problems() {
                 1.0,
                 1.0,
                 &(barrier.clone(), w.clone(), hard.clone()),
+                &tiers,
                 &dir,
                 &mut stats,
                 |un| {
-                    let o = eng.solve(un, &barrier, &w, &hard);
+                    let o = eng.solve_tiered(un, &barrier, &w, &tiers, &hard);
                     let st = if o.kind == Kind::Relaxed {
                         FilterStatus::Relaxed
                     } else {

@@ -353,15 +353,12 @@ fn attitude_cone_and_rates_invariant_under_adversarial_nominal() {
     assert!(run.interventions > 1000, "{run:?}");
 }
 
-/// KNOWN SRC/DESIGN ISSUE (reported): under the same adversarial nominal the attitude
-/// filter lets the body roll about the boresight at its rate rows' equilibrium
-/// (0.136 rad/s) while coning near the cone's edge; there the line-of-sight row needs
-/// `ḧ ≥ φ_req ≈ 2–6e-3 rad/s²` but the torque box can only add `‖Pᵀ(d × s_B)‖₁ T ≈
-/// 9e-3` to a drift of `≈ −7.5e-3` (the braking requirement `μ + M₂ + M₃T ≈ 0.034` is
-/// ~3.5× the authority): 9 relaxed steps in 300 s, `t*` up to 1.06. The barriers still
-/// hold (previous test) but the certificate is lost.
+/// The certificate itself holds under the same adversarial nominal: the line-of-sight
+/// row never needs the relaxed problem. (Before the certified set limited the boresight's
+/// rate across itself, the body rolled about the boresight at the rate rows' equilibrium
+/// while coning near the cone's edge, and the row needed more than the torque box gave:
+/// 9 relaxed steps in 300 s, docs/SAFETY.md "Line of sight".)
 #[test]
-#[ignore = "src issue: the attitude certified set is not forward invariant (LOS row infeasible while coning)"]
 fn attitude_certified_set_is_forward_invariant_under_adversarial_nominal() {
     let run = attitude_run(true, 3000);
     assert_eq!(run.relaxed, 0, "{run:?}");

@@ -1,8 +1,8 @@
 //! The whole mission in one process.
 
+use crate::nominal_source::{NominalCommands, NominalOverride};
 use crate::record::StepRecord;
 use crate::setup::{Setup, SetupError};
-use crate::nominal_source::{NominalCommands, NominalOverride};
 use crate::stages;
 use sc_cbf::monitor::{Barriers, Monitor, min_into};
 use sc_cbf::{QpDump, SafetyLayer};
@@ -141,10 +141,10 @@ impl Mission {
         } else {
             tr.actuated
         };
-        let at = self
-            .safety
-            .attitude
-            .filter_with(&stages::attitude_input(&o, &robot, &f_b), tau_b_nom.as_ref());
+        let at = self.safety.attitude.filter_with(
+            &stages::attitude_input(&o, &robot, &f_b),
+            tau_b_nom.as_ref(),
+        );
         let tau_b = if self.options.no_filter {
             stages::saturate(&tau_b_nom.unwrap_or_default(), limits.torque_max_nm)
         } else {

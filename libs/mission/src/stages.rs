@@ -3,11 +3,11 @@
 //! causal order translational → attitude → robotic.
 
 use nalgebra::{Matrix3, Vector3};
+use sc_cbf::monitor::MonitorState;
 use sc_cbf::{AttitudeInput, RoboticInput, TranslationalInput, attitude::tidal_acceleration};
 use sc_models::quat;
 use sc_multibody::{Robot, Vector7};
 use sc_nominal::NominalInput;
-use sc_cbf::monitor::MonitorState;
 use sc_sim::{BarrierState, Observation};
 
 /// What the safety monitor reads, from an observation (the true state at a control step).

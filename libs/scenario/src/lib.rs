@@ -239,6 +239,11 @@ pub struct SafetyAttitude {
     pub gamma_omega_per_s: f64,
     /// u_max of the line-of-sight auxiliary barrier [1/s²].
     pub u_max_att_per_s2: f64,
+    /// Certified set: the boresight's angular rate across itself, `‖ω_B × d_B‖`, at most
+    /// this [rad/s] (not one of the paper's barriers; docs/SAFETY.md, "Line of sight").
+    pub boresight_rate_max_rad_s: f64,
+    /// γ of the boresight-rate row [1/s].
+    pub gamma_boresight_rate_per_s: f64,
     /// Contract with the robotic filter: the arm's reaction on the base angular
     /// acceleration, `|(Q τ_M)_i| ≤ β_i` per body axis [rad/s²].
     pub arm_reaction_budget_rad_s2: V3,

@@ -278,6 +278,14 @@ impl Scenario {
         non_negative("safety.attitude.eps_omega", at.eps_omega)?;
         positive("safety.attitude.gamma_omega_per_s", at.gamma_omega_per_s)?;
         positive("safety.attitude.u_max_att_per_s2", at.u_max_att_per_s2)?;
+        positive(
+            "safety.attitude.boresight_rate_max_rad_s",
+            at.boresight_rate_max_rad_s,
+        )?;
+        positive(
+            "safety.attitude.gamma_boresight_rate_per_s",
+            at.gamma_boresight_rate_per_s,
+        )?;
 
         for i in 0..3 {
             non_negative(

@@ -469,6 +469,13 @@ pub struct Lexicographic {
 /// vertex of the supporting rows when that vertex is feasible). The command is then the
 /// projection of the nominal onto `qp.relaxed(&allowance)`. Independent of `qp.u_nom`.
 pub fn lexicographic(qp: &Qp, w: &[f64]) -> Result<Lexicographic, String> {
+    lexicographic_tiered(qp, w, &[])
+}
+
+/// [`lexicographic`] with priority tiers (`sc_cbf::engine`): tier by tier, the later
+/// tiers' rows left out, the earlier tiers' allowances fixed. `t1` is then the largest
+/// round value of all tiers (what the engine reports).
+pub fn lexicographic_tiered(qp: &Qp, w: &[f64], tiers: &[u8]) -> Result<Lexicographic, String> {
     use clarabel::algebra::CscMatrix;
     use clarabel::solver::{
         DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
@@ -489,99 +496,112 @@ pub fn lexicographic(qp: &Qp, w: &[f64]) -> Result<Lexicographic, String> {
         st.tol_feas = tol;
         st
     };
-    for round in 0..nb {
-        // variables [u; t]: min t  s.t.  −a_i u − w_i t ≤ c_i (soft), −a_i u ≤ c_i + w_i t_i
-        // (fixed), −g u ≤ c (hard), −t ≤ 0
-        let cols = m + 1;
-        let rows = n + 1;
-        let mut dense = vec![vec![0.0; cols]; rows];
-        let mut b = vec![0.0; rows];
-        for i in 0..n {
-            for (j, d) in dense[i].iter_mut().enumerate().take(m) {
-                *d = -qp.a[i][j];
-            }
-            b[i] = qp.c[i];
-            if i < nb {
-                if fixed[i] {
-                    b[i] += w[i] * allow[i];
-                } else {
-                    dense[i][m] = -w[i];
+    let tier = |i: usize| tiers.get(i).copied().unwrap_or(0);
+    let last_tier = (0..nb).map(tier).max().unwrap_or(0);
+    for current in 0..=last_tier {
+        let in_tier = |i: usize| tier(i) == current;
+        if !(0..nb).any(in_tier) {
+            continue;
+        }
+        for round in 0..nb {
+            // variables [u; t]: min t  s.t.  −a_i u − w_i t ≤ c_i (soft), −a_i u ≤ c_i + w_i t_i
+            // (fixed), −g u ≤ c (hard), −t ≤ 0; later tiers' rows left out (0 ≤ 1)
+            let cols = m + 1;
+            let rows = n + 1;
+            let mut dense = vec![vec![0.0; cols]; rows];
+            let mut b = vec![0.0; rows];
+            for i in 0..n {
+                if i < nb && tier(i) > current {
+                    b[i] = 1.0;
+                    continue;
+                }
+                for (j, d) in dense[i].iter_mut().enumerate().take(m) {
+                    *d = -qp.a[i][j];
+                }
+                b[i] = qp.c[i];
+                if i < nb {
+                    if fixed[i] {
+                        b[i] += w[i] * allow[i];
+                    } else if in_tier(i) {
+                        dense[i][m] = -w[i];
+                    }
                 }
             }
-        }
-        dense[n][m] = -1.0;
-        let a = CscMatrix::from(&dense);
-        let p = CscMatrix::<f64>::zeros((cols, cols));
-        let mut q = vec![0.0; cols];
-        q[m] = 1.0;
-        let cones = [SupportedConeT::NonnegativeConeT(rows)];
-        // tight tolerances first, looser ones if Clarabel stalls on an ill-conditioned LP
-        let mut solved = None;
-        for tol in [1e-12, 1e-10, 1e-8] {
-            let mut s = DefaultSolver::new(&p, &q, &a, &b, &cones, settings(tol))
-                .map_err(|e| format!("{e:?}"))?;
-            s.solve();
-            if matches!(
-                s.solution.status,
-                SolverStatus::Solved | SolverStatus::AlmostSolved
-            ) {
-                solved = Some(s);
+            dense[n][m] = -1.0;
+            let a = CscMatrix::from(&dense);
+            let p = CscMatrix::<f64>::zeros((cols, cols));
+            let mut q = vec![0.0; cols];
+            q[m] = 1.0;
+            let cones = [SupportedConeT::NonnegativeConeT(rows)];
+            // tight tolerances first, looser ones if Clarabel stalls on an ill-conditioned LP
+            let mut solved = None;
+            for tol in [1e-12, 1e-10, 1e-8] {
+                let mut s = DefaultSolver::new(&p, &q, &a, &b, &cones, settings(tol))
+                    .map_err(|e| format!("{e:?}"))?;
+                s.solve();
+                if matches!(
+                    s.solution.status,
+                    SolverStatus::Solved | SolverStatus::AlmostSolved
+                ) {
+                    solved = Some(s);
+                    break;
+                }
+            }
+            let s = solved.ok_or(format!("LP round {round}: Clarabel failed"))?;
+            let t_clarabel = s.solution.x[m];
+            let z = &s.solution.z;
+            let zmax = z[..n].iter().cloned().fold(0.0, f64::max);
+            let mut t = t_clarabel;
+            if cols <= 4 {
+                let (exact, _) =
+                    exact_lp_min_last(&dense, &b).ok_or(format!("LP round {round}: no vertex"))?;
+                deviation = deviation.max((t_clarabel - exact).abs() / exact.abs().max(1e-9));
+                t = exact;
+            } else if t > 1e-9 {
+                // crossover: the vertex of the supporting rows, accepted only when feasible and
+                // close to Clarabel's value (an incomplete support gives some other point)
+                let support: Vec<usize> = (0..n).filter(|&i| z[i] > 1e-6 * zmax).collect();
+                let am = DMatrix::from_fn(support.len(), cols, |r, c| dense[support[r]][c]);
+                let bv = DVector::from_fn(support.len(), |r, _| b[support[r]]);
+                if let Ok(sol) = am.clone().svd(true, true).solve(&bv, 1e-13) {
+                    let res = (&am * &sol - &bv).amax();
+                    let feasible = (0..rows).all(|i| {
+                        let lhs: f64 = (0..cols).map(|j| dense[i][j] * sol[j]).sum();
+                        lhs <= b[i] + 1e-12 * (1.0 + b[i].abs())
+                    });
+                    if feasible
+                        && res <= 1e-12 * (1.0 + bv.amax())
+                        && (sol[m] - t).abs() <= 1e-7 * t
+                    {
+                        t = sol[m];
+                    }
+                }
+            }
+            if t <= 1e-10 {
                 break;
             }
-        }
-        let s = solved.ok_or(format!("LP round {round}: Clarabel failed"))?;
-        let t_clarabel = s.solution.x[m];
-        let z = &s.solution.z;
-        let zmax = z[..n].iter().cloned().fold(0.0, f64::max);
-        let mut t = t_clarabel;
-        if cols <= 4 {
-            let (exact, _) =
-                exact_lp_min_last(&dense, &b).ok_or(format!("LP round {round}: no vertex"))?;
-            deviation = deviation.max((t_clarabel - exact).abs() / exact.abs().max(1e-9));
-            t = exact;
-        } else if t > 1e-9 {
-            // crossover: the vertex of the supporting rows, accepted only when feasible and
-            // close to Clarabel's value (an incomplete support gives some other point)
-            let support: Vec<usize> = (0..n).filter(|&i| z[i] > 1e-6 * zmax).collect();
-            let am = DMatrix::from_fn(support.len(), cols, |r, c| dense[support[r]][c]);
-            let bv = DVector::from_fn(support.len(), |r, _| b[support[r]]);
-            if let Ok(sol) = am.clone().svd(true, true).solve(&bv, 1e-13) {
-                let res = (&am * &sol - &bv).amax();
-                let feasible = (0..rows).all(|i| {
-                    let lhs: f64 = (0..cols).map(|j| dense[i][j] * sol[j]).sum();
-                    lhs <= b[i] + 1e-12 * (1.0 + b[i].abs())
-                });
-                if feasible && res <= 1e-12 * (1.0 + bv.amax()) && (sol[m] - t).abs() <= 1e-7 * t {
-                    t = sol[m];
-                }
-            }
-        }
-        if t <= 1e-10 {
-            break;
-        }
-        if round == 0 {
-            t1 = t;
-        }
-        // the engine's documented rounding room on every allowance: t (1 + 1e-9) + 1e-12
-        // (it enters the later rounds, and rows can be ill-conditioned enough for it to
-        // matter)
-        let t_allow = t * (1.0 + 1e-9) + 1e-12;
-        let mut any = false;
-        for i in 0..nb {
-            if !fixed[i] && z[i] > 1e-6 * zmax {
-                fixed[i] = true;
-                allow[i] = t_allow;
-                any = true;
-            }
-        }
-        if !any || fixed.iter().all(|f| *f) {
+            t1 = t1.max(t);
+            // the engine's documented rounding room on every allowance: t (1 + 1e-9) + 1e-12
+            // (it enters the later rounds, and rows can be ill-conditioned enough for it to
+            // matter)
+            let t_allow = t * (1.0 + 1e-9) + 1e-12;
+            let mut any = false;
             for i in 0..nb {
-                if !fixed[i] {
+                if in_tier(i) && !fixed[i] && z[i] > 1e-6 * zmax {
                     fixed[i] = true;
                     allow[i] = t_allow;
+                    any = true;
                 }
             }
-            break;
+            if !any || (0..nb).filter(|i| in_tier(*i)).all(|i| fixed[i]) {
+                for i in 0..nb {
+                    if in_tier(i) && !fixed[i] {
+                        fixed[i] = true;
+                        allow[i] = t_allow;
+                    }
+                }
+                break;
+            }
         }
     }
     let allowance: Vec<f64> = (0..nb).map(|i| w[i] * allow[i]).collect();
