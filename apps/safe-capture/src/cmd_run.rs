@@ -44,8 +44,52 @@ pub struct Args {
     /// Replace nominal controllers by a red-team adversary, `<target>/<strategy>`
     /// (`safe-capture redteam --list` lists them), e.g. `all/random:3` or
     /// `robotic/toward:theta_dot_max_7`.
-    #[arg(long, value_name = "CASE")]
+    #[arg(long, value_name = "CASE", conflicts_with = "replay_nominals")]
     redteam: Option<String>,
+    /// Feed the filters the nominal commands a recorded run's filters received (DIR holds
+    /// its telemetry.csv and timing.csv, e.g. a partition run or a red-team case's
+    /// `cases/<case>/`): with the same scenario the run is recomputed exactly, in one
+    /// process.
+    #[arg(long, value_name = "DIR")]
+    replay_nominals: Option<PathBuf>,
+}
+
+/// Where the run's nominal commands come from.
+#[derive(Clone)]
+enum Nominals {
+    Reference,
+    RedTeam(sc_redteam::Case),
+    Replay(std::sync::Arc<Vec<StepRecord>>),
+}
+
+impl Nominals {
+    fn from_args(a: &Args) -> anyhow::Result<Self> {
+        if let Some(c) = &a.redteam {
+            return sc_redteam::Case::parse(c)
+                .map(Nominals::RedTeam)
+                .map_err(|e| anyhow::anyhow!("--redteam: {e}"));
+        }
+        if let Some(dir) = &a.replay_nominals {
+            let read = |name: &str| {
+                let p = dir.join(name);
+                std::fs::read_to_string(&p)
+                    .with_context(|| format!("--replay-nominals: cannot read {}", p.display()))
+            };
+            let records =
+                sc_mission::parse_telemetry(&read("telemetry.csv")?, &read("timing.csv")?, true)
+                    .map_err(|e| anyhow::anyhow!("--replay-nominals {}: {e}", dir.display()))?;
+            return Ok(Nominals::Replay(std::sync::Arc::new(records)));
+        }
+        Ok(Nominals::Reference)
+    }
+
+    fn source(&self, setup: &Setup) -> Option<Box<dyn sc_mission::NominalOverride>> {
+        match self {
+            Nominals::Reference => None,
+            Nominals::RedTeam(c) => Some(adversary(setup, *c)),
+            Nominals::Replay(r) => Some(Box::new(sc_mission::ReplayNominals::new(r))),
+        }
+    }
 }
 
 /// Runs one mission, writing telemetry into `out`; returns the records and how it ended.
@@ -133,20 +177,15 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let started = std::time::Instant::now();
     let scenario = setup.scenario.clone();
     let compare_setup = setup.clone();
-    let case = a
-        .redteam
-        .as_deref()
-        .map(sc_redteam::Case::parse)
-        .transpose()
-        .map_err(|e| anyhow::anyhow!("--redteam: {e}"))?;
-    let adversary = case.map(|c| adversary(&setup, c));
+    let nominals = Nominals::from_args(&a)?;
+    let source = nominals.source(&setup);
     let (records, end) = run_mission(
         setup,
         options,
         &a.out,
         a.dump_qp.as_deref(),
         a.quiet,
-        adversary,
+        source,
     )?;
     let summary = summarize(&records, &end, &phase_names, !a.no_filter);
     let path = a.out.join("summary.json");
@@ -159,18 +198,25 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             &records,
             compare_setup,
             a.no_filter || a.no_compare,
-            case,
+            &nominals,
         )?;
     }
     let safe = summary.violated_constraints.is_empty() && summary.fault_count == 0;
-    println!(
-        "{}: {} at t = {:.1} s; min margin {} = {:.3e}; violated: [{}]; faults: {}; total solve time geomean {:.1} us, max {:.1} us; wall {:.2} s -> {}",
-        match (&a.redteam, a.no_filter) {
-            (Some(c), true) => format!("red team {c}, nominal only"),
-            (Some(c), false) => format!("red team {c}, filtered"),
-            (None, true) => "nominal only".into(),
-            (None, false) => "filtered".into(),
+    let what = format!(
+        "{}{}",
+        match (&a.redteam, &a.replay_nominals) {
+            (Some(c), _) => format!("red team {c}, "),
+            (None, Some(d)) => format!("replay of {}, ", d.display()),
+            _ => String::new(),
         },
+        if a.no_filter {
+            "nominal only"
+        } else {
+            "filtered"
+        }
+    );
+    println!(
+        "{what}: {} at t = {:.1} s; min margin {} = {:.3e}; violated: [{}]; faults: {}; total solve time geomean {:.1} us, max {:.1} us; wall {:.2} s -> {}",
         summary.end,
         summary.final_time_s,
         summary.min_margin.0,
@@ -207,7 +253,7 @@ fn write_figures(
     records: &[StepRecord],
     setup: Setup,
     alone: bool,
-    case: Option<sc_redteam::Case>,
+    nominals: &Nominals,
 ) -> anyhow::Result<()> {
     let nominal = if alone {
         None
@@ -220,9 +266,15 @@ fn write_figures(
             .map(|p| p.name.clone())
             .collect();
         // the same nominal (or adversary) without the filters
-        let adv = case.map(|c| adversary(&setup, c));
-        let (recs, end) =
-            run_mission(setup, RunOptions { no_filter: true }, &dir, None, true, adv)?;
+        let source = nominals.source(&setup);
+        let (recs, end) = run_mission(
+            setup,
+            RunOptions { no_filter: true },
+            &dir,
+            None,
+            true,
+            source,
+        )?;
         let summary = summarize(&recs, &end, &phase_names, false);
         let path = dir.join("summary.json");
         std::fs::write(&path, serde_json::to_string_pretty(&summary)? + "\n")

@@ -8,6 +8,7 @@
 pub mod mission;
 pub mod nominal_source;
 pub mod record;
+pub mod replay;
 pub mod setup;
 pub mod stages;
 pub mod summary;
@@ -15,6 +16,7 @@ pub mod summary;
 pub use mission::{Mission, MissionEnd, RunOptions, all_hold, capture_check, timeout_check};
 pub use nominal_source::{NominalCommand, NominalCommands, NominalOverride};
 pub use record::{StepRecord, TelemetryWriter, parse_telemetry, telemetry_columns, timing_columns};
+pub use replay::ReplayNominals;
 pub use setup::{Setup, SetupError};
 pub use summary::{Summary, summarize};
 
