@@ -18,9 +18,13 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import sc_icd  # noqa: E402
 
 # sc_bus::ServiceSettings::lock_step()
-LOCK_STEP = dict(buffer=4, history=0, max_publishers=2, max_subscribers=8, max_nodes=16)
-# sc_partition::process::qos(): the partition's data services
-PARTITION = dict(LOCK_STEP, buffer=16)
+LOCK_STEP = dict(buffer=4, history=0, max_publishers=2, max_subscribers=8, max_nodes=16, safe_overflow=False)
+# sc_partition::process::qos(): the partition's data services (lossless: a full queue
+# makes the publisher wait)
+PARTITION = dict(LOCK_STEP, buffer=16, safe_overflow=False)
+# sc_partition::process::partner_qos(): the services a partner's nominal controller
+# publishes on (safe_capture/nominal/*): newest wins, nobody ever waits
+NOMINAL = dict(PARTITION, safe_overflow=True)
 # event ids up to this on data services (sc_bus::pubsub::EVENT_ID_MAX)
 EVENT_ID_MAX = 7
 # the handshake's event services (sc_bus::handshake)
@@ -39,7 +43,7 @@ def open_pubsub(node, name, ctype, qos):
         .max_publishers(qos["max_publishers"])
         .max_subscribers(qos["max_subscribers"])
         .max_nodes(qos["max_nodes"])
-        .enable_safe_overflow(False)
+        .enable_safe_overflow(qos["safe_overflow"])
         .subscriber_max_borrowed_samples(2)
         .open_or_create()
     )

@@ -36,6 +36,18 @@ pub fn qos() -> ServiceSettings {
     }
 }
 
+/// Service settings of the services a partner's nominal controller publishes on
+/// (`safe_capture/nominal/*`): newest wins. A partner that floods cannot make anyone
+/// wait — not itself, not the filter, not the recorder: a full queue drops its oldest
+/// sample (the filters use the newest of the tick anyway, docs/PARTITION.md).
+pub fn partner_qos() -> ServiceSettings {
+    ServiceSettings {
+        safe_overflow: true,
+        backpressure_timeout: std::time::Duration::ZERO,
+        ..qos()
+    }
+}
+
 impl Proc {
     /// Parses `--config FILE --out DIR` (or the environment), joins the run of
     /// `SC_RUN_ID` and creates the node `role`.

@@ -4,14 +4,12 @@
 
 use crate::convert;
 use crate::fallback;
-use crate::process::{Proc, qos, wait};
+use crate::process::{Proc, partner_qos, qos, wait};
 use anyhow::Context;
-use nalgebra::Vector3;
 use sc_bus::{Subscriber, Waiter};
 use sc_cbf::{AttitudeOutput, RoboticOutput, SafetyLayer, TranslationalOutput};
 use sc_icd::*;
 use sc_mission::{MissionEnd, StepRecord, TelemetryWriter, summarize};
-use sc_multibody::Vector7;
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::time::{Duration, Instant};
@@ -56,12 +54,18 @@ struct Tickset {
 pub fn recorder() -> anyhow::Result<i32> {
     let p = Proc::start("recorder")?;
     let q = qos();
+    let partner_q = partner_qos();
     let tick_rx = Subscriber::<Tick>::polled(&p.node, services::TICK, &q)?;
     let state_rx = Subscriber::<SimState>::polled(&p.node, services::SIM_STATE, &q)?;
-    let nt_rx =
-        Subscriber::<NominalTranslational>::polled(&p.node, services::NOMINAL_TRANSLATIONAL, &q)?;
-    let na_rx = Subscriber::<NominalAttitude>::polled(&p.node, services::NOMINAL_ATTITUDE, &q)?;
-    let nr_rx = Subscriber::<NominalRobotic>::polled(&p.node, services::NOMINAL_ROBOTIC, &q)?;
+    let nt_rx = Subscriber::<NominalTranslational>::polled(
+        &p.node,
+        services::NOMINAL_TRANSLATIONAL,
+        &partner_q,
+    )?;
+    let na_rx =
+        Subscriber::<NominalAttitude>::polled(&p.node, services::NOMINAL_ATTITUDE, &partner_q)?;
+    let nr_rx =
+        Subscriber::<NominalRobotic>::polled(&p.node, services::NOMINAL_ROBOTIC, &partner_q)?;
     let st_rx = Subscriber::<SafeTranslational>::polled(&p.node, services::SAFE_TRANSLATIONAL, &q)?;
     let sa_rx = Subscriber::<SafeAttitude>::polled(&p.node, services::SAFE_ATTITUDE, &q)?;
     let sr_rx = Subscriber::<SafeRobotic>::polled(&p.node, services::SAFE_ROBOTIC, &q)?;
@@ -291,10 +295,9 @@ pub fn recorder() -> anyhow::Result<i32> {
                 None if r.fallback_mask & due::ATTITUDE != 0 => {
                     fallback::attitude(&mut layer, &o, &robot, &applied.force_b)
                 }
-                None => {
-                    h.sa.map(|m| convert::filter_output(&m))
-                        .unwrap_or_else(|| fallback::attitude(&mut layer, &o, &robot, &applied.force_b))
-                }
+                None => h.sa.map(|m| convert::filter_output(&m)).unwrap_or_else(|| {
+                    fallback::attitude(&mut layer, &o, &robot, &applied.force_b)
+                }),
             };
             let rb: RoboticOutput = match set.sr {
                 Some(m) => {
@@ -315,18 +318,11 @@ pub fn recorder() -> anyhow::Result<i32> {
                 t: o.t,
                 phase,
                 obs: o,
-                f_h_nom: h
-                    .nt
-                    .map(|m| convert::vec3(&m.f_h))
-                    .unwrap_or_else(Vector3::zeros),
-                tau_b_nom: h
-                    .na
-                    .map(|m| convert::vec3(&m.tau_b))
-                    .unwrap_or_else(Vector3::zeros),
-                tau_m_nom: h
-                    .nr
-                    .map(|m| convert::vec7(&m.tau_m))
-                    .unwrap_or_else(Vector7::zeros),
+                // what the filter got: NaN where it ran on the substitute nominal (as
+                // in process), never a message of another tick or one marked invalid
+                f_h_nom: nominal_seen(h.nt.map(|m| convert::vec3(&m.f_h)), tr.report.faults),
+                tau_b_nom: nominal_seen(h.na.map(|m| convert::vec3(&m.tau_b)), at.report.faults),
+                tau_m_nom: nominal_seen(h.nr.map(|m| convert::vec7(&m.tau_m)), rb.report.faults),
                 translational: tr,
                 attitude: at,
                 robotic: rb,
@@ -444,4 +440,17 @@ pub fn recorder() -> anyhow::Result<i32> {
         summary.fault_count
     );
     Ok(if safe && summary.captured { 0 } else { 1 })
+}
+
+/// The nominal command a filter ran on, as the record holds it: the message's values,
+/// or NaN when the filter flagged the nominal missing (absent, late, for another tick,
+/// marked invalid) and ran on its substitute nominal.
+fn nominal_seen<const D: usize>(
+    msg: Option<nalgebra::SVector<f64, D>>,
+    faults: u32,
+) -> nalgebra::SVector<f64, D> {
+    match msg {
+        Some(v) if faults & sc_cbf::faults::NOMINAL_MISSING == 0 => v,
+        _ => nalgebra::SVector::from_element(f64::NAN),
+    }
 }

@@ -5,7 +5,8 @@ use crate::config::ClockMode;
 use crate::convert;
 use crate::fallback;
 use crate::process::{
-    LOST_STOP_WAKEUP, Proc, prepare_listener, qos, send, wait, wait_outcome, warmup_enabled,
+    LOST_STOP_WAKEUP, Proc, partner_qos, prepare_listener, qos, send, wait, wait_outcome,
+    warmup_enabled,
 };
 use anyhow::Context;
 use nalgebra::Vector3;
@@ -42,6 +43,29 @@ fn newest<T: core::fmt::Debug + sc_bus::ZeroCopySend + Copy + 'static>(
         Some(s) => drain(s)?.pop(),
         None => None,
     })
+}
+
+/// Drains a partner's nominal-command subscriber into `held`: a command for the awaited
+/// tick `want` is never replaced by one for another tick (a partner bursting commands
+/// with other ticks cannot hide the one the filter waits for); among several for the
+/// same tick the newest wins. Returns whether anything came.
+fn keep_for_tick<T: core::fmt::Debug + sc_bus::ZeroCopySend + Copy + 'static>(
+    s: Option<&Subscriber<T>>,
+    held: &mut Option<T>,
+    want: Option<u64>,
+    tick: impl Fn(&T) -> u64,
+) -> anyhow::Result<bool> {
+    let Some(s) = s else {
+        return Ok(false);
+    };
+    let got = drain(s)?;
+    for m in &got {
+        let holds_wanted = held.as_ref().is_some_and(|h| Some(tick(h)) == want);
+        if Some(tick(m)) == want || !holds_wanted {
+            *held = Some(*m);
+        }
+    }
+    Ok(!got.is_empty())
 }
 
 /// The `Instant` of a monotonic time stamp `ns` of another process (same clock).
@@ -529,7 +553,8 @@ pub fn simulator() -> anyhow::Result<i32> {
             if let Some(m) = fresh_r {
                 held.tau = convert::vec7(&m.u);
             } else {
-                held.tau = fallback::robotic(&mut layer, &o, &robot, &held.force_b, &held.torque_b).u;
+                held.tau =
+                    fallback::robotic(&mut layer, &o, &robot, &held.force_b, &held.torque_b).u;
                 fallback_mask |= due::ROBOTIC;
                 if !absent[2] {
                     eprintln!(
@@ -600,18 +625,23 @@ pub fn nominal(which: usize) -> anyhow::Result<i32> {
     ][which];
     let p = Proc::start(role)?;
     let q = qos();
+    let partner_q = partner_qos();
     let tick_rx = Subscriber::<Tick>::polled(&p.node, services::CONTROL, &q)?;
     let state_rx = Subscriber::<SimState>::new(&p.node, services::SIM_STATE, &q)?;
     let tx_t = (which == 0)
         .then(|| {
-            Publisher::<NominalTranslational>::new(&p.node, services::NOMINAL_TRANSLATIONAL, &q)
+            Publisher::<NominalTranslational>::new(
+                &p.node,
+                services::NOMINAL_TRANSLATIONAL,
+                &partner_q,
+            )
         })
         .transpose()?;
     let tx_a = (which == 1)
-        .then(|| Publisher::<NominalAttitude>::new(&p.node, services::NOMINAL_ATTITUDE, &q))
+        .then(|| Publisher::<NominalAttitude>::new(&p.node, services::NOMINAL_ATTITUDE, &partner_q))
         .transpose()?;
     let tx_r = (which == 2)
-        .then(|| Publisher::<NominalRobotic>::new(&p.node, services::NOMINAL_ROBOTIC, &q))
+        .then(|| Publisher::<NominalRobotic>::new(&p.node, services::NOMINAL_ROBOTIC, &partner_q))
         .transpose()?;
     // Wakes on states only; the tick queue is read at every wake-up for the stop
     // (the simulator wakes its consumers once when it stops).
@@ -729,19 +759,26 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
     let role = ["safety_translational", "safety_attitude", "safety_robotic"][which];
     let p = Proc::start(role)?;
     let q = qos();
+    let partner_q = partner_qos();
     // Subscribers without a listener until needed (see the wake-ups below).
     let tick_rx = Subscriber::<Tick>::polled(&p.node, services::CONTROL, &q)?;
     let state_rx = Subscriber::<SimState>::polled(&p.node, services::SIM_STATE, &q)?;
     let nt_rx = (which == 0)
         .then(|| {
-            Subscriber::<NominalTranslational>::new(&p.node, services::NOMINAL_TRANSLATIONAL, &q)
+            Subscriber::<NominalTranslational>::new(
+                &p.node,
+                services::NOMINAL_TRANSLATIONAL,
+                &partner_q,
+            )
         })
         .transpose()?;
     let na_rx = (which == 1)
-        .then(|| Subscriber::<NominalAttitude>::new(&p.node, services::NOMINAL_ATTITUDE, &q))
+        .then(|| {
+            Subscriber::<NominalAttitude>::new(&p.node, services::NOMINAL_ATTITUDE, &partner_q)
+        })
         .transpose()?;
     let nr_rx = (which == 2)
-        .then(|| Subscriber::<NominalRobotic>::new(&p.node, services::NOMINAL_ROBOTIC, &q))
+        .then(|| Subscriber::<NominalRobotic>::new(&p.node, services::NOMINAL_ROBOTIC, &partner_q))
         .transpose()?;
     let st_rx = (which >= 1)
         .then(|| Subscriber::<SafeTranslational>::polled(&p.node, services::SAFE_TRANSLATIONAL, &q))
@@ -828,6 +865,8 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
     let mut up_a: Option<SafeAttitude> = None;
     // inputs found missing at a deadline are not waited for again until they reappear
     let mut absent = [false; 3]; // nominal, upstream translational, upstream attitude
+    // the tick whose nominal command this filter waits for (the next state's)
+    let mut awaited: Option<u64>;
     let mut misses = 0u64;
     let mut stop = false;
     let mut last_state: Option<SimState> = None;
@@ -853,17 +892,12 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
                 up_t = Some(m);
                 absent[1] = false;
             }
-            // this filter's nominal command (only one of the three subscribers exists)
-            if let Some(m) = newest(nt_rx.as_ref())? {
-                nom_t = Some(m);
-                absent[0] = false;
-            }
-            if let Some(m) = newest(na_rx.as_ref())? {
-                nom_a = Some(m);
-                absent[0] = false;
-            }
-            if let Some(m) = newest(nr_rx.as_ref())? {
-                nom_r = Some(m);
+            // this filter's nominal command (only one of the three subscribers exists),
+            // the one for the awaited tick kept
+            if keep_for_tick(nt_rx.as_ref(), &mut nom_t, awaited, |m| m.tick)?
+                | keep_for_tick(na_rx.as_ref(), &mut nom_a, awaited, |m| m.tick)?
+                | keep_for_tick(nr_rx.as_ref(), &mut nom_r, awaited, |m| m.tick)?
+            {
                 absent[0] = false;
             }
             states.extend(
@@ -874,6 +908,10 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
         }};
     }
     loop {
+        awaited = states
+            .first()
+            .or(last_state.as_ref())
+            .map(|s| s.tick + u64::from(states.is_empty()));
         if states.is_empty() {
             if stop {
                 break;
@@ -958,6 +996,7 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
         let s = states.remove(0);
         last_state = Some(s);
         let k = s.tick;
+        awaited = Some(k);
         // the stage deadline counts from the publication of the state
         let until = instant_of(s.publish_ns) + deadline;
         let need_t = which >= 1 && s.due_mask & due::TRANSLATIONAL != 0;
@@ -1053,7 +1092,7 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
                 if upstream_missing {
                     out = fallback::flag_missing(out);
                 }
-                let mut m: SafeTranslational = convert::safe_msg(&out, k, s.t, phase as usize);
+                let mut m: SafeTranslational = convert::safe_msg(&out, k, s.t, phase);
                 m.recv_ns = recv_ns;
                 publish_ns = now();
                 m.publish_ns = publish_ns;
@@ -1068,7 +1107,7 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
                 if upstream_missing {
                     out = fallback::flag_missing(out);
                 }
-                let mut m: SafeAttitude = convert::safe_msg(&out, k, s.t, phase as usize);
+                let mut m: SafeAttitude = convert::safe_msg(&out, k, s.t, phase);
                 m.recv_ns = recv_ns;
                 publish_ns = now();
                 m.publish_ns = publish_ns;
@@ -1077,18 +1116,12 @@ pub fn filter(which: usize) -> anyhow::Result<i32> {
             _ => {
                 let nom = nom_r.filter(|m| m.tick == k && m.valid != 0);
                 let t = nom.map(|n| convert::vec7(&n.tau_m));
-                let mut out = stages::robotic_step(
-                    &mut layer.robotic,
-                    &o,
-                    &robot,
-                    &f_b,
-                    &tau_b,
-                    t.as_ref(),
-                );
+                let mut out =
+                    stages::robotic_step(&mut layer.robotic, &o, &robot, &f_b, &tau_b, t.as_ref());
                 if upstream_missing {
                     out = fallback::flag_missing(out);
                 }
-                let mut m: SafeRobotic = convert::safe_msg(&out, k, s.t, phase as usize);
+                let mut m: SafeRobotic = convert::safe_msg(&out, k, s.t, phase);
                 m.recv_ns = recv_ns;
                 publish_ns = now();
                 m.publish_ns = publish_ns;
