@@ -23,16 +23,47 @@ pub struct Args {
     /// Stop after N ticks (0 = to the end of the mission).
     #[arg(long, value_name = "N")]
     max_ticks: Option<u64>,
+    /// Red team: a hostile partner process (scripts/python/hostile_nominal.py) in place
+    /// of the nominal controller(s) of a target, `<target>/<strategy>`, e.g.
+    /// `attitude/spin:-y+burst:40` or `all/random:1+hang:300` (`safe-capture redteam
+    /// --partition --list` lists the campaign's cases).
+    #[arg(long, value_name = "CASE")]
+    hostile: Option<String>,
+    /// --hostile: Python interpreter with the iceoryx2 package (default: $SC_PYTHON,
+    /// else scripts/.venv/bin/python).
+    #[arg(long, value_name = "PY", default_value_os_t = crate::redteam_partition::default_python())]
+    python: PathBuf,
+    /// --hostile: the hostile partner script.
+    #[arg(
+        long,
+        value_name = "FILE",
+        default_value = "scripts/python/hostile_nominal.py"
+    )]
+    partner: PathBuf,
 }
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
-    let opts = LaunchOptions {
-        config: a.config,
+    let mut opts = LaunchOptions {
+        config: a.config.clone(),
         out: a.out.clone(),
         clock: a.real_time.then_some(ClockMode::RealTime),
         max_ticks: a.max_ticks,
         ..Default::default()
     };
+    if let Some(h) = &a.hostile {
+        let case = crate::redteam_partition::parse_hostile(h)?;
+        let cfg = sc_partition::PartitionConfig::load(&a.config)?;
+        let p = crate::redteam_partition::Partners::new(
+            &a.python,
+            &a.partner,
+            &a.config,
+            &cfg.base_dir.join(&cfg.scenario),
+            0,
+            None,
+        )?;
+        p.check(&case)?;
+        opts.role_override = p.overrides(&case);
+    }
     let rep = launch(&opts)?;
     let failed: Vec<String> = rep
         .exits

@@ -1,12 +1,16 @@
 //! `safe-capture redteam`: the red-team campaign against the safety layer.
 
+use crate::redteam_partition::{Partners, case_dir, default_python};
 use anyhow::Context;
+use rayon::prelude::*;
 use sc_mission::Setup;
-use sc_redteam::{Case, Target, report};
+use sc_redteam::partners::{parse_partition_case, partition_cases};
+use sc_redteam::{Case, CaseLabel, CaseResult, Target, report};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Attacks the safety layer with adversarial nominal controllers and measures the result
 /// from the simulator's true state.
@@ -19,6 +23,15 @@ use std::sync::Mutex;
 /// (`silent`). Each case runs to capture or the end of the mission; every barrier is
 /// evaluated from the true state at every physics step, every applied command is checked
 /// for finiteness and bounds.
+///
+/// With --partition the cases run through the process partition instead: a hostile
+/// partner process (scripts/python/hostile_nominal.py, Python with iceoryx2) replaces the
+/// nominal controller process(es) of the target, and besides bad values it misbehaves as
+/// a process: it crashes or hangs mid-run, stays silent, sends bursts of 40 messages per
+/// state, answers late, labels its commands with old or future ticks, sends garbage
+/// fields (`--list` shows the cases; the script's docstring defines them). Every run is
+/// lock-step and measured from its recorded telemetry in the same way; each run's outputs
+/// stay in OUT/cases/<case>/.
 ///
 /// Writes to OUT: cases.csv (one line per case), min_h.csv (each case's smallest value of
 /// every barrier), summary.json, report.md, figures/redteam_margins.svg.
@@ -39,9 +52,34 @@ pub struct Args {
     #[arg(long, value_name = "T", value_delimiter = ',')]
     target: Vec<String>,
     /// Only these cases, `<target>/<strategy>` (comma-separated), e.g.
-    /// `robotic/toward:theta_dot_max_7,all/random:3`.
+    /// `robotic/toward:theta_dot_max_7,all/random:3`; with --partition e.g.
+    /// `attitude/spin:-y+burst:40,all/hang:300`.
     #[arg(long, value_name = "CASE", value_delimiter = ',')]
     cases: Vec<String>,
+    /// Run the cases through the process partition, with hostile partner processes.
+    #[arg(long)]
+    partition: bool,
+    /// --partition: the partition config (schedule, deadlines, the other executables).
+    #[arg(long, value_name = "FILE", default_value = "config/partition.toml")]
+    partition_config: PathBuf,
+    /// --partition: Python interpreter with the iceoryx2 package (default: $SC_PYTHON,
+    /// else scripts/.venv/bin/python).
+    #[arg(long, value_name = "PY", default_value_os_t = default_python())]
+    python: PathBuf,
+    /// --partition: the hostile partner script.
+    #[arg(
+        long,
+        value_name = "FILE",
+        default_value = "scripts/python/hostile_nominal.py"
+    )]
+    partner: PathBuf,
+    /// --partition: stop each run after N ticks (0: the whole mission).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    max_ticks: u64,
+    /// --partition: lock-step deadlines as this multiple of the real-time ones (a hung
+    /// partner costs every tick this much; the config's value is for healthy runs).
+    #[arg(long, value_name = "X", default_value_t = 5.0)]
+    deadline_scale: f64,
     /// Parallel runs (default: the machine's cores).
     #[arg(long, short, value_name = "N")]
     jobs: Option<usize>,
@@ -53,13 +91,20 @@ pub struct Args {
     list: bool,
 }
 
-/// The cases the arguments select.
-fn selected(a: &Args) -> anyhow::Result<Vec<Case>> {
+/// The cases the arguments select (`ticks`: a partition run's length).
+fn selected(a: &Args, ticks: u64) -> anyhow::Result<Vec<CaseLabel>> {
     if !a.cases.is_empty() {
         return a
             .cases
             .iter()
-            .map(|c| Case::parse(c).map_err(anyhow::Error::msg))
+            .map(|c| {
+                if a.partition {
+                    parse_partition_case(c)
+                } else {
+                    Case::parse(c).map(|c| c.label())
+                }
+                .map_err(anyhow::Error::msg)
+            })
             .collect();
     }
     let targets: Vec<Target> = a
@@ -71,21 +116,51 @@ fn selected(a: &Args) -> anyhow::Result<Vec<Case>> {
             })
         })
         .collect::<anyhow::Result<_>>()?;
-    Ok(Case::all(a.seeds)
+    let all: Vec<CaseLabel> = if a.partition {
+        partition_cases(a.seeds, ticks)
+    } else {
+        Case::all(a.seeds).iter().map(Case::label).collect()
+    };
+    Ok(all
         .into_iter()
         .filter(|c| targets.is_empty() || targets.contains(&c.target))
         .collect())
 }
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
-    let cases = selected(&a)?;
+    let setup = Setup::load(&a.scenario)?;
+    let mission_ticks = setup.scenario.control_steps() as u64;
+    let ticks = if a.max_ticks > 0 {
+        a.max_ticks.min(mission_ticks)
+    } else {
+        mission_ticks
+    };
+    let cases = selected(&a, ticks)?;
     if a.list {
         for c in &cases {
             println!("{}", c.name());
         }
         return Ok(ExitCode::SUCCESS);
     }
-    let setup = Setup::load(&a.scenario)?;
+    let partners = if a.partition {
+        if !(a.deadline_scale.is_finite() && a.deadline_scale >= 1.0) {
+            anyhow::bail!("--deadline-scale {}: must be >= 1", a.deadline_scale);
+        }
+        let p = Partners::new(
+            &a.python,
+            &a.partner,
+            &a.partition_config,
+            &a.scenario,
+            a.max_ticks,
+            Some(a.deadline_scale),
+        )?;
+        for c in &cases {
+            p.check(c)?;
+        }
+        Some(p)
+    } else {
+        None
+    };
     if let Some(j) = a.jobs {
         rayon::ThreadPoolBuilder::new()
             .num_threads(j.max(1))
@@ -105,7 +180,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         b
     });
     let unsafe_count = Mutex::new(0usize);
-    let results = sc_redteam::run_campaign(&setup, &cases, &|done, total, r| {
+    let progress = |done: usize, total: usize, r: &Result<CaseResult, String>| {
         let bad = match r {
             Ok(r) => !r.safe(),
             Err(_) => true,
@@ -116,24 +191,65 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         }
         if let Some(b) = &bar {
             b.set_position(done as u64);
-            b.set_message(format!("{} unsafe", *u));
-        } else if !a.quiet && (done % 10 == 0 || done == total) {
-            eprintln!("redteam: {done}/{total} cases, {} unsafe", *u);
+            b.set_message(format!("{} unsafe or failed", *u));
+        } else if !a.quiet && (a.partition || done.is_multiple_of(10) || done == total) {
+            eprintln!("redteam: {done}/{total} cases, {} unsafe or failed", *u);
         }
-    });
+    };
+    let results: Vec<Result<CaseResult, String>> = match &partners {
+        None => {
+            let in_process: Vec<Case> = cases
+                .iter()
+                .map(|c| Case::parse(&c.name()).map_err(anyhow::Error::msg))
+                .collect::<anyhow::Result<_>>()?;
+            sc_redteam::run_campaign(&setup, &in_process, &progress)
+        }
+        Some(p) => {
+            let done = AtomicUsize::new(0);
+            let pid = std::process::id();
+            cases
+                .par_iter()
+                .enumerate()
+                .map(|(k, c)| {
+                    let out = a.out.join("cases").join(case_dir(c));
+                    let r = p.run_case(&setup, c, &out, &format!("rt{k}-{pid}"));
+                    let n = done.fetch_add(1, Ordering::SeqCst) + 1;
+                    progress(n, cases.len(), &r);
+                    r
+                })
+                .collect()
+        }
+    };
     if let Some(b) = bar {
         b.finish_and_clear();
     }
     let wall = started.elapsed().as_secs_f64();
-    let s = report::write(&a.out, &setup, &cases, &results, wall).map_err(anyhow::Error::msg)?;
+    let how = if a.partition {
+        "Each case runs the mission through the process partition (lock-step), the hostile partner process `scripts/python/hostile_nominal.py` in place of the nominal controller process of its target (`all`: all three); the barriers come from the simulator's state as the recorder logged it (`cases/<case>/telemetry.csv`)."
+    } else {
+        report::IN_PROCESS
+    };
+    let s =
+        report::write(&a.out, &setup, how, &cases, &results, wall).map_err(anyhow::Error::msg)?;
+    for (c, r) in cases.iter().zip(&results) {
+        if let Err(e) = r {
+            eprintln!("redteam: {}: {e}", c.name());
+        }
+    }
     println!(
-        "redteam: {} of {} cases safe{}; non-finite applied {}, out-of-bound applied {}; solve time geomean (worst case) {:.1} us, max {:.0} us; wall {:.1} s -> {}",
+        "redteam{}: {} of {} cases safe{}{}; non-finite applied {}, out-of-bound applied {}; solve time geomean (worst case) {:.1} us, max {:.0} us; wall {:.1} s -> {}",
+        if a.partition { " (partition)" } else { "" },
         s.safe,
         s.cases,
         if s.unsafe_cases.is_empty() {
             String::new()
         } else {
             format!(" (unsafe: {})", s.unsafe_cases.join(", "))
+        },
+        if s.errors.is_empty() {
+            String::new()
+        } else {
+            format!(", {} could not run", s.errors.len())
         },
         s.nonfinite_applied,
         s.out_of_bounds_applied,

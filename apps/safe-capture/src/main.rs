@@ -13,6 +13,7 @@ mod cmd_run;
 mod cmd_simulate;
 // `montecarlo --mode partition`: runs through the process partition
 mod montecarlo_partition;
+mod redteam_partition;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;

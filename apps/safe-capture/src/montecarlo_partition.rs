@@ -194,6 +194,80 @@ fn read(path: &Path) -> Result<String, String> {
     std::fs::read_to_string(path).map_err(|e| format!("partition: {}: {e}", path.display()))
 }
 
+/// Reads a finished partition run back from `out` into step records and the mission's
+/// end, after checking that the telemetry is complete: every tick of the scheduler
+/// recorded, no step missing, and no sample the schedule requires missing at the
+/// recorder except on the services in `may_miss` (a hostile partner's own service).
+pub fn read_run(out: &Path, may_miss: &[&str]) -> Result<(Vec<StepRecord>, MissionEnd), String> {
+    let rec_path = out.join("recorder.json");
+    let rec: RecorderReport = serde_json::from_str(&read(&rec_path)?)
+        .map_err(|e| format!("partition: {}: {e}", rec_path.display()))?;
+    let missing: u64 = rec
+        .missing
+        .iter()
+        .filter(|(svc, _)| !may_miss.contains(&svc.as_str()))
+        .map(|(_, n)| n)
+        .sum();
+    if missing > 0 {
+        return Err(format!(
+            "partition: the recorder missed {missing} of the samples the schedule requires ({}): the telemetry is incomplete",
+            rec_path.display()
+        ));
+    }
+    let records = parse_telemetry(
+        &read(&out.join("telemetry.csv"))?,
+        &read(&out.join("timing.csv"))?,
+        true,
+    )
+    .map_err(|e| format!("partition: {}: {e}", out.display()))?;
+    if records.len() as u64 != rec.steps {
+        return Err(format!(
+            "partition: telemetry.csv has {} steps, the recorder wrote {} ({})",
+            records.len(),
+            rec.steps,
+            rec_path.display()
+        ));
+    }
+    // a state sample the recorder never got is a step missing from the telemetry
+    let sched_path = out.join("scheduler.json");
+    let sched: serde_json::Value = serde_json::from_str(&read(&sched_path)?)
+        .map_err(|e| format!("partition: {}: {e}", sched_path.display()))?;
+    let ticks = sched["ticks"]
+        .as_u64()
+        .ok_or_else(|| format!("partition: {}: no `ticks`", sched_path.display()))?;
+    if records.len() as u64 != ticks {
+        return Err(format!(
+            "partition: the recorder wrote {} steps of the scheduler's {ticks} ticks ({}): the telemetry is incomplete",
+            records.len(),
+            out.join("logs/recorder.log").display()
+        ));
+    }
+    if let Some((i, r)) = records
+        .iter()
+        .enumerate()
+        .find(|(i, r)| r.step != *i as u64)
+    {
+        return Err(format!(
+            "partition: telemetry.csv row {i} holds step {} (a step is missing)",
+            r.step
+        ));
+    }
+    let Some(last) = records.last() else {
+        return Err(format!(
+            "partition: no step recorded ({})",
+            out.join("telemetry.csv").display()
+        ));
+    };
+    let end = MissionEnd::from_name(&rec.end, last.t).ok_or_else(|| {
+        format!(
+            "partition: {}: unknown end `{}`",
+            rec_path.display(),
+            rec.end
+        )
+    })?;
+    Ok((records, end))
+}
+
 impl Executor for PartitionExecutor {
     fn execute(
         &self,
@@ -230,67 +304,7 @@ impl Executor for PartitionExecutor {
         if rep.code == 3 {
             return Err(failure(&rep, &out));
         }
-        let rec_path = out.join("recorder.json");
-        let rec: RecorderReport = serde_json::from_str(&read(&rec_path)?)
-            .map_err(|e| format!("partition: {}: {e}", rec_path.display()))?;
-        let missing: u64 = rec.missing.values().sum();
-        if missing > 0 {
-            return Err(format!(
-                "partition: the recorder missed {missing} of the samples the schedule requires ({}): the telemetry is incomplete",
-                rec_path.display()
-            ));
-        }
-        let records = parse_telemetry(
-            &read(&out.join("telemetry.csv"))?,
-            &read(&out.join("timing.csv"))?,
-            true,
-        )
-        .map_err(|e| format!("partition: {}: {e}", out.display()))?;
-        if records.len() as u64 != rec.steps {
-            return Err(format!(
-                "partition: telemetry.csv has {} steps, the recorder wrote {} ({})",
-                records.len(),
-                rec.steps,
-                rec_path.display()
-            ));
-        }
-        // a state sample the recorder never got is a step missing from the telemetry
-        let sched_path = out.join("scheduler.json");
-        let sched: serde_json::Value = serde_json::from_str(&read(&sched_path)?)
-            .map_err(|e| format!("partition: {}: {e}", sched_path.display()))?;
-        let ticks = sched["ticks"]
-            .as_u64()
-            .ok_or_else(|| format!("partition: {}: no `ticks`", sched_path.display()))?;
-        if records.len() as u64 != ticks {
-            return Err(format!(
-                "partition: the recorder wrote {} steps of the scheduler's {ticks} ticks ({}): the telemetry is incomplete",
-                records.len(),
-                out.join("logs/recorder.log").display()
-            ));
-        }
-        if let Some((i, r)) = records
-            .iter()
-            .enumerate()
-            .find(|(i, r)| r.step != *i as u64)
-        {
-            return Err(format!(
-                "partition: telemetry.csv row {i} holds step {} (a step is missing)",
-                r.step
-            ));
-        }
-        let Some(last) = records.last() else {
-            return Err(format!(
-                "partition: no step recorded ({})",
-                out.join("telemetry.csv").display()
-            ));
-        };
-        let end = MissionEnd::from_name(&rec.end, last.t).ok_or_else(|| {
-            format!(
-                "partition: {}: unknown end `{}`",
-                rec_path.display(),
-                rec.end
-            )
-        })?;
+        let (records, end) = read_run(&out, &[])?;
         if !self.keep_recordings {
             for f in RECORDINGS {
                 let p = out.join(f);

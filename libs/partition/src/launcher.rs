@@ -26,6 +26,8 @@ pub struct LaunchOptions {
     /// Overrides of the config.
     pub clock: Option<ClockMode>,
     pub max_ticks: Option<u64>,
+    /// Lock-step deadlines as a multiple of the real-time ones (`[lock_step] deadline_scale`).
+    pub deadline_scale: Option<f64>,
     /// Kill everything after this long (default 15 min).
     pub timeout: Option<Duration>,
     /// Replace role executables: (role, exec, args).
@@ -206,6 +208,9 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
     }
     if let Some(n) = opts.max_ticks {
         cfg.max_ticks = n;
+    }
+    if let Some(d) = opts.deadline_scale {
+        cfg.lock_step.deadline_scale = d;
     }
     for (role, exec, args) in &opts.role_override {
         if !ROLES.contains(&role.as_str()) {

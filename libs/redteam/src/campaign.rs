@@ -4,7 +4,7 @@
 //! never from a filter's report.
 
 use crate::adversary::Adversary;
-use crate::strategy::Case;
+use crate::strategy::{Case, CaseLabel};
 use rayon::prelude::*;
 use sc_cbf::faults;
 use sc_mission::summary::TimeStats;
@@ -63,11 +63,17 @@ pub fn run_case(setup: &Setup, case: &Case) -> Result<CaseResult, String> {
     mission.nominal_override = Some(Box::new(adversary));
     let mut records: Vec<StepRecord> = Vec::new();
     let end = mission.run(|_, r| records.push(*r));
-    Ok(measure(setup, case, &records, &end))
+    Ok(measure(setup, &case.label(), &records, &end))
 }
 
-/// The result of a case from its records.
-pub fn measure(setup: &Setup, case: &Case, records: &[StepRecord], end: &MissionEnd) -> CaseResult {
+/// The result of a case from its records (in process, or read back from a partition
+/// run's telemetry with [`sc_mission::parse_telemetry`]).
+pub fn measure(
+    setup: &Setup,
+    case: &CaseLabel,
+    records: &[StepRecord],
+    end: &MissionEnd,
+) -> CaseResult {
     let phases: Vec<String> = setup
         .scenario
         .mission
@@ -80,7 +86,7 @@ pub fn measure(setup: &Setup, case: &Case, records: &[StepRecord], end: &Mission
     let mut r = CaseResult {
         case: case.name(),
         target: case.target.name().into(),
-        strategy: case.strategy.name(case.target),
+        strategy: case.strategy.clone(),
         end: end.name().into(),
         final_time_s: end.t(),
         steps: records.len(),
@@ -136,13 +142,16 @@ pub fn measure(setup: &Setup, case: &Case, records: &[StepRecord], end: &Mission
     r
 }
 
+/// Called as cases finish: `(done, total, result)`.
+pub type Progress<'a> = dyn Fn(usize, usize, &Result<CaseResult, String>) + Sync + 'a;
+
 /// Runs every case in parallel (rayon), calling `progress(done, total, result)` as cases
 /// finish (from worker threads). Results come back in the order of `cases`; a case whose
 /// mission cannot be set up is an `Err` with the reason.
 pub fn run_campaign(
     setup: &Setup,
     cases: &[Case],
-    progress: &(dyn Fn(usize, usize, &Result<CaseResult, String>) + Sync),
+    progress: &Progress,
 ) -> Vec<Result<CaseResult, String>> {
     let done = AtomicUsize::new(0);
     let total = cases.len();

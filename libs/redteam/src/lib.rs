@@ -4,10 +4,11 @@
 
 pub mod adversary;
 pub mod campaign;
+pub mod partners;
 pub mod report;
 pub mod scales;
 pub mod strategy;
 
 pub use adversary::Adversary;
 pub use campaign::{CaseResult, run_campaign, run_case};
-pub use strategy::{Case, Strategy, Target};
+pub use strategy::{Case, CaseLabel, Strategy, Target};

@@ -4,7 +4,7 @@
 
 use crate::campaign::CaseResult;
 use crate::scales::barrier_scales;
-use crate::strategy::Case;
+use crate::strategy::CaseLabel;
 use sc_mission::Setup;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -33,11 +33,13 @@ pub struct CampaignSummary {
     pub wall_s: f64,
 }
 
-/// Writes every output into `dir`; returns the summary.
+/// Writes every output into `dir`; returns the summary. `how` is the report's paragraph
+/// on how the cases were run.
 pub fn write(
     dir: &Path,
     setup: &Setup,
-    cases: &[Case],
+    how: &str,
+    cases: &[CaseLabel],
     results: &[Result<CaseResult, String>],
     wall_s: f64,
 ) -> Result<CampaignSummary, String> {
@@ -155,7 +157,10 @@ backup_translational,backup_attitude,backup_robotic,worst_barrier,worst_normalis
         "summary.json",
         &(serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())? + "\n"),
     )?;
-    write("report.md", &markdown(&summary, cases, results, &scales))?;
+    write(
+        "report.md",
+        &markdown(&summary, how, cases, results, &scales),
+    )?;
     let barrier_names: Vec<String> = names.iter().map(|s| s.to_string()).collect();
     sc_plots::redteam_margins(
         &dir.join("figures/redteam_margins.svg"),
@@ -169,9 +174,13 @@ backup_translational,backup_attitude,backup_robotic,worst_barrier,worst_normalis
     Ok(summary)
 }
 
+/// How the in-process campaign runs its cases (the report's paragraph).
+pub const IN_PROCESS: &str = "Each case runs the whole mission in one process with the adversary in place of the nominal controller of its target (`all`: all three).";
+
 fn markdown(
     s: &CampaignSummary,
-    cases: &[Case],
+    how: &str,
+    cases: &[CaseLabel],
     results: &[Result<CaseResult, String>],
     scales: &sc_cbf::monitor::Barriers,
 ) -> String {
@@ -191,7 +200,7 @@ fn markdown(
     }
     let _ = writeln!(
         m,
-        "Each case replaces the nominal controller of its target (`all`: all three) by the adversary for the whole mission. Columns: how the mission ended, the barrier closest to its boundary (value / barrier scale, `figures/redteam_margins.svg`), and per filter (translational/attitude/robotic) the steps on the substitute nominal, on the relaxed problem and on the backup law.\n"
+        "{how} Columns: how the mission ended, the barrier closest to its boundary (value / barrier scale, `figures/redteam_margins.svg`), and per filter (translational/attitude/robotic) the steps on the substitute nominal, on the relaxed problem and on the backup law.\n"
     );
     let mut target = "";
     for (case, r) in cases.iter().zip(results) {
@@ -226,11 +235,7 @@ fn markdown(
                 );
             }
             Err(e) => {
-                let _ = writeln!(
-                    m,
-                    "| {} | error: {e} | | | | | | | |",
-                    case.strategy.name(case.target)
-                );
+                let _ = writeln!(m, "| {} | error: {e} | | | | | | | |", case.strategy);
             }
         }
     }

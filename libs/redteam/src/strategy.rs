@@ -173,10 +173,34 @@ pub struct Case {
     pub strategy: Strategy,
 }
 
+/// What names a case in the reports: its target and its strategy's name. In-process
+/// cases are [`Case`]s; the partition's hostile partner processes
+/// (`safe-capture redteam --partition`) have strategies of their own.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct CaseLabel {
+    pub target: Target,
+    pub strategy: String,
+}
+
+impl CaseLabel {
+    /// `<target>/<strategy>`.
+    pub fn name(&self) -> String {
+        format!("{}/{}", self.target, self.strategy)
+    }
+}
+
 impl Case {
     /// `<target>/<strategy>`, e.g. `robotic/toward:theta_dot_max_7`.
     pub fn name(&self) -> String {
-        format!("{}/{}", self.target, self.strategy.name(self.target))
+        self.label().name()
+    }
+
+    /// The case's name parts.
+    pub fn label(&self) -> CaseLabel {
+        CaseLabel {
+            target: self.target,
+            strategy: self.strategy.name(self.target),
+        }
     }
 
     /// Parses [`Self::name`].

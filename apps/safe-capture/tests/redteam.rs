@@ -1,0 +1,185 @@
+//! `safe-capture redteam`, the acceptance of "safety against any nominal" on a subset
+//! that fits CI: in process, every strategy on every target (one seed of the random
+//! ones); through the partition, hostile Python partner processes that crash, hang, fall
+//! silent, flood, send garbage or non-finite values. The verdict is the campaign's own
+//! (barriers recomputed from the simulator's true state at every physics step); the
+//! test also checks that the hostile partners really misbehaved (their logs) and that
+//! no run left shared memory behind.
+//!
+//! The partition part needs a Python with iceoryx2: `SC_PYTHON` (scripts/test.sh sets
+//! it; then a broken interpreter fails the test), else scripts/.venv/bin/python; without
+//! either it is skipped with the reason printed.
+
+mod common;
+use common::*;
+use std::path::PathBuf;
+
+/// The campaign's summary.json must say: every case ran and is safe, no non-finite or
+/// out-of-bound command applied, every barrier's worst value ≥ 0.
+fn assert_all_safe(out: &std::path::Path, cases: usize) {
+    let s = json(&out.join("summary.json"));
+    assert_eq!(s["cases"].as_u64(), Some(cases as u64), "{s}");
+    assert_eq!(s["errors"].as_array().unwrap().len(), 0, "{s}");
+    assert_eq!(s["unsafe_cases"].as_array().unwrap().len(), 0, "{s}");
+    assert_eq!(s["safe"].as_u64(), Some(cases as u64), "{s}");
+    assert_eq!(s["nonfinite_applied"].as_u64(), Some(0), "{s}");
+    assert_eq!(s["out_of_bounds_applied"].as_u64(), Some(0), "{s}");
+    let worst = s["worst"].as_object().unwrap();
+    assert!(worst.len() >= 10, "{s}");
+    for (name, v) in worst {
+        let h = v[0].as_f64().unwrap_or(f64::NAN);
+        assert!(h >= 0.0, "{name}: worst {h} in {}", v[1]);
+    }
+    for f in [
+        "cases.csv",
+        "min_h.csv",
+        "report.md",
+        "figures/redteam_margins.svg",
+    ] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    let lines = std::fs::read_to_string(out.join("cases.csv")).unwrap();
+    assert_eq!(lines.lines().count(), cases + 1);
+}
+
+#[test]
+fn every_strategy_on_every_target_in_process_is_safe() {
+    let _cpu = exclusive();
+    let d = tmp("redteam");
+    let out = d.join("rt");
+    let list = cli(&["redteam", "--seeds", "1", "--list"], &[]);
+    assert!(list.status.success(), "{}", text(&list));
+    let cases = String::from_utf8_lossy(&list.stdout).lines().count();
+    // every target, each with bang-bang, random, non-finite, huge, frozen, stale, silent
+    for t in ["translational/", "attitude/", "robotic/", "all/"] {
+        for s in ["random:1", "nonfinite", "huge", "frozen", "stale", "silent"] {
+            let have = String::from_utf8_lossy(&list.stdout)
+                .lines()
+                .any(|l| l.starts_with(t) && l.contains(s));
+            assert!(have, "no {t}{s}* case in --list");
+        }
+    }
+    assert!(cases >= 40, "{cases} cases");
+    let o = cli(
+        &[
+            "redteam",
+            "--seeds",
+            "1",
+            "-j",
+            "2",
+            "--out",
+            out.to_str().unwrap(),
+            "-q",
+        ],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    assert_all_safe(&out, cases);
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+fn python() -> Option<PathBuf> {
+    let required = std::env::var_os("SC_PYTHON");
+    let py = required
+        .clone()
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root().join("scripts/.venv/bin/python"));
+    let ok = std::process::Command::new(&py)
+        .args(["-c", "import iceoryx2"])
+        .status()
+        .map(|s| s.success());
+    if ok.ok() == Some(true) {
+        return Some(py);
+    }
+    assert!(
+        required.is_none(),
+        "SC_PYTHON={} cannot import iceoryx2",
+        py.display()
+    );
+    eprintln!(
+        "SKIPPED: no python with iceoryx2 at {} (run scripts/setup.sh or set SC_PYTHON)",
+        py.display()
+    );
+    None
+}
+
+/// Hostile partner processes through the partition: ≥ 8 behaviours, 60 s of mission
+/// each (600 ticks) in lock-step.
+#[test]
+fn hostile_partner_processes_through_the_partition_are_safe() {
+    let Some(py) = python() else {
+        return;
+    };
+    let _cpu = exclusive();
+    let d = tmp("redteam-partition");
+    let out = d.join("rt");
+    // (case, a line its hostile partner must have logged)
+    let cases = [
+        ("translational/toward_zone+crash:150", "crashing at tick"),
+        ("attitude/spin:x+hang:100", "hanging at tick"),
+        ("robotic/joints:1+silent", ""),
+        ("all/random:2+burst:10", ""),
+        ("translational/off_corridor", ""),
+        ("attitude/nonfinite", ""),
+        ("robotic/huge+garbage", ""),
+        ("all/random:1+old_tick:10", ""),
+    ];
+    let names: Vec<&str> = cases.iter().map(|c| c.0).collect();
+    let joined = names.join(",");
+    let (o, pid) = cli_partition(
+        &[
+            "redteam",
+            "--partition",
+            "--cases",
+            &joined,
+            "--max-ticks",
+            "600",
+            "-j",
+            "1",
+            "--python",
+            py.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "-q",
+        ],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    assert_all_safe(&out, cases.len());
+    for (k, (case, line)) in cases.iter().enumerate() {
+        let (target, _) = case.split_once('/').unwrap();
+        let dir_name: String = case
+            .chars()
+            .map(|c| match c {
+                '/' => '_',
+                ':' => '=',
+                c => c,
+            })
+            .collect();
+        let dir = out.join("cases").join(dir_name);
+        let launch = json(&dir.join("launch.json"));
+        assert_eq!(
+            launch["run_id"].as_str(),
+            Some(format!("rt{k}-{pid}").as_str()),
+            "{launch}"
+        );
+        assert_eq!(launch["leftovers"].as_array().unwrap().len(), 0, "{launch}");
+        if !line.is_empty() {
+            let log = std::fs::read_to_string(dir.join(format!("logs/nominal_{target}.log")))
+                .unwrap_or_default();
+            assert!(log.contains(line), "{case}: no `{line}` in its log:\n{log}");
+        }
+    }
+    // nothing of these runs left in shared memory
+    let ours = format!("-{pid}_");
+    let left: Vec<String> = std::fs::read_dir("/dev/shm")
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .filter(|n| n.starts_with("sc_rt") && n.contains(&ours))
+                .collect()
+        })
+        .unwrap_or_default();
+    assert!(left.is_empty(), "left in /dev/shm: {left:?}");
+    let _ = std::fs::remove_dir_all(&d);
+}
