@@ -25,10 +25,10 @@
 //! * **Priorities.** Rows may carry a priority tier ([`Engine::solve_tiered`], 0 first):
 //!   the lexicographic relaxation then runs tier by tier, each tier's allowances chosen
 //!   with the earlier tiers' fixed and the later tiers ignored, so a row of a later tier
-//!   never makes one of an earlier tier give way. The filters put the rate limits first
-//!   (they bound every other row's in-sample motion, and braking the rates is always
-//!   possible inside the input box), the positions (line of sight, joint angles, link
-//!   spheres) after them: a lost line of sight cannot drag the body rates with it.
+//!   never makes one of an earlier tier give way. The attitude filter puts its rate rows
+//!   first (body rates and the boresight's rate: they bound the line of sight's in-sample
+//!   motion, and braking the rates is always possible inside the torque box), the line
+//!   of sight after them: a lost line of sight cannot drag the body rates with it.
 
 use crate::barrier::Row;
 use nalgebra::SVector;
