@@ -35,8 +35,7 @@ def main():
         print("interop_check: SC_RUN_ID not set", file=sys.stderr)
         return 2
     iox2.set_log_level_from_env_or(iox2.LogLevel.Warn)
-    cfg = iox2.config.default()
-    cfg.global_cfg.prefix = iox2.FileName.new(sc_icd.run_prefix(run_id))
+    cfg = sc_bus.run_config(run_id)
     node = iox2.NodeBuilder.new().name(iox2.NodeName.new("py_nominal_t")).config(cfg).create(iox2.ServiceType.Ipc)
 
     state_svc = sc_bus.open_pubsub(node, sc_icd.SERVICE_SIM_STATE, sc_icd.SimState, sc_bus.LOCK_STEP)

@@ -88,8 +88,7 @@ def main():
     kp, kd = OMEGA * OMEGA, 2.0 * ZETA * OMEGA
 
     iox2.set_log_level_from_env_or(iox2.LogLevel.Warn)
-    cfg = iox2.config.default()
-    cfg.global_cfg.prefix = iox2.FileName.new(sc_icd.run_prefix(run_id))
+    cfg = sc_bus.run_config(run_id)
     node = iox2.NodeBuilder.new().name(iox2.NodeName.new("nominal_translational")).config(cfg).create(iox2.ServiceType.Ipc)
     state_svc = sc_bus.open_pubsub(node, sc_icd.SERVICE_SIM_STATE, sc_icd.SimState, sc_bus.PARTITION)
     state_ev = sc_bus.data_event(node, sc_icd.SERVICE_SIM_STATE, sc_bus.PARTITION)

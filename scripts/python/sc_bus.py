@@ -20,8 +20,8 @@ import sc_icd  # noqa: E402
 # sc_bus::ServiceSettings::lock_step()
 LOCK_STEP = dict(buffer=4, history=0, max_publishers=2, max_subscribers=8, max_nodes=16, safe_overflow=False)
 # sc_partition::process::qos(): the partition's data services (lossless: a full queue
-# makes the publisher wait)
-PARTITION = dict(LOCK_STEP, buffer=16, safe_overflow=False)
+# makes the publisher wait; exactly one publisher, the owner)
+PARTITION = dict(LOCK_STEP, buffer=16, max_publishers=1, safe_overflow=False)
 # sc_partition::process::partner_qos(): the services a partner's nominal controller
 # publishes on (safe_capture/nominal/*): newest wins, nobody ever waits
 NOMINAL = dict(PARTITION, safe_overflow=True)
@@ -31,6 +31,18 @@ EVENT_ID_MAX = 7
 HANDSHAKE_MAX_PORTS = 32
 HANDSHAKE_MAX_NODES = 40
 HANDSHAKE_MAX_PARTICIPANTS = 64
+
+
+# sc_bus::run::SERVICE_CREATION_TIMEOUT: how long opening a service waits for its creator
+CREATION_TIMEOUT_S = 10
+
+
+def run_config(run_id):
+    """The iceoryx2 config of run `run_id`, as sc_bus::RunScope builds it."""
+    cfg = iox2.config.default()
+    cfg.global_cfg.prefix = iox2.FileName.new(sc_icd.run_prefix(run_id))
+    cfg.global_cfg.creation_timeout = iox2.Duration.from_secs(CREATION_TIMEOUT_S)
+    return cfg
 
 
 def open_pubsub(node, name, ctype, qos):

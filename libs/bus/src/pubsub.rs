@@ -207,7 +207,8 @@ fn open_pubsub<T: Debug + ZeroCopySend + Copy>(
     name: &str,
     s: &ServiceSettings,
 ) -> Result<PubSubFactory<ipc::Service, T, ()>> {
-    node.service_builder(&service_name(name)?)
+    let factory = node
+        .service_builder(&service_name(name)?)
         .publish_subscribe::<T>()
         .subscriber_max_buffer_size(s.subscriber_buffer)
         .history_size(s.history)
@@ -229,7 +230,21 @@ fn open_pubsub<T: Debug + ZeroCopySend + Copy>(
                 service: name.to_string(),
                 reason: reason(e),
             },
-        })
+        })?;
+    // iceoryx2 opens a service that allows *at least* the requested publishers; one
+    // created by a process outside the ICD with more is refused (impersonation)
+    let allowed = factory.static_config().max_publishers();
+    if allowed != s.max_publishers {
+        return Err(BusError::Service {
+            kind: "pub/sub",
+            service: name.to_string(),
+            reason: format!(
+                "it allows {allowed} publishers where the settings say {}: created by a process with other settings",
+                s.max_publishers
+            ),
+        });
+    }
+    Ok(factory)
 }
 
 /// Publishing side of one service.
@@ -389,6 +404,12 @@ pub struct Subscriber<T: Debug + ZeroCopySend + Copy + 'static> {
     listener: std::cell::OnceCell<Listener<ipc::Service>>,
     _pubsub: PubSubFactory<ipc::Service, T, ()>,
     event: EventFactory<ipc::Service>,
+    /// The publisher this subscriber accepts samples from: the first one it received a
+    /// sample from (the owner — the handshake makes every port exist before the first
+    /// tick, and the partition's services take one publisher).
+    pinned: std::cell::Cell<Option<iceoryx2::identifiers::UniquePublisherId>>,
+    /// Samples from any other publisher, dropped.
+    rejected: std::cell::Cell<u64>,
 }
 
 impl<T: Debug + ZeroCopySend + Copy + 'static> Subscriber<T> {
@@ -440,12 +461,20 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Subscriber<T> {
             listener: std::cell::OnceCell::new(),
             _pubsub: pubsub,
             event,
+            pinned: std::cell::Cell::new(None),
+            rejected: std::cell::Cell::new(0),
         })
     }
 
     /// Service name.
     pub fn name(&self) -> &str {
         &self.name
+    }
+
+    /// Samples dropped because another publisher than the pinned one sent them (an
+    /// impersonator, or a restarted owner).
+    pub fn rejected(&self) -> u64 {
+        self.rejected.get()
     }
 
     /// True if the subscriber has an event listener (publishers wake it).
@@ -505,15 +534,31 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Subscriber<T> {
         self.wait(left)
     }
 
-    /// Oldest queued sample, if any.
+    /// Oldest queued sample of the pinned publisher, if any (samples of any other
+    /// publisher are dropped and counted, [`rejected`](Self::rejected)).
     pub fn try_receive(&self) -> Result<Option<T>> {
-        match self.subscriber.receive() {
-            Ok(Some(sample)) => Ok(Some(*sample.payload())),
-            Ok(None) => Ok(None),
-            Err(e) => Err(BusError::Receive {
-                service: self.name.clone(),
-                reason: reason(e),
-            }),
+        loop {
+            match self.subscriber.receive() {
+                Ok(Some(sample)) => {
+                    let from = sample.header().publisher_id();
+                    match self.pinned.get() {
+                        None => self.pinned.set(Some(from)),
+                        Some(p) if p != from => {
+                            self.rejected.set(self.rejected.get() + 1);
+                            continue;
+                        }
+                        Some(_) => {}
+                    }
+                    return Ok(Some(*sample.payload()));
+                }
+                Ok(None) => return Ok(None),
+                Err(e) => {
+                    return Err(BusError::Receive {
+                        service: self.name.clone(),
+                        reason: reason(e),
+                    });
+                }
+            }
         }
     }
 

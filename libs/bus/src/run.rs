@@ -19,6 +19,12 @@ use iceoryx2::config::Config;
 use iceoryx2::prelude::*;
 use std::path::{Path, PathBuf};
 
+/// How long opening a service may wait for another process that is creating it
+/// (iceoryx2's `global.creation_timeout`, default 1 s). The roles of a run open their
+/// services concurrently at start-up; on a loaded 2-core machine a creator was measured
+/// to take longer than 1 s, and the opener then failed with `DoesNotExist`.
+pub const SERVICE_CREATION_TIMEOUT: core::time::Duration = core::time::Duration::from_secs(10);
+
 /// Environment variable read by [`RunScope::from_env`]: the run id of this run.
 pub const RUN_ID_ENV: &str = "SC_RUN_ID";
 
@@ -66,6 +72,7 @@ impl RunScope {
         }
         let prefix = format!("sc_{clean}_");
         let mut config = Config::default();
+        config.global.creation_timeout = SERVICE_CREATION_TIMEOUT;
         config.global.prefix =
             FileName::new(prefix.as_bytes()).map_err(|e| BusError::InvalidName {
                 what: "prefix",

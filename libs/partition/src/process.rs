@@ -28,10 +28,14 @@ pub struct Proc {
 }
 
 /// Service settings of the partition's data services: no sample is ever lost
-/// silently; a full subscriber (dead or stuck) delays a send by at most 50 ms.
+/// silently; a full subscriber (dead or stuck) delays a send by at most 50 ms. Every
+/// service has exactly one publisher, its owner (docs/ICD.md): a second one is refused
+/// by iceoryx2, a service created with room for more is refused by `sc_bus`, and
+/// subscribers accept samples only from the first publisher they heard.
 pub fn qos() -> ServiceSettings {
     ServiceSettings {
         subscriber_buffer: 16,
+        max_publishers: 1,
         ..ServiceSettings::lock_step()
     }
 }
