@@ -37,7 +37,11 @@ Behaviours (how a broken or malicious process acts):
 - ``late:<ms>[:<every>]``: sleeps ms before answering every ``every``-th state (default 1);
 - ``silent``: never publishes (but reads, and follows the stop);
 - ``crash:<tick>``: SIGKILLs itself at that tick (no clean-up: its ports are left dead);
-- ``hang:<tick>``: from that tick on stops reading and publishing and sleeps until killed.
+- ``hang:<tick>``: from that tick on stops reading and publishing and sleeps until killed;
+- ``impersonate``: after the handshake, tries to publish on its filter's safe-command
+  service (the one the simulator applies) — with the partition's settings, and by opening
+  it with room for more publishers — and, if it ever gets a publisher, sends 1000 x the
+  bound there every state. Every attempt is logged (``impersonation refused: ...``).
 
 ``--check`` only validates ``--role`` and ``--strategy`` against the scenario and exits
 (0 valid, 2 not). Everything it did is counted on stderr when it stops. Like every partner process it
@@ -64,7 +68,43 @@ TIMEOUT_S = 60.0
 OVERDRIVE = 1.5  # commands are this times the input bound
 HUGE_FACTOR = 1000.0
 
-BEHAVIOURS = {"frozen", "stale", "old_tick", "future_tick", "garbage", "burst", "late", "silent", "crash", "hang"}
+BEHAVIOURS = {
+    "frozen",
+    "stale",
+    "old_tick",
+    "future_tick",
+    "garbage",
+    "burst",
+    "late",
+    "silent",
+    "crash",
+    "hang",
+    "impersonate",
+}
+
+# the safe-command service of each role's filter, what an impersonator would publish on
+SAFE = {
+    "translational": (sc_icd.SERVICE_SAFE_TRANSLATIONAL, sc_icd.SafeTranslational, 3),
+    "attitude": (sc_icd.SERVICE_SAFE_ATTITUDE, sc_icd.SafeAttitude, 3),
+    "robotic": (sc_icd.SERVICE_SAFE_ROBOTIC, sc_icd.SafeRobotic, sc_icd.N_JOINTS),
+}
+
+
+def impersonate(node, role):
+    """Tries to become a publisher of ``role``'s safe-command service; returns the
+    publisher, or None (each refusal logged)."""
+    name, ctype, _ = SAFE[role]
+    for label, qos in (("as the ICD says", sc_bus.PARTITION), ("asking for 8 publishers", dict(sc_bus.PARTITION, max_publishers=8))):
+        try:
+            svc = sc_bus.open_pubsub(node, name, ctype, qos)
+            pub = svc.publisher_builder().create()
+        except Exception as e:  # noqa: BLE001 - any refusal is the expected outcome
+            print(f"hostile_nominal.py: impersonation refused ({name}, {label}): {e!r}", file=sys.stderr, flush=True)
+            continue
+        print(f"hostile_nominal.py: impersonation: got a publisher on {name} ({label})", file=sys.stderr, flush=True)
+        return pub
+    return None
+
 
 ROLES = {
     # role: (ICD role id, nominal service, message type, payload field, components, due bit, limit key)
@@ -268,8 +308,7 @@ def main():
     role_id, service, ctype, field, n, due_bit, _ = ROLES[role]
 
     iox2.set_log_level_from_env_or(iox2.LogLevel.Warn)
-    cfg = iox2.config.default()
-    cfg.global_cfg.prefix = iox2.FileName.new(sc_icd.run_prefix(run_id))
+    cfg = sc_bus.run_config(run_id)
     node = iox2.NodeBuilder.new().name(iox2.NodeName.new(f"nominal_{role}")).config(cfg).create(iox2.ServiceType.Ipc)
     state_svc = sc_bus.open_pubsub(node, sc_icd.SERVICE_SIM_STATE, sc_icd.SimState, sc_bus.PARTITION)
     state_ev = sc_bus.data_event(node, sc_icd.SERVICE_SIM_STATE, sc_bus.PARTITION)
@@ -297,6 +336,9 @@ def main():
         if not sc_bus.handshake(node, role_id, TIMEOUT_S):
             print("hostile_nominal.py: handshake timed out", file=sys.stderr)
             return 1
+        fake = impersonate(node, role) if "impersonate" in beh else None
+        if fake is not None:
+            ports.insert(0, fake)
         while True:
             state_lis.timed_wait(iox2.Duration.from_millis(100))
             while True:
@@ -315,6 +357,14 @@ def main():
                     print(f"hostile_nominal.py: hanging at tick {s.tick} ({counts})", file=sys.stderr, flush=True)
                     while True:  # reads nothing, answers nothing, until the launcher kills it
                         time.sleep(3600)
+                if fake is not None:
+                    fctype, fn = SAFE[role][1], SAFE[role][2]
+                    m = fctype(tick=s.tick, t=s.t)
+                    for i in range(fn):
+                        m.u[i] = HUGE_FACTOR * attack.bound
+                        m.actuated[i] = HUGE_FACTOR * attack.bound
+                    fake.loan_uninit().write_payload(m).send()
+                    counts["impersonated"] = counts.get("impersonated", 0) + 1
                 if "silent" in beh:
                     continue
                 if late_s > 0 and s.tick % late_every == 0:

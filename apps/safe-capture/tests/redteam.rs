@@ -104,7 +104,7 @@ fn python() -> Option<PathBuf> {
 }
 
 /// Hostile partner processes through the partition: ≥ 8 behaviours, 60 s of mission
-/// each (600 ticks) in lock-step.
+/// each (600 ticks) in lock-step; an impersonation attempt is refused and logged.
 #[test]
 fn hostile_partner_processes_through_the_partition_are_safe() {
     let Some(py) = python() else {
@@ -123,6 +123,8 @@ fn hostile_partner_processes_through_the_partition_are_safe() {
         ("attitude/nonfinite", ""),
         ("robotic/huge+garbage", ""),
         ("all/random:1+old_tick:10", ""),
+        // tries to publish on its filter's safe-command service: refused twice
+        ("translational/off_corridor+impersonate", "impersonation refused"),
     ];
     let names: Vec<&str> = cases.iter().map(|c| c.0).collect();
     let joined = names.join(",");
@@ -168,7 +170,14 @@ fn hostile_partner_processes_through_the_partition_are_safe() {
             let log = std::fs::read_to_string(dir.join(format!("logs/nominal_{target}.log")))
                 .unwrap_or_default();
             assert!(log.contains(line), "{case}: no `{line}` in its log:\n{log}");
+            assert!(!log.contains("impersonation: got a publisher"), "{case}:\n{log}");
         }
+        // the simulator applied only its filters' commands
+        let sim = std::fs::read_to_string(dir.join("logs/simulator.log")).unwrap();
+        assert!(
+            sim.contains("safe commands rejected (translational, attitude, robotic) [0, 0, 0], samples from a second publisher dropped [0, 0, 0]"),
+            "{case}: {sim}"
+        );
     }
     // nothing of these runs left in shared memory
     let ours = format!("-{pid}_");

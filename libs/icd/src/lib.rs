@@ -149,6 +149,9 @@ pub mod fault {
     pub const DEADLINE_MISS: u32 = 1 << 6;
     /// A peer process was detected dead.
     pub const PEER_DEAD: u32 = 1 << 7;
+    /// The simulator rejected a safe command (not finite or beyond the input bounds,
+    /// `sc_partition::admission`) and applied the filter's backup instead.
+    pub const REJECTED_COMMAND: u32 = 1 << 8;
 }
 
 /// Values of [`Tick::command`].

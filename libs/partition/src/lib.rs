@@ -12,6 +12,7 @@
 //! functions of `sc_mission::stages`, so its telemetry.csv is bit-for-bit that of
 //! `safe-capture run`.
 
+pub mod admission;
 pub mod config;
 pub mod convert;
 pub mod fallback;

@@ -275,12 +275,14 @@ pub fn recorder() -> anyhow::Result<i32> {
             }
             let applied = convert::applied(&r);
             let tr: TranslationalOutput = match set.st {
+                // the simulator applied the backup (the command was missing at its
+                // deadline, or it rejected the one that came): that is what was applied
+                _ if r.fallback_mask & due::TRANSLATIONAL != 0 => {
+                    fallback::translational(&mut layer, &o)
+                }
                 Some(m) => {
                     h.st = Some(m);
                     convert::filter_output(&m)
-                }
-                None if r.fallback_mask & due::TRANSLATIONAL != 0 => {
-                    fallback::translational(&mut layer, &o)
                 }
                 None => {
                     h.st.map(|m| convert::filter_output(&m))
@@ -288,24 +290,28 @@ pub fn recorder() -> anyhow::Result<i32> {
                 }
             };
             let at: AttitudeOutput = match set.sa {
+                // the simulator applied the backup (the command was missing at its
+                // deadline, or it rejected the one that came): that is what was applied
+                _ if r.fallback_mask & due::ATTITUDE != 0 => {
+                    fallback::attitude(&mut layer, &o, &robot, &applied.force_b)
+                }
                 Some(m) => {
                     h.sa = Some(m);
                     convert::filter_output(&m)
-                }
-                None if r.fallback_mask & due::ATTITUDE != 0 => {
-                    fallback::attitude(&mut layer, &o, &robot, &applied.force_b)
                 }
                 None => h.sa.map(|m| convert::filter_output(&m)).unwrap_or_else(|| {
                     fallback::attitude(&mut layer, &o, &robot, &applied.force_b)
                 }),
             };
             let rb: RoboticOutput = match set.sr {
+                // the simulator applied the backup (the command was missing at its
+                // deadline, or it rejected the one that came): that is what was applied
+                _ if r.fallback_mask & due::ROBOTIC != 0 => {
+                    fallback::robotic(&mut layer, &o, &robot, &applied.force_b, &applied.torque_b)
+                }
                 Some(m) => {
                     h.sr = Some(m);
                     convert::filter_output(&m)
-                }
-                None if r.fallback_mask & due::ROBOTIC != 0 => {
-                    fallback::robotic(&mut layer, &o, &robot, &applied.force_b, &applied.torque_b)
                 }
                 None => h.sr.map(|m| convert::filter_output(&m)).unwrap_or_else(|| {
                     fallback::robotic(&mut layer, &o, &robot, &applied.force_b, &applied.torque_b)

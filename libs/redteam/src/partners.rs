@@ -25,8 +25,9 @@ fn bangs(target: Target) -> &'static [&'static str] {
 /// bang-bang strategies; random, non-finite and huge values; and the process faults —
 /// silence, a crash and a hang mid-run, bursts of 40 messages per state, answers
 /// 250 ms late every 50th state, frozen and stale values, old and future tick labels,
-/// garbage `valid`/`phase`/`t` fields. `ticks` is the run's length (the faults happen at
-/// a quarter of it).
+/// garbage `valid`/`phase`/`t` fields, and an attempt to publish on its filter's
+/// safe-command service (impersonation). `ticks` is the run's length (the faults happen
+/// at a quarter of it).
 pub fn partition_cases(seeds: u64, ticks: u64) -> Vec<CaseLabel> {
     let at = (ticks / 4).max(1);
     let mut v = Vec::new();
@@ -45,6 +46,7 @@ pub fn partition_cases(seeds: u64, ticks: u64) -> Vec<CaseLabel> {
             format!("{aim}+old_tick:10"),
             format!("{aim}+future_tick"),
             format!("{aim}+garbage"),
+            format!("{aim}+impersonate"),
         ]);
         v.extend(s.into_iter().map(|strategy| CaseLabel { target, strategy }));
     }
@@ -97,6 +99,7 @@ mod tests {
                 "old_tick:",
                 "future_tick",
                 "garbage",
+                "impersonate",
                 "nonfinite",
                 "huge",
                 "random:2",

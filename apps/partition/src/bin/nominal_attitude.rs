@@ -1,4 +1,6 @@
 //! The nominal attitude controller process of the partition.
+use sc_partition::roles::{Subsystem, nominal};
+
 fn main() -> std::process::ExitCode {
-    sc_partition::main_of(|| sc_partition::roles::nominal(1))
+    sc_partition::main_of(|| nominal(Subsystem::Attitude))
 }

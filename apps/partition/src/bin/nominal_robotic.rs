@@ -1,4 +1,6 @@
 //! The nominal robotic controller process of the partition.
+use sc_partition::roles::{Subsystem, nominal};
+
 fn main() -> std::process::ExitCode {
-    sc_partition::main_of(|| sc_partition::roles::nominal(2))
+    sc_partition::main_of(|| nominal(Subsystem::Robotic))
 }

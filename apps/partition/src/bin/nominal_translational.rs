@@ -1,4 +1,6 @@
 //! The nominal translational controller process of the partition.
+use sc_partition::roles::{Subsystem, nominal};
+
 fn main() -> std::process::ExitCode {
-    sc_partition::main_of(|| sc_partition::roles::nominal(0))
+    sc_partition::main_of(|| nominal(Subsystem::Translational))
 }

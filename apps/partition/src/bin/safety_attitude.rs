@@ -1,4 +1,6 @@
 //! The attitude safety filter process of the partition.
+use sc_partition::roles::{Subsystem, filter};
+
 fn main() -> std::process::ExitCode {
-    sc_partition::main_of(|| sc_partition::roles::filter(1))
+    sc_partition::main_of(|| filter(Subsystem::Attitude))
 }

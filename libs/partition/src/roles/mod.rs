@@ -1,0 +1,108 @@
+//! The loop of every process, one file per role kind. Each wakes on iceoryx2 events
+//! only (WaitSet), no busy polling; deadlines are timed waits.
+//!
+//! * [`scheduler`] — rate groups, lock-step or real time, the end of the run, liveness;
+//! * [`simulator`] — the plant: applies the (re-validated) safe commands, publishes states;
+//! * [`nominal`] — a nominal controller ([`Subsystem`]), replaceable by a partner's process;
+//! * [`filter`] — a safety filter ([`Subsystem`]).
+//!
+//! The recorder's loop is [`crate::recorder`].
+
+mod filter;
+mod nominal;
+mod scheduler;
+mod simulator;
+
+pub use filter::filter;
+pub use nominal::nominal;
+pub use scheduler::{SchedulerReport, scheduler};
+pub use simulator::simulator;
+
+use sc_bus::Subscriber;
+use sc_icd::{Tick, monotonic_ns, tick_command};
+use std::time::{Duration, Instant};
+
+/// The three subsystems, in causal order: which nominal controller or filter a
+/// process is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Subsystem {
+    Translational,
+    Attitude,
+    Robotic,
+}
+
+impl Subsystem {
+    /// 0, 1, 2 in causal order.
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
+pub(crate) fn now() -> u64 {
+    monotonic_ns()
+}
+
+/// Drains a subscriber's events and returns its queued samples.
+pub(crate) fn drain<T: core::fmt::Debug + sc_bus::ZeroCopySend + Copy + 'static>(
+    s: &Subscriber<T>,
+) -> anyhow::Result<Vec<T>> {
+    s.drain_events()?;
+    let mut v = Vec::new();
+    s.receive_all(&mut v)?;
+    Ok(v)
+}
+
+/// Drains an optional subscriber (a role's input that this process may not have)
+/// and returns its newest sample, if any came.
+pub(crate) fn newest<T: core::fmt::Debug + sc_bus::ZeroCopySend + Copy + 'static>(
+    s: Option<&Subscriber<T>>,
+) -> anyhow::Result<Option<T>> {
+    Ok(match s {
+        Some(s) => drain(s)?.pop(),
+        None => None,
+    })
+}
+
+/// Drains a partner's nominal-command subscriber into `held`: a command for the awaited
+/// tick `want` is never replaced by one for another tick (a partner bursting commands
+/// with other ticks cannot hide the one the filter waits for); among several for the
+/// same tick the newest wins. Returns whether a command for the awaited tick or the
+/// one before it came: only that brings an absent partner back (a late partner answers
+/// the tick before; one that answers for older or future ticks would otherwise cost
+/// every tick a full deadline).
+pub(crate) fn keep_for_tick<T: core::fmt::Debug + sc_bus::ZeroCopySend + Copy + 'static>(
+    s: Option<&Subscriber<T>>,
+    held: &mut Option<T>,
+    want: Option<u64>,
+    tick: impl Fn(&T) -> u64,
+) -> anyhow::Result<bool> {
+    let Some(s) = s else {
+        return Ok(false);
+    };
+    let got = drain(s)?;
+    let mut came = false;
+    for m in &got {
+        let holds_wanted = held.as_ref().is_some_and(|h| Some(tick(h)) == want);
+        let wanted = Some(tick(m)) == want;
+        // a partner's tick is any u64: no arithmetic on it
+        came |= wanted || Some(tick(m)) == want.and_then(|w| w.checked_sub(1));
+        if wanted || !holds_wanted {
+            *held = Some(*m);
+        }
+    }
+    Ok(came)
+}
+
+/// The `Instant` of a monotonic time stamp `ns` of another process (same clock).
+pub(crate) fn instant_of(ns: u64) -> Instant {
+    let t = Instant::now();
+    if ns == 0 {
+        return t; // no stamp: count from now
+    }
+    let ago = Duration::from_nanos(now().saturating_sub(ns));
+    t.checked_sub(ago).unwrap_or(t)
+}
+
+pub(crate) fn stop_seen(ticks: &[Tick]) -> bool {
+    ticks.iter().any(|t| t.command == tick_command::STOP)
+}
