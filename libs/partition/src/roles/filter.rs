@@ -2,6 +2,7 @@
 //! commands up to its stage deadline, runs its QP (on the substitute nominal when the
 //! nominal is missing or invalid), publishes the safe command.
 
+use crate::admission;
 use crate::convert;
 use crate::fallback;
 use crate::process::{
@@ -319,10 +320,15 @@ pub fn filter(subsystem: Subsystem) -> anyhow::Result<i32> {
         // the mission's own schedule (a nominal's report of its phase is not trusted)
         let phase = p.setup.scenario.phase_index(o.t);
         // upstream safe commands: this tick's, the held one of a slower group, or
-        // (missing / dead upstream) the upstream fallback, which is what the simulator applies
+        // (missing / dead upstream, or one the simulator would reject) the upstream
+        // fallback, which is what the simulator applies
         let mut upstream_missing = false;
+        let lim = &p.setup.scenario.limits;
         let f_b: Vector3<f64> = if which >= 1 {
-            match up_t.filter(|m| if need_t { m.tick == k } else { !absent[1] }) {
+            match up_t
+                .filter(|m| if need_t { m.tick == k } else { !absent[1] })
+                .filter(|m| admission::translational(m, lim))
+            {
                 Some(m) => convert::vec3(&m.actuated),
                 None => {
                     upstream_missing = true;
@@ -333,7 +339,10 @@ pub fn filter(subsystem: Subsystem) -> anyhow::Result<i32> {
             Vector3::zeros()
         };
         let tau_b: Vector3<f64> = if which == 2 {
-            match up_a.filter(|m| if need_a { m.tick == k } else { !absent[2] }) {
+            match up_a
+                .filter(|m| if need_a { m.tick == k } else { !absent[2] })
+                .filter(|m| admission::attitude(m, lim))
+            {
                 Some(m) => convert::vec3(&m.u),
                 None => {
                     upstream_missing = true;
