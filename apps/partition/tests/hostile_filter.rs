@@ -8,28 +8,6 @@
 mod common;
 use common::*;
 
-fn python() -> Option<std::path::PathBuf> {
-    let required = std::env::var_os("SC_PYTHON");
-    let py = required
-        .clone()
-        .map(std::path::PathBuf::from)
-        .unwrap_or_else(|| repo().join("scripts/.venv/bin/python"));
-    let ok = std::process::Command::new(&py)
-        .args(["-c", "import iceoryx2"])
-        .status()
-        .map(|s| s.success());
-    if ok.ok() == Some(true) {
-        return Some(py);
-    }
-    assert!(
-        required.is_none(),
-        "SC_PYTHON={} cannot import iceoryx2",
-        py.display()
-    );
-    eprintln!("SKIPPED: no python with iceoryx2 at {}", py.display());
-    None
-}
-
 #[test]
 fn lying_safe_commands_are_rejected_and_the_backup_applied() {
     let Some(py) = python() else {

@@ -12,7 +12,6 @@
 
 mod common;
 use common::*;
-use std::path::PathBuf;
 
 /// The campaign's summary.json must say: every case ran and is safe, no non-finite or
 /// out-of-bound command applied, every barrier's worst value ≥ 0.
@@ -78,31 +77,6 @@ fn every_strategy_on_every_target_in_process_is_safe() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
-fn python() -> Option<PathBuf> {
-    let required = std::env::var_os("SC_PYTHON");
-    let py = required
-        .clone()
-        .map(PathBuf::from)
-        .unwrap_or_else(|| root().join("scripts/.venv/bin/python"));
-    let ok = std::process::Command::new(&py)
-        .args(["-c", "import iceoryx2"])
-        .status()
-        .map(|s| s.success());
-    if ok.ok() == Some(true) {
-        return Some(py);
-    }
-    assert!(
-        required.is_none(),
-        "SC_PYTHON={} cannot import iceoryx2",
-        py.display()
-    );
-    eprintln!(
-        "SKIPPED: no python with iceoryx2 at {} (run scripts/setup.sh or set SC_PYTHON)",
-        py.display()
-    );
-    None
-}
-
 /// Hostile partner processes through the partition: ≥ 8 behaviours, 60 s of mission
 /// each (600 ticks) in lock-step; an impersonation attempt is refused and logged.
 #[test]
@@ -124,7 +98,10 @@ fn hostile_partner_processes_through_the_partition_are_safe() {
         ("robotic/huge+garbage", ""),
         ("all/random:1+old_tick:10", ""),
         // tries to publish on its filter's safe-command service: refused twice
-        ("translational/off_corridor+impersonate", "impersonation refused"),
+        (
+            "translational/off_corridor+impersonate",
+            "impersonation refused",
+        ),
     ];
     let names: Vec<&str> = cases.iter().map(|c| c.0).collect();
     let joined = names.join(",");
@@ -170,7 +147,10 @@ fn hostile_partner_processes_through_the_partition_are_safe() {
             let log = std::fs::read_to_string(dir.join(format!("logs/nominal_{target}.log")))
                 .unwrap_or_default();
             assert!(log.contains(line), "{case}: no `{line}` in its log:\n{log}");
-            assert!(!log.contains("impersonation: got a publisher"), "{case}:\n{log}");
+            assert!(
+                !log.contains("impersonation: got a publisher"),
+                "{case}:\n{log}"
+            );
         }
         // the simulator applied only its filters' commands
         let sim = std::fs::read_to_string(dir.join("logs/simulator.log")).unwrap();

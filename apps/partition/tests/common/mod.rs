@@ -180,3 +180,32 @@ pub fn assert_no_lost_wakeups(out: &Path) {
         );
     }
 }
+
+/// The Python interpreter with the `iceoryx2` package for tests that start Python
+/// partner processes: `SC_PYTHON` (set by scripts/test.sh; then a broken interpreter
+/// fails the test), else scripts/.venv/bin/python; without either `None`, and the test
+/// is skipped with the reason printed.
+pub fn python() -> Option<PathBuf> {
+    let required = std::env::var_os("SC_PYTHON");
+    let py = required
+        .clone()
+        .map(PathBuf::from)
+        .unwrap_or_else(|| repo().join("scripts/.venv/bin/python"));
+    let ok = std::process::Command::new(&py)
+        .args(["-c", "import iceoryx2"])
+        .status()
+        .map(|s| s.success());
+    if ok.ok() == Some(true) {
+        return Some(py);
+    }
+    assert!(
+        required.is_none(),
+        "SC_PYTHON={} cannot import iceoryx2",
+        py.display()
+    );
+    eprintln!(
+        "SKIPPED: no python with iceoryx2 at {} (run scripts/setup.sh or set SC_PYTHON)",
+        py.display()
+    );
+    None
+}

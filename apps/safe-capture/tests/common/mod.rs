@@ -118,3 +118,32 @@ pub fn json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap())
         .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
+
+/// The Python interpreter with the `iceoryx2` package for tests that start Python
+/// partner processes: `SC_PYTHON` (set by scripts/test.sh; then a broken interpreter
+/// fails the test), else scripts/.venv/bin/python; without either `None`, and the test
+/// is skipped with the reason printed.
+pub fn python() -> Option<PathBuf> {
+    let required = std::env::var_os("SC_PYTHON");
+    let py = required
+        .clone()
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root().join("scripts/.venv/bin/python"));
+    let ok = std::process::Command::new(&py)
+        .args(["-c", "import iceoryx2"])
+        .status()
+        .map(|s| s.success());
+    if ok.ok() == Some(true) {
+        return Some(py);
+    }
+    assert!(
+        required.is_none(),
+        "SC_PYTHON={} cannot import iceoryx2",
+        py.display()
+    );
+    eprintln!(
+        "SKIPPED: no python with iceoryx2 at {} (run scripts/setup.sh or set SC_PYTHON)",
+        py.display()
+    );
+    None
+}
