@@ -158,18 +158,24 @@ pub fn filter(subsystem: Subsystem) -> anyhow::Result<i32> {
                 absent[1] = false;
             }
             // this filter's nominal command (only one of the three subscribers exists),
-            // the one for the awaited tick kept
-            if keep_for_tick(nt_rx.as_ref(), &mut nom_t, awaited, |m| m.tick)?
-                | keep_for_tick(na_rx.as_ref(), &mut nom_a, awaited, |m| m.tick)?
-                | keep_for_tick(nr_rx.as_ref(), &mut nom_r, awaited, |m| m.tick)?
-            {
-                absent[0] = false;
-            }
+            // judged once the states it may answer are known
+            let (got_t, got_a, got_r) = (
+                drain_opt(nt_rx.as_ref())?,
+                drain_opt(na_rx.as_ref())?,
+                drain_opt(nr_rx.as_ref())?,
+            );
             states.extend(
                 drain(&state_rx)?
                     .into_iter()
                     .filter(|s| s.due_mask & bit != 0),
             );
+            let known = states.last().or(last_state.as_ref()).map(|s| s.tick);
+            if keep_for_tick(got_t, &mut nom_t, awaited, known, |m| m.tick)
+                | keep_for_tick(got_a, &mut nom_a, awaited, known, |m| m.tick)
+                | keep_for_tick(got_r, &mut nom_r, awaited, known, |m| m.tick)
+            {
+                absent[0] = false;
+            }
         }};
     }
     loop {
