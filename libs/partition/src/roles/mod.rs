@@ -103,6 +103,20 @@ pub(crate) fn keep_for_tick<T>(
     came
 }
 
+/// The `Instant` of a monotonic time stamp `ns` of another process (same clock).
+pub(crate) fn instant_of(ns: u64) -> Instant {
+    let t = Instant::now();
+    if ns == 0 {
+        return t; // no stamp: count from now
+    }
+    let ago = Duration::from_nanos(now().saturating_sub(ns));
+    t.checked_sub(ago).unwrap_or(t)
+}
+
+pub(crate) fn stop_seen(ticks: &[Tick]) -> bool {
+    ticks.iter().any(|t| t.command == tick_command::STOP)
+}
+
 #[cfg(test)]
 mod tests {
     use super::keep_for_tick;
@@ -147,18 +161,4 @@ mod tests {
         assert!(!keep_for_tick(vec![0], &mut held, Some(0), None, id));
         assert_eq!(held, None);
     }
-}
-
-/// The `Instant` of a monotonic time stamp `ns` of another process (same clock).
-pub(crate) fn instant_of(ns: u64) -> Instant {
-    let t = Instant::now();
-    if ns == 0 {
-        return t; // no stamp: count from now
-    }
-    let ago = Duration::from_nanos(now().saturating_sub(ns));
-    t.checked_sub(ago).unwrap_or(t)
-}
-
-pub(crate) fn stop_seen(ticks: &[Tick]) -> bool {
-    ticks.iter().any(|t| t.command == tick_command::STOP)
 }
