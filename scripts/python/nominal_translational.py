@@ -13,7 +13,8 @@ docs/PARTITION.md)::
 What a partner's controller has to do (every step below is in this file):
 
 1. join the run: iceoryx2 ``global.prefix`` = ``sc_<SC_RUN_ID>_`` (set by the launcher);
-2. create its ports: subscriber + listener on ``safe_capture/sim/state`` (SimState),
+2. create its ports: subscriber + listener on ``safe_capture/partner/state`` (SimState,
+   newest wins),
    a subscriber without listener on ``safe_capture/scheduler/control`` (Tick
    messages: the stop; read at every wake-up),
    publisher + notifier on ``safe_capture/nominal/translational`` (NominalTranslational);
@@ -90,8 +91,8 @@ def main():
     iox2.set_log_level_from_env_or(iox2.LogLevel.Warn)
     cfg = sc_bus.run_config(run_id)
     node = iox2.NodeBuilder.new().name(iox2.NodeName.new("nominal_translational")).config(cfg).create(iox2.ServiceType.Ipc)
-    state_svc = sc_bus.open_pubsub(node, sc_icd.SERVICE_SIM_STATE, sc_icd.SimState, sc_bus.PARTITION)
-    state_ev = sc_bus.data_event(node, sc_icd.SERVICE_SIM_STATE, sc_bus.PARTITION)
+    state_svc = sc_bus.open_pubsub(node, sc_icd.SERVICE_PARTNER_STATE, sc_icd.SimState, sc_bus.NOMINAL)
+    state_ev = sc_bus.data_event(node, sc_icd.SERVICE_PARTNER_STATE, sc_bus.NOMINAL)
     tick_svc = sc_bus.open_pubsub(node, sc_icd.SERVICE_CONTROL, sc_icd.Tick, sc_bus.PARTITION)
     cmd_svc = sc_bus.open_pubsub(node, sc_icd.SERVICE_NOMINAL_TRANSLATIONAL, sc_icd.NominalTranslational, sc_bus.NOMINAL)
     cmd_ev = sc_bus.data_event(node, sc_icd.SERVICE_NOMINAL_TRANSLATIONAL, sc_bus.NOMINAL)

@@ -37,7 +37,9 @@ def _vec(n):
 # service of the same name: the publisher notifies it after every send.
 SERVICE_TICK = "safe_capture/scheduler/tick"
 SERVICE_CONTROL = "safe_capture/scheduler/control"  # Tick messages; the stop
-SERVICE_SIM_STATE = "safe_capture/sim/state"
+SERVICE_SIM_STATE = "safe_capture/sim/state"  # flight side (filters, recorder)
+# the same SimState for nominal controllers (partners): newest wins (sc_bus.NOMINAL)
+SERVICE_PARTNER_STATE = "safe_capture/partner/state"
 SERVICE_NOMINAL_TRANSLATIONAL = "safe_capture/nominal/translational"
 SERVICE_NOMINAL_ATTITUDE = "safe_capture/nominal/attitude"
 SERVICE_NOMINAL_ROBOTIC = "safe_capture/nominal/robotic"

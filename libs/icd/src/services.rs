@@ -29,9 +29,15 @@ pub const TICK: ServiceName = ServiceName("safe_capture/scheduler/tick");
 /// from [`TICK`] so that a tick is delivered to the two processes that need it, not
 /// to all eight: each subscriber costs the scheduler's send, on the critical path.
 pub const CONTROL: ServiceName = ServiceName("safe_capture/scheduler/control");
-/// [`crate::SimState`]. Publisher: simulator. Subscribers: the three nominal controllers
-/// (woken by it), the three safety filters, recorder.
+/// [`crate::SimState`]. Publisher: simulator. Subscribers: the three safety filters,
+/// recorder (the flight side: lossless).
 pub const SIM_STATE: ServiceName = ServiceName("safe_capture/sim/state");
+/// The same [`crate::SimState`] for the nominal controllers — the processes partners
+/// replace — on a newest-wins service: a partner that stops reading loses only its own
+/// states and can never make the simulator wait. Publisher: simulator (just after
+/// [`SIM_STATE`]: so the filters always have the state before any command answering it).
+/// Subscribers: the three nominal controllers (woken by it).
+pub const PARTNER_STATE: ServiceName = ServiceName("safe_capture/partner/state");
 /// [`crate::NominalTranslational`]. Publisher: nominal translational controller.
 /// Subscribers: translational safety filter, recorder.
 pub const NOMINAL_TRANSLATIONAL: ServiceName = ServiceName("safe_capture/nominal/translational");
@@ -79,6 +85,7 @@ pub const ALL: &[(ServiceName, &str)] = &[
     (TICK, "safe_capture::v2::Tick"),
     (CONTROL, "safe_capture::v2::Tick"),
     (SIM_STATE, "safe_capture::v3::SimState"),
+    (PARTNER_STATE, "safe_capture::v3::SimState"),
     (
         NOMINAL_TRANSLATIONAL,
         "safe_capture::v2::NominalTranslational",

@@ -25,7 +25,7 @@ pub fn nominal(subsystem: Subsystem) -> anyhow::Result<i32> {
     let q = qos();
     let partner_q = partner_qos();
     let tick_rx = Subscriber::<Tick>::polled(&p.node, services::CONTROL, &q)?;
-    let state_rx = Subscriber::<SimState>::new(&p.node, services::SIM_STATE, &q)?;
+    let state_rx = Subscriber::<SimState>::new(&p.node, services::PARTNER_STATE, &partner_q)?;
     let tx_t = (which == 0)
         .then(|| {
             Publisher::<NominalTranslational>::new(

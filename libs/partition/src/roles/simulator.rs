@@ -5,7 +5,7 @@
 use crate::admission;
 use crate::convert;
 use crate::fallback;
-use crate::process::{Proc, prepare_listener, qos, send, wait};
+use crate::process::{Proc, partner_qos, prepare_listener, qos, send, wait};
 use nalgebra::Vector3;
 use sc_bus::{Publisher, Subscriber, Waiter};
 use sc_cbf::SafetyLayer;
@@ -37,6 +37,9 @@ pub fn simulator() -> anyhow::Result<i32> {
     let sa_rx = Subscriber::<SafeAttitude>::polled(&p.node, services::SAFE_ATTITUDE, &q)?;
     let sr_rx = Subscriber::<SafeRobotic>::new(&p.node, services::SAFE_ROBOTIC, &q)?;
     let state_tx = Publisher::<SimState>::new(&p.node, services::SIM_STATE, &q)?;
+    // the nominal controllers' copy: newest wins, a partner cannot hold the tick up
+    let partner_state_tx =
+        Publisher::<SimState>::new(&p.node, services::PARTNER_STATE, &partner_qos())?;
     let result_tx = Publisher::<StepResult>::new(&p.node, services::STEP_RESULT, &q)?;
     // Wake-ups (docs/PARTITION.md, "Who wakes whom"): between ticks on the tick only;
     // within a tick on the robotic safe command, the last of the causal chain (the
@@ -88,6 +91,7 @@ pub fn simulator() -> anyhow::Result<i32> {
                 // rehearse the start of a tick on the current state; nothing is sent
                 p.rehearse(|| {
                     std::hint::black_box(convert::sim_state(&sim.observe()));
+                    partner_state_tx.warm()?;
                     state_tx.warm()
                 })?;
             }
@@ -102,6 +106,7 @@ pub fn simulator() -> anyhow::Result<i32> {
         let tick = ticks.remove(0);
         if tick.command == tick_command::STOP {
             // wake the consumers once so that they see the stop too
+            partner_state_tx.notify()?;
             state_tx.notify()?;
             result_tx.notify()?;
             break;
@@ -122,7 +127,11 @@ pub fn simulator() -> anyhow::Result<i32> {
         msg.tick_send_ns = tick.send_ns;
         msg.recv_ns = recv_ns;
         msg.publish_ns = now();
+        // flight side first: a nominal command can then never reach a filter before
+        // the state it answers (the filters drop commands for states they have not
+        // seen as lies about the tick)
         send(&state_tx, &msg)?;
+        send(&partner_state_tx, &msg)?;
         let k = tick.tick;
         let due = tick.due_mask;
         let until = Instant::now() + deadline;
