@@ -5,6 +5,7 @@
 mod cmd_bench;
 mod cmd_bench_filters;
 mod cmd_bench_latency;
+mod cmd_bounds;
 mod cmd_launch;
 mod cmd_model;
 mod cmd_montecarlo;
@@ -47,6 +48,9 @@ enum Command {
     /// Red team: adversarial nominal controllers against the safety layer, measured from
     /// the simulator's true state.
     Redteam(cmd_redteam::Args),
+    /// The envelope bounds of the sampled-data rows: sampled from the model, compared
+    /// with the scenario's.
+    Bounds(cmd_bounds::Args),
 }
 
 /// Default scenario path (relative to the working directory).
@@ -64,6 +68,7 @@ fn main() -> ExitCode {
         Command::Bench(a) => cmd_bench::run(a),
         Command::Montecarlo(a) => cmd_montecarlo::run(a),
         Command::Redteam(a) => cmd_redteam::run(a),
+        Command::Bounds(a) => cmd_bounds::run(a),
     };
     match result {
         Ok(code) => code,

@@ -62,6 +62,10 @@ fn help_on_every_subcommand() {
         &["model", "--help"],
         &["bench", "--help"],
         &["bench", "filters", "--help"],
+        &["launch", "--help"],
+        &["montecarlo", "--help"],
+        &["redteam", "--help"],
+        &["bounds", "--help"],
     ] {
         let out = bin().args(sub).output().unwrap();
         assert!(out.status.success(), "{sub:?}");
@@ -70,6 +74,41 @@ fn help_on_every_subcommand() {
             "{sub:?}"
         );
     }
+}
+
+/// `bounds` samples the envelope and compares every configured bound; with a bound cut
+/// below its sampled maximum it names the key and fails.
+#[test]
+fn bounds_checks_every_envelope_bound() {
+    let out = bin()
+        .args(["bounds", "--samples", "2000"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    assert!(
+        text.contains("16 of 16 bounds keep the factor 1.5"),
+        "{text}"
+    );
+    let d = tmp("bounds");
+    let sc = scenario_with(
+        &d,
+        "angular_jerk_bound_rad_s3 = 0.15",
+        "angular_jerk_bound_rad_s3 = 0.01",
+    );
+    let out = bin()
+        .args(["bounds", "--samples", "2000", "--scenario"])
+        .arg(&sc)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(!out.status.success(), "{text}");
+    assert!(
+        text.lines()
+            .any(|l| l.contains("angular_jerk_bound_rad_s3") && l.contains("raise it")),
+        "{text}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
 }
 
 #[test]

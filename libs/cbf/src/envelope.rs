@@ -170,3 +170,55 @@ pub fn sample(
     }
     out
 }
+
+/// One configured envelope bound against its sampled maximum.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BoundCheck {
+    /// The scenario key, e.g. `safety.robotic.joint_jerk_bound_rad_s3[6]`.
+    pub key: String,
+    pub configured: f64,
+    pub sampled: f64,
+}
+
+impl BoundCheck {
+    /// The configured bound keeps [`SAFETY_FACTOR`] over the sampled maximum.
+    pub fn holds(&self) -> bool {
+        self.configured >= SAFETY_FACTOR * self.sampled
+    }
+}
+
+/// Every envelope bound of scenario `s` against the maxima `m` (the link-sphere bound
+/// is per link: the largest of its three spheres).
+pub fn checks(s: &sc_scenario::Scenario, m: &EnvelopeMaxima) -> Vec<BoundCheck> {
+    let a = &s.safety.attitude;
+    let r = &s.safety.robotic;
+    let mut v = vec![
+        BoundCheck {
+            key: "safety.attitude.angular_accel_bound_rad_s2".into(),
+            configured: a.angular_accel_bound_rad_s2,
+            sampled: m.angular_accel,
+        },
+        BoundCheck {
+            key: "safety.attitude.angular_jerk_bound_rad_s3".into(),
+            configured: a.angular_jerk_bound_rad_s3,
+            sampled: m.angular_jerk,
+        },
+    ];
+    for i in 0..7 {
+        v.push(BoundCheck {
+            key: format!("safety.robotic.joint_jerk_bound_rad_s3[{i}]"),
+            configured: r.joint_jerk_bound_rad_s3[i],
+            sampled: m.joint_jerk[i],
+        });
+    }
+    for link in 0..7 {
+        v.push(BoundCheck {
+            key: format!("safety.robotic.link_sphere_jerk_bound_m_s3[{link}]"),
+            configured: r.link_sphere_jerk_bound_m_s3[link],
+            sampled: (0..3)
+                .map(|k| m.sphere_jerk[3 * link + k])
+                .fold(0.0, f64::max),
+        });
+    }
+    v
+}

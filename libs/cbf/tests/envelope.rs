@@ -38,45 +38,19 @@ fn check_bounds(samples: usize, seed: u64) {
     assert!(m.angular_accel > 0.0 && m.angular_jerk > 0.0);
     assert!(m.joint_jerk.iter().all(|j| *j > 0.0), "{:?}", m.joint_jerk);
     assert_eq!(SAFETY_FACTOR, 1.5);
-    let a = &s.safety.attitude;
-    let r = &s.safety.robotic;
-    let mut short = Vec::new();
-    let mut check = |name: String, configured: f64, sampled: f64| {
-        if configured < SAFETY_FACTOR * sampled {
-            short.push(format!(
-                "{name}: configured {configured} < {SAFETY_FACTOR} × sampled {sampled:.4} = {:.4}",
-                SAFETY_FACTOR * sampled
-            ));
-        }
-    };
-    check(
-        "angular_accel_bound_rad_s2".into(),
-        a.angular_accel_bound_rad_s2,
-        m.angular_accel,
-    );
-    check(
-        "angular_jerk_bound_rad_s3".into(),
-        a.angular_jerk_bound_rad_s3,
-        m.angular_jerk,
-    );
-    for i in 0..7 {
-        check(
-            format!("joint_jerk_bound_rad_s3[{i}]"),
-            r.joint_jerk_bound_rad_s3[i],
-            m.joint_jerk[i],
-        );
-    }
-    // the sphere bound is per link (three spheres each)
-    for link in 0..7 {
-        let sampled = (0..3)
-            .map(|k| m.sphere_jerk[3 * link + k])
-            .fold(0.0, f64::max);
-        check(
-            format!("link_sphere_jerk_bound_m_s3[{link}]"),
-            r.link_sphere_jerk_bound_m_s3[link],
-            sampled,
-        );
-    }
+    let short: Vec<String> = envelope::checks(&s, &m)
+        .iter()
+        .filter(|c| !c.holds())
+        .map(|c| {
+            format!(
+                "{}: configured {} < {SAFETY_FACTOR} × sampled {:.4} = {:.4}",
+                c.key,
+                c.configured,
+                c.sampled,
+                SAFETY_FACTOR * c.sampled
+            )
+        })
+        .collect();
     assert!(
         short.is_empty(),
         "bounds below the model's sampled maxima:\n{}",

@@ -1,0 +1,67 @@
+//! `safe-capture bounds`: the envelope bounds the sampled-data rows rest on, sampled
+//! from the model and compared with the scenario's (docs/SAFETY.md, "The envelope
+//! bounds").
+
+use sc_cbf::envelope::{self, SAFETY_FACTOR};
+use sc_mission::Setup;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Samples the certified envelope (states, inputs and accelerations the safety layer
+/// admits) with the scenario's servicer model and prints, for every envelope bound of
+/// the scenario, the sampled maximum, the configured value and their ratio; exits 1 if a
+/// bound keeps less than the factor 1.5 over its maximum. More samples find larger
+/// maxima (sampling is not a proof): the tests use 20 000, the configured values were
+/// checked with 500 000.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Scenario file.
+    #[arg(long, value_name = "FILE", default_value_os_t = crate::default_scenario())]
+    scenario: PathBuf,
+    /// States drawn from the envelope.
+    #[arg(long, default_value_t = 20_000)]
+    samples: usize,
+    /// Seed of the sampling (deterministic).
+    #[arg(long, default_value_t = 7)]
+    seed: u64,
+}
+
+pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    let setup = Setup::load(&a.scenario)?;
+    let started = std::time::Instant::now();
+    let m = envelope::sample(&setup.scenario, &setup.robot, a.samples, a.seed);
+    let checks = envelope::checks(&setup.scenario, &m);
+    println!(
+        "{:<52} {:>12} {:>12} {:>8}",
+        "bound", "sampled max", "configured", "ratio"
+    );
+    for c in &checks {
+        let ratio = if c.sampled > 0.0 {
+            format!("{:.2}", c.configured / c.sampled)
+        } else {
+            "-".into() // nothing moves there (link 1's spheres lie on joint 1's axis)
+        };
+        println!(
+            "{:<52} {:>12.4} {:>12.4} {:>8}{}",
+            c.key,
+            c.sampled,
+            c.configured,
+            ratio,
+            if c.holds() { "" } else { "  < 1.5: raise it" }
+        );
+    }
+    let short = checks.iter().filter(|c| !c.holds()).count();
+    println!(
+        "{} of {} samples usable, {:.1} s; {} of {} bounds keep the factor {SAFETY_FACTOR}",
+        m.samples,
+        a.samples,
+        started.elapsed().as_secs_f64(),
+        checks.len() - short,
+        checks.len()
+    );
+    Ok(if short == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
+}
