@@ -78,7 +78,9 @@ impl ServiceSettings {
     /// - `history = 0`: the start-up handshake guarantees every port exists before
     ///   the first tick, so no replay is needed and nothing stale is replayed.
     /// - `max_publishers = 2`: the owner plus one replacement (e.g. a Python
-    ///   controller started while the Rust one is being stopped).
+    ///   controller started while the Rust one is being stopped). A subscriber still
+    ///   accepts samples only from the first publisher it heard; the partition's
+    ///   settings (`sc_partition::process::qos`) allow exactly one.
     /// - `max_subscribers = 8`: the consumers, recorder and debug tools.
     /// - `backpressure_timeout = 50 ms`: far above a tick's work, small enough
     ///   that a SIGKILLed subscriber cannot stall the loop for long.

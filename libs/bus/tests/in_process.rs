@@ -291,3 +291,42 @@ fn teardown_refuses_while_a_node_is_alive() {
     run.teardown().unwrap();
     assert!(run.leftovers().is_empty(), "{:?}", run.leftovers());
 }
+
+/// Who may publish: a subscriber accepts samples only from the first publisher it heard
+/// (a second one's are dropped and counted), and a service created with room for more
+/// publishers than the settings say is refused at open (impersonation, issue #12).
+#[test]
+fn subscribers_are_pinned_to_their_first_publisher() {
+    let run = RunScope::unique("pinned").unwrap();
+    {
+        let node = run.node("main").unwrap();
+        let qos = ServiceSettings::lock_step(); // two publishers allowed
+        let owner = Publisher::<Tick>::with_name(&node, "cmd", &qos).unwrap();
+        let rx = Subscriber::<Tick>::with_name(&node, "cmd", &qos).unwrap();
+        let tick = |tick| Tick {
+            tick,
+            ..Default::default()
+        };
+        owner.send(&tick(1)).unwrap();
+        assert_eq!(rx.try_receive().unwrap().map(|t| t.tick), Some(1));
+        let intruder = Publisher::<Tick>::with_name(&node, "cmd", &qos).unwrap();
+        intruder.send(&tick(666)).unwrap();
+        owner.send(&tick(2)).unwrap();
+        intruder.send(&tick(667)).unwrap();
+        let mut got = Vec::new();
+        rx.receive_all(&mut got).unwrap();
+        assert_eq!(got.iter().map(|t| t.tick).collect::<Vec<_>>(), vec![2]);
+        assert_eq!(rx.rejected(), 2);
+        // the service allows 2 publishers; opening it as a 1-publisher service is refused
+        let one = ServiceSettings {
+            max_publishers: 1,
+            ..qos
+        };
+        let err = Subscriber::<Tick>::with_name(&node, "cmd", &one)
+            .err()
+            .expect("a service with room for more publishers must be refused");
+        assert!(err.to_string().contains("allows 2 publishers"), "{err}");
+    }
+    run.teardown().unwrap();
+    assert!(run.leftovers().is_empty(), "{:?}", run.leftovers());
+}
