@@ -857,3 +857,43 @@ fn monitor_barriers_equal_the_filters_barriers() {
         }
     }
 }
+
+/// The certified set's boresight-rate rows (`attitude::boresight_rate`): the two axes
+/// are orthonormal and across the boresight, and `ḣ = hdot_drift + hdot_u·τ` matches the
+/// finite difference of `h = w̄ ∓ e_kᵀω` along `ω̇ = Pτ + r`, for random states.
+#[test]
+fn boresight_rate_rows_match_finite_differences() {
+    let mut rng = 0x5eedu64;
+    let mut r = || {
+        rng = rng
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((rng >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    };
+    for _ in 0..200 {
+        let d = Vector3::new(r(), r(), r()).normalize();
+        let [e1, e2] = attitude::across_boresight(&d);
+        assert!((e1.norm() - 1.0).abs() < 1e-12 && (e2.norm() - 1.0).abs() < 1e-12);
+        assert!(e1.dot(&d).abs() < 1e-12 && e2.dot(&d).abs() < 1e-12 && e1.dot(&e2).abs() < 1e-12);
+        let omega = Vector3::new(r(), r(), r()) * 0.1;
+        let p = nalgebra::Matrix3::from_fn(|_, _| r() * 0.02);
+        let drift = Vector3::new(r(), r(), r()) * 0.01;
+        let tau = Vector3::new(r(), r(), r()) * 10.0;
+        let w_max = 0.06;
+        let rows = attitude::boresight_rate(&omega, &p, &drift, &d, w_max);
+        let dt = 1e-6;
+        let omega_next = omega + (p * tau + drift) * dt;
+        let next = attitude::boresight_rate(&omega_next, &p, &drift, &d, w_max);
+        for k in 0..4 {
+            let fd = (next[k].h - rows[k].h) / dt;
+            let analytic = rows[k].hdot_drift + rows[k].hdot_u.dot(&tau);
+            assert!(
+                (fd - analytic).abs() <= 1e-8 * (1.0 + analytic.abs()),
+                "row {k}: finite difference {fd}, analytic {analytic}"
+            );
+        }
+        // the four rows are ± the two axes: h sums to 2 w̄ per axis
+        assert!((rows[0].h + rows[2].h - 2.0 * w_max).abs() < 1e-12);
+        assert!((rows[1].h + rows[3].h - 2.0 * w_max).abs() < 1e-12);
+    }
+}
