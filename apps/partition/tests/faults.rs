@@ -275,3 +275,28 @@ fn hung_nominal_is_caught_by_the_stage_deadline_watchdog() {
     assert_eq!(rec["fallback_steps"], 0, "no simulator fallback: {rec}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A role whose process never joins the handshake (here: a process that only sleeps)
+/// fails the launch, and the scheduler names the role, not its number.
+#[test]
+fn a_role_that_never_joins_is_named() {
+    let dir = tmp("nojoin");
+    let out = dir.join("out");
+    let config = write_config(&dir, Some(5.0), None, 20.0);
+    let text = std::fs::read_to_string(&config)
+        .unwrap()
+        .replace("handshake_timeout_s = 30.0", "handshake_timeout_s = 2.0");
+    assert!(text.contains("handshake_timeout_s = 2.0"));
+    std::fs::write(&config, text).unwrap();
+    let mut opts = options(&config, &out, "nojoin");
+    opts.role_override
+        .push(("safety_robotic".into(), "/bin/sleep".into(), vec!["60".into()]));
+    let t0 = std::time::Instant::now();
+    let rep = sc_partition::launch(&opts).unwrap();
+    assert_ne!(rep.code, 0, "{rep:?}");
+    assert!(t0.elapsed() < std::time::Duration::from_secs(60), "{rep:?}");
+    let log = std::fs::read_to_string(out.join("logs/scheduler.log")).unwrap();
+    assert!(log.contains("never joined: safety_robotic"), "{log}");
+    assert!(rep.leftovers.is_empty(), "{rep:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -59,7 +59,27 @@ pub fn scheduler() -> anyhow::Result<i32> {
     let peers: Vec<&str> = crate::config::ROLES[1..].to_vec();
     let ids: Vec<u32> = (1..crate::config::ROLES.len() as u32).collect();
     let coord = sc_bus::Coordinator::new(&p.node, services::HANDSHAKE, &ids)?;
-    coord.wait_all(Duration::from_secs_f64(p.cfg.handshake_timeout_s))?;
+    coord
+        .wait_all(Duration::from_secs_f64(p.cfg.handshake_timeout_s))
+        .map_err(|e| match e {
+            // name the roles that never joined (the bus only knows their ids)
+            sc_bus::BusError::HandshakeTimeout { timeout, missing } => {
+                let names: Vec<&str> = missing
+                    .iter()
+                    .map(|&id| {
+                        crate::config::ROLES
+                            .get(id as usize)
+                            .copied()
+                            .unwrap_or("?")
+                    })
+                    .collect();
+                anyhow::anyhow!(
+                    "handshake timed out after {timeout:?}: never joined: {} (see their logs)",
+                    names.join(", ")
+                )
+            }
+            e => e.into(),
+        })?;
     eprintln!("scheduler: all {} processes ready", ids.len());
     let mut monitor = PeerMonitor::new(&peers);
     monitor.poll(&p.run)?;
