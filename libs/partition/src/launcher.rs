@@ -56,7 +56,9 @@ pub struct ProcessExit {
 pub struct LaunchReport {
     pub run_id: String,
     pub exits: Vec<ProcessExit>,
-    /// 0 all fine and captured safely; 1 the mission did not capture safely; 3 a process failed.
+    /// 0 all fine and captured safely; 1 the mission did not capture safely; 3 a process
+    /// failed; 4 every process ended well but flight-side samples were lost in transport
+    /// (an infrastructure failure, named in `error`).
     pub code: i32,
     pub interrupted: bool,
     /// Files of the run left in /dev/shm or /tmp/iceoryx2 after teardown (should be empty).
@@ -67,7 +69,7 @@ pub struct LaunchReport {
     /// real-time mode only).
     pub cpu_wakeup_latency: String,
     pub wall_s: f64,
-    /// Why a role could not be started, if one could not.
+    /// Why a role could not be started, or what the infrastructure lost (code 4).
     pub error: Option<String>,
 }
 
@@ -397,14 +399,29 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
         .iter()
         .find(|e| e.role == "recorder")
         .and_then(|e| e.code);
-    let code = if failed || interrupted || spawn_err.is_some() || !leftovers.is_empty() {
+    let mut code = if failed || interrupted || spawn_err.is_some() || !leftovers.is_empty() {
         3
     } else if recorder_code == Some(0) {
         0
     } else {
         1
     };
-    if let Some(e) = spawn_err.as_ref().filter(|_| !opts.quiet) {
+    let mut error = spawn_err;
+    // every process ended well, yet the flight side lost samples: the transport failed
+    // (e.g. a publisher gave up on a full queue under load), not the mission
+    let lost = std::fs::read_to_string(out.join("recorder.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+        .map(|v| infrastructure_losses(&v))
+        .unwrap_or_default();
+    if code <= 1 && !lost.is_empty() {
+        code = 4;
+        error = Some(format!(
+            "infrastructure: flight-side samples lost in transport ({}); the run's result is not the mission's",
+            lost.join(", ")
+        ));
+    }
+    if let Some(e) = error.as_ref().filter(|_| !opts.quiet) {
         eprintln!("launch: {e}");
     }
     let rep = LaunchReport {
@@ -416,11 +433,46 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
         stale_removed,
         cpu_wakeup_latency: crate::pm_qos::describe(wakeup_request, &wakeup_held),
         wall_s: started.elapsed().as_secs_f64(),
-        error: spawn_err,
+        error,
     };
     std::fs::write(
         out.join("launch.json"),
         serde_json::to_string_pretty(&rep)? + "\n",
     )?;
     Ok(rep)
+}
+
+/// The flight-side services (everything but the partners' `safe_capture/nominal/*`) of
+/// which the recorder missed samples, from its `recorder.json`, as `service: count`.
+pub fn infrastructure_losses(recorder: &serde_json::Value) -> Vec<String> {
+    recorder["missing"]
+        .as_object()
+        .map(|m| {
+            m.iter()
+                .filter(|(svc, _)| !svc.starts_with("safe_capture/nominal/"))
+                .filter_map(|(svc, n)| n.as_u64().filter(|n| *n > 0).map(|n| format!("{svc}: {n}")))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+#[cfg(test)]
+mod infrastructure_tests {
+    use super::infrastructure_losses;
+
+    #[test]
+    fn only_flight_side_losses_count() {
+        let r = serde_json::json!({"missing": {
+            "safe_capture/nominal/attitude": 550,
+            "safe_capture/sim/state": 0,
+            "safe_capture/safe/robotic": 3,
+        }});
+        assert_eq!(
+            infrastructure_losses(&r),
+            vec!["safe_capture/safe/robotic: 3"]
+        );
+        let healthy = serde_json::json!({"missing": {"safe_capture/nominal/robotic": 9}});
+        assert!(infrastructure_losses(&healthy).is_empty());
+        assert!(infrastructure_losses(&serde_json::json!({})).is_empty());
+    }
 }
