@@ -15,7 +15,6 @@ Needs ``SC_RUN_ID`` and ``--config`` (or ``SC_PARTITION_CONFIG``), set by the la
 import os
 import sys
 import time
-import tomllib
 
 import iceoryx2 as iox2
 
@@ -26,16 +25,6 @@ import sc_icd  # noqa: E402
 TIMEOUT_S = 60.0
 
 
-def force_bound(config_path):
-    with open(config_path, "rb") as f:
-        cfg = tomllib.load(f)
-    sc_path = cfg["scenario"]
-    if not os.path.isabs(sc_path):
-        sc_path = os.path.join(os.path.dirname(os.path.abspath(config_path)), sc_path)
-    with open(sc_path, "rb") as f:
-        return float(tomllib.load(f)["limits"]["force_max_n"])
-
-
 def main():
     run_id = os.environ.get("SC_RUN_ID")
     argv = sys.argv[1:]
@@ -43,7 +32,8 @@ def main():
     if not run_id or not config:
         print("hostile_filter.py: SC_RUN_ID and --config are required", file=sys.stderr)
         return 2
-    lies = [1000.0 * force_bound(config), float("nan"), float("inf")]
+    bound = float(sc_bus.load_scenario(config)["limits"]["force_max_n"])
+    lies = [1000.0 * bound, float("nan"), float("inf")]
 
     iox2.set_log_level_from_env_or(iox2.LogLevel.Warn)
     node = (

@@ -55,7 +55,6 @@ import random
 import signal
 import sys
 import time
-import tomllib
 from collections import deque
 
 import iceoryx2 as iox2
@@ -145,24 +144,6 @@ def arg(name, env=None):
     return os.environ.get(env) if env else None
 
 
-def load_scenario(config_path):
-    with open(config_path, "rb") as f:
-        cfg = tomllib.load(f)
-    sc_path = cfg["scenario"]
-    if not os.path.isabs(sc_path):
-        sc_path = os.path.join(os.path.dirname(os.path.abspath(config_path)), sc_path)
-    with open(sc_path, "rb") as f:
-        return tomllib.load(f)
-
-
-def rotate(q, v):
-    """Rotates v by the scalar-first unit quaternion q."""
-    w, x, y, z = q
-    ux = (y * v[2] - z * v[1], z * v[0] - x * v[2], x * v[1] - y * v[0])
-    uux = (y * ux[2] - z * ux[1], z * ux[0] - x * ux[2], x * ux[1] - y * ux[0])
-    return [v[i] + 2.0 * w * ux[i] + 2.0 * uux[i] for i in range(3)]
-
-
 def unit(v, fallback):
     n = math.sqrt(sum(x * x for x in v))
     return [x / n for x in v] if n > 1e-9 else fallback
@@ -230,7 +211,7 @@ class Attack:
             c = list(s.com_r)
             along = sum(c[i] * d[i] for i in range(3))
             perp = unit([c[i] - along * d[i] for i in range(3)], unit([d[1], -d[0], 0.0], [0.0, 0.0, 1.0]))
-            return [b * x for x in rotate(list(s.q_hr), perp)]
+            return [b * x for x in sc_icd.rotate(list(s.q_hr), perp)]
         sign, what = (-1.0, v.split(":", 1)[1][1:]) if v.count(":-") else (1.0, v.partition(":")[2])
         if self.role == "attitude" and v.startswith("spin:") and what in ("x", "y", "z"):
             u = [0.0] * 3
@@ -298,7 +279,7 @@ def main():
         )
         return 2
     try:
-        attack, crash_at, hang_at, burst, late_s, late_every = parse(role, spec, load_scenario(config))
+        attack, crash_at, hang_at, burst, late_s, late_every = parse(role, spec, sc_bus.load_scenario(config))
     except (ValueError, KeyError, OSError) as e:
         print(f"hostile_nominal.py: {role} --strategy {spec}: {e}", file=sys.stderr)
         return 2

@@ -35,7 +35,6 @@ import math
 import os
 import sys
 import time
-import tomllib
 
 import iceoryx2 as iox2
 
@@ -56,32 +55,13 @@ def arg(name, env):
     return os.environ.get(env)
 
 
-def load_scenario(config_path):
-    with open(config_path, "rb") as f:
-        cfg = tomllib.load(f)
-    sc_path = cfg["scenario"]
-    if not os.path.isabs(sc_path):
-        sc_path = os.path.join(os.path.dirname(os.path.abspath(config_path)), sc_path)
-    with open(sc_path, "rb") as f:
-        return tomllib.load(f)
-
-
-def rotate(q, v):
-    """Rotates v by the scalar-first unit quaternion q (q_AB: F_B -> F_A)."""
-    w, x, y, z = q
-    # v + 2 w (u x v) + 2 u x (u x v), u = (x, y, z)
-    ux = (y * v[2] - z * v[1], z * v[0] - x * v[2], x * v[1] - y * v[0])
-    uux = (y * ux[2] - z * ux[1], z * ux[0] - x * ux[2], x * ux[1] - y * ux[0])
-    return [v[i] + 2.0 * w * ux[i] + 2.0 * uux[i] for i in range(3)]
-
-
 def main():
     run_id = os.environ.get("SC_RUN_ID")
     config = arg("--config", "SC_PARTITION_CONFIG")
     if not run_id or not config:
         print("nominal_translational.py: SC_RUN_ID and --config are required", file=sys.stderr)
         return 2
-    sc = load_scenario(config)
+    sc = sc_bus.load_scenario(config)
     phases = sorted(sc["mission"]["phases"], key=lambda p: p["start_s"])
     axis = sc["safety"]["translational"]["corridor_axis"]
     norm = math.sqrt(sum(a * a for a in axis))
@@ -126,7 +106,7 @@ def main():
                     continue
                 recv_ns = time.monotonic_ns()
                 phase = max(i for i, p in enumerate(phases) if t + 1e-9 >= p["start_s"]) if t >= 0 else 0
-                gfc_h = rotate(q_hr, gfc_r)
+                gfc_h = sc_icd.rotate(q_hr, gfc_r)
                 f_h = [MASS_KG * (-kp * (r_h[i] - gfc_h[i]) - kd * v_h[i]) for i in range(3)]
                 if phases[phase]["translational"] == "off":
                     f_h = [0.0, 0.0, 0.0]

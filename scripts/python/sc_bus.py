@@ -11,6 +11,7 @@ so every process must ask for the same ones.
 import os
 import sys
 import time
+import tomllib
 
 import iceoryx2 as iox2
 
@@ -43,6 +44,17 @@ def run_config(run_id):
     cfg.global_cfg.prefix = iox2.FileName.new(sc_icd.run_prefix(run_id))
     cfg.global_cfg.creation_timeout = iox2.Duration.from_secs(CREATION_TIMEOUT_S)
     return cfg
+
+
+def load_scenario(config_path):
+    """The scenario of a partition config (its `scenario` key, relative to the config file)."""
+    with open(config_path, "rb") as f:
+        cfg = tomllib.load(f)
+    sc_path = cfg["scenario"]
+    if not os.path.isabs(sc_path):
+        sc_path = os.path.join(os.path.dirname(os.path.abspath(config_path)), sc_path)
+    with open(sc_path, "rb") as f:
+        return tomllib.load(f)
 
 
 def open_pubsub(node, name, ctype, qos):

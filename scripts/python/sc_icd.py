@@ -69,6 +69,15 @@ ROLE_SAFETY_ROBOTIC = 7
 ROLE_RECORDER = 8
 
 
+def rotate(q, v):
+    """Rotates v by the scalar-first unit quaternion q (q_AB: F_B -> F_A), the ICD's convention."""
+    w, x, y, z = q
+    # v + 2 w (u x v) + 2 u x (u x v), u = (x, y, z)
+    ux = (y * v[2] - z * v[1], z * v[0] - x * v[2], x * v[1] - y * v[0])
+    uux = (y * ux[2] - z * ux[1], z * ux[0] - x * ux[2], x * ux[1] - y * ux[0])
+    return [v[i] + 2.0 * w * ux[i] + 2.0 * uux[i] for i in range(3)]
+
+
 def run_prefix(run_id):
     """iceoryx2 global.prefix of a run, as sc_bus::RunScope builds it."""
     clean = "".join(c if (c.isascii() and (c.isalnum() or c in "-.")) else "-" for c in run_id)

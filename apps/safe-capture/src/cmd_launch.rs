@@ -68,7 +68,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let failed: Vec<String> = rep
         .exits
         .iter()
-        .filter(|e| !(e.code == Some(0) || (e.role == "recorder" && e.code == Some(1))))
+        .filter(|e| !e.ended_well())
         .map(|e| e.role.clone())
         .collect();
     let summary = std::fs::read_to_string(a.out.join("summary.json"))

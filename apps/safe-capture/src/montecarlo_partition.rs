@@ -136,9 +136,7 @@ fn failure(rep: &LaunchReport, out: &Path) -> String {
     if let Some(e) = &rep.error {
         return format!("partition: {e}");
     }
-    let bad = |e: &&sc_partition::launcher::ProcessExit| {
-        !(e.code == Some(0) || (e.role == "recorder" && e.code == Some(1)))
-    };
+    let bad = |e: &&sc_partition::launcher::ProcessExit| !e.ended_well();
     // the processes that failed by themselves, with the last line of their log
     let mut parts: Vec<String> = rep
         .exits

@@ -171,7 +171,7 @@ impl Partners {
             .exits
             .iter()
             .filter(|e| !hostile.contains(&e.role))
-            .filter(|e| !(e.code == Some(0) || (e.role == "recorder" && e.code == Some(1))))
+            .filter(|e| !e.ended_well())
             .map(|e| format!("{} ({:?}/{:?})", e.role, e.code, e.signal))
             .collect();
         if !failed.is_empty() {

@@ -51,6 +51,14 @@ pub struct ProcessExit {
     pub killed_by_launcher: bool,
 }
 
+impl ProcessExit {
+    /// The process did its job: exit 0, or the recorder's 1 (it recorded everything, and
+    /// the mission did not end captured and safe — a result, not a failure).
+    pub fn ended_well(&self) -> bool {
+        self.code == Some(0) || (self.role == "recorder" && self.code == Some(1))
+    }
+}
+
 /// Result of a launch.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct LaunchReport {
