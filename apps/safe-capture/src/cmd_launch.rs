@@ -60,6 +60,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             &cfg.base_dir.join(&cfg.scenario),
             0,
             None,
+            opts.clock.unwrap_or(ClockMode::LockStep),
         )?;
         p.check(&case)?;
         opts.role_override = p.overrides(&case);

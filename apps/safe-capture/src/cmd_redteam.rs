@@ -4,6 +4,7 @@ use crate::redteam_partition::{Partners, case_dir, default_python};
 use anyhow::Context;
 use rayon::prelude::*;
 use sc_mission::Setup;
+use sc_partition::ClockMode;
 use sc_redteam::partners::{parse_partition_case, partition_cases};
 use sc_redteam::{Case, CaseLabel, CaseResult, Target, report};
 use std::io::IsTerminal;
@@ -30,13 +31,19 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 /// a process: it crashes or hangs mid-run, stays silent, sends bursts of 40 messages per
 /// state, answers late, labels its commands with old or future ticks, sends garbage
 /// fields (`--list` shows the cases; the script's docstring defines them). Every run is
-/// lock-step and measured from its recorded telemetry in the same way; each run's outputs
-/// stay in OUT/cases/<case>/.
+/// lock-step (or, with --real-time, paced at 10 Hz on the wall clock, one at a time) and
+/// measured from its recorded telemetry in the same way; each run's outputs stay in
+/// OUT/cases/<case>/.
+///
+/// Isolation: in every case, a subsystem the case does not attack (a bystander) must not
+/// lose or refuse an input nor run its backup law on any step — in real time this is the
+/// measurement that a misbehaving partner costs no other subsystem a deadline.
 ///
 /// Writes to OUT: cases.csv (one line per case), min_h.csv (each case's smallest value of
 /// every barrier), summary.json, report.md, figures/redteam_margins.svg.
 ///
-/// Exit codes: 0 every case safe, 1 a case unsafe, 2 bad arguments or configuration.
+/// Exit codes: 0 every case safe and no bystander disturbed, 1 a case unsafe or a
+/// bystander disturbed, 2 bad arguments or configuration.
 #[derive(clap::Args)]
 pub struct Args {
     /// Scenario file.
@@ -80,6 +87,11 @@ pub struct Args {
     /// partner costs every tick this much; the config's value is for healthy runs).
     #[arg(long, value_name = "X", default_value_t = 5.0)]
     deadline_scale: f64,
+    /// --partition: run each case in real time (10 Hz on the wall clock, the config's
+    /// deadlines) instead of lock-step, one case at a time unless --jobs says otherwise.
+    /// Combine with --max-ticks: a whole mission takes its 240 s of wall time.
+    #[arg(long, requires = "partition")]
+    real_time: bool,
     /// Parallel runs (default: the machine's cores).
     #[arg(long, short, value_name = "N")]
     jobs: Option<usize>,
@@ -153,6 +165,11 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             &a.scenario,
             a.max_ticks,
             Some(a.deadline_scale),
+            if a.real_time {
+                ClockMode::RealTime
+            } else {
+                ClockMode::LockStep
+            },
         )?;
         for c in &cases {
             p.check(c)?;
@@ -161,7 +178,8 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     } else {
         None
     };
-    if let Some(j) = a.jobs {
+    // real-time runs side by side would measure each other
+    if let Some(j) = a.jobs.or(a.real_time.then_some(1)) {
         rayon::ThreadPoolBuilder::new()
             .num_threads(j.max(1))
             .build_global()
@@ -224,7 +242,9 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         b.finish_and_clear();
     }
     let wall = started.elapsed().as_secs_f64();
-    let how = if a.partition {
+    let how = if a.real_time {
+        "Each case runs the mission through the process partition in real time (10 Hz on the wall clock, one case at a time), the hostile partner process `scripts/python/hostile_nominal.py` in place of the nominal controller process of its target (`all`: all three); the barriers come from the simulator's state as the recorder logged it (`cases/<case>/telemetry.csv`)."
+    } else if a.partition {
         "Each case runs the mission through the process partition (lock-step), the hostile partner process `scripts/python/hostile_nominal.py` in place of the nominal controller process of its target (`all`: all three); the barriers come from the simulator's state as the recorder logged it (`cases/<case>/telemetry.csv`)."
     } else {
         report::IN_PROCESS
@@ -237,8 +257,12 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         }
     }
     println!(
-        "redteam{}: {} of {} cases safe{}{}; non-finite applied {}, out-of-bound applied {}; solve time geomean (worst case) {:.1} us, max {:.0} us; wall {:.1} s -> {}",
-        if a.partition { " (partition)" } else { "" },
+        "redteam{}: {} of {} cases safe{}{}; non-finite applied {}, out-of-bound applied {}; bystanders disturbed in {} cases{}; solve time geomean (worst case) {:.1} us, max {:.0} us; wall {:.1} s -> {}",
+        match (a.partition, a.real_time) {
+            (true, true) => " (partition, real time)",
+            (true, false) => " (partition)",
+            _ => "",
+        },
         s.safe,
         s.cases,
         if s.unsafe_cases.is_empty() {
@@ -253,14 +277,22 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         },
         s.nonfinite_applied,
         s.out_of_bounds_applied,
+        s.bystanders_disturbed.len(),
+        if s.bystanders_disturbed.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", s.bystanders_disturbed.join(", "))
+        },
         s.solve_time_geomean_max_us,
         s.solve_time_max_us,
         wall,
         a.out.display()
     );
-    Ok(if s.safe == s.cases && s.errors.is_empty() {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::from(1)
-    })
+    Ok(
+        if s.safe == s.cases && s.errors.is_empty() && s.bystanders_disturbed.is_empty() {
+            ExitCode::SUCCESS
+        } else {
+            ExitCode::from(1)
+        },
+    )
 }

@@ -33,6 +33,8 @@ pub struct Partners {
     pub max_ticks: u64,
     /// Lock-step deadlines as a multiple of the real-time ones.
     pub deadline_scale: Option<f64>,
+    /// Lock-step (deterministic) or real time (the isolation measured on the clock).
+    pub clock: ClockMode,
 }
 
 /// `scripts/.venv/bin/python` unless `SC_PYTHON` names another interpreter.
@@ -55,6 +57,7 @@ impl Partners {
         scenario: &Path,
         max_ticks: u64,
         deadline_scale: Option<f64>,
+        clock: ClockMode,
     ) -> anyhow::Result<Self> {
         let ok = std::process::Command::new(python)
             .args(["-c", "import iceoryx2"])
@@ -76,6 +79,7 @@ impl Partners {
             scenario: absolute(scenario),
             max_ticks,
             deadline_scale,
+            clock,
         })
     }
 
@@ -129,9 +133,12 @@ impl Partners {
             config: self.config.clone(),
             out: out.to_path_buf(),
             run_id: Some(tag.into()),
-            clock: Some(ClockMode::LockStep),
+            clock: Some(self.clock),
             max_ticks: Some(self.max_ticks),
-            deadline_scale: self.deadline_scale,
+            deadline_scale: match self.clock {
+                ClockMode::LockStep => self.deadline_scale,
+                _ => None,
+            },
             scenario: Some(self.scenario.clone()),
             role_override: self.overrides(case),
             quiet: true,
@@ -154,6 +161,9 @@ impl Partners {
             let chain: Vec<String> = e.chain().map(|c| c.to_string()).collect();
             format!("partition: {}", chain.join(": ").replace('\n', " "))
         })?;
+        if let Some(e) = &rep.error {
+            return Err(format!("partition: {e} (exit code {})", rep.code));
+        }
         if !rep.leftovers.is_empty() {
             return Err(format!(
                 "partition: {} files left in /dev/shm: {:?}",

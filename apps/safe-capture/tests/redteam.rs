@@ -23,6 +23,13 @@ fn assert_all_safe(out: &std::path::Path, cases: usize) {
     assert_eq!(s["safe"].as_u64(), Some(cases as u64), "{s}");
     assert_eq!(s["nonfinite_applied"].as_u64(), Some(0), "{s}");
     assert_eq!(s["out_of_bounds_applied"].as_u64(), Some(0), "{s}");
+    // an attack on one subsystem never disturbs another's filter (input lost or refused,
+    // backup run): deterministic in process and in lock-step
+    assert_eq!(
+        s["bystanders_disturbed"].as_array().map(Vec::len),
+        Some(0),
+        "{s}"
+    );
     let worst = s["worst"].as_object().unwrap();
     assert!(worst.len() >= 10, "{s}");
     for (name, v) in worst {

@@ -4,7 +4,7 @@
 //! never from a filter's report.
 
 use crate::adversary::Adversary;
-use crate::strategy::{Case, CaseLabel};
+use crate::strategy::{Case, CaseLabel, Target};
 use rayon::prelude::*;
 use sc_cbf::faults;
 use sc_mission::summary::TimeStats;
@@ -38,6 +38,12 @@ pub struct CaseResult {
     pub substituted_steps: [usize; 3],
     pub relaxed_steps: [usize; 3],
     pub backup_steps: [usize; 3],
+    /// Per filter: steps on which it lacked or refused an input (its nominal missing or
+    /// invalid, the upstream safe command missing, the coupling ξ invalid) or ran its
+    /// backup law. On a subsystem the case does not attack — a bystander — any such step
+    /// is a fault of the partition's isolation, not of the adversary.
+    #[serde(default)]
+    pub disturbed_steps: [usize; 3],
     /// Safety-layer time per step (wall clock) [µs].
     pub solve_time_us: TimeStats,
 }
@@ -48,7 +54,24 @@ impl CaseResult {
     pub fn safe(&self) -> bool {
         self.violated.is_empty() && self.nonfinite_applied == 0 && self.out_of_bounds_applied == 0
     }
+
+    /// Disturbed steps summed over the subsystems the case does not attack.
+    pub fn bystander_disturbed_steps(&self) -> usize {
+        let target = Target::parse(&self.target);
+        (0..3)
+            .filter(|&i| target.is_some_and(|t| !t.covers(i)))
+            .map(|i| self.disturbed_steps[i])
+            .sum()
+    }
 }
+
+/// Filter faults that mean an input did not arrive or was refused, or the backup ran.
+const DISTURBED: u32 = faults::INVALID_NOMINAL
+    | faults::NOMINAL_MISSING
+    | faults::UPSTREAM_MISSING
+    | faults::INVALID_COUPLING
+    | faults::QP_FAILED_FALLBACK
+    | faults::INVALID_STATE;
 
 /// Runs one case to the end of its mission.
 pub fn run_case(setup: &Setup, case: &Case) -> Result<CaseResult, String> {
@@ -106,6 +129,7 @@ pub fn measure(
         substituted_steps: [0; 3],
         relaxed_steps: [0; 3],
         backup_steps: [0; 3],
+        disturbed_steps: [0; 3],
         solve_time_us: summary
             .solve_time_us
             .get("total")
@@ -136,6 +160,9 @@ pub fn measure(
             }
             if f & (faults::QP_FAILED_FALLBACK | faults::INVALID_STATE) != 0 {
                 r.backup_steps[i] += 1;
+            }
+            if f & DISTURBED != 0 {
+                r.disturbed_steps[i] += 1;
             }
         }
     }

@@ -23,6 +23,11 @@ pub struct CampaignSummary {
     pub errors: Vec<String>,
     pub nonfinite_applied: usize,
     pub out_of_bounds_applied: usize,
+    /// Cases in which a subsystem the case does not attack lost or refused an input or ran
+    /// its backup (`CaseResult::bystander_disturbed_steps` > 0): the attack reached past
+    /// its own subsystem.
+    #[serde(default)]
+    pub bystanders_disturbed: Vec<String>,
     /// Per barrier: the smallest value over all cases and the case it came from.
     pub worst: BTreeMap<String, (f64, String)>,
     /// Safety-layer time per step over all cases [µs]: the largest geometric mean of a
@@ -54,6 +59,7 @@ pub fn write(
         errors: Vec::new(),
         nonfinite_applied: 0,
         out_of_bounds_applied: 0,
+        bystanders_disturbed: Vec::new(),
         worst: BTreeMap::new(),
         solve_time_geomean_max_us: 0.0,
         solve_time_max_us: 0.0,
@@ -62,7 +68,7 @@ pub fn write(
     let mut cases_csv = String::from(
         "case,target,strategy,end,final_time_s,steps,safe,violated,nonfinite_applied,out_of_bounds_applied,\
 substituted_translational,substituted_attitude,substituted_robotic,relaxed_translational,relaxed_attitude,relaxed_robotic,\
-backup_translational,backup_attitude,backup_robotic,worst_barrier,worst_normalised_margin,solve_geomean_us,solve_max_us\n",
+backup_translational,backup_attitude,backup_robotic,bystander_disturbed_steps,worst_barrier,worst_normalised_margin,solve_geomean_us,solve_max_us\n",
     );
     let mut min_csv = format!("case,{}\n", names.join(","));
     let mut rows: Vec<String> = Vec::new();
@@ -79,6 +85,9 @@ backup_translational,backup_attitude,backup_robotic,worst_barrier,worst_normalis
             summary.safe += 1;
         } else {
             summary.unsafe_cases.push(r.case.clone());
+        }
+        if r.bystander_disturbed_steps() > 0 {
+            summary.bystanders_disturbed.push(r.case.clone());
         }
         summary.nonfinite_applied += r.nonfinite_applied;
         summary.out_of_bounds_applied += r.out_of_bounds_applied;
@@ -109,7 +118,7 @@ backup_translational,backup_attitude,backup_robotic,worst_barrier,worst_normalis
         }
         let _ = writeln!(
             cases_csv,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             r.case,
             r.target,
             r.strategy,
@@ -129,6 +138,7 @@ backup_translational,backup_attitude,backup_robotic,worst_barrier,worst_normalis
             r.backup_steps[0],
             r.backup_steps[1],
             r.backup_steps[2],
+            r.bystander_disturbed_steps(),
             names[wi],
             wv,
             r.solve_time_us.geomean,
@@ -200,7 +210,17 @@ fn markdown(
     }
     let _ = writeln!(
         m,
-        "{how} Columns: how the mission ended, the barrier closest to its boundary (value / barrier scale, `figures/redteam_margins.svg`), and per filter (translational/attitude/robotic) the steps on the substitute nominal, on the relaxed problem and on the backup law.\n"
+        "Isolation: {} of the cases disturbed a subsystem they do not attack (an input of its filter missing or refused, or its backup law run){}.\n",
+        s.bystanders_disturbed.len(),
+        if s.bystanders_disturbed.is_empty() {
+            String::new()
+        } else {
+            format!(": {}", s.bystanders_disturbed.join(", "))
+        }
+    );
+    let _ = writeln!(
+        m,
+        "{how} Columns: how the mission ended, the barrier closest to its boundary (value / barrier scale, `figures/redteam_margins.svg`), and per filter (translational/attitude/robotic) the steps on the substitute nominal, on the relaxed problem and on the backup law, and the steps on which a subsystem the case does not attack was disturbed.\n"
     );
     let mut target = "";
     for (case, r) in cases.iter().zip(results) {
@@ -208,7 +228,7 @@ fn markdown(
             target = case.target.name();
             let _ = writeln!(
                 m,
-                "\n## {target}\n\n| strategy | end | safe | closest barrier | margin / scale | substituted | relaxed | backup | solve geomean / max [µs] |\n|---|---|---|---|---|---|---|---|---|"
+                "\n## {target}\n\n| strategy | end | safe | closest barrier | margin / scale | substituted | relaxed | backup | bystanders disturbed | solve geomean / max [µs] |\n|---|---|---|---|---|---|---|---|---|---|"
             );
         }
         match r {
@@ -221,7 +241,7 @@ fn markdown(
                     .unwrap_or(("", f64::NAN));
                 let _ = writeln!(
                     m,
-                    "| {} | {} | {} | {} | {:.3e} | {:?} | {:?} | {:?} | {:.1} / {:.0} |",
+                    "| {} | {} | {} | {} | {:.3e} | {:?} | {:?} | {:?} | {} | {:.1} / {:.0} |",
                     r.strategy,
                     r.end,
                     if r.safe() { "yes" } else { "**NO**" },
@@ -230,12 +250,13 @@ fn markdown(
                     r.substituted_steps,
                     r.relaxed_steps,
                     r.backup_steps,
+                    r.bystander_disturbed_steps(),
                     r.solve_time_us.geomean,
                     r.solve_time_us.max
                 );
             }
             Err(e) => {
-                let _ = writeln!(m, "| {} | error: {e} | | | | | | | |", case.strategy);
+                let _ = writeln!(m, "| {} | error: {e} | | | | | | | | |", case.strategy);
             }
         }
     }
