@@ -2,12 +2,14 @@
 //! synchronisation phase, angular-rate synchronisation with the tumbling target
 //! (paper, Sec. "Concept of Operations", phase II, and Sec. "Nominal Controllers").
 //!
-//! The paper uses an attitude MPC [Stadler2026] with its constraints removed; this is
-//! an equivalent unconstrained tracking law: a geometric pointing PD with
-//! gyroscopic and reference-rate feed-forward,
+//! The paper uses an attitude MPC [Stadler2026] with its constraints removed
+//! ([`AttitudeLaw::Mpc`], [`crate::attitude_mpc`]); the feedback acts on the pointing and
+//! rate errors defined here, with gyroscopic and reference-rate feed-forward,
 //! ```text
-//! τ_B = k_p φ ê + k_ω (ω_ref − ω_B) + ω_B × (I ω_B) + I ω̇_ref ,
+//! τ_B = u(φ ê, ω_B − ω_ref) + ω_B × (I ω_B) + I ω̇_ref ,
 //! ```
+//! where `u = K_x [−φ ê; ω_B − ω_ref]` for the MPC and, for the simpler geometric PD
+//! ([`AttitudeLaw::Pd`]), `u = k_p φ ê + k_ω (ω_ref − ω_B)`.
 //! * `φ ê` (F_B): the smallest rotation that turns the boresight `d_B` onto the
 //!   line of sight `s_B = R_BR s_R` (paper, eq. of `s_R(t)`), `ê ∥ d_B × s_B`,
 //!   `φ = ∠(d_B, s_B)`; the rotation about the boresight is left free.
@@ -16,6 +18,14 @@
 //! * **point and sync** mode: `ω_ref = R_BT ω_T` (the target's rate expressed in
 //!   F_B), and `k_ω = k_sync`. `ω̇_ref = −ω_B × ω_ref + R_BT ω̇_T` (torque-free
 //!   target, Euler's equation with the target inertia).
+//! * **gripper alignment** (point and sync, optional, [`AttitudeController::with_alignment`]):
+//!   the rotation about the boresight is no longer free — the gripper axis `g_B` is turned
+//!   onto the grasping fixture's axis `a_B = R_BT a_T`, both projected on the plane normal
+//!   to the boresight, by adding `ψ d_B` to the pointing error, with `ψ` the signed angle
+//!   from `g⊥` to `a⊥` about `d_B`. The fixture is a bar, so `a` and `−a` are the same and
+//!   `ψ ∈ (−π/2, π/2]`. Once aligned the servicer turns rigidly with the target and the
+//!   fixture stays where the arm expects it; until then the catch-up in roll comes on top
+//!   of the target's rate.
 //!
 //! The law is deliberately **unaware of the line-of-sight cone** (β_ATT) and of the
 //! angular-rate limits: with the servicer off the target's spin axis, the target
@@ -24,6 +34,7 @@
 //! synchronisation, which the attitude safety filter must prevent. `τ_B` [N m] is
 //! **not saturated**.
 
+use crate::attitude_mpc::AttitudeMpc;
 use nalgebra::Matrix3;
 use sc_models::quat::{self, Quat};
 use sc_models::{Mat3, Vec3};
@@ -37,7 +48,16 @@ pub enum AttitudeTask {
     PointAndSync,
 }
 
-/// Gains of [`AttitudeController`].
+/// The feedback law of [`AttitudeController`].
+#[derive(Debug, Clone, PartialEq)]
+pub enum AttitudeLaw {
+    /// Geometric PD with the gains below.
+    Pd(AttitudeGains),
+    /// The unconstrained condensed MPC (same gain in both tasks).
+    Mpc(AttitudeMpc),
+}
+
+/// Gains of the PD law ([`AttitudeLaw::Pd`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AttitudeGains {
     /// `k_p` [N m/rad].
@@ -97,13 +117,16 @@ impl AttitudeCommand {
 }
 
 /// Pointing / rate-synchronisation law (see the module doc).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct AttitudeController {
-    gains: AttitudeGains,
+    law: AttitudeLaw,
     /// Boresight `d_B` (unit, F_B).
     boresight: Vec3,
     /// Target inertia and its inverse (F_T), for `ω̇_T`; `None` ⇒ `ω̇_T = 0`.
     target_inertia: Option<(Mat3, Mat3)>,
+    /// Gripper axis `g_B` (unit, F_B) and fixture axis `a_T` (unit, F_T) aligned in sync
+    /// mode; `None`: the rotation about the boresight is left free.
+    alignment: Option<(Vec3, Vec3)>,
 }
 
 impl AttitudeController {
@@ -115,24 +138,53 @@ impl AttitudeController {
         boresight: Vec3,
         target_inertia: Option<Mat3>,
     ) -> Option<Self> {
-        let ok = [gains.kp, gains.kd, gains.k_sync]
-            .iter()
-            .all(|g| g.is_finite() && *g >= 0.0);
+        Self::with_law(AttitudeLaw::Pd(gains), boresight, target_inertia)
+    }
+
+    /// As [`Self::new`], with either feedback law.
+    pub fn with_law(
+        law: AttitudeLaw,
+        boresight: Vec3,
+        target_inertia: Option<Mat3>,
+    ) -> Option<Self> {
+        let ok = match &law {
+            AttitudeLaw::Pd(g) => [g.kp, g.kd, g.k_sync]
+                .iter()
+                .all(|g| g.is_finite() && *g >= 0.0),
+            AttitudeLaw::Mpc(_) => true,
+        };
         let n = boresight.norm();
         if !ok || !n.is_finite() || n < 1e-9 {
             return None;
         }
         let target_inertia = target_inertia.and_then(|i| i.try_inverse().map(|inv| (i, inv)));
         Some(Self {
-            gains,
+            law,
             boresight: boresight / n,
             target_inertia,
+            alignment: None,
         })
     }
 
-    /// The gains.
-    pub fn gains(&self) -> &AttitudeGains {
-        &self.gains
+    /// Also aligns the gripper axis `gripper_b` (F_B) with the fixture axis `fixture_t`
+    /// (F_T) about the boresight in sync mode (module doc). Both are normalised; `None` if
+    /// either is zero, non-finite or parallel to the boresight.
+    pub fn with_alignment(mut self, gripper_b: Vec3, fixture_t: Vec3) -> Option<Self> {
+        let unit = |v: Vec3| {
+            let n = v.norm();
+            (n.is_finite() && n > 1e-9).then(|| v / n)
+        };
+        let (g, a) = (unit(gripper_b)?, unit(fixture_t)?);
+        if g.cross(&self.boresight).norm() < 1e-3 {
+            return None;
+        }
+        self.alignment = Some((g, a));
+        Some(self)
+    }
+
+    /// The feedback law.
+    pub fn law(&self) -> &AttitudeLaw {
+        &self.law
     }
 
     /// One control step. Allocation-free; never panics.
@@ -175,14 +227,14 @@ impl AttitudeController {
         } else {
             any_perpendicular(&d)
         };
-        let rot_err = axis * phi;
+        let mut rot_err = axis * phi;
 
         let w = x.omega_b;
-        let (w_ref, w_ref_dot, k_w) = match task {
+        let (w_ref, w_ref_dot) = match task {
             AttitudeTask::Point => {
                 let w_los_r = s_r.cross(&(x.grasp_vel_r - x.v_r)) / rho;
                 let w_ref = r_br * w_los_r;
-                (w_ref, -w.cross(&w_ref), self.gains.kd)
+                (w_ref, -w.cross(&w_ref))
             }
             AttitudeTask::PointAndSync => {
                 let r_bt: Matrix3<f64> = r_br * quat::to_matrix(&q_rt);
@@ -191,13 +243,22 @@ impl AttitudeController {
                     Some((it, it_inv)) => it_inv * (-x.omega_t.cross(&(it * x.omega_t))),
                     None => Vec3::zeros(),
                 };
-                (w_ref, -w.cross(&w_ref) + r_bt * w_t_dot, self.gains.k_sync)
+                (w_ref, -w.cross(&w_ref) + r_bt * w_t_dot)
             }
         };
+        if let (AttitudeTask::PointAndSync, Some((g, a_t))) = (task, &self.alignment) {
+            let a = r_br * quat::to_matrix(&q_rt) * a_t;
+            rot_err += d * roll_to_align(&d, g, &a);
+        }
         let rate_error = w - w_ref;
-        let tau = self.gains.kp * rot_err - k_w * rate_error
-            + w.cross(&(x.inertia_b * w))
-            + x.inertia_b * w_ref_dot;
+        let feedback = match (&self.law, task) {
+            (AttitudeLaw::Pd(g), AttitudeTask::Point) => g.kp * rot_err - g.kd * rate_error,
+            (AttitudeLaw::Pd(g), AttitudeTask::PointAndSync) => {
+                g.kp * rot_err - g.k_sync * rate_error
+            }
+            (AttitudeLaw::Mpc(m), _) => m.feedback(&-rot_err, &rate_error),
+        };
+        let tau = feedback + w.cross(&(x.inertia_b * w)) + x.inertia_b * w_ref_dot;
         if !fin3(&tau) {
             return AttitudeCommand::invalid();
         }
@@ -207,6 +268,26 @@ impl AttitudeController {
             rate_error,
             valid: true,
         }
+    }
+}
+
+/// The signed angle `ψ ∈ (−π/2, π/2]` about the unit vector `d` that turns the line of
+/// `g` onto the line of `a`, both projected on the plane normal to `d`; 0 if a projection
+/// vanishes.
+pub fn roll_to_align(d: &Vec3, g: &Vec3, a: &Vec3) -> f64 {
+    let gp = g - d * d.dot(g);
+    let ap = a - d * d.dot(a);
+    if gp.norm() < 1e-9 || ap.norm() < 1e-9 {
+        return 0.0;
+    }
+    let psi = d.dot(&gp.cross(&ap)).atan2(gp.dot(&ap));
+    let half = std::f64::consts::FRAC_PI_2;
+    if psi > half {
+        psi - std::f64::consts::PI
+    } else if psi <= -half {
+        psi + std::f64::consts::PI
+    } else {
+        psi
     }
 }
 

@@ -10,7 +10,8 @@
 //! * [`translational::TranslationalMpc`]: unconstrained CW MPC to the Go-for-Capture
 //!   point, closed-form gain, output `f_H` [N] in the Hill frame.
 //! * [`attitude::AttitudeController`]: boresight pointing at the grasping point and
-//!   rate synchronisation with the target, output `τ_B` [N m] in F_B.
+//!   rate synchronisation with the target, output `τ_B` [N m] in F_B; its feedback is the
+//!   unconstrained attitude MPC [`attitude_mpc::AttitudeMpc`] (the paper's) or a PD.
 //! * [`robotic::RoboticController`]: PD computed torque to the initial joint angles
 //!   (hold) or to a DLS-IK solution of the grasping point (grasp), output `τ_M` [N m].
 //! * [`NominalControllers`]: selects per mission phase which of them run, from a plain
@@ -26,15 +27,18 @@
 //! [`NominalError`]. Everything is deterministic (no clocks, no randomness).
 
 pub mod attitude;
+pub mod attitude_mpc;
+pub mod condensed;
 pub mod robotic;
 pub mod translational;
 
-use attitude::{AttitudeController, AttitudeGains, AttitudeInput, AttitudeTask};
+use attitude::{AttitudeController, AttitudeGains, AttitudeInput, AttitudeLaw, AttitudeTask};
+use attitude_mpc::{AttitudeMpc, AttitudeMpcParams};
 use robotic::{IkSolution, RoboticController, RoboticGains};
 use sc_models::quat::{self, Quat};
 use sc_models::{Mat3, Vec3};
 use sc_multibody::{Robot, Vector7};
-use sc_scenario::{AttitudeMode, RoboticMode, Scenario, TranslationalMode};
+use sc_scenario::{AttitudeLawKind, AttitudeMode, RoboticMode, Scenario, TranslationalMode};
 use translational::{TranslationalMpc, TranslationalMpcParams};
 
 pub use sc_multibody::Vector7 as JointVector;
@@ -207,28 +211,6 @@ impl NominalControllers {
         })?;
         let na = &scenario.nominal.attitude;
         let target_inertia = Mat3::from_fn(|i, j| scenario.target.inertia_kg_m2[i][j]);
-        let attitude = AttitudeController::new(
-            AttitudeGains {
-                kp: na.kp_nm_per_rad,
-                kd: na.kd_nm_s_per_rad,
-                k_sync: na.sync_gain_nm_s_per_rad,
-            },
-            Vec3::from(scenario.servicer.boresight_body),
-            Some(target_inertia),
-        )
-        .ok_or_else(|| NominalError::Param("attitude gains or boresight".into()))?;
-        let nr = &scenario.nominal.robotic;
-        let robotic = RoboticController::new(
-            RoboticGains {
-                kp: nr.kp_per_s2,
-                kd: nr.kd_per_s,
-                ik_iterations: nr.ik_iterations,
-                ik_damping: nr.ik_damping,
-                ik_tolerance: nr.ik_tolerance_m,
-            },
-            &robot,
-        )
-        .ok_or_else(|| NominalError::Param("robotic gains or IK settings".into()))?;
         let theta_hold = Vector7::from(scenario.servicer.initial_theta_rad);
         let grasp_point_t = Vec3::from(scenario.target.grasp_point_m);
         if !theta_hold
@@ -241,6 +223,58 @@ impl NominalControllers {
             ));
         }
         let inertia_hold = robot.system_inertia_com(&theta_hold);
+        let law = match (na.law, &na.mpc) {
+            (AttitudeLawKind::Mpc, Some(m)) => {
+                AttitudeLaw::Mpc(AttitudeMpc::new(AttitudeMpcParams {
+                    dt: scenario.mission.control_period_s,
+                    horizon: m.horizon_steps as usize,
+                    inertia: inertia_hold,
+                    weight_pointing: m.weight_pointing_per_rad2,
+                    weight_rate: m.weight_rate_s2_per_rad2,
+                    weight_torque: m.weight_torque_per_nm2,
+                    weight_terminal: m.weight_terminal,
+                })?)
+            }
+            (AttitudeLawKind::Mpc, None) => {
+                return Err(NominalError::Param(
+                    "nominal.attitude.law = mpc without [nominal.attitude.mpc]".into(),
+                ));
+            }
+            (AttitudeLawKind::Pd, _) => AttitudeLaw::Pd(AttitudeGains {
+                kp: na.kp_nm_per_rad,
+                kd: na.kd_nm_s_per_rad,
+                k_sync: na.sync_gain_nm_s_per_rad,
+            }),
+        };
+        let attitude = AttitudeController::with_law(
+            law,
+            Vec3::from(scenario.servicer.boresight_body),
+            Some(target_inertia),
+        )
+        .ok_or_else(|| NominalError::Param("attitude gains or boresight".into()))?;
+        let attitude = match (
+            scenario.servicer.gripper_axis_body,
+            scenario.target.grasp_fixture_axis,
+        ) {
+            (Some(g), Some(a)) => attitude
+                .with_alignment(Vec3::from(g), Vec3::from(a))
+                .ok_or_else(|| {
+                    NominalError::Param("gripper_axis_body or grasp_fixture_axis".into())
+                })?,
+            _ => attitude,
+        };
+        let nr = &scenario.nominal.robotic;
+        let robotic = RoboticController::new(
+            RoboticGains {
+                kp: nr.kp_per_s2,
+                kd: nr.kd_per_s,
+                ik_iterations: nr.ik_iterations,
+                ik_damping: nr.ik_damping,
+                ik_tolerance: nr.ik_tolerance_m,
+            },
+            &robot,
+        )
+        .ok_or_else(|| NominalError::Param("robotic gains or IK settings".into()))?;
         let mut phases: Vec<PhaseModes> = scenario
             .mission
             .phases

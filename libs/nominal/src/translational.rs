@@ -34,6 +34,7 @@
 //! input bound `‖f‖∞ ≤ f_max` and the state constraints.
 
 use crate::NominalError;
+use crate::condensed::{CondensedGain, CondensedWeights};
 use nalgebra::{DMatrix, Matrix3, Matrix3x6, Matrix6, Matrix6x3, Vector3, Vector6};
 use sc_models::Vec3;
 use sc_models::cw::ClohessyWiltshire;
@@ -122,38 +123,23 @@ impl TranslationalMpc {
         for i in 0..3 {
             check("gfc_point", p.gfc_point_r[i], true)?;
         }
-        if p.horizon == 0 || p.horizon > 1000 {
-            return Err(NominalError::Param(format!(
-                "translational horizon = {} (1..=1000)",
-                p.horizon
-            )));
-        }
-
         let cw = ClohessyWiltshire {
             n: p.mean_motion,
             mass: p.mass,
         };
         let (ad, bd) = cw.discretize(p.dt);
-        let (phi, gamma) = batch_prediction(&ad, &bd, p.horizon);
-        let qbar = stage_weights(p);
-        let nu = 3 * p.horizon;
-        // H = Γᵀ Q̄ Γ + R̄ (Q̄ diagonal, stored as a vector)
-        let qg = DMatrix::from_fn(6 * p.horizon, nu, |i, j| qbar[i] * gamma[(i, j)]);
-        let mut h = gamma.transpose() * &qg;
-        for i in 0..nu {
-            h[(i, i)] += p.weight_force;
-        }
-        let chol = h.cholesky().ok_or_else(|| {
-            NominalError::Param("translational MPC Hessian not positive definite".into())
-        })?;
-        // H⁻¹ Γᵀ Q̄ = (Q̄ Γ H⁻¹)ᵀ; solve for the full matrix, keep the first 3 rows.
-        let full = chol.solve(&qg.transpose());
-        let gmat = full.rows(0, 3).into_owned();
-        let k_x_dyn = -(&gmat * &phi);
-        let k_x = Matrix3x6::from_fn(|i, j| k_x_dyn[(i, j)]);
-        let g = (0..p.horizon)
-            .map(|k| Matrix3x6::from_fn(|i, j| gmat[(i, 6 * k + j)]))
-            .collect();
+        let (wp, wv) = (p.weight_position, p.weight_velocity);
+        let CondensedGain { k_x, g } = CondensedGain::new(
+            "translational",
+            &ad,
+            &bd,
+            &CondensedWeights {
+                state: [wp, wp, wp, wv, wv, wv],
+                terminal: p.weight_terminal,
+                input: p.weight_force,
+            },
+            p.horizon,
+        )?;
         Ok(Self {
             params,
             ad,
@@ -176,13 +162,11 @@ impl TranslationalMpc {
     /// The first block row of the batch gain, `[K_x | G_1 … G_N]` (3 × (6 + 6N)), so
     /// that `u_0 = K_x x_0 + Σ G_k x_ref,k`. For tests and analysis (allocates).
     pub fn gain(&self) -> DMatrix<f64> {
-        let n = self.params.horizon;
-        let mut m = DMatrix::zeros(3, 6 + 6 * n);
-        m.view_mut((0, 0), (3, 6)).copy_from(&self.k_x);
-        for (k, gk) in self.g.iter().enumerate() {
-            m.view_mut((0, 6 + 6 * k), (3, 6)).copy_from(gk);
+        CondensedGain {
+            k_x: self.k_x,
+            g: self.g.clone(),
         }
-        m
+        .matrix()
     }
 
     /// One MPC step.
@@ -234,50 +218,6 @@ impl TranslationalMpc {
             valid: true,
         }
     }
-}
-
-/// `Φ = [A_d; A_d²; …; A_dᴺ]` (6N×6) and the lower block-triangular
-/// `Γ_{k,j} = A_d^{k−j} B_d` for `j ≤ k` (6N×3N), rows `x_1 … x_N`.
-pub fn batch_prediction(
-    ad: &Matrix6<f64>,
-    bd: &Matrix6x3<f64>,
-    n: usize,
-) -> (DMatrix<f64>, DMatrix<f64>) {
-    let mut phi = DMatrix::zeros(6 * n, 6);
-    let mut gamma = DMatrix::zeros(6 * n, 3 * n);
-    // powers A_d^k B_d, k = 0..N-1
-    let mut akb = Vec::with_capacity(n);
-    let mut apow = Matrix6::identity();
-    for _ in 0..n {
-        akb.push(apow * bd);
-        apow = ad * apow;
-    }
-    let mut ak = Matrix6::identity();
-    for k in 0..n {
-        ak = ad * ak;
-        phi.view_mut((6 * k, 0), (6, 6)).copy_from(&ak);
-        for j in 0..=k {
-            gamma
-                .view_mut((6 * k, 3 * j), (6, 3))
-                .copy_from(&akb[k - j]);
-        }
-    }
-    (phi, gamma)
-}
-
-/// Diagonal of `Q̄ = blkdiag(Q, …, Q, Q_N)` (6N).
-fn stage_weights(p: &TranslationalMpcParams) -> Vec<f64> {
-    let mut q = Vec::with_capacity(6 * p.horizon);
-    for k in 0..p.horizon {
-        let s = if k + 1 == p.horizon {
-            p.weight_terminal
-        } else {
-            1.0
-        };
-        q.extend(std::iter::repeat_n(s * p.weight_position, 3));
-        q.extend(std::iter::repeat_n(s * p.weight_velocity, 3));
-    }
-    q
 }
 
 /// Rotation matrix `exp([φ]×)` of the rotation vector `φ` (Rodrigues).

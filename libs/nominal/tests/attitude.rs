@@ -5,7 +5,10 @@
 use sc_models::attitude::euler;
 use sc_models::quat::{self, Quat};
 use sc_models::{Mat3, Vec3};
-use sc_nominal::attitude::{AttitudeController, AttitudeGains, AttitudeInput, AttitudeTask};
+use sc_nominal::attitude::{
+    AttitudeController, AttitudeGains, AttitudeInput, AttitudeLaw, AttitudeTask,
+};
+use sc_nominal::attitude_mpc::{AttitudeMpc, AttitudeMpcParams};
 
 const DT_CTRL: f64 = 0.1;
 const SUBSTEPS: usize = 10;
@@ -22,6 +25,26 @@ fn controller() -> AttitudeController {
             kd: 30.0,
             k_sync: 80.0,
         },
+        Vec3::x(),
+        Some(Mat3::from_diagonal(&Vec3::new(1200.0, 900.0, 800.0))),
+    )
+    .unwrap()
+}
+
+/// The same pointing and synchronisation with the paper's unconstrained MPC as feedback.
+fn mpc_controller() -> AttitudeController {
+    let mpc = AttitudeMpc::new(AttitudeMpcParams {
+        dt: DT_CTRL,
+        horizon: 20,
+        inertia: inertia(),
+        weight_pointing: 1.0,
+        weight_rate: 20.0,
+        weight_torque: 1e-3,
+        weight_terminal: 10.0,
+    })
+    .unwrap();
+    AttitudeController::with_law(
+        AttitudeLaw::Mpc(mpc),
         Vec3::x(),
         Some(Mat3::from_diagonal(&Vec3::new(1200.0, 900.0, 800.0))),
     )
@@ -82,24 +105,25 @@ impl World {
 
 #[test]
 fn point_mode_converges_to_static_line_of_sight() {
-    let ctl = controller();
-    let mut w = World {
-        q_rb: quat::from_axis_angle(&Vec3::new(0.3, 1.0, -0.5), 0.5),
-        w_b: Vec3::new(0.01, -0.02, 0.015),
-        q_rt: quat::IDENTITY,
-        w_t: Vec3::zeros(),
-        r_r: Vec3::new(-6.0, 0.8, -0.4),
-        grasp_t: Vec3::new(-0.55, 0.12, 0.0),
-    };
-    let mut err = 0.0;
-    for _ in 0..1200 {
-        let c = ctl.command(AttitudeTask::Point, &w.input());
-        assert!(c.valid);
-        err = c.pointing_error_rad;
-        w.step(&c.tau_b);
+    for ctl in [controller(), mpc_controller()] {
+        let mut w = World {
+            q_rb: quat::from_axis_angle(&Vec3::new(0.3, 1.0, -0.5), 0.5),
+            w_b: Vec3::new(0.01, -0.02, 0.015),
+            q_rt: quat::IDENTITY,
+            w_t: Vec3::zeros(),
+            r_r: Vec3::new(-6.0, 0.8, -0.4),
+            grasp_t: Vec3::new(-0.55, 0.12, 0.0),
+        };
+        let mut err = 0.0;
+        for _ in 0..1200 {
+            let c = ctl.command(AttitudeTask::Point, &w.input());
+            assert!(c.valid);
+            err = c.pointing_error_rad;
+            w.step(&c.tau_b);
+        }
+        assert!(err < 1e-5, "{:?}: pointing error {err}", ctl.law());
+        assert!(w.w_b.norm() < 1e-5, "residual rate {}", w.w_b.norm());
     }
-    assert!(err < 1e-5, "pointing error {err}");
-    assert!(w.w_b.norm() < 1e-5, "residual rate {}", w.w_b.norm());
 }
 
 #[test]
@@ -107,34 +131,85 @@ fn sync_mode_converges_on_the_spin_axis() {
     // Servicer on the target's spin axis (grasping point off the axis): the line of
     // sight turns rigidly with the target, so pointing and rate synchronisation are
     // consistent and both errors must vanish.
-    let ctl = controller();
-    let mut w = World {
-        q_rb: quat::from_axis_angle(&Vec3::new(0.0, 1.0, 0.4), 0.2),
-        w_b: Vec3::zeros(),
-        q_rt: quat::IDENTITY,
-        w_t: Vec3::new(-0.08, 0.0, 0.0),
-        r_r: Vec3::new(-2.2, 0.0, 0.0),
-        grasp_t: Vec3::new(-0.55, 0.12, 0.0),
-    };
-    let mut last = None;
-    // k_p / k_sync = 0.05 1/s is the slowest closed-loop pole: give it 20 time constants
-    for _ in 0..4000 {
-        let c = ctl.command(AttitudeTask::PointAndSync, &w.input());
-        assert!(c.valid);
-        last = Some(c);
-        w.step(&c.tau_b);
+    for ctl in [controller(), mpc_controller()] {
+        let mut w = World {
+            q_rb: quat::from_axis_angle(&Vec3::new(0.0, 1.0, 0.4), 0.2),
+            w_b: Vec3::zeros(),
+            q_rt: quat::IDENTITY,
+            w_t: Vec3::new(-0.08, 0.0, 0.0),
+            r_r: Vec3::new(-2.2, 0.0, 0.0),
+            grasp_t: Vec3::new(-0.55, 0.12, 0.0),
+        };
+        let mut last = None;
+        // k_p / k_sync = 0.05 1/s is the slowest closed-loop pole: give it 20 time constants
+        for _ in 0..4000 {
+            let c = ctl.command(AttitudeTask::PointAndSync, &w.input());
+            assert!(c.valid);
+            last = Some(c);
+            w.step(&c.tau_b);
+        }
+        let c = last.unwrap();
+        assert!(
+            c.pointing_error_rad < 1e-5,
+            "pointing error {}",
+            c.pointing_error_rad
+        );
+        assert!(
+            c.rate_error.norm() < 1e-6,
+            "rate error {}",
+            c.rate_error.norm()
+        );
     }
-    let c = last.unwrap();
-    assert!(
-        c.pointing_error_rad < 1e-5,
-        "pointing error {}",
-        c.pointing_error_rad
-    );
-    assert!(
-        c.rate_error.norm() < 1e-6,
-        "rate error {}",
-        c.rate_error.norm()
-    );
+}
+
+#[test]
+fn sync_with_alignment_turns_the_gripper_onto_the_fixture() {
+    use sc_nominal::attitude::roll_to_align;
+    // from a roll 80° away from the fixture, both laws align the gripper (+z_B) with the
+    // fixture's bar (+y_T) while pointing and turning with the target
+    let fixture_t = Vec3::y();
+    for ctl in [controller(), mpc_controller()] {
+        let ctl = ctl.with_alignment(Vec3::z(), fixture_t).unwrap();
+        let mut w = World {
+            q_rb: quat::from_axis_angle(&Vec3::x(), 80f64.to_radians()),
+            w_b: Vec3::zeros(),
+            q_rt: quat::IDENTITY,
+            w_t: Vec3::new(-0.08, 0.0, 0.0),
+            r_r: Vec3::new(-2.2, 0.0, 0.0),
+            grasp_t: Vec3::new(-0.55, 0.12, 0.0),
+        };
+        let mut last = None;
+        for _ in 0..4000 {
+            let c = ctl.command(AttitudeTask::PointAndSync, &w.input());
+            assert!(c.valid);
+            last = Some(c);
+            w.step(&c.tau_b);
+        }
+        let c = last.unwrap();
+        let r_br = quat::to_matrix(&w.q_rb).transpose();
+        let a_b = r_br * quat::to_matrix(&w.q_rt) * fixture_t;
+        let psi = roll_to_align(&Vec3::x(), &Vec3::z(), &a_b);
+        assert!(psi.abs() < 1e-5, "{:?}: roll misalignment {psi}", ctl.law());
+        assert!(c.pointing_error_rad < 1e-5, "{}", c.pointing_error_rad);
+        assert!(c.rate_error.norm() < 1e-6, "{}", c.rate_error.norm());
+    }
+}
+
+#[test]
+fn roll_to_align_is_the_signed_angle_between_the_lines() {
+    use sc_nominal::attitude::roll_to_align;
+    let d = Vec3::x();
+    for deg in [-89.0f64, -45.0, 0.0, 30.0, 89.0] {
+        let a = quat::rotate(&quat::from_axis_angle(&d, deg.to_radians()), &Vec3::y());
+        let psi = roll_to_align(&d, &Vec3::y(), &a);
+        assert!((psi - deg.to_radians()).abs() < 1e-12, "{deg}: {psi}");
+        // a bar: the opposite direction is the same line
+        assert!((roll_to_align(&d, &Vec3::y(), &-a) - psi).abs() < 1e-12);
+    }
+    // components along d do not matter; a vanishing projection gives 0
+    let psi = roll_to_align(&d, &(Vec3::y() + 3.0 * d), &Vec3::new(5.0, 0.0, 1.0));
+    assert!((psi - std::f64::consts::FRAC_PI_2).abs() < 1e-12, "{psi}");
+    assert_eq!(roll_to_align(&d, &d, &Vec3::y()), 0.0);
 }
 
 #[test]

@@ -66,6 +66,12 @@ pub struct Servicer {
     pub urdf: PathBuf,
     /// Boresight `d_B`, unit vector in F_B.
     pub boresight_body: V3,
+    /// Gripper axis `g_B`, unit vector in F_B normal to the boresight: in the
+    /// synchronisation phase the nominal attitude controller turns it onto the grasping
+    /// fixture's axis (`target.grasp_fixture_axis`). Absent: the roll about the boresight
+    /// is left free.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gripper_axis_body: Option<V3>,
     /// Base origin relative to the target CoM, in F_R [m].
     pub initial_position_m: V3,
     /// Its time derivative in the non-rotating F_R [m/s].
@@ -89,6 +95,10 @@ pub struct Target {
     pub initial_omega_rad_s: V3,
     /// Grasping point `p_G,T` in F_T [m].
     pub grasp_point_m: V3,
+    /// Axis of the grasping fixture (a bar), unit vector in F_T; see
+    /// `servicer.gripper_axis_body`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grasp_fixture_axis: Option<V3>,
 }
 
 /// Timing and phases of the mission.
@@ -316,9 +326,42 @@ pub struct NominalTranslational {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct NominalAttitude {
+    /// The feedback law: the paper's unconstrained MPC or the geometric PD (default,
+    /// with the gains below).
+    #[serde(default)]
+    pub law: AttitudeLawKind,
     pub kp_nm_per_rad: f64,
     pub kd_nm_s_per_rad: f64,
     pub sync_gain_nm_s_per_rad: f64,
+    /// `[nominal.attitude.mpc]`, required with `law = "mpc"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mpc: Option<NominalAttitudeMpc>,
+}
+
+/// Which feedback law the nominal attitude controller runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AttitudeLawKind {
+    /// Geometric PD (`kp`, `kd`, `sync_gain`).
+    #[default]
+    Pd,
+    /// Unconstrained condensed MPC of the attitude error (paper, [Stadler2026]).
+    Mpc,
+}
+
+/// The attitude MPC's horizon and weights (`sc_nominal::attitude_mpc`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NominalAttitudeMpc {
+    pub horizon_steps: u32,
+    /// w_φ on the pointing error [1/rad²].
+    pub weight_pointing_per_rad2: f64,
+    /// w_ω on the rate error [s²/rad²].
+    pub weight_rate_s2_per_rad2: f64,
+    /// w_τ on the feedback torque [1/(N m)²].
+    pub weight_torque_per_nm2: f64,
+    /// w_N: terminal weight as a multiple of the stage weight [-].
+    pub weight_terminal: f64,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

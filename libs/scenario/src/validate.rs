@@ -184,6 +184,35 @@ impl Scenario {
             ));
         }
         unit("servicer.boresight_body", &s.boresight_body)?;
+        match (&s.gripper_axis_body, &self.target.grasp_fixture_axis) {
+            (Some(g), Some(a)) => {
+                unit("servicer.gripper_axis_body", g)?;
+                unit("target.grasp_fixture_axis", a)?;
+                let along: f64 = g.iter().zip(&s.boresight_body).map(|(x, y)| x * y).sum();
+                if along.abs() > 0.5 {
+                    return Err(invalid(
+                        "servicer.gripper_axis_body",
+                        g,
+                        "must be (nearly) normal to the boresight: the alignment turns it about the boresight",
+                    ));
+                }
+            }
+            (None, None) => {}
+            (Some(_), None) => {
+                return Err(invalid(
+                    "target.grasp_fixture_axis",
+                    "missing",
+                    "servicer.gripper_axis_body is set: give the fixture's axis too (or neither)",
+                ));
+            }
+            (None, Some(_)) => {
+                return Err(invalid(
+                    "servicer.gripper_axis_body",
+                    "missing",
+                    "target.grasp_fixture_axis is set: give the gripper's axis too (or neither)",
+                ));
+            }
+        }
         finite_all("servicer.initial_position_m", &s.initial_position_m)?;
         finite_all("servicer.initial_velocity_m_s", &s.initial_velocity_m_s)?;
         finite_all("servicer.initial_omega_rad_s", &s.initial_omega_rad_s)?;
@@ -411,6 +440,38 @@ impl Scenario {
             "nominal.attitude.sync_gain_nm_s_per_rad",
             na.sync_gain_nm_s_per_rad,
         )?;
+        match (na.law, &na.mpc) {
+            (crate::AttitudeLawKind::Mpc, None) => {
+                return Err(invalid(
+                    "nominal.attitude.law",
+                    "mpc",
+                    "needs a [nominal.attitude.mpc] table (horizon_steps and the weights)",
+                ));
+            }
+            (_, Some(m)) => {
+                if m.horizon_steps == 0 || m.horizon_steps > 1000 {
+                    return Err(invalid(
+                        "nominal.attitude.mpc.horizon_steps",
+                        m.horizon_steps,
+                        "must be 1..=1000",
+                    ));
+                }
+                non_negative(
+                    "nominal.attitude.mpc.weight_pointing_per_rad2",
+                    m.weight_pointing_per_rad2,
+                )?;
+                non_negative(
+                    "nominal.attitude.mpc.weight_rate_s2_per_rad2",
+                    m.weight_rate_s2_per_rad2,
+                )?;
+                positive(
+                    "nominal.attitude.mpc.weight_torque_per_nm2",
+                    m.weight_torque_per_nm2,
+                )?;
+                non_negative("nominal.attitude.mpc.weight_terminal", m.weight_terminal)?;
+            }
+            _ => {}
+        }
         let nr = &self.nominal.robotic;
         non_negative("nominal.robotic.kp_per_s2", nr.kp_per_s2)?;
         non_negative("nominal.robotic.kd_per_s", nr.kd_per_s)?;
