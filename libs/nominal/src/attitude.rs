@@ -54,7 +54,7 @@ pub enum AttitudeLaw {
     /// Geometric PD with the gains below.
     Pd(AttitudeGains),
     /// The unconstrained condensed MPC (same gain in both tasks).
-    Mpc(AttitudeMpc),
+    Mpc(Box<AttitudeMpc>),
 }
 
 /// Gains of the PD law ([`AttitudeLaw::Pd`]).

@@ -225,7 +225,7 @@ impl NominalControllers {
         let inertia_hold = robot.system_inertia_com(&theta_hold);
         let law = match (na.law, &na.mpc) {
             (AttitudeLawKind::Mpc, Some(m)) => {
-                AttitudeLaw::Mpc(AttitudeMpc::new(AttitudeMpcParams {
+                AttitudeLaw::Mpc(Box::new(AttitudeMpc::new(AttitudeMpcParams {
                     dt: scenario.mission.control_period_s,
                     horizon: m.horizon_steps as usize,
                     inertia: inertia_hold,
@@ -233,7 +233,7 @@ impl NominalControllers {
                     weight_rate: m.weight_rate_s2_per_rad2,
                     weight_torque: m.weight_torque_per_nm2,
                     weight_terminal: m.weight_terminal,
-                })?)
+                })?))
             }
             (AttitudeLawKind::Mpc, None) => {
                 return Err(NominalError::Param(

@@ -44,7 +44,7 @@ fn mpc_controller() -> AttitudeController {
     })
     .unwrap();
     AttitudeController::with_law(
-        AttitudeLaw::Mpc(mpc),
+        AttitudeLaw::Mpc(Box::new(mpc)),
         Vec3::x(),
         Some(Mat3::from_diagonal(&Vec3::new(1200.0, 900.0, 800.0))),
     )
