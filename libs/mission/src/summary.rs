@@ -66,11 +66,18 @@ pub struct FaultEvent {
 }
 
 /// Interventions of one filter.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 pub struct Interventions {
     /// Steps in which the safe command differed from the nominal one.
     pub steps: usize,
     pub fraction: f64,
+    /// Of those steps, how many had each barrier row active (the filter's report).
+    #[serde(default)]
+    pub active_rows: BTreeMap<String, usize>,
+    /// Of those steps, how many had no barrier row active: the input bounds (or a
+    /// substitute nominal) alone changed the command.
+    #[serde(default)]
+    pub without_active_row: usize,
 }
 
 /// The summary of a run.
@@ -136,7 +143,12 @@ pub fn summarize(
         );
     }
     let mut solve: [Vec<f64>; 4] = Default::default();
-    let mut inter = [0usize; 3];
+    let mut inter: [Interventions; 3] = Default::default();
+    let row_names: [&[&str]; 3] = [
+        &sc_cbf::names::TRANSLATIONAL,
+        &sc_cbf::names::ATTITUDE,
+        &sc_cbf::names::ROBOTIC,
+    ];
     let mut sync_peak: BTreeMap<String, f64> = BTreeMap::new();
     let mut torque_peak: BTreeMap<String, f64> = BTreeMap::new();
     let mut fault_events = Vec::new();
@@ -175,8 +187,24 @@ pub fn summarize(
             (r.attitude.u - r.tau_b_nom).amax() > 1e-9,
             (r.robotic.u - r.tau_m_nom).amax() > 1e-9,
         ];
+        let active = [
+            r.translational.report.active,
+            r.attitude.report.active,
+            r.robotic.report.active,
+        ];
         for i in 0..3 {
-            inter[i] += changed[i] as usize;
+            if !changed[i] {
+                continue;
+            }
+            inter[i].steps += 1;
+            if active[i] == 0 {
+                inter[i].without_active_row += 1;
+            }
+            for (bit, name) in row_names[i].iter().enumerate() {
+                if bit < 64 && active[i] & (1u64 << bit) != 0 {
+                    *inter[i].active_rows.entry(name.to_string()).or_insert(0) += 1;
+                }
+            }
         }
         let s = sync_peak.entry(pn.clone()).or_insert(0.0);
         *s = s.max(r.obs.sync_error().norm());
@@ -222,14 +250,9 @@ pub fn summarize(
     let interventions = ["translational", "attitude", "robotic"]
         .iter()
         .zip(inter)
-        .map(|(n, k)| {
-            (
-                n.to_string(),
-                Interventions {
-                    steps: k,
-                    fraction: fraction(k),
-                },
-            )
+        .map(|(n, mut k)| {
+            k.fraction = fraction(k.steps);
+            (n.to_string(), k)
         })
         .collect();
     let solve_time_us = ["translational", "attitude", "robotic", "total"]
