@@ -2,8 +2,20 @@
 # One-time (idempotent) set-up of everything the project needs besides the Rust toolchain:
 # a Python venv with the independent reference tools (Pinocchio) and the iceoryx2 wheel
 # used by the Python partner controller. Safe to run repeatedly.
+#
+#   scripts/setup.sh                   the lean set-up every test needs
+#   scripts/setup.sh --with-basilisk   also Basilisk (bsk, ~600 MB) for the opt-in
+#                                      cross-check scripts/basilisk_reference.py
 set -euo pipefail
 cd "$(dirname "$0")/.."
+WITH_BASILISK=0
+for arg in "$@"; do
+  case "$arg" in
+    --with-basilisk) WITH_BASILISK=1 ;;
+    -h|--help) sed -n '2,9p' "$0"; exit 0 ;;
+    *) echo "setup: unknown option $arg (see --help)" >&2; exit 2 ;;
+  esac
+done
 VENV=scripts/.venv
 if [ ! -x "$VENV/bin/python" ]; then
   python3 -m venv "$VENV"
@@ -13,5 +25,14 @@ want=$(sha256sum scripts/requirements.txt | cut -d' ' -f1)
 if [ "$(cat "$stamp" 2>/dev/null || true)" != "$want" ]; then
   "$VENV/bin/pip" install --quiet --disable-pip-version-check -r scripts/requirements.txt
   echo "$want" > "$stamp"
+fi
+if [ "$WITH_BASILISK" = 1 ]; then
+  bstamp="$VENV/.requirements-basilisk.sha"
+  bwant=$(sha256sum scripts/requirements-basilisk.txt | cut -d' ' -f1)
+  if [ "$(cat "$bstamp" 2>/dev/null || true)" != "$bwant" ]; then
+    "$VENV/bin/pip" install --quiet --disable-pip-version-check -r scripts/requirements-basilisk.txt
+    echo "$bwant" > "$bstamp"
+  fi
+  echo "setup: Basilisk $("$VENV/bin/python" -c 'import Basilisk; print(Basilisk.__version__)') in $VENV"
 fi
 echo "setup: python venv ready at $VENV ($("$VENV/bin/python" -c 'import pinocchio, iceoryx2; print("pinocchio", pinocchio.__version__)'))"
