@@ -209,7 +209,7 @@ def _safe(n, m):
         ("fault_flags", c_u32),  # sc_cbf::faults bits
         ("n_constraints", c_u32),
         ("phase", c_u32),
-        ("_pad0", c_u32),
+        ("solve_cpu_ns", c_u32),  # [ns], saturating
         ("slack", c_f64),
         ("h", _vec(n)),  # barrier values
         ("phi", _vec(n)),  # CBF conditions

@@ -1,14 +1,27 @@
 //! `safe-capture bench filters`: per-filter and total safety-layer solve time over whole
-//! default missions, as geometric mean and percentiles.
+//! default missions, as geometric mean and percentiles, in wall and thread CPU time.
 
+use sc_cbf::FilterStatus;
 use sc_mission::summary::TimeStats;
 use sc_mission::{Mission, RunOptions, Setup};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Runs the mission REPEAT times in one process and reports the solve time of each filter
-/// and of the whole safety layer per control step (µs): N, geomean, p50, p90, p99, p99.9, max.
-/// Also the simulator's wall time per mission.
+/// and of the whole safety layer per control step (µs): N, geomean, p50, p90, p99, p99.9,
+/// max — as wall time (what a deadline sees, preemption included) and as the thread's CPU
+/// time (the filter's own work) — and, over the steps where a QP was solved, the solver's
+/// iterations and the number of active barrier rows. Also the wall time per mission.
+///
+/// With --solve-all the filters' skip path is off: every step solves its QP although the
+/// nominal command may already be safe (the worst case a flight processor must budget for).
+///
+/// --json FILE writes {"total"|"translational"|"attitude"|"robotic": {"n", "geomean_us",
+/// "p50_us", "p90_us", "p99_us", "p999_us", "max_us", "cpu": {same keys}, "solved_steps",
+/// "iterations": {"mean", "max"}, "active_rows": {"mean", "max"}}, "solve_all",
+/// "mission_wall_s"}.
+///
+/// Exit codes: 0 done, 2 bad arguments or configuration.
 #[derive(clap::Args)]
 pub struct Args {
     /// Scenario file.
@@ -17,6 +30,9 @@ pub struct Args {
     /// Number of missions.
     #[arg(long, default_value_t = 5)]
     repeat: usize,
+    /// Solve every QP (the skip path for an already safe nominal off).
+    #[arg(long)]
+    solve_all: bool,
     /// Write the report as JSON to FILE as well.
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
@@ -29,63 +45,148 @@ fn pct(sorted: &[f64], p: f64) -> f64 {
     sorted[((p / 100.0 * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1]
 }
 
+/// geomean, p50, p90, p99, p99.9, max of `v` (sorted in place).
+fn stats(v: &mut [f64]) -> [f64; 6] {
+    v.sort_by(f64::total_cmp);
+    [
+        TimeStats::of(v).geomean,
+        pct(v, 50.0),
+        pct(v, 90.0),
+        pct(v, 99.0),
+        pct(v, 99.9),
+        pct(v, 100.0),
+    ]
+}
+
+fn json_stats(s: &[f64; 6], n: usize) -> serde_json::Value {
+    serde_json::json!({"n": n, "geomean_us": s[0], "p50_us": s[1], "p90_us": s[2], "p99_us": s[3], "p999_us": s[4], "max_us": s[5]})
+}
+
+/// Per filter: (iterations, active rows) of the steps that solved a QP.
+#[derive(Default)]
+struct SolverWork {
+    iterations: Vec<u32>,
+    active_rows: Vec<u32>,
+}
+
+impl SolverWork {
+    fn push(&mut self, status: FilterStatus, iterations: u32, active: u64) {
+        if matches!(status, FilterStatus::Solved | FilterStatus::Relaxed) {
+            self.iterations.push(iterations);
+            self.active_rows.push(active.count_ones());
+        }
+    }
+
+    fn mean_max(v: &[u32]) -> (f64, u32) {
+        if v.is_empty() {
+            return (0.0, 0);
+        }
+        let sum: u64 = v.iter().map(|&x| x as u64).sum();
+        (
+            sum as f64 / v.len() as f64,
+            v.iter().copied().max().unwrap_or(0),
+        )
+    }
+}
+
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let setup = Setup::load(&a.scenario)?;
-    let mut times: [Vec<f64>; 4] = Default::default();
+    let mut wall: [Vec<f64>; 4] = Default::default();
+    let mut cpu: [Vec<f64>; 4] = Default::default();
+    let mut work: [SolverWork; 3] = Default::default();
     let mut mission_wall = Vec::new();
+    let tty = std::io::IsTerminal::is_terminal(&std::io::stderr());
     for k in 0..a.repeat.max(1) {
         let started = std::time::Instant::now();
         let mut m = Mission::new(setup.clone(), RunOptions::default())?;
+        if a.solve_all {
+            m.safety.translational.set_skip_enabled(false);
+            m.safety.attitude.set_skip_enabled(false);
+            m.safety.robotic.set_skip_enabled(false);
+        }
         m.run(|_, r| {
-            let t = r.solve_time_us();
+            let (t, c) = (r.solve_time_us(), r.solve_cpu_us());
             for i in 0..4 {
-                times[i].push(t[i]);
+                wall[i].push(t[i]);
+                cpu[i].push(c[i]);
             }
+            let tr = &r.translational.report;
+            let at = &r.attitude.report;
+            let ro = &r.robotic.report;
+            work[0].push(tr.status, tr.iterations, tr.active);
+            work[1].push(at.status, at.iterations, at.active);
+            work[2].push(ro.status, ro.iterations, ro.active);
         });
         mission_wall.push(started.elapsed().as_secs_f64());
-        eprint!("\r  mission {}/{}", k + 1, a.repeat.max(1));
+        if tty {
+            eprint!("\r  mission {}/{}", k + 1, a.repeat.max(1));
+        } else {
+            eprintln!("  mission {}/{}", k + 1, a.repeat.max(1));
+        }
     }
-    eprintln!();
+    if tty {
+        eprintln!();
+    }
     let names = ["translational", "attitude", "robotic", "total"];
     let mut report = serde_json::Map::new();
     println!(
-        "safety-layer solve time per control step [us] ({} missions)",
-        a.repeat.max(1)
+        "safety-layer solve time per control step [us] ({} missions, {})",
+        a.repeat.max(1),
+        if a.solve_all {
+            "every QP solved"
+        } else {
+            "skip path on"
+        }
     );
     println!(
-        "{:<14} {:>7} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}",
-        "filter", "N", "geomean", "p50", "p90", "p99", "p99.9", "max"
+        "{:<14} {:<5} {:>7} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}",
+        "filter", "clock", "N", "geomean", "p50", "p90", "p99", "p99.9", "max"
     );
     for (i, n) in names.iter().enumerate() {
-        let mut v = times[i].clone();
-        v.sort_by(f64::total_cmp);
-        let g = TimeStats::of(&v).geomean;
-        let row = [
-            g,
-            pct(&v, 50.0),
-            pct(&v, 90.0),
-            pct(&v, 99.0),
-            pct(&v, 99.9),
-            pct(&v, 100.0),
-        ];
+        let w = stats(&mut wall[i]);
+        let c = stats(&mut cpu[i]);
+        for (clock, s) in [("wall", &w), ("cpu", &c)] {
+            println!(
+                "{:<14} {:<5} {:>7} {:>9.2} {:>9.2} {:>9.2} {:>9.2} {:>9.2} {:>9.2}",
+                n,
+                clock,
+                wall[i].len(),
+                s[0],
+                s[1],
+                s[2],
+                s[3],
+                s[4],
+                s[5]
+            );
+        }
+        let mut entry = json_stats(&w, wall[i].len());
+        entry["cpu"] = json_stats(&c, cpu[i].len());
+        if i < 3 {
+            let (im, ix) = SolverWork::mean_max(&work[i].iterations);
+            let (am, ax) = SolverWork::mean_max(&work[i].active_rows);
+            entry["solved_steps"] = serde_json::json!(work[i].iterations.len());
+            entry["iterations"] = serde_json::json!({"mean": im, "max": ix});
+            entry["active_rows"] = serde_json::json!({"mean": am, "max": ax});
+        }
+        report.insert(n.to_string(), entry);
+    }
+    println!("QPs solved (steps), solver iterations and active barrier rows per solved QP:");
+    for (i, n) in names[..3].iter().enumerate() {
+        let (im, ix) = SolverWork::mean_max(&work[i].iterations);
+        let (am, ax) = SolverWork::mean_max(&work[i].active_rows);
         println!(
-            "{:<14} {:>7} {:>9.2} {:>9.2} {:>9.2} {:>9.2} {:>9.2} {:>9.2}",
+            "{:<14} solved {:>7}  iterations mean {:>5.2} max {:>3}  active rows mean {:>5.2} max {:>3}",
             n,
-            v.len(),
-            row[0],
-            row[1],
-            row[2],
-            row[3],
-            row[4],
-            row[5]
-        );
-        report.insert(
-            n.to_string(),
-            serde_json::json!({"n": v.len(), "geomean": row[0], "p50": row[1], "p90": row[2], "p99": row[3], "p99_9": row[4], "max": row[5]}),
+            work[i].iterations.len(),
+            im,
+            ix,
+            am,
+            ax
         );
     }
     let mean_wall = mission_wall.iter().sum::<f64>() / mission_wall.len() as f64;
     println!("whole mission (simulator + nominal + filters) wall time: mean {mean_wall:.3} s");
+    report.insert("solve_all".into(), serde_json::json!(a.solve_all));
     report.insert("mission_wall_s".into(), serde_json::json!(mission_wall));
     if let Some(p) = a.json {
         std::fs::write(&p, serde_json::to_string_pretty(&report)?)?;

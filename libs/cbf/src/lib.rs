@@ -33,7 +33,7 @@ pub mod translational;
 
 pub use attitude::{AttitudeFilter, AttitudeInput, AttitudeParams};
 pub use barrier::{RelDegOne, RelDegTwo, Row};
-pub use common::{FilterOutput, FilterReport, FilterStatus, faults};
+pub use common::{FilterOutput, FilterReport, FilterStatus, faults, thread_cpu_ns};
 pub use qp::{QpDump, QpOutcome, SolverParams};
 pub use robotic::{RoboticFilter, RoboticInput, RoboticParams, robotic_input_from_model};
 pub use sampled::{RateBounds, RelDeg1, RelDeg2, SampleBounds};

@@ -585,8 +585,11 @@ impl RoboticFilter {
         tau_nom: Option<&Vector7>,
     ) -> FilterOutput<NJ, N> {
         let t0 = std::time::Instant::now();
+        // the thread's CPU clock inside the wall interval: CPU ≤ wall
+        let c0 = crate::common::thread_cpu_ns();
         let mut report = FilterReport::<N>::default();
         let u = self.filter_inner(x, tau_nom, &mut report);
+        report.solve_cpu_ns = crate::common::thread_cpu_ns().saturating_sub(c0);
         report.solve_time_ns = t0.elapsed().as_nanos().min(u64::MAX as u128) as u64;
         FilterOutput {
             u,

@@ -487,8 +487,11 @@ impl TranslationalFilter {
         f_nom_h: Option<&Vector3<f64>>,
     ) -> FilterOutput<3, N> {
         let t0 = Instant::now();
+        // the thread's CPU clock inside the wall interval: CPU ≤ wall
+        let c0 = crate::common::thread_cpu_ns();
         let mut report = FilterReport::<N>::default();
         let out = self.filter_inner(x, f_nom_h, &mut report);
+        report.solve_cpu_ns = crate::common::thread_cpu_ns().saturating_sub(c0);
         report.solve_time_ns = t0.elapsed().as_nanos().min(u64::MAX as u128) as u64;
         FilterOutput {
             u: out.0,

@@ -360,8 +360,8 @@ macro_rules! safe_msg {
             pub n_constraints: u32,
             /// Mission phase of the nominal command filtered (0-based) [-].
             pub phase: u32,
-            /// Always 0.
-            pub _pad0: u32,
+            /// CPU time of the filter call on its thread, saturating at u32::MAX [ns].
+            pub solve_cpu_ns: u32,
             /// Slack of the relaxed QP (0 otherwise), normalised rows [-].
             pub slack: f64,
             /// Barrier values h_i (NaN when not evaluated) [see docs/ICD.md].

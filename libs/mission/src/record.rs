@@ -2,7 +2,8 @@
 //!
 //! * `telemetry.csv` — deterministic: bit-for-bit identical between the in-process run
 //!   and the lock-step partition (floats printed in Rust's shortest round-trip form).
-//! * `timing.csv` — wall-clock solve times of the filters (not reproducible by nature).
+//! * `timing.csv` — solve times of the filters, wall clock and the thread's CPU time (not
+//!   reproducible by nature).
 
 use nalgebra::Vector3;
 use sc_cbf::monitor::Barriers;
@@ -48,6 +49,15 @@ impl StepRecord {
         let t = self.translational.report.solve_time_ns as f64 / 1e3;
         let a = self.attitude.report.solve_time_ns as f64 / 1e3;
         let r = self.robotic.report.solve_time_ns as f64 / 1e3;
+        [t, a, r, t + a + r]
+    }
+
+    /// The CPU time the filters' thread spent in each filter and in all three [µs]: their
+    /// own work, without preemption (the wall time is [`Self::solve_time_us`]).
+    pub fn solve_cpu_us(&self) -> [f64; 4] {
+        let t = self.translational.report.solve_cpu_ns as f64 / 1e3;
+        let a = self.attitude.report.solve_cpu_ns as f64 / 1e3;
+        let r = self.robotic.report.solve_cpu_ns as f64 / 1e3;
         [t, a, r, t + a + r]
     }
 }
@@ -124,6 +134,10 @@ pub fn timing_columns() -> Vec<String> {
         "attitude_us",
         "robotic_us",
         "total_us",
+        "translational_cpu_us",
+        "attitude_cpu_us",
+        "robotic_cpu_us",
+        "total_cpu_us",
     ]
     .iter()
     .map(|s| s.to_string())
@@ -197,7 +211,11 @@ pub fn telemetry_line(r: &StepRecord) -> String {
 /// Formats one record as a `timing.csv` line.
 pub fn timing_line(r: &StepRecord) -> String {
     let t = r.solve_time_us();
-    format!("{},{},{},{},{},{}", r.step, r.t, t[0], t[1], t[2], t[3])
+    let c = r.solve_cpu_us();
+    format!(
+        "{},{},{},{},{},{},{},{},{},{}",
+        r.step, r.t, t[0], t[1], t[2], t[3], c[0], c[1], c[2], c[3]
+    )
 }
 
 /// Writes `telemetry.csv` and `timing.csv` as records arrive.
@@ -489,6 +507,10 @@ pub fn parse_telemetry(
         translational.report.solve_time_ns = tc.ns()?;
         attitude.report.solve_time_ns = tc.ns()?;
         robotic.report.solve_time_ns = tc.ns()?;
+        tc.ns()?; // total_us
+        translational.report.solve_cpu_ns = tc.ns()?;
+        attitude.report.solve_cpu_ns = tc.ns()?;
+        robotic.report.solve_cpu_ns = tc.ns()?;
         if c.next != tel_names.len() {
             return Err(format!(
                 "telemetry.csv line {n}: read {} of {} columns (the reader is out of step with telemetry_columns)",

@@ -95,7 +95,11 @@ pub struct Summary {
     pub violated_constraints: Vec<String>,
     pub constraints: BTreeMap<String, ConstraintSummary>,
     pub interventions: BTreeMap<String, Interventions>,
+    /// Wall time of each filter call per step [µs] (includes preemption).
     pub solve_time_us: BTreeMap<String, TimeStats>,
+    /// CPU time the filters' thread spent per step [µs]: the filters' own work.
+    #[serde(default)]
+    pub solve_cpu_us: BTreeMap<String, TimeStats>,
     /// Peak ‖ω_B − R_BT ω_T‖ per phase [rad/s].
     pub sync_error_peak_rad_s: BTreeMap<String, f64>,
     /// Peak ‖τ_M‖₂ applied in each phase [N m].
@@ -143,6 +147,7 @@ pub fn summarize(
         );
     }
     let mut solve: [Vec<f64>; 4] = Default::default();
+    let mut solve_cpu: [Vec<f64>; 4] = Default::default();
     let mut inter: [Interventions; 3] = Default::default();
     let row_names: [&[&str]; 3] = [
         &sc_cbf::names::TRANSLATIONAL,
@@ -179,8 +184,10 @@ pub fn summarize(
             }
         }
         let t = r.solve_time_us();
+        let c = r.solve_cpu_us();
         for i in 0..4 {
             solve[i].push(t[i]);
+            solve_cpu[i].push(c[i]);
         }
         let changed = [
             (r.translational.u - r.f_h_nom).amax() > 1e-9,
@@ -260,6 +267,11 @@ pub fn summarize(
         .zip(solve.iter())
         .map(|(n, v)| (n.to_string(), TimeStats::of(v)))
         .collect();
+    let solve_cpu_us = ["translational", "attitude", "robotic", "total"]
+        .iter()
+        .zip(solve_cpu.iter())
+        .map(|(n, v)| (n.to_string(), TimeStats::of(v)))
+        .collect();
     let (captured, capture_time_s) = match end {
         MissionEnd::Captured { t } => (true, Some(*t)),
         _ => (false, None),
@@ -277,6 +289,7 @@ pub fn summarize(
         constraints,
         interventions,
         solve_time_us,
+        solve_cpu_us,
         sync_error_peak_rad_s: sync_peak,
         joint_torque_norm_peak_nm: torque_peak,
         fault_count,

@@ -256,3 +256,42 @@ fn bad_files_are_one_line_errors() {
         assert!(!e.contains('\n'), "{e}");
     }
 }
+
+/// The filters' thread CPU time is measured inside their wall interval: on every step and
+/// filter it is at most the wall time, and the filters did measurable work.
+#[test]
+fn thread_cpu_time_lies_within_the_wall_time() {
+    let (records, _, _, _, _) = run(30.0, false);
+    let mut cpu_total = 0u64;
+    for r in &records {
+        for (name, cpu, wall) in [
+            (
+                "translational",
+                r.translational.report.solve_cpu_ns,
+                r.translational.report.solve_time_ns,
+            ),
+            (
+                "attitude",
+                r.attitude.report.solve_cpu_ns,
+                r.attitude.report.solve_time_ns,
+            ),
+            (
+                "robotic",
+                r.robotic.report.solve_cpu_ns,
+                r.robotic.report.solve_time_ns,
+            ),
+        ] {
+            assert!(
+                cpu <= wall,
+                "step {} {name}: cpu {cpu} ns > wall {wall} ns",
+                r.step
+            );
+            cpu_total += cpu;
+        }
+    }
+    assert!(
+        cpu_total > 0,
+        "no CPU time measured over {} steps",
+        records.len()
+    );
+}

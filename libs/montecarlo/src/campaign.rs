@@ -23,7 +23,9 @@
 
 use crate::config::MonteCarloConfig;
 use crate::hist::LogHistogram;
-use crate::run::{self, CampaignBase, Execution, Executor, RunResult, RunTiming, TIMERS};
+use crate::run::{
+    self, CPU_TIMERS, CampaignBase, Execution, Executor, RunResult, RunTiming, TIMERS,
+};
 use crate::sample::{run_seed, sample};
 use rayon::prelude::*;
 use sc_mission::summary::TimeStats;
@@ -212,12 +214,15 @@ pub struct CampaignSummary {
     pub joint_torque_norm_rms_grasp_nm: Option<Spread>,
     /// Wall clock: filter → statistics over every step of every run [µs].
     pub solve_time_us: BTreeMap<String, TimeStats>,
+    /// Thread CPU time: filter → statistics over every step of every run [µs].
+    #[serde(default)]
+    pub solve_cpu_us: BTreeMap<String, TimeStats>,
     /// Wall clock: the campaign's wall time (merged: sum over the shards) [s].
     pub wall_time_s: f64,
 }
 
 /// Keys of [`CampaignSummary`] that depend on the wall clock.
-pub const WALL_CLOCK_KEYS: [&str; 2] = ["solve_time_us", "wall_time_s"];
+pub const WALL_CLOCK_KEYS: [&str; 3] = ["solve_time_us", "solve_cpu_us", "wall_time_s"];
 
 /// Files of a campaign directory that depend on the wall clock (everything else is
 /// byte-identical between a campaign and the merge of its shards; in `summary.json` only
@@ -545,7 +550,7 @@ fn runs_csv(loaded: &[Loaded], phases: &[String], grasp: Option<&str>) -> String
 
 fn runs_timing_csv(loaded: &[Loaded]) -> String {
     let mut cols = vec!["run".to_string()];
-    for t in TIMERS {
+    for t in TIMERS.iter().chain(CPU_TIMERS.iter()) {
         cols.push(format!("{t}_geomean_us"));
         cols.push(format!("{t}_max_us"));
     }
@@ -553,8 +558,8 @@ fn runs_timing_csv(loaded: &[Loaded]) -> String {
     for l in loaded {
         let Some(t) = &l.timing else { continue };
         let mut v = vec![l.result.run.to_string()];
-        for n in TIMERS {
-            let st = t.stats.get(n).copied().unwrap_or_default();
+        for n in TIMERS.iter().chain(CPU_TIMERS.iter()) {
+            let st = t.stats.get(*n).copied().unwrap_or_default();
             v.push(format!("{:.3}", st.geomean));
             v.push(format!("{:.3}", st.max));
         }
@@ -628,6 +633,7 @@ pub fn aggregate(dir: &Path, wall_time_s: f64) -> Result<CampaignSummary, McErro
         joint_torque_norm_peak_nm: BTreeMap::new(),
         joint_torque_norm_rms_grasp_nm: None,
         solve_time_us: BTreeMap::new(),
+        solve_cpu_us: BTreeMap::new(),
         wall_time_s,
     };
     let mut traces = Vec::new();
@@ -713,6 +719,16 @@ pub fn aggregate(dir: &Path, wall_time_s: f64) -> Result<CampaignSummary, McErro
             )
         })
         .collect();
+    s.solve_cpu_us = TIMERS
+        .iter()
+        .zip(CPU_TIMERS)
+        .map(|(n, c)| {
+            (
+                n.to_string(),
+                hist.get(c).map(|h| h.stats()).unwrap_or_default(),
+            )
+        })
+        .collect();
     let text = serde_json::to_string_pretty(&s).map_err(|e| McError::Invalid(e.to_string()))?;
     write(&dir.join("summary.json"), text + "\n")?;
     write(
@@ -730,10 +746,13 @@ pub fn aggregate(dir: &Path, wall_time_s: f64) -> Result<CampaignSummary, McErro
         .iter()
         .map(|n| {
             let st = s.solve_time_us.get(*n).copied().unwrap_or_default();
+            let cpu = s.solve_cpu_us.get(*n).copied().unwrap_or_default();
             RuntimeBar {
                 name: n.to_string(),
                 geomean_us: st.geomean,
                 max_us: st.max,
+                cpu_geomean_us: cpu.geomean,
+                cpu_max_us: cpu.max,
             }
         })
         .collect();

@@ -14,6 +14,14 @@ use std::path::{Path, PathBuf};
 /// Filter names of the timing statistics, in order.
 pub const TIMERS: [&str; 4] = ["translational", "attitude", "robotic", "total"];
 
+/// The same for the filters' thread CPU time (their own work, without preemption).
+pub const CPU_TIMERS: [&str; 4] = [
+    "translational_cpu",
+    "attitude_cpu",
+    "robotic_cpu",
+    "total_cpu",
+];
+
 /// Deterministic result of one run (`runs/K/result.json`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RunResult {
@@ -64,7 +72,8 @@ pub struct RunMetrics {
     pub fault_flags: Vec<String>,
 }
 
-/// Wall-clock solve times of one run (`runs/K/timing.json`), not reproducible.
+/// Solve times of one run (`runs/K/timing.json`), not reproducible: wall clock under
+/// [`TIMERS`], thread CPU time under [`CPU_TIMERS`].
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct RunTiming {
     pub stats: BTreeMap<String, TimeStats>,
@@ -203,15 +212,16 @@ pub fn measure(
         })
         .collect();
     let mut timing = RunTiming::default();
-    let mut h: [LogHistogram; 4] = Default::default();
-    let mut v: [Vec<f64>; 4] = Default::default();
+    let mut h: [LogHistogram; 8] = Default::default();
+    let mut v: [Vec<f64>; 8] = Default::default();
     for r in records {
-        for (i, x) in r.solve_time_us().iter().enumerate() {
+        let (wall, cpu) = (r.solve_time_us(), r.solve_cpu_us());
+        for (i, x) in wall.iter().chain(cpu.iter()).enumerate() {
             h[i].add(*x);
             v[i].push(*x);
         }
     }
-    for (i, name) in TIMERS.iter().enumerate() {
+    for (i, name) in TIMERS.iter().chain(CPU_TIMERS.iter()).enumerate() {
         timing.stats.insert(name.to_string(), TimeStats::of(&v[i]));
         timing
             .histograms

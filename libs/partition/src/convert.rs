@@ -121,6 +121,7 @@ pub struct SafeHead<'a> {
     pub publish_ns: &'a mut u64,
     pub active_mask: &'a mut u64,
     pub solve_ns: &'a mut u64,
+    pub solve_cpu_ns: &'a mut u32,
     pub solver_status: &'a mut u32,
     pub iterations: &'a mut u32,
     pub fault_flags: &'a mut u32,
@@ -146,6 +147,7 @@ macro_rules! safe_impl {
                     publish_ns: &mut self.publish_ns,
                     active_mask: &mut self.active_mask,
                     solve_ns: &mut self.solve_ns,
+                    solve_cpu_ns: &mut self.solve_cpu_ns,
                     solver_status: &mut self.solver_status,
                     iterations: &mut self.iterations,
                     fault_flags: &mut self.fault_flags,
@@ -187,6 +189,7 @@ pub fn safe_msg<T: SafeMsg, const M: usize, const N: usize>(
         *h.t = t;
         *h.active_mask = out.report.active;
         *h.solve_ns = out.report.solve_time_ns;
+        *h.solve_cpu_ns = out.report.solve_cpu_ns.min(u32::MAX as u64) as u32;
         *h.solver_status = out.report.status as u32;
         *h.iterations = out.report.iterations;
         *h.fault_flags = out.report.faults;
@@ -212,6 +215,7 @@ pub fn filter_output<T: SafeMsg, const M: usize, const N: usize>(msg: &T) -> Fil
     report.status = status_from_u32(*h.solver_status);
     report.iterations = *h.iterations;
     report.solve_time_ns = *h.solve_ns;
+    report.solve_cpu_ns = *h.solve_cpu_ns as u64;
     report.faults = *h.fault_flags;
     report.violation = *h.slack;
     FilterOutput {

@@ -125,6 +125,8 @@ fn campaign_data() -> CampaignData {
             name: n.to_string(),
             geomean_us: 10.0,
             max_us: 100.0,
+            cpu_geomean_us: 9.0,
+            cpu_max_us: 40.0,
         })
         .collect();
     let minima = sc_mission::constraint_names()
