@@ -12,6 +12,7 @@ mod cmd_montecarlo;
 mod cmd_redteam;
 mod cmd_run;
 mod cmd_simulate;
+mod cmd_verify_qp;
 // `montecarlo --mode partition`: runs through the process partition
 mod montecarlo_partition;
 mod redteam_partition;
@@ -51,6 +52,9 @@ enum Command {
     /// The envelope bounds of the sampled-data rows: sampled from the model, compared
     /// with the scenario's.
     Bounds(cmd_bounds::Args),
+    /// Check every QP a run dumped (`run --dump-qp`) independently: KKT conditions and
+    /// Clarabel's solution of the same data.
+    VerifyQp(cmd_verify_qp::Args),
 }
 
 /// Default scenario path (relative to the working directory).
@@ -69,6 +73,7 @@ fn main() -> ExitCode {
         Command::Montecarlo(a) => cmd_montecarlo::run(a),
         Command::Redteam(a) => cmd_redteam::run(a),
         Command::Bounds(a) => cmd_bounds::run(a),
+        Command::VerifyQp(a) => cmd_verify_qp::run(a),
     };
     match result {
         Ok(code) => code,

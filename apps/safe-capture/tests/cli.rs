@@ -422,3 +422,51 @@ fn dump_qp_writes_every_filter_every_step() {
         );
     }
 }
+
+/// `verify-qp` on every QP of the default mission: each solved QP's solution is feasible and
+/// Clarabel's solution of the same data agrees with it; a tampered solution is caught.
+#[test]
+fn verify_qp_agrees_with_clarabel_on_the_default_mission_and_catches_a_tampered_solution() {
+    let d = tmp("verify-qp");
+    let dump = d.join("qp.jsonl");
+    let out = bin()
+        .args(["run", "--quiet", "--no-compare", "--no-figures", "--out"])
+        .arg(d.join("o"))
+        .arg("--dump-qp")
+        .arg(&dump)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v = bin().arg("verify-qp").arg(&dump).output().unwrap();
+    let stdout = String::from_utf8_lossy(&v.stdout).to_string();
+    assert!(v.status.success(), "{stdout}");
+    assert!(stdout.contains("all within"), "{stdout}");
+    for f in ["translational", "attitude", "robotic"] {
+        assert!(stdout.contains(f), "no {f} QP checked: {stdout}");
+    }
+    // move one solved translational command by 1 % of the bound: no longer the optimum
+    let text = std::fs::read_to_string(&dump).unwrap();
+    let mut tampered = Vec::new();
+    let mut done = false;
+    for l in text.lines() {
+        let mut j: Value = serde_json::from_str(l).unwrap();
+        if !done && j["filter"] == "translational" && j["qp"]["outcome"] == "Solved" {
+            let x = j["qp"]["solution"][0].as_f64().unwrap();
+            j["qp"]["solution"][0] = serde_json::json!(x + 0.07);
+            done = true;
+        }
+        tampered.push(j.to_string());
+    }
+    assert!(done, "no solved translational QP in the default mission");
+    let bad = d.join("tampered.jsonl");
+    std::fs::write(&bad, tampered.join("\n") + "\n").unwrap();
+    let v = bin().arg("verify-qp").arg(&bad).output().unwrap();
+    let stdout = String::from_utf8_lossy(&v.stdout).to_string();
+    assert_eq!(v.status.code(), Some(1), "{stdout}");
+    assert!(stdout.contains("BEYOND TOLERANCE"), "{stdout}");
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -30,6 +30,7 @@ pub mod qp;
 pub mod robotic;
 pub mod sampled;
 pub mod translational;
+pub mod verify;
 
 pub use attitude::{AttitudeFilter, AttitudeInput, AttitudeParams};
 pub use barrier::{RelDegOne, RelDegTwo, Row};

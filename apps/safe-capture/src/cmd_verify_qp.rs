@@ -1,0 +1,128 @@
+//! `safe-capture verify-qp`: every QP a run dumped, checked independently of the engine
+//! that solved it (`sc_cbf::verify`).
+
+use anyhow::Context;
+use sc_cbf::QpOutcome;
+use sc_cbf::qp::QpDump;
+use sc_cbf::verify::{check, input_bound};
+use std::collections::BTreeMap;
+use std::io::BufRead;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Checks every hard QP of a `run --dump-qp FILE` (JSON lines) independently of the exact
+/// active-set engine that solved it: feasibility of its solution (the largest row
+/// violation) and its distance to Clarabel's interior-point solution of the same data —
+/// both judged — and, for information, the KKT stationarity residual with multipliers
+/// recomputed by non-negative least squares over the active rows (its accuracy is limited
+/// by how well conditioned the active rows are). Lengths are relative to the filter's
+/// input bound.
+///
+/// Prints per filter: QPs checked, largest relative violation, stationarity residual and
+/// distance to Clarabel, and the step of each largest value.
+///
+/// Exit codes: 0 every check within the tolerances, 1 a check beyond them, 2 bad
+/// arguments or an unreadable dump.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The dump written by `safe-capture run --dump-qp FILE`.
+    #[arg(value_name = "DUMP.jsonl")]
+    dump: PathBuf,
+    /// Largest accepted row violation at the solution, relative to the input bound.
+    #[arg(long, value_name = "REL", default_value_t = 1e-9)]
+    feasibility_tolerance: f64,
+    /// Largest accepted distance to Clarabel's solution, relative to the input bound (an
+    /// interior-point method at tolerance 1e-11 agrees to about this).
+    #[arg(long, value_name = "REL", default_value_t = 1e-6)]
+    clarabel_tolerance: f64,
+}
+
+/// Rows within this distance of their boundary (relative to the input bound) count as
+/// active when the multipliers are recomputed: the engine keeps a rounding room of this
+/// order between a solution and its rows.
+const ACTIVE_TOLERANCE: f64 = 1e-7;
+
+#[derive(serde::Deserialize)]
+struct Line {
+    filter: String,
+    step: u64,
+    qp: QpDump,
+}
+
+#[derive(Default)]
+struct Worst {
+    checked: usize,
+    clarabel_failed: usize,
+    violation: (f64, u64),
+    stationarity: (f64, u64),
+    clarabel: (f64, u64),
+}
+
+fn raise(slot: &mut (f64, u64), v: f64, step: u64) {
+    if v > slot.0 || v.is_nan() {
+        *slot = (v, step);
+    }
+}
+
+pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    let file = std::fs::File::open(&a.dump)
+        .with_context(|| format!("cannot open {}", a.dump.display()))?;
+    let mut worst: BTreeMap<String, Worst> = BTreeMap::new();
+    for (n, line) in std::io::BufReader::new(file).lines().enumerate() {
+        let line = line.with_context(|| format!("reading {}", a.dump.display()))?;
+        let l: Line = serde_json::from_str(&line)
+            .with_context(|| format!("{} line {}", a.dump.display(), n + 1))?;
+        if l.qp.outcome != Some(QpOutcome::Solved) {
+            continue;
+        }
+        let u_inf = input_bound(&l.qp, 1.0);
+        let m = l.qp.u_nom.len().max(1) as f64;
+        let c = check(&l.qp, u_inf * m.sqrt(), ACTIVE_TOLERANCE * u_inf);
+        let w = worst.entry(l.filter).or_default();
+        w.checked += 1;
+        raise(&mut w.violation, c.violation / u_inf, l.step);
+        raise(&mut w.stationarity, c.stationarity / u_inf, l.step);
+        match c.clarabel_distance {
+            Some(d) => raise(&mut w.clarabel, d / u_inf, l.step),
+            None => w.clarabel_failed += 1,
+        }
+    }
+    let mut ok = true;
+    for (f, w) in &worst {
+        let kkt_ok = w.violation.0 <= a.feasibility_tolerance;
+        let cl_ok = w.clarabel.0 <= a.clarabel_tolerance && w.clarabel_failed == 0;
+        ok &= kkt_ok && cl_ok;
+        println!(
+            "{f:<14} {:>6} QPs  violation {:.1e} (step {})  stationarity {:.1e} (step {})  distance to Clarabel {:.1e} (step {}){}  {}",
+            w.checked,
+            w.violation.0,
+            w.violation.1,
+            w.stationarity.0,
+            w.stationarity.1,
+            w.clarabel.0,
+            w.clarabel.1,
+            if w.clarabel_failed > 0 {
+                format!(", Clarabel failed on {}", w.clarabel_failed)
+            } else {
+                String::new()
+            },
+            if kkt_ok && cl_ok {
+                "ok"
+            } else {
+                "BEYOND TOLERANCE"
+            }
+        );
+    }
+    let total: usize = worst.values().map(|w| w.checked).sum();
+    println!(
+        "verify-qp: {total} solved QPs checked (relative to the input bound: violation <= {:e}, distance to Clarabel <= {:e}): {}",
+        a.feasibility_tolerance,
+        a.clarabel_tolerance,
+        if ok { "all within" } else { "NOT all within" }
+    );
+    Ok(if ok {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}

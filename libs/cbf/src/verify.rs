@@ -1,0 +1,225 @@
+//! Independent verification of a filter's QP: the same problem, checked by means that
+//! share no code with the exact engine ([`crate::engine`]) — the KKT conditions with
+//! multipliers recomputed by non-negative least squares over the active rows, and the
+//! Clarabel interior-point reference ([`crate::qp::QpEngine`]). Used by the tests and by
+//! `safe-capture verify-qp` on every QP a run dumped (`run --dump-qp`).
+
+use crate::barrier::Row;
+use crate::qp::{QpDump, QpEngine, QpOutcome, SolverParams};
+use nalgebra::{DMatrix, DVector, SVector};
+
+/// A filter's QP `min ‖u − u_nom‖²` s.t. `c_i + a_i·u ≥ 0` for every row (barrier rows
+/// first, then the hard rows written the same way).
+#[derive(Debug, Clone)]
+pub struct Qp {
+    pub u_nom: DVector<f64>,
+    pub a: Vec<DVector<f64>>,
+    pub c: Vec<f64>,
+    /// Number of barrier rows (the first `nb`).
+    pub nb: usize,
+}
+
+impl Qp {
+    pub fn from_rows<const M: usize>(
+        u_nom: &SVector<f64, M>,
+        rows: &[Row<M>],
+        hard: &[Row<M>],
+    ) -> Self {
+        Self {
+            u_nom: DVector::from_column_slice(u_nom.as_slice()),
+            a: rows
+                .iter()
+                .chain(hard)
+                .map(|r| DVector::from_column_slice(r.a.as_slice()))
+                .collect(),
+            c: rows.iter().chain(hard).map(|r| r.c).collect(),
+            nb: rows.len(),
+        }
+    }
+
+    /// From a filter's `dump_qp()`: barrier rows `c + a·u ≥ 0`, bounds `g·u ≤ g_max`.
+    pub fn from_dump(d: &QpDump) -> Self {
+        let mut a: Vec<DVector<f64>> = d
+            .rows_a
+            .iter()
+            .map(|r| DVector::from_column_slice(r))
+            .collect();
+        let mut c = d.rows_c.clone();
+        for (g, gm) in d.bounds_g.iter().zip(&d.bounds_g_max) {
+            a.push(-DVector::from_column_slice(g));
+            c.push(*gm);
+        }
+        Self {
+            u_nom: DVector::from_column_slice(&d.u_nom),
+            a,
+            c,
+            nb: d.rows_a.len(),
+        }
+    }
+
+    pub fn m(&self) -> usize {
+        self.u_nom.len()
+    }
+
+    pub fn phi(&self, i: usize, u: &DVector<f64>) -> f64 {
+        self.c[i] + self.a[i].dot(u)
+    }
+
+    /// Rows with allowances: `c_i + w_i t_i` for the first rows.
+    pub fn relaxed(&self, allowance: &[f64]) -> Self {
+        let mut q = self.clone();
+        for (i, t) in allowance.iter().enumerate() {
+            q.c[i] += t;
+        }
+        q
+    }
+}
+
+/// Non-negative least squares `min ‖A λ − b‖, λ ≥ 0` (Lawson–Hanson).
+pub fn nnls(a: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {
+    let n = a.ncols();
+    let mut x = DVector::zeros(n);
+    let mut passive = vec![false; n];
+    for _outer in 0..3 * n + 10 {
+        let w = a.transpose() * (b - a * &x);
+        let cand = (0..n)
+            .filter(|&j| !passive[j])
+            .max_by(|&i, &j| w[i].partial_cmp(&w[j]).unwrap());
+        let Some(j) = cand else { break };
+        if w[j] <= 1e-14 * (1.0 + b.norm()) * (1.0 + a.norm()) {
+            break;
+        }
+        passive[j] = true;
+        for _inner in 0..3 * n + 10 {
+            let idx: Vec<usize> = (0..n).filter(|&k| passive[k]).collect();
+            let ap = DMatrix::from_fn(a.nrows(), idx.len(), |r, c| a[(r, idx[c])]);
+            let Some(z) = ap.clone().svd(true, true).solve(b, 1e-14).ok() else {
+                return x;
+            };
+            if z.iter().all(|v| *v > 0.0) {
+                for (k, &i) in idx.iter().enumerate() {
+                    x[i] = z[k];
+                }
+                for k in 0..n {
+                    if !passive[k] {
+                        x[k] = 0.0;
+                    }
+                }
+                break;
+            }
+            let mut alpha = 1.0f64;
+            for (k, &i) in idx.iter().enumerate() {
+                if z[k] <= 0.0 {
+                    alpha = alpha.min(x[i] / (x[i] - z[k]));
+                }
+            }
+            for (k, &i) in idx.iter().enumerate() {
+                x[i] += alpha * (z[k] - x[i]);
+                if x[i] <= 1e-300 {
+                    x[i] = 0.0;
+                    passive[i] = false;
+                }
+            }
+        }
+    }
+    x
+}
+
+/// KKT residuals of `u` for `qp`, with multipliers computed here (NNLS over the rows
+/// active within `act_tol` in distance): `(max row violation in distance, stationarity
+/// residual ‖(u − u_nom) − Σ λ_i a_i‖, multipliers)`. The multipliers are those of the ½
+/// cost `½‖u − u_nom‖²`.
+pub fn kkt(qp: &Qp, u: &DVector<f64>, act_tol: f64) -> (f64, f64, Vec<f64>) {
+    let mut viol = 0.0f64;
+    let mut act = Vec::new();
+    for i in 0..qp.a.len() {
+        let n = qp.a[i].norm();
+        let d = if n > 0.0 { qp.phi(i, u) / n } else { qp.c[i] };
+        viol = viol.max(-d);
+        if n > 0.0 && d <= act_tol {
+            act.push(i);
+        }
+    }
+    let g = u - &qp.u_nom;
+    let mut lam = vec![0.0; qp.a.len()];
+    if act.is_empty() {
+        return (viol, g.norm(), lam);
+    }
+    let a = DMatrix::from_fn(qp.m(), act.len(), |r, c| qp.a[act[c]][r]);
+    let l = nnls(&a, &g);
+    for (k, &i) in act.iter().enumerate() {
+        lam[i] = l[k];
+    }
+    ((viol), (a * l - g).norm(), lam)
+}
+
+/// Clarabel's solution of `qp` through the crate's independent reference engine
+/// [`QpEngine`] (barrier rows as rows, hard rows as bounds; tight tolerances). `u_inf`
+/// bounds `‖u‖∞` on the hard rows' feasible set.
+pub fn clarabel(qp: &Qp, u_inf: f64) -> Option<DVector<f64>> {
+    let m = qp.m();
+    let (nb, ng) = (qp.nb, qp.a.len() - qp.nb);
+    let params = SolverParams {
+        max_iterations: 200,
+        tolerance: 1e-11,
+        slack_weight: 1e6,
+    };
+    let mut eng = QpEngine::new(m, nb, ng, u_inf, &params);
+    eng.set_skip_enabled(false);
+    let rows_a: Vec<f64> = qp.a[..nb].iter().flat_map(|a| a.iter().copied()).collect();
+    let g: Vec<f64> = qp.a[nb..]
+        .iter()
+        .flat_map(|a| a.iter().map(|x| -x))
+        .collect();
+    let mut u = vec![0.0; m];
+    let r = eng.solve(
+        qp.u_nom.as_slice(),
+        &rows_a,
+        &qp.c[..nb],
+        &g,
+        &qp.c[nb..],
+        &mut u,
+    );
+    (r.outcome == QpOutcome::Solved).then(|| DVector::from_vec(u))
+}
+
+/// What [`check`] found for one solved QP, relative to `u_inf` where a length.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Check {
+    /// Largest row violation at the engine's solution, in distance (`−(c + a·u)/‖a‖`) [u].
+    pub violation: f64,
+    /// Stationarity residual `‖(u − u_nom) − Σ λ_i a_i‖` with NNLS multipliers [u].
+    pub stationarity: f64,
+    /// `‖u − u_Clarabel‖∞`, `None` when Clarabel did not solve it [u].
+    pub clarabel_distance: Option<f64>,
+}
+
+/// Checks the solution `d.solution` of the hard QP in `d` (KKT with recomputed multipliers,
+/// rows active within `act_tol` in distance; and the distance to Clarabel's solution).
+/// `u_inf` bounds `‖u‖∞` over the hard rows.
+pub fn check(d: &QpDump, u_inf: f64, act_tol: f64) -> Check {
+    let qp = Qp::from_dump(d);
+    let u = DVector::from_column_slice(&d.solution);
+    let (violation, stationarity, _) = kkt(&qp, &u, act_tol);
+    let clarabel_distance = clarabel(&qp, u_inf).map(|v| (v - &u).amax());
+    Check {
+        violation,
+        stationarity,
+        clarabel_distance,
+    }
+}
+
+/// The scale of the filter's inputs: the largest half-width `g_max/‖g‖` of its hard rows
+/// (the input bound for a box, also a rotated one); `fallback` when there is none. A box
+/// rotated in `m` dimensions bounds `‖u‖∞` by `√m` times this.
+pub fn input_bound(d: &QpDump, fallback: f64) -> f64 {
+    d.bounds_g
+        .iter()
+        .zip(&d.bounds_g_max)
+        .filter_map(|(g, gm)| {
+            let n = g.iter().map(|x| x * x).sum::<f64>().sqrt();
+            (n > 0.0 && gm.is_finite()).then(|| gm.abs() / n)
+        })
+        .fold(None, |m: Option<f64>, x| Some(m.map_or(x, |m| m.max(x))))
+        .unwrap_or(fallback)
+}
