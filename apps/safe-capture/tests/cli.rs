@@ -470,3 +470,35 @@ fn verify_qp_agrees_with_clarabel_on_the_default_mission_and_catches_a_tampered_
     assert!(stdout.contains("BEYOND TOLERANCE"), "{stdout}");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// Under a random all-subsystem attack every filter works on every step; the dump records
+/// the problem each command was solved with, so every solved QP agrees with Clarabel (the
+/// robotic filter once dumped its certifying rows instead: 3.2e-2 of the bound apart).
+#[test]
+fn verify_qp_agrees_with_clarabel_under_a_random_attack() {
+    let d = tmp("verify-qp-attack");
+    let dump = d.join("qp.jsonl");
+    let out = bin()
+        .args([
+            "run",
+            "--quiet",
+            "--no-compare",
+            "--no-figures",
+            "--redteam",
+            "all/random:1",
+            "--out",
+        ])
+        .arg(d.join("o"))
+        .arg("--dump-qp")
+        .arg(&dump)
+        .output()
+        .unwrap();
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+    let v = bin().arg("verify-qp").arg(&dump).output().unwrap();
+    let stdout = String::from_utf8_lossy(&v.stdout).to_string();
+    assert!(v.status.success(), "{stdout}");
+    let robotic = stdout.lines().find(|l| l.starts_with("robotic")).unwrap();
+    let n: usize = robotic.split_whitespace().nth(1).unwrap().parse().unwrap();
+    assert!(n > 2000, "only {n} robotic QPs solved: {robotic}");
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -629,6 +629,9 @@ impl RoboticFilter {
         let local = self.barrier_rows(x, &terms, Level::Local, &zero);
         let mut res = self.engine.solve(&u_nom, &local, &weights, &hard);
         report.iterations = res.iterations;
+        // the rows the returned command was solved with (the dump's problem) and the rows
+        // that certify it (evaluated into the report)
+        let mut solved_rows = local;
         let mut final_rows = local;
         let mut certified = false;
         // the accelerations the rows `res` was solved with were built for (None: the
@@ -641,7 +644,11 @@ impl RoboticFilter {
                 let cap = solved_cap.map_or(own, |c| c.sup(&own));
                 let rows = self.barrier_rows(x, &terms, Level::Certified(cap), &zero);
                 if rows.iter().all(|r| r.phi(&res.u) >= 0.0) {
-                    // inside tighter rows than it was solved with: still their minimiser
+                    // inside rows valid for its own accelerations: certified. It is the
+                    // minimiser of the rows it was solved with (`solved_rows`, the dump's
+                    // problem); the certifying rows are not always a subset of those
+                    // (`safe-capture verify-qp` measured up to 3e-2 of the bound between
+                    // the two projections under attack), so it need not be theirs.
                     certified = true;
                     final_rows = rows;
                     break;
@@ -655,6 +662,7 @@ impl RoboticFilter {
                     break;
                 }
                 res = next;
+                solved_rows = rows;
                 solved_cap = Some(grown);
                 if accel(&res.u)
                     .abs()
@@ -686,6 +694,7 @@ impl RoboticFilter {
             match verified {
                 Some((u, rows, relaxed_violation)) => {
                     tau = u;
+                    solved_rows = rows;
                     final_rows = rows;
                     if relaxed_violation > 0.0 {
                         report.status = FilterStatus::Relaxed;
@@ -725,7 +734,7 @@ impl RoboticFilter {
             row_duals: [0.0; 64],
         };
         self.last
-            .record(&u_nom, &final_rows, &weights, &hard, &outcome);
+            .record(&u_nom, &solved_rows, &weights, &hard, &outcome);
         let (tau, clamped) = clamp_box(&tau, tmax);
         if clamped {
             report.faults |= faults::OUTPUT_CLAMPED;
