@@ -8,4 +8,13 @@ mkdir -p tests/reference
 scripts/.venv/bin/python scripts/pinocchio_reference.py
 # the partition's Python partner controller and the interop tests find the venv here
 export SC_PYTHON="$PWD/scripts/.venv/bin/python"
-cargo test --workspace --no-fail-fast "$@"
+started=$(date +%s)
+status=0
+cargo test --workspace --no-fail-fast "$@" || status=$?
+elapsed=$(( $(date +%s) - started ))
+if [ "$status" = 0 ]; then
+  echo "test.sh: every test passed (cargo test: ${elapsed} s)"
+else
+  echo "test.sh: FAILED, exit $status (cargo test: ${elapsed} s); the failing tests are listed above"
+fi
+exit "$status"

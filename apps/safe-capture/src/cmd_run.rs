@@ -121,6 +121,8 @@ pub fn run_mission(
     let mut records = Vec::new();
     let mut io_err: Option<std::io::Error> = None;
     let mut last_print = 0.0;
+    // a terminal gets one line redrawn in place; a log gets one line per report
+    let tty = std::io::IsTerminal::is_terminal(&std::io::stderr());
     let end = mission.run(|m, r| {
         if let Err(e) = writer.write(r) {
             io_err.get_or_insert(e);
@@ -140,16 +142,21 @@ pub fn run_mission(
         }
         if !quiet && r.t - last_print >= 10.0 {
             last_print = r.t;
-            eprint!(
-                "\r  t = {:6.1} / {duration:.0} s  phase {}  grasp distance {:7.3} m",
+            let line = format!(
+                "  t = {:6.1} / {duration:.0} s  phase {}  grasp distance {:7.3} m",
                 r.t,
                 r.phase + 1,
                 r.obs.grasp_distance()
             );
+            if tty {
+                eprint!("\r{line}");
+            } else {
+                eprintln!("{line}");
+            }
         }
         records.push(*r);
     });
-    if !quiet {
+    if !quiet && tty {
         eprintln!();
     }
     if let Some(e) = io_err {

@@ -34,6 +34,11 @@ fn assert_one_line_error(out: &Output, needle: &str) {
         lines[0].starts_with("error: ") && lines[0].contains(needle),
         "{err}"
     );
+    // said once: no part of the message repeated as its own cause
+    let parts: Vec<&str> = lines[0].split(": ").collect();
+    for (i, p) in parts.iter().enumerate() {
+        assert!(!parts[i + 1..].contains(p), "`{p}` repeated: {err}");
+    }
 }
 
 fn scenario_with(dir: &Path, from: &str, to: &str) -> PathBuf {
@@ -500,5 +505,28 @@ fn verify_qp_agrees_with_clarabel_under_a_random_attack() {
     let robotic = stdout.lines().find(|l| l.starts_with("robotic")).unwrap();
     let n: usize = robotic.split_whitespace().nth(1).unwrap().parse().unwrap();
     assert!(n > 2000, "only {n} robotic QPs solved: {robotic}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// Progress into a log (stderr not a terminal) is one line per report, never redrawn with
+/// carriage returns.
+#[test]
+fn run_progress_in_a_log_is_plain_lines() {
+    let d = tmp("progress");
+    let s = scenario_with(&d, "duration_s = 240.0", "duration_s = 25.0");
+    let out = bin()
+        .args(["run", "--no-compare", "--no-figures", "--scenario"])
+        .arg(&s)
+        .arg("--out")
+        .arg(d.join("o"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains('\r'), "carriage return in a log: {err:?}");
+    let reports = err
+        .lines()
+        .filter(|l| l.trim_start().starts_with("t ="))
+        .count();
+    assert_eq!(reports, 2, "one line at t = 10 s and one at 20 s: {err}");
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -8,7 +8,8 @@ use std::sync::Arc;
 /// Why a mission could not be set up. One line each, naming the problem.
 #[derive(Debug, thiserror::Error)]
 pub enum SetupError {
-    #[error("{0}")]
+    /// (transparent: the scenario's message is printed once, not again as the source)
+    #[error(transparent)]
     Scenario(#[from] ScenarioError),
     #[error("{path}: {message}")]
     Urdf { path: String, message: String },

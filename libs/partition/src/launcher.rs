@@ -325,7 +325,9 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
                     signal: st.signal(),
                     killed_by_launcher: termed,
                 };
-                if !opts.quiet {
+                // a process that ended well is counted in the verdict line; one that did
+                // not is named here as it happens
+                if !opts.quiet && !ex.ended_well() {
                     eprintln!(
                         "launch: {} (pid {}) exited: {}",
                         p.role,
