@@ -646,9 +646,9 @@ impl RoboticFilter {
                 if rows.iter().all(|r| r.phi(&res.u) >= 0.0) {
                     // inside rows valid for its own accelerations: certified. It is the
                     // minimiser of the rows it was solved with (`solved_rows`, the dump's
-                    // problem); the certifying rows are not always a subset of those
-                    // (`safe-capture verify-qp` measured up to 3e-2 of the bound between
-                    // the two projections under attack), so it need not be theirs.
+                    // problem), not necessarily of the certifying rows (`safe-capture
+                    // verify-qp` measured up to 3e-2 of the bound between the two under
+                    // attack when the dump held the certifying rows).
                     certified = true;
                     final_rows = rows;
                     break;
