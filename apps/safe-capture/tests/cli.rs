@@ -428,25 +428,34 @@ fn dump_qp_writes_every_filter_every_step() {
     }
 }
 
-/// `verify-qp` on every QP of the default mission: each solved QP's solution is feasible and
-/// Clarabel's solution of the same data agrees with it; a tampered solution is caught.
-#[test]
-fn verify_qp_agrees_with_clarabel_on_the_default_mission_and_catches_a_tampered_solution() {
-    let d = tmp("verify-qp");
+/// Runs the default mission (plus `extra` arguments) into `d` with every QP dumped, then
+/// `verify-qp` on the dump: the dump's path, the run's and verify-qp's output.
+fn run_and_verify_qps(d: &Path, extra: &[&str]) -> (PathBuf, Output, Output) {
     let dump = d.join("qp.jsonl");
     let out = bin()
-        .args(["run", "--quiet", "--no-compare", "--no-figures", "--out"])
+        .args(["run", "--quiet", "--no-compare", "--no-figures"])
+        .args(extra)
+        .arg("--out")
         .arg(d.join("o"))
         .arg("--dump-qp")
         .arg(&dump)
         .output()
         .unwrap();
+    let v = bin().arg("verify-qp").arg(&dump).output().unwrap();
+    (dump, out, v)
+}
+
+/// `verify-qp` on every QP of the default mission: each solved QP's solution is feasible and
+/// Clarabel's solution of the same data agrees with it; a tampered solution is caught.
+#[test]
+fn verify_qp_agrees_with_clarabel_on_the_default_mission_and_catches_a_tampered_solution() {
+    let d = tmp("verify-qp");
+    let (dump, out, v) = run_and_verify_qps(&d, &[]);
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let v = bin().arg("verify-qp").arg(&dump).output().unwrap();
     let stdout = String::from_utf8_lossy(&v.stdout).to_string();
     assert!(v.status.success(), "{stdout}");
     assert!(stdout.contains("all within"), "{stdout}");
@@ -482,24 +491,8 @@ fn verify_qp_agrees_with_clarabel_on_the_default_mission_and_catches_a_tampered_
 #[test]
 fn verify_qp_agrees_with_clarabel_under_a_random_attack() {
     let d = tmp("verify-qp-attack");
-    let dump = d.join("qp.jsonl");
-    let out = bin()
-        .args([
-            "run",
-            "--quiet",
-            "--no-compare",
-            "--no-figures",
-            "--redteam",
-            "all/random:1",
-            "--out",
-        ])
-        .arg(d.join("o"))
-        .arg("--dump-qp")
-        .arg(&dump)
-        .output()
-        .unwrap();
+    let (_, out, v) = run_and_verify_qps(&d, &["--redteam", "all/random:1"]);
     assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
-    let v = bin().arg("verify-qp").arg(&dump).output().unwrap();
     let stdout = String::from_utf8_lossy(&v.stdout).to_string();
     assert!(v.status.success(), "{stdout}");
     let robotic = stdout.lines().find(|l| l.starts_with("robotic")).unwrap();

@@ -78,16 +78,16 @@ impl AttitudeMpc {
         bd.fixed_view_mut::<3, 3>(0, 0)
             .copy_from(&(j_inv * (0.5 * t * t)));
         bd.fixed_view_mut::<3, 3>(3, 0).copy_from(&(j_inv * t));
-        let (wp, wr) = (p.weight_pointing, p.weight_rate);
         let gain = CondensedGain::new(
             "attitude",
             &ad,
             &bd,
-            &CondensedWeights {
-                state: [wp, wp, wp, wr, wr, wr],
-                terminal: p.weight_terminal,
-                input: p.weight_torque,
-            },
+            &CondensedWeights::two_blocks(
+                p.weight_pointing,
+                p.weight_rate,
+                p.weight_terminal,
+                p.weight_torque,
+            ),
             p.horizon,
         )?;
         Ok(Self {

@@ -35,6 +35,18 @@ pub struct CondensedWeights {
     pub input: f64,
 }
 
+impl CondensedWeights {
+    /// Weights of a state made of two 3-vectors (position and rate, attitude and rate
+    /// errors): `Q = diag(w₁ I₃, w₂ I₃)`, terminal `w_N Q`, `R = w_u I₃`.
+    pub fn two_blocks(first: f64, second: f64, terminal: f64, input: f64) -> Self {
+        Self {
+            state: [first, first, first, second, second, second],
+            terminal,
+            input,
+        }
+    }
+}
+
 impl CondensedGain {
     /// Builds `Φ`, `Γ` and the gain. `what` names the controller in errors.
     pub fn new(

@@ -35,7 +35,7 @@
 
 use crate::NominalError;
 use crate::condensed::{CondensedGain, CondensedWeights};
-use nalgebra::{DMatrix, Matrix3, Matrix3x6, Matrix6, Matrix6x3, Vector3, Vector6};
+use nalgebra::{DMatrix, Matrix3, Matrix6, Matrix6x3, Vector3, Vector6};
 use sc_models::Vec3;
 use sc_models::cw::ClohessyWiltshire;
 use sc_models::quat::{self, Quat};
@@ -80,10 +80,8 @@ pub struct TranslationalMpc {
     params: TranslationalMpcParams,
     ad: Matrix6<f64>,
     bd: Matrix6x3<f64>,
-    /// `K_x = −G Φ` (3×6).
-    k_x: Matrix3x6<f64>,
-    /// `G_k`, k = 1..N: the blocks of `G` acting on `x_ref,k` (3×6 each).
-    g: Vec<Matrix3x6<f64>>,
+    /// `K_x` and the `G_k` of the closed-form solution.
+    gain: CondensedGain,
 }
 
 impl TranslationalMpc {
@@ -128,24 +126,23 @@ impl TranslationalMpc {
             mass: p.mass,
         };
         let (ad, bd) = cw.discretize(p.dt);
-        let (wp, wv) = (p.weight_position, p.weight_velocity);
-        let CondensedGain { k_x, g } = CondensedGain::new(
+        let gain = CondensedGain::new(
             "translational",
             &ad,
             &bd,
-            &CondensedWeights {
-                state: [wp, wp, wp, wv, wv, wv],
-                terminal: p.weight_terminal,
-                input: p.weight_force,
-            },
+            &CondensedWeights::two_blocks(
+                p.weight_position,
+                p.weight_velocity,
+                p.weight_terminal,
+                p.weight_force,
+            ),
             p.horizon,
         )?;
         Ok(Self {
             params,
             ad,
             bd,
-            k_x,
-            g,
+            gain,
         })
     }
 
@@ -162,11 +159,7 @@ impl TranslationalMpc {
     /// The first block row of the batch gain, `[K_x | G_1 … G_N]` (3 × (6 + 6N)), so
     /// that `u_0 = K_x x_0 + Σ G_k x_ref,k`. For tests and analysis (allocates).
     pub fn gain(&self) -> DMatrix<f64> {
-        CondensedGain {
-            k_x: self.k_x,
-            g: self.g.clone(),
-        }
-        .matrix()
+        self.gain.matrix()
     }
 
     /// One MPC step.
@@ -201,9 +194,9 @@ impl TranslationalMpc {
         let p0 = quat::rotate(&q, &self.params.gfc_point_r);
         let step = rotation_exp(&(-omega_h * self.params.dt));
         let x0 = Vector6::new(r_h.x, r_h.y, r_h.z, v_h.x, v_h.y, v_h.z);
-        let mut u: Vector3<f64> = self.k_x * x0;
+        let mut u: Vector3<f64> = self.gain.k_x * x0;
         let mut pk = p0;
-        for gk in &self.g {
+        for gk in &self.gain.g {
             pk = step * pk;
             let vk = -omega_h.cross(&pk);
             let xr = Vector6::new(pk.x, pk.y, pk.z, vk.x, vk.y, vk.z);

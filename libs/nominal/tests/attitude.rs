@@ -6,7 +6,7 @@ use sc_models::attitude::euler;
 use sc_models::quat::{self, Quat};
 use sc_models::{Mat3, Vec3};
 use sc_nominal::attitude::{
-    AttitudeController, AttitudeGains, AttitudeInput, AttitudeLaw, AttitudeTask,
+    AttitudeCommand, AttitudeController, AttitudeGains, AttitudeInput, AttitudeLaw, AttitudeTask,
 };
 use sc_nominal::attitude_mpc::{AttitudeMpc, AttitudeMpcParams};
 
@@ -103,6 +103,29 @@ impl World {
     }
 }
 
+/// 400 s of sync mode on the spin axis (the servicer 2.2 m out, the grasping point 0.12 m
+/// off the axis, the target at 0.08 rad/s) from the attitude `q_rb`: the world and the last
+/// command.
+fn sync_on_the_spin_axis(ctl: &AttitudeController, q_rb: Quat) -> (World, AttitudeCommand) {
+    let mut w = World {
+        q_rb,
+        w_b: Vec3::zeros(),
+        q_rt: quat::IDENTITY,
+        w_t: Vec3::new(-0.08, 0.0, 0.0),
+        r_r: Vec3::new(-2.2, 0.0, 0.0),
+        grasp_t: Vec3::new(-0.55, 0.12, 0.0),
+    };
+    let mut last = None;
+    // k_p / k_sync = 0.05 1/s is the PD's slowest closed-loop pole: 20 time constants
+    for _ in 0..4000 {
+        let c = ctl.command(AttitudeTask::PointAndSync, &w.input());
+        assert!(c.valid);
+        last = Some(c);
+        w.step(&c.tau_b);
+    }
+    (w, last.expect("4000 steps"))
+}
+
 #[test]
 fn point_mode_converges_to_static_line_of_sight() {
     for ctl in [controller(), mpc_controller()] {
@@ -132,23 +155,8 @@ fn sync_mode_converges_on_the_spin_axis() {
     // sight turns rigidly with the target, so pointing and rate synchronisation are
     // consistent and both errors must vanish.
     for ctl in [controller(), mpc_controller()] {
-        let mut w = World {
-            q_rb: quat::from_axis_angle(&Vec3::new(0.0, 1.0, 0.4), 0.2),
-            w_b: Vec3::zeros(),
-            q_rt: quat::IDENTITY,
-            w_t: Vec3::new(-0.08, 0.0, 0.0),
-            r_r: Vec3::new(-2.2, 0.0, 0.0),
-            grasp_t: Vec3::new(-0.55, 0.12, 0.0),
-        };
-        let mut last = None;
-        // k_p / k_sync = 0.05 1/s is the slowest closed-loop pole: give it 20 time constants
-        for _ in 0..4000 {
-            let c = ctl.command(AttitudeTask::PointAndSync, &w.input());
-            assert!(c.valid);
-            last = Some(c);
-            w.step(&c.tau_b);
-        }
-        let c = last.unwrap();
+        let (_, c) =
+            sync_on_the_spin_axis(&ctl, quat::from_axis_angle(&Vec3::new(0.0, 1.0, 0.4), 0.2));
         assert!(
             c.pointing_error_rad < 1e-5,
             "pointing error {}",
@@ -170,22 +178,8 @@ fn sync_with_alignment_turns_the_gripper_onto_the_fixture() {
     let fixture_t = Vec3::y();
     for ctl in [controller(), mpc_controller()] {
         let ctl = ctl.with_alignment(Vec3::z(), fixture_t).unwrap();
-        let mut w = World {
-            q_rb: quat::from_axis_angle(&Vec3::x(), 80f64.to_radians()),
-            w_b: Vec3::zeros(),
-            q_rt: quat::IDENTITY,
-            w_t: Vec3::new(-0.08, 0.0, 0.0),
-            r_r: Vec3::new(-2.2, 0.0, 0.0),
-            grasp_t: Vec3::new(-0.55, 0.12, 0.0),
-        };
-        let mut last = None;
-        for _ in 0..4000 {
-            let c = ctl.command(AttitudeTask::PointAndSync, &w.input());
-            assert!(c.valid);
-            last = Some(c);
-            w.step(&c.tau_b);
-        }
-        let c = last.unwrap();
+        let (w, c) =
+            sync_on_the_spin_axis(&ctl, quat::from_axis_angle(&Vec3::x(), 80f64.to_radians()));
         let r_br = quat::to_matrix(&w.q_rb).transpose();
         let a_b = r_br * quat::to_matrix(&w.q_rt) * fixture_t;
         let psi = roll_to_align(&Vec3::x(), &Vec3::z(), &a_b);
