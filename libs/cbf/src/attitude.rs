@@ -25,7 +25,7 @@ use crate::common::{
     unit_quat,
 };
 use crate::engine::{Engine, Kind, LastProblem};
-use crate::sampled::{RateBounds, RelDeg1, RelDeg2, SampleBounds};
+use crate::sampled::{Decay, RateBounds, RelDeg1, RelDeg2, SampleBounds};
 use crate::{Formulation, qp::SolverParams};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use sc_models::quat::{self, Quat};
@@ -70,6 +70,9 @@ pub struct AttitudeParams {
     pub gamma: f64,
     pub eps_att: f64,
     pub u_max_att: f64,
+    /// The decay (C2) allows `H_ATT`: the paper's `γ_h` near the cone's edge, steeper
+    /// closer to its axis than the knee ([`Decay`]).
+    pub decay: Decay,
     /// Per-axis rate limits `ω_min ≤ ω_B ≤ ω_max` [rad/s].
     pub omega_max: Vector3<f64>,
     pub omega_min: Vector3<f64>,
@@ -114,6 +117,14 @@ impl AttitudeParams {
             gamma: s.safety.gamma_per_s,
             eps_att: a.eps_att,
             u_max_att: a.u_max_att_per_s2,
+            decay: Decay {
+                gamma: s.safety.gamma_per_s,
+                // H ≤ h ≤ cos θ − cos β while turning away from the axis: H above the knee
+                // only closer to the axis than the knee's angle
+                knee: a.los_decay_knee_deg.to_radians().cos()
+                    - a.los_half_angle_deg.to_radians().cos(),
+                gamma_inner: a.gamma_los_inner_per_s,
+            },
             omega_max: Vector3::from(a.omega_max_rad_s),
             omega_min: Vector3::from(a.omega_min_rad_s),
             gamma_omega: a.gamma_omega_per_s,
@@ -575,7 +586,7 @@ impl AttitudeFilter {
     ) -> [Row<3>; ROWS] {
         let p = &self.params;
         let (b_los, b_rate, b_w) = self.sample_bounds(x, rho, accel);
-        let mut rows = [RelDeg2::from(t.los).row(&b_los, p.u_max_att, p.gamma); ROWS];
+        let mut rows = [RelDeg2::from(t.los).row_with(&b_los, p.u_max_att, &p.decay); ROWS];
         for (k, o) in t.omega.iter().enumerate() {
             rows[1 + k] = RelDeg1::from(*o).row(&b_rate[k], p.gamma_omega, p.eps_omega);
         }

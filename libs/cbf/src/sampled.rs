@@ -18,7 +18,8 @@
 //! * (C1) `p(s) ≥ 0` for all `s ∈ [0, T]` — the barrier itself holds inside the sample;
 //! * (C2) `H(p(T), v(T)) ≥ e^{−γT} H(h, ḣ)` with the paper's auxiliary (braking) barrier
 //!   `H(h, ḣ) = h + |ḣ| ḣ / (2μ)` — the next sample is again in the braking-safe set, and
-//!   `H` decays at most like the paper's `α(H) = γH`.
+//!   `H` decays at most like the paper's `α(H) = γH` (or, far inside the set, like a
+//!   steeper class-K function: [`Decay`]).
 //!
 //! `H` is increasing in both arguments and `p`, `v` increase with `φ`, so both become
 //! `φ ≥ φ_req`: one affine row `b·u ≥ φ_req − a`. Unlike the paper's row (whose input
@@ -37,6 +38,48 @@ use nalgebra::SVector;
 /// The paper's auxiliary barrier `H = h + |ḣ| ḣ / (2μ)`.
 pub fn braking_barrier(h: f64, hdot: f64, mu: f64) -> f64 {
     h + hdot.abs() * hdot / (2.0 * mu)
+}
+
+/// How much (C2) lets `H` decay in one sample: the discrete form of a class-K function
+/// that is the paper's `α(H) = γH` up to a knee `H_k` and steeper above it,
+/// `κ(H) = e^{−γT} min(H, H_k) + e^{−γ_in T} max(H − H_k, 0)`.
+///
+/// With `H_k = ∞` ([`Decay::linear`]) this is the paper's `e^{−γT} H`. For `γ_in ≥ γ ≥ 0`,
+/// `κ(0) = 0`, `κ` is increasing and `κ(H) ≤ H` on `H ≥ 0`: the braking command (which
+/// does not decrease `H`) still meets (C2), `{h ≥ 0, H ≥ 0}` stays invariant, and wherever
+/// `H ≤ H_k` — everywhere near the boundary — the row is exactly the paper's. Above the
+/// knee, far inside the set, `H` may fall faster: there a barrier whose input gain
+/// vanishes (the line of sight near its cone's axis) need not be braked for a decay that
+/// cannot threaten it (docs/SAFETY.md, "Line of sight").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Decay {
+    /// γ [1/s] of `α(H) = γH` below the knee (the paper's γ_h).
+    pub gamma: f64,
+    /// `H_k` [unit of h]; `f64::INFINITY`: no knee.
+    pub knee: f64,
+    /// γ_in [1/s] above the knee, `≥ γ`.
+    pub gamma_inner: f64,
+}
+
+impl Decay {
+    /// The paper's `α(H) = γH` everywhere.
+    pub fn linear(gamma: f64) -> Self {
+        Self {
+            gamma,
+            knee: f64::INFINITY,
+            gamma_inner: gamma,
+        }
+    }
+
+    /// `κ(H)` for a sample of length `t` [s].
+    pub fn target(&self, big_h: f64, t: f64) -> f64 {
+        let below = (-self.gamma * t).exp();
+        if big_h <= self.knee {
+            below * big_h
+        } else {
+            below * self.knee + (-self.gamma_inner * t).exp() * (big_h - self.knee)
+        }
+    }
 }
 
 /// Bounds on the model's error inside one sample of a relative-degree-two barrier.
@@ -127,10 +170,15 @@ impl<const M: usize> RelDeg2<M> {
     /// `φ_req`: the smallest `ḧ` at the sample for which (C1) and (C2) hold, with braking
     /// authority `μ` in `H` and class-K gain `γ`.
     pub fn phi_required(&self, bounds: &SampleBounds, mu: f64, gamma: f64) -> f64 {
+        self.phi_required_with(bounds, mu, &Decay::linear(gamma))
+    }
+
+    /// [`Self::phi_required`] with the decay of (C2) given by `decay`.
+    pub fn phi_required_with(&self, bounds: &SampleBounds, mu: f64, decay: &Decay) -> f64 {
         let t = bounds.period;
         let (h, hd) = (self.h, self.hdot);
         let c1 = bounds.m2 + bounds.m3 * t / 3.0 + c1_requirement(h, hd, t);
-        let kappa = (-gamma * t).exp() * braking_barrier(h, hd, mu);
+        let kappa = decay.target(braking_barrier(h, hd, mu), t);
         let p0 = h + hd * t - bounds.m3 * t * t * t / 6.0;
         let v0 = hd - 0.5 * bounds.m3 * t * t;
         let c2 = bounds.m2 + c2_requirement(p0, v0, t, mu, kappa);
@@ -139,9 +187,14 @@ impl<const M: usize> RelDeg2<M> {
 
     /// The row `b·u + (a − φ_req) ≥ 0`.
     pub fn row(&self, bounds: &SampleBounds, mu: f64, gamma: f64) -> Row<M> {
+        self.row_with(bounds, mu, &Decay::linear(gamma))
+    }
+
+    /// [`Self::row`] with the decay of (C2) given by `decay`.
+    pub fn row_with(&self, bounds: &SampleBounds, mu: f64, decay: &Decay) -> Row<M> {
         Row {
             a: self.b,
-            c: self.a - self.phi_required(bounds, mu, gamma),
+            c: self.a - self.phi_required_with(bounds, mu, decay),
         }
     }
 }
@@ -246,6 +299,52 @@ mod tests {
                 "phi_req {phi} > braking {}",
                 braking_requirement(&b, mu)
             );
+        }
+    }
+
+    #[test]
+    fn a_knee_only_relaxes_the_row_above_it_and_keeps_the_set_invariant() {
+        let mut seed = 3;
+        for _ in 0..20000 {
+            let mut r = || lcg(&mut seed);
+            let mu = 0.001 + r();
+            let b = SampleBounds {
+                period: 0.01 + 0.2 * r(),
+                m2: 0.1 * r(),
+                m3: r() * r(),
+            };
+            let hdot = 2.0 * r() - 1.0;
+            let h = hdot.min(0.0).powi(2) / (2.0 * mu) + r() * r();
+            let x = RelDeg2 {
+                h,
+                hdot,
+                a: 0.0,
+                b: Vector1::new(1.0),
+            };
+            let gamma = 2.0 * r();
+            let decay = Decay {
+                gamma,
+                knee: r() * r(),
+                gamma_inner: gamma + 20.0 * r(),
+            };
+            let big_h = braking_barrier(h, hdot, mu);
+            let kappa = decay.target(big_h, b.period);
+            assert!((0.0..=big_h).contains(&kappa), "κ({big_h}) = {kappa}");
+            let linear = x.phi_required(&b, mu, gamma);
+            let phi = x.phi_required_with(&b, mu, &decay);
+            // never stricter than the paper's decay, and the same up to the knee
+            assert!(phi <= linear + 1e-12, "{phi} > {linear}");
+            if big_h <= decay.knee {
+                assert_eq!(phi, linear);
+            }
+            // the worst case still keeps h ≥ 0 inside the sample and H(T) ≥ κ(H) ≥ 0
+            for k in 0..=200 {
+                let s = b.period * k as f64 / 200.0;
+                let (p, _) = worst(&x, &b, phi, s);
+                assert!(p >= -1e-12 * (1.0 + h), "h({s}) = {p}");
+            }
+            let (p, v) = worst(&x, &b, phi, b.period);
+            assert!(braking_barrier(p, v, mu) >= kappa - 1e-9 * (1.0 + kappa.abs()));
         }
     }
 

@@ -249,6 +249,13 @@ pub struct SafetyAttitude {
     pub gamma_omega_per_s: f64,
     /// u_max of the line-of-sight auxiliary barrier [1/s²].
     pub u_max_att_per_s2: f64,
+    /// Knee of the line of sight's class-K function, as the angle from the cone's axis
+    /// [deg]: where the boresight is closer to the line of sight than this, `H_ATT` may
+    /// decay at `gamma_los_inner_per_s` instead of γ_h (`sc_cbf::sampled::Decay`;
+    /// 0: the paper's `α(H) = γ_h H` everywhere).
+    pub los_decay_knee_deg: f64,
+    /// γ of the line of sight's class-K function inside the knee [1/s] (≥ γ_h).
+    pub gamma_los_inner_per_s: f64,
     /// Certified set: the boresight's angular rate across itself, `‖ω_B × d_B‖`, at most
     /// this [rad/s] (not one of the paper's barriers; docs/SAFETY.md, "Line of sight").
     pub boresight_rate_max_rad_s: f64,

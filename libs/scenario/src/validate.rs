@@ -307,6 +307,26 @@ impl Scenario {
         non_negative("safety.attitude.eps_omega", at.eps_omega)?;
         positive("safety.attitude.gamma_omega_per_s", at.gamma_omega_per_s)?;
         positive("safety.attitude.u_max_att_per_s2", at.u_max_att_per_s2)?;
+        if !(at.los_decay_knee_deg >= 0.0 && at.los_decay_knee_deg < at.los_half_angle_deg) {
+            return Err(invalid(
+                "safety.attitude.los_decay_knee_deg",
+                at.los_decay_knee_deg,
+                format!(
+                    "an angle in [0, los_half_angle_deg = {}) deg",
+                    at.los_half_angle_deg
+                ),
+            ));
+        }
+        if !(at.gamma_los_inner_per_s >= sf.gamma_per_s && at.gamma_los_inner_per_s.is_finite()) {
+            return Err(invalid(
+                "safety.attitude.gamma_los_inner_per_s",
+                at.gamma_los_inner_per_s,
+                format!(
+                    "a finite rate >= safety.gamma_per_s = {} 1/s",
+                    sf.gamma_per_s
+                ),
+            ));
+        }
         positive(
             "safety.attitude.boresight_rate_max_rad_s",
             at.boresight_rate_max_rad_s,

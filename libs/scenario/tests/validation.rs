@@ -103,6 +103,22 @@ fn limits_with_min_above_max_are_rejected() {
 }
 
 #[test]
+fn line_of_sight_knee_must_lie_inside_the_cone_and_be_steeper() {
+    let msg = reject(&with("safety.attitude", "los_decay_knee_deg", "5.0"));
+    assert!(
+        msg.contains("los_decay_knee_deg") && msg.contains("los_half_angle_deg = 5"),
+        "{msg}"
+    );
+    let msg = reject(&with("safety.attitude", "los_decay_knee_deg", "-1.0"));
+    assert!(msg.contains("los_decay_knee_deg"), "{msg}");
+    let msg = reject(&with("safety.attitude", "gamma_los_inner_per_s", "0.5"));
+    assert!(
+        msg.contains("gamma_los_inner_per_s") && msg.contains("safety.gamma_per_s"),
+        "{msg}"
+    );
+}
+
+#[test]
 fn missing_urdf_is_rejected() {
     let msg = reject(&with("servicer", "urdf", "\"no_such_arm.urdf\""));
     assert!(
