@@ -212,6 +212,10 @@ pub struct CampaignSummary {
     /// Phase → spread of the per-run peak joint-torque norm [N m].
     pub joint_torque_norm_peak_nm: BTreeMap<String, Spread>,
     pub joint_torque_norm_rms_grasp_nm: Option<Spread>,
+    /// Result in the grasping phase → its correlation with the target's tumbling rate over
+    /// the runs (the paper: synchronisation error and joint torque rise with the rate).
+    #[serde(default)]
+    pub trend_with_tumble_rate: BTreeMap<String, crate::trend::Trend>,
     /// Wall clock: filter → statistics over every step of every run [µs].
     pub solve_time_us: BTreeMap<String, TimeStats>,
     /// Thread CPU time: filter → statistics over every step of every run [µs].
@@ -220,6 +224,12 @@ pub struct CampaignSummary {
     /// Wall clock: the campaign's wall time (merged: sum over the shards) [s].
     pub wall_time_s: f64,
 }
+
+/// Keys of [`CampaignSummary::trend_with_tumble_rate`]: the grasping phase's peak
+/// synchronisation error [rad/s], RMS and peak joint-torque norm [N m].
+pub const TREND_SYNC_PEAK: &str = "sync_error_peak_grasp_rad_s";
+pub const TREND_TORQUE_RMS: &str = "joint_torque_norm_rms_grasp_nm";
+pub const TREND_TORQUE_PEAK: &str = "joint_torque_norm_peak_grasp_nm";
 
 /// Keys of [`CampaignSummary`] that depend on the wall clock.
 pub const WALL_CLOCK_KEYS: [&str; 3] = ["solve_time_us", "solve_cpu_us", "wall_time_s"];
@@ -632,12 +642,14 @@ pub fn aggregate(dir: &Path, wall_time_s: f64) -> Result<CampaignSummary, McErro
         sync_error_peak_rad_s: BTreeMap::new(),
         joint_torque_norm_peak_nm: BTreeMap::new(),
         joint_torque_norm_rms_grasp_nm: None,
+        trend_with_tumble_rate: BTreeMap::new(),
         solve_time_us: BTreeMap::new(),
         solve_cpu_us: BTreeMap::new(),
         wall_time_s,
     };
     let mut traces = Vec::new();
     let mut points = Vec::new();
+    let mut trend_pairs: BTreeMap<&str, Vec<(f64, f64)>> = BTreeMap::new();
     for l in &loaded {
         let r = &l.result;
         if let Some(t) = &l.timing {
@@ -689,6 +701,22 @@ pub fn aggregate(dir: &Path, wall_time_s: f64) -> Result<CampaignSummary, McErro
         }
         if let (Some(d), Some(g)) = (&r.dispersion, &grasp) {
             let peak = m.sync_error_peak_rad_s.get(g).copied().flatten();
+            let results = [
+                (TREND_SYNC_PEAK, peak),
+                (TREND_TORQUE_RMS, m.joint_torque_norm_rms_grasp_nm),
+                (
+                    TREND_TORQUE_PEAK,
+                    m.joint_torque_norm_peak_nm.get(g).copied().flatten(),
+                ),
+            ];
+            for (k, v) in results {
+                if let Some(v) = v {
+                    trend_pairs
+                        .entry(k)
+                        .or_default()
+                        .push((d.tumble_rate_rad_s, v));
+                }
+            }
             if let (Some(peak), Some(tq)) = (peak, m.joint_torque_norm_rms_grasp_nm) {
                 points.push(RunPoint {
                     run: r.run,
@@ -710,6 +738,10 @@ pub fn aggregate(dir: &Path, wall_time_s: f64) -> Result<CampaignSummary, McErro
         .filter_map(|(k, v)| v.0.map(|x| (k, x)))
         .collect();
     s.joint_torque_norm_rms_grasp_nm = rms.0;
+    s.trend_with_tumble_rate = trend_pairs
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), crate::trend::trend(&v)))
+        .collect();
     s.solve_time_us = TIMERS
         .iter()
         .map(|n| {

@@ -10,6 +10,7 @@
 //! * [`campaign`] — run a campaign or a shard in parallel (rayon, `--jobs` threads, an
 //!   indicatif progress bar), aggregate, merge shards, rerun one run.
 //! * [`report`] — the Markdown report beside the paper's numbers.
+//! * [`trend`] — correlation of a result with a dispersed parameter (Pearson, Spearman).
 
 pub mod campaign;
 pub mod config;
@@ -17,6 +18,7 @@ pub mod hist;
 pub mod report;
 pub mod run;
 pub mod sample;
+pub mod trend;
 
 pub use campaign::{
     CampaignInfo, CampaignOptions, CampaignSummary, McError, WALL_CLOCK_FILES, WALL_CLOCK_KEYS,

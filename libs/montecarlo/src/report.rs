@@ -118,6 +118,31 @@ pub fn report(
         "| RMS joint-torque norm in grasping, range | {} N m | (figure only) |",
         spread(s.joint_torque_norm_rms_grasp_nm.as_ref(), 3)
     );
+    let corr = |v: Option<f64>| v.map_or("–".into(), |c| format!("{c:+.2}"));
+    for (key, what) in [
+        (
+            crate::campaign::TREND_SYNC_PEAK,
+            "peak sync error in grasping",
+        ),
+        (
+            crate::campaign::TREND_TORQUE_RMS,
+            "RMS joint-torque norm in grasping",
+        ),
+        (
+            crate::campaign::TREND_TORQUE_PEAK,
+            "peak joint-torque norm in grasping",
+        ),
+    ] {
+        if let Some(t) = s.trend_with_tumble_rate.get(key) {
+            let _ = writeln!(
+                o,
+                "| {what} against the tumbling rate, correlation (Pearson / Spearman, {} runs) | {} / {} | rises with the rate |",
+                t.runs,
+                corr(t.pearson),
+                corr(t.spearman)
+            );
+        }
+    }
     let _ = writeln!(
         o,
         "| capture time, range | {} s | – |\n",
