@@ -1,6 +1,6 @@
 //! `safe-capture redteam`: the red-team campaign against the safety layer.
 
-use crate::redteam_partition::{Partners, case_dir, default_python};
+use crate::redteam_partition::{Partners, default_python};
 use anyhow::Context;
 use rayon::prelude::*;
 use sc_mission::Setup;
@@ -101,6 +101,10 @@ pub struct Args {
     /// List the cases and exit.
     #[arg(long)]
     list: bool,
+    /// In process: also write each case's telemetry.csv and timing.csv to
+    /// OUT/cases/<case>/ (the partition always does), to look at a case step by step.
+    #[arg(long, conflicts_with = "partition")]
+    telemetry: bool,
 }
 
 /// The cases the arguments select (`ticks`: a partition run's length).
@@ -220,7 +224,8 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
                 .iter()
                 .map(|c| Case::parse(&c.name()).map_err(anyhow::Error::msg))
                 .collect::<anyhow::Result<_>>()?;
-            sc_redteam::run_campaign(&setup, &in_process, &progress)
+            let telemetry = a.telemetry.then_some(a.out.as_path());
+            sc_redteam::run_campaign_recorded(&setup, &in_process, &progress, telemetry)
         }
         Some(p) => {
             let done = AtomicUsize::new(0);
@@ -229,7 +234,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
                 .par_iter()
                 .enumerate()
                 .map(|(k, c)| {
-                    let out = a.out.join("cases").join(case_dir(c));
+                    let out = a.out.join("cases").join(c.dir_name());
                     let r = p.run_case(&setup, c, &out, &format!("rt{k}-{pid}"));
                     let n = done.fetch_add(1, Ordering::SeqCst) + 1;
                     progress(n, cases.len(), &r);

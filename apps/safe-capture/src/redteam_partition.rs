@@ -201,18 +201,6 @@ impl Partners {
     }
 }
 
-/// The directory name of a case (`/` and `:` are awkward in paths).
-pub fn case_dir(case: &CaseLabel) -> String {
-    case.name()
-        .chars()
-        .map(|c| match c {
-            '/' => '_',
-            ':' => '=',
-            c => c,
-        })
-        .collect()
-}
-
 /// Parses `--hostile <target>/<strategy>` of `launch`.
 pub fn parse_hostile(s: &str) -> anyhow::Result<CaseLabel> {
     sc_redteam::partners::parse_partition_case(s)

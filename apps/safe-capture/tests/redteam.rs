@@ -84,6 +84,55 @@ fn every_strategy_on_every_target_in_process_is_safe() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
+/// `--telemetry` writes a case's steps in process, consistent with its verdict: one row
+/// per control step, and no logged barrier value below the case's minimum (which is
+/// taken over every physics step).
+#[test]
+fn a_case_can_be_looked_at_step_by_step() {
+    let d = tmp("redteam-telemetry");
+    let out = d.join("rt");
+    let o = cli(
+        &[
+            "redteam",
+            "--cases",
+            "translational/frozen",
+            "--telemetry",
+            "--out",
+            out.to_str().unwrap(),
+            "-q",
+        ],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let cases = std::fs::read_to_string(out.join("cases.csv")).unwrap();
+    let header: Vec<&str> = cases.lines().next().unwrap().split(',').collect();
+    let row: Vec<&str> = cases.lines().nth(1).unwrap().split(',').collect();
+    let steps: usize = row[header.iter().position(|c| *c == "steps").unwrap()]
+        .parse()
+        .unwrap();
+    let dir = out.join("cases").join("translational_frozen");
+    let tel = std::fs::read_to_string(dir.join("telemetry.csv")).unwrap();
+    assert_eq!(tel.lines().count(), steps + 1, "one row per control step");
+    assert!(dir.join("timing.csv").is_file());
+    let cols: Vec<&str> = tel.lines().next().unwrap().split(',').collect();
+    let k = cols.iter().position(|c| *c == "h_line_of_sight").unwrap();
+    let logged = tel
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(k).unwrap().parse::<f64>().unwrap())
+        .fold(f64::INFINITY, f64::min);
+    let min_h = std::fs::read_to_string(out.join("min_h.csv")).unwrap();
+    let mh: Vec<&str> = min_h.lines().next().unwrap().split(',').collect();
+    let mr: Vec<&str> = min_h.lines().nth(1).unwrap().split(',').collect();
+    let j = mh.iter().position(|c| *c == "line_of_sight").unwrap();
+    let case_min: f64 = mr[j].parse().unwrap();
+    assert!(
+        logged >= case_min && logged.is_finite(),
+        "logged {logged} < {case_min}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
 /// Hostile partner processes through the partition: ≥ 8 behaviours, 60 s of mission
 /// each (600 ticks) in lock-step; an impersonation attempt is refused and logged.
 #[test]

@@ -8,9 +8,10 @@ use crate::strategy::{Case, CaseLabel, Target};
 use rayon::prelude::*;
 use sc_cbf::faults;
 use sc_mission::summary::TimeStats;
-use sc_mission::{Mission, MissionEnd, RunOptions, Setup, StepRecord, summarize};
+use sc_mission::{Mission, MissionEnd, RunOptions, Setup, StepRecord, TelemetryWriter, summarize};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
+use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// What one case measured.
@@ -75,6 +76,16 @@ const DISTURBED: u32 = faults::INVALID_NOMINAL
 
 /// Runs one case to the end of its mission.
 pub fn run_case(setup: &Setup, case: &Case) -> Result<CaseResult, String> {
+    run_case_recorded(setup, case, None)
+}
+
+/// [`run_case`], and with `telemetry` (a directory, created) its `telemetry.csv` and
+/// `timing.csv` written there as `safe-capture run` writes them.
+pub fn run_case_recorded(
+    setup: &Setup,
+    case: &Case,
+    telemetry: Option<&Path>,
+) -> Result<CaseResult, String> {
     let adversary = Adversary::new(
         &setup.scenario,
         setup.robot.clone(),
@@ -86,7 +97,20 @@ pub fn run_case(setup: &Setup, case: &Case) -> Result<CaseResult, String> {
     mission.nominal_override = Some(Box::new(adversary));
     let mut records: Vec<StepRecord> = Vec::new();
     let end = mission.run(|_, r| records.push(*r));
+    if let Some(dir) = telemetry {
+        write_telemetry(dir, &records).map_err(|e| format!("{}: {e}", dir.display()))?;
+    }
     Ok(measure(setup, &case.label(), &records, &end))
+}
+
+fn write_telemetry(dir: &Path, records: &[StepRecord]) -> std::io::Result<()> {
+    std::fs::create_dir_all(dir)?;
+    let file = |n: &str| std::fs::File::create(dir.join(n)).map(std::io::BufWriter::new);
+    let mut w = TelemetryWriter::new(file("telemetry.csv")?, file("timing.csv")?)?;
+    for r in records {
+        w.write(r)?;
+    }
+    w.flush()
 }
 
 /// The result of a case from its records (in process, or read back from a partition
@@ -180,12 +204,24 @@ pub fn run_campaign(
     cases: &[Case],
     progress: &Progress,
 ) -> Vec<Result<CaseResult, String>> {
+    run_campaign_recorded(setup, cases, progress, None)
+}
+
+/// [`run_campaign`], and with `out` each case's telemetry in
+/// `out/cases/<case>/` ([`CaseLabel::dir_name`], [`run_case_recorded`]).
+pub fn run_campaign_recorded(
+    setup: &Setup,
+    cases: &[Case],
+    progress: &Progress,
+    out: Option<&Path>,
+) -> Vec<Result<CaseResult, String>> {
     let done = AtomicUsize::new(0);
     let total = cases.len();
     cases
         .par_iter()
         .map(|c| {
-            let r = run_case(setup, c);
+            let dir = out.map(|o| o.join("cases").join(c.label().dir_name()));
+            let r = run_case_recorded(setup, c, dir.as_deref());
             let k = done.fetch_add(1, Ordering::SeqCst) + 1;
             progress(k, total, &r);
             r

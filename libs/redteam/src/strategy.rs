@@ -187,6 +187,18 @@ impl CaseLabel {
     pub fn name(&self) -> String {
         format!("{}/{}", self.target, self.strategy)
     }
+
+    /// The case's directory name under `OUT/cases/` (`/` and `:` are awkward in paths).
+    pub fn dir_name(&self) -> String {
+        self.name()
+            .chars()
+            .map(|c| match c {
+                '/' => '_',
+                ':' => '=',
+                c => c,
+            })
+            .collect()
+    }
 }
 
 impl Case {
