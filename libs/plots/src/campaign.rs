@@ -117,14 +117,13 @@ fn trajectories(area: &Area, f: &CampaignFigures) -> DrawResult {
             .chain([g.caz_radius_m, -g.caz_radius_m]),
         0.1,
     );
+    let title = format!(
+        "Approach trajectories of {} runs in F_R (x_R–y_R), coloured by speed",
+        f.traces.len()
+    );
+    let (xr, yr) = crate::chart::equal_aspect(&main, &title, xr, yr);
     let mut chart = ChartBuilder::on(&main)
-        .caption(
-            format!(
-                "Approach trajectories of {} runs in F_R (x_R–y_R), coloured by speed",
-                f.traces.len()
-            ),
-            ("sans-serif", 18),
-        )
+        .caption(&title, ("sans-serif", 18))
         .margin(8)
         .x_label_area_size(36)
         .y_label_area_size(64)

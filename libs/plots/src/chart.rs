@@ -14,6 +14,39 @@ pub fn e<T: std::fmt::Display>(x: T) -> String {
     x.to_string()
 }
 
+/// Ranges for a spatial chart of the standard layout ([`Panel`]: caption `title`, margin 8,
+/// label areas 36 and 64 px) on `area`: the shorter range is widened about its centre so
+/// that a metre is as long on both axes and a sphere is drawn round.
+pub fn equal_aspect(
+    area: &Area,
+    title: &str,
+    x: (f64, f64),
+    y: (f64, f64),
+) -> ((f64, f64), (f64, f64)) {
+    // the plotting area this layout leaves, measured on a scratch canvas of the same size
+    let mut scratch = String::new();
+    let root = SVGBackend::with_string(&mut scratch, area.dim_in_pixel()).into_drawing_area();
+    let Ok(chart) = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 18))
+        .margin(8)
+        .x_label_area_size(36)
+        .y_label_area_size(64)
+        .build_cartesian_2d(0f64..1.0, 0f64..1.0)
+    else {
+        return (x, y);
+    };
+    let (w, h) = chart.plotting_area().dim_in_pixel();
+    if w == 0 || h == 0 {
+        return (x, y);
+    }
+    let per_px = ((x.1 - x.0) / w as f64).max((y.1 - y.0) / h as f64);
+    let widen = |r: (f64, f64), px: u32| {
+        let (c, half) = (0.5 * (r.0 + r.1), 0.5 * per_px * px as f64);
+        (c - half, c + half)
+    };
+    (widen(x, w), widen(y, h))
+}
+
 /// Renders an SVG of `size` with `draw` and writes it to `path`. A panic inside plotters
 /// (it has a few on degenerate input) is caught and reported as an error.
 pub fn svg(

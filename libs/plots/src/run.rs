@@ -195,6 +195,7 @@ fn trajectory(area: &Area, runs: &Runs, g: &Geometry) -> DrawResult {
             .flat_map(|(r, ..)| r.iter().map(|x| x.obs.r_r[*j]));
         let xr = crate::chart::range(xs.chain([g.caz_radius_m, -g.caz_radius_m]), 0.05);
         let yr = crate::chart::range(ys.chain([g.caz_radius_m, -g.caz_radius_m]), 0.1);
+        let (xr, yr) = crate::chart::equal_aspect(&panels[k], &p.title, xr, yr);
         p.x_range = Some(xr);
         p.y_range = Some(yr);
         p.draw(&panels[k])?;

@@ -139,6 +139,29 @@ fn campaign_data() -> CampaignData {
     (traces, points, runtime, minima)
 }
 
+/// Pixel width and height of the widest polyline of `stroke` colour in an SVG.
+fn widest_polyline_extent(svg: &str, stroke: &str) -> Option<(f64, f64)> {
+    svg.split("<polyline")
+        .skip(1)
+        .filter(|p| p.contains(&format!("stroke=\"{stroke}\"")))
+        .filter_map(|p| {
+            let pts = p.split("points=\"").nth(1)?.split('"').next()?;
+            let xy: Vec<(f64, f64)> = pts
+                .split_whitespace()
+                .filter_map(|q| {
+                    let (x, y) = q.split_once(',')?;
+                    Some((x.parse().ok()?, y.parse().ok()?))
+                })
+                .collect();
+            let ext = |f: fn(&(f64, f64)) -> f64| {
+                let v = xy.iter().map(f);
+                v.clone().fold(f64::NEG_INFINITY, f64::max) - v.fold(f64::INFINITY, f64::min)
+            };
+            Some((ext(|p| p.0), ext(|p| p.1)))
+        })
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+}
+
 #[test]
 fn campaign_figures_are_written_and_deterministic() {
     let s = short_scenario(1.0);
@@ -161,6 +184,11 @@ fn campaign_figures_are_written_and_deterministic() {
         assert!(x.starts_with("<svg"));
         assert_eq!(x, std::fs::read_to_string(b.join(name)).unwrap());
     }
+    // the collision-avoidance zone is drawn round (equal aspect): its polyline is as wide
+    // as it is tall, in pixels
+    let traj = std::fs::read_to_string(a.join("trajectories_xy.svg")).unwrap();
+    let (w, h) = widest_polyline_extent(&traj, "#D62728").expect("zone drawn");
+    assert!(w > 50.0 && (w - h).abs() <= 2.0, "zone {w} x {h} px");
     // empty campaign
     let empty = CampaignFigures {
         traces: &[],
