@@ -52,6 +52,16 @@ pub struct Args {
     /// process.
     #[arg(long, value_name = "DIR")]
     replay_nominals: Option<PathBuf>,
+    /// Basilisk propagates the true state instead of our simulator (a child process,
+    /// scripts/basilisk_plant.py; needs `scripts/setup.sh --with-basilisk`): everything
+    /// else — filters, nominal controllers, barrier monitor, outputs — is this process's.
+    /// Implies --no-compare. docs/SIMULATOR.md, "Basilisk in the loop".
+    #[arg(long)]
+    basilisk: bool,
+    /// --basilisk: the Python interpreter with Basilisk (default: $SC_PYTHON, else
+    /// scripts/.venv/bin/python).
+    #[arg(long, value_name = "PY", default_value_os_t = crate::redteam_partition::default_python())]
+    python: PathBuf,
 }
 
 /// Where the run's nominal commands come from.
@@ -100,6 +110,7 @@ pub fn run_mission(
     dump_qp: Option<&Path>,
     quiet: bool,
     nominal_override: Option<Box<dyn sc_mission::NominalOverride>>,
+    plant: Option<Box<dyn sc_sim::Plant + Send>>,
 ) -> anyhow::Result<(Vec<StepRecord>, MissionEnd)> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let open = |name: &str| -> anyhow::Result<std::io::BufWriter<std::fs::File>> {
@@ -118,6 +129,9 @@ pub fn run_mission(
     let duration = setup.scenario.mission.duration_s;
     let mut mission = Mission::new(setup, options)?;
     mission.nominal_override = nominal_override;
+    if let Some(p) = plant {
+        mission.set_plant(p).map_err(anyhow::Error::msg)?;
+    }
     let mut records = Vec::new();
     let mut io_err: Option<std::io::Error> = None;
     let mut last_print = 0.0;
@@ -186,6 +200,19 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let compare_setup = setup.clone();
     let nominals = Nominals::from_args(&a)?;
     let source = nominals.source(&setup);
+    let plant: Option<Box<dyn sc_sim::Plant + Send>> = if a.basilisk {
+        let script = Path::new("scripts/basilisk_plant.py");
+        let args = vec![
+            script.display().to_string(),
+            "--scenario".to_string(),
+            a.scenario.display().to_string(),
+        ];
+        Some(Box::new(crate::plant_process::ProcessPlant::spawn(
+            &a.python, &args,
+        )?))
+    } else {
+        None
+    };
     let (records, end) = run_mission(
         setup,
         options,
@@ -193,6 +220,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         a.dump_qp.as_deref(),
         a.quiet,
         source,
+        plant,
     )?;
     let summary = summarize(&records, &end, &phase_names, !a.no_filter);
     let path = a.out.join("summary.json");
@@ -204,13 +232,14 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             &scenario,
             &records,
             compare_setup,
-            a.no_filter || a.no_compare,
+            a.no_filter || a.no_compare || a.basilisk,
             &nominals,
         )?;
     }
     let safe = summary.violated_constraints.is_empty() && summary.fault_count == 0;
     let what = format!(
-        "{}{}",
+        "{}{}{}",
+        if a.basilisk { "Basilisk plant, " } else { "" },
         match (&a.redteam, &a.replay_nominals) {
             (Some(c), _) => format!("red team {c}, "),
             (None, Some(d)) => format!("replay of {}, ", d.display()),
@@ -281,6 +310,7 @@ fn write_figures(
             None,
             true,
             source,
+            None,
         )?;
         let summary = summarize(&recs, &end, &phase_names, false);
         let path = dir.join("summary.json");

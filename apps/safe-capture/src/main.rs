@@ -15,6 +15,7 @@ mod cmd_simulate;
 mod cmd_verify_qp;
 // `montecarlo --mode partition`: runs through the process partition
 mod montecarlo_partition;
+mod plant_process;
 mod redteam_partition;
 
 use clap::{Parser, Subcommand};

@@ -7,7 +7,7 @@ use crate::stages;
 use sc_cbf::monitor::{Barriers, Monitor, min_into};
 use sc_cbf::{QpDump, SafetyLayer};
 use sc_nominal::NominalControllers;
-use sc_sim::{Command, Simulator};
+use sc_sim::{Command, Plant, Simulator};
 
 /// Options of a run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -82,6 +82,8 @@ pub struct Mission {
     between: Option<Barriers>,
     /// Replaces nominal commands (a partner's controller or a red-team adversary).
     pub nominal_override: Option<Box<dyn NominalOverride>>,
+    /// Propagates the true state instead of the simulator's own RK4 ([`Self::set_plant`]).
+    plant: Option<Box<dyn Plant + Send>>,
     end: Option<MissionEnd>,
 }
 
@@ -103,8 +105,17 @@ impl Mission {
             monitor,
             between: None,
             nominal_override: None,
+            plant: None,
             end: None,
         })
+    }
+
+    /// Propagates with `plant` from now on (another simulator in the loop, e.g. Basilisk),
+    /// started at the current state.
+    pub fn set_plant(&mut self, mut plant: Box<dyn Plant + Send>) -> Result<(), String> {
+        plant.start(self.sim.state())?;
+        self.plant = Some(plant);
+        Ok(())
     }
 
     /// How the run ended, once it has.
@@ -228,12 +239,18 @@ impl Mission {
         }
         let monitor = &self.monitor;
         let mut between: Barriers = [f64::INFINITY; sc_cbf::monitor::N_ALL];
-        let stepped = self.sim.step_with(&r.applied, |b| {
+        let at_physics_step = |b: &sc_sim::BarrierState| {
             min_into(
                 &mut between,
                 &monitor.evaluate(&stages::monitor_state_between(b)),
             )
-        });
+        };
+        let stepped = match self.plant.as_mut() {
+            Some(p) => self
+                .sim
+                .step_with_plant(p.as_mut(), &r.applied, at_physics_step),
+            None => self.sim.step_with(&r.applied, at_physics_step),
+        };
         self.between = Some(between);
         if let Err(e) = stepped {
             self.end = Some(MissionEnd::SimulatorFailed {

@@ -18,11 +18,13 @@
 //! [`Simulator::observe`] gives what each subsystem needs ([`Observation`]).
 
 mod observation;
+mod plant;
 mod profile;
 mod report;
 mod state;
 
 pub use observation::{Observation, TRAJECTORY_COLUMNS, TrajectoryRow};
+pub use plant::{Plant, SIM_STATE_LEN};
 pub use profile::{CommandProfile, PROFILE_COLUMNS, ProfileError};
 pub use report::{ModelReport, ModelState, evaluate_model};
 pub use state::{BarrierState, Command, SimError, SimState, Simulator};

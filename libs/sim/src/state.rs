@@ -51,6 +51,8 @@ pub enum SimError {
     Diverged { t: f64 },
     #[error("model: {0}")]
     Model(String),
+    #[error("plant at t = {t} s: {message}")]
+    Plant { t: f64, message: String },
 }
 
 /// The part of the true state every safety barrier depends on (see `sc_cbf::monitor`).
@@ -331,7 +333,7 @@ impl Simulator {
         self.barrier_state_of(&self.state)
     }
 
-    fn barrier_state_of(&self, s: &SimState) -> BarrierState {
+    pub(crate) fn barrier_state_of(&self, s: &SimState) -> BarrierState {
         let q_ri = quat::conj(&self.p.q_ir);
         let r_ri = quat::to_matrix(&q_ri);
         let com_b = self.robot.center_of_mass(&s.theta);

@@ -1,0 +1,216 @@
+#!/usr/bin/env python3
+"""Basilisk as the plant of `safe-capture run --basilisk`: propagates the true state.
+
+The servicer is a Basilisk hub with the 7-DoF arm as a `spinningBodyNDOFStateEffector`,
+built from the scenario's URDF (parsed, not re-typed: `basilisk_reference.parse_urdf`);
+the target is a second, torque-free spacecraft; both on two-body orbits around a
+point-mass Earth with the scenario's mu; Basilisk's RK4 at the physics step it is asked
+for. Everything else of the mission — nominal controllers, safety filters, the barrier
+monitor, telemetry — stays in the Rust process that started this one.
+
+Protocol (one line per message on stdin/stdout; numbers in shortest round-trip form;
+`safe-capture`'s `plant_process.rs` is the other side):
+  init <41 numbers>      -> ready          (SimState: t, r_t, v_t, q_it, w_t, dr, dv, q_ib,
+                                            w_b, theta, theta_dot; inertial frame, SI,
+                                            quaternions scalar first)
+  step <h> <n> <13 numbers: f_B, tau_B, tau_M>  -> n lines `state <41 numbers>`
+  stop                   -> exit 0
+Any failure is answered with `error <message>` and exit 1.
+
+Conventions that bite (docs/SIMULATOR.md): Basilisk's hub initial position and velocity
+are the system's centre of mass, its outputs the hub origin; attitudes are MRPs (converted
+through rotation matrices); a command written before ExecuteSimulation acts on the whole
+step; the arm is updated before the spacecraft so that it integrates this step's torques.
+"""
+
+import argparse
+import math
+import os
+import sys
+import tomllib
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from basilisk_reference import com_offset, parse_urdf, quat_to_dcm  # noqa: E402
+
+
+def dcm_to_quat(m, previous):
+    """Scalar-first unit quaternion of the rotation matrix m, the sign nearest `previous`."""
+    tr = np.trace(m)
+    if tr > 0:
+        s = 2.0 * math.sqrt(1.0 + tr)
+        q = np.array([0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s])
+    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2])
+        q = np.array([(m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s])
+    elif m[1, 1] > m[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2])
+        q = np.array([(m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s])
+    else:
+        s = 2.0 * math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1])
+        q = np.array([(m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s])
+    q /= np.linalg.norm(q)
+    return -q if np.dot(q, previous) < 0 else q
+
+
+class BasiliskPlant:
+    def __init__(self, scenario_path):
+        with open(scenario_path, "rb") as f:
+            self.scenario = tomllib.load(f)
+        urdf = self.scenario["servicer"]["urdf"]
+        if not os.path.isabs(urdf):
+            urdf = os.path.join(os.path.dirname(os.path.abspath(scenario_path)), urdf)
+        self.model = parse_urdf(urdf)
+        self.sim = None
+
+    def init(self, x):
+        from Basilisk.architecture import messaging
+        from Basilisk.simulation import extForceTorque, spacecraft, spinningBodyNDOFStateEffector, svIntegrators
+        from Basilisk.utilities import RigidBodyKinematics as rbk
+        from Basilisk.utilities import SimulationBaseClass, macros, simIncludeGravBody
+
+        self.rbk, self.macros, self.messaging = rbk, macros, messaging
+        t, r_t, v_t, q_it, w_t = x[0], x[1:4], x[4:7], x[7:11], x[11:14]
+        dr, dv, q_ib, w_b, theta, theta_dot = x[14:17], x[17:20], x[20:24], x[24:27], x[27:34], x[34:41]
+        self.q_it, self.q_ib = q_it, q_ib
+        self.t_ns = int(round(t * 1e9))
+
+        sim = SimulationBaseClass.SimBaseClass()
+        self.proc = sim.CreateNewProcess("dynamics")
+        self.task_step_ns = None
+        grav = simIncludeGravBody.gravBodyFactory()
+        earth = grav.createEarth()
+        earth.isCentralBody = True
+        earth.mu = self.scenario["orbit"]["earth_mu_m3_s2"]
+
+        sc = spacecraft.Spacecraft()
+        sc.ModelTag = "servicer"
+        m0, c0, i0 = self.model["base"]
+        sc.hub.mHub = m0
+        sc.hub.r_BcB_B = c0.reshape(3, 1).tolist()
+        sc.hub.IHubPntBc_B = i0.tolist()
+        arm = spinningBodyNDOFStateEffector.SpinningBodyNDOFStateEffector()
+        arm.ModelTag = "arm"
+        for b, th, thd in zip(self.model["chain"], theta, theta_dot):
+            s = spinningBodyNDOFStateEffector.SpinningBody()
+            s.setMass(b["mass"])
+            s.setISPntSc_S(b["inertia"].tolist())
+            s.setDCM_S0P(b["rot"].T.tolist())
+            s.setR_ScS_S(b["com"].reshape(3, 1).tolist())
+            s.setR_SP_P(b["pos"].reshape(3, 1).tolist())
+            s.setSHat_S((b["axis"] / np.linalg.norm(b["axis"])).reshape(3, 1).tolist())
+            s.setThetaInit(float(th))
+            s.setThetaDotInit(float(thd))
+            arm.addSpinningBody(s)
+        sc.addStateEffector(arm)
+        ext = extForceTorque.ExtForceTorque()
+        ext.ModelTag = "wrench"
+        sc.addDynamicEffector(ext)
+        self.torque_msg = messaging.ArrayMotorTorqueMsg()
+        arm.motorTorqueInMsg.subscribeTo(self.torque_msg)
+
+        r_ib = quat_to_dcm(q_ib)
+        c_b, c_dot_b = com_offset(self.model, theta, theta_dot)
+        r_b, v_b = r_t + dr, v_t + dv
+        sc.hub.r_CN_NInit = (r_b + r_ib @ c_b).reshape(3, 1).tolist()
+        sc.hub.v_CN_NInit = (v_b + r_ib @ (np.cross(w_b, c_b) + c_dot_b)).reshape(3, 1).tolist()
+        sc.hub.sigma_BNInit = np.array(rbk.C2MRP(r_ib.T)).reshape(3, 1).tolist()
+        sc.hub.omega_BN_BInit = w_b.reshape(3, 1).tolist()
+        sc.setIntegrator(svIntegrators.svIntegratorRK4(sc))
+        grav.addBodiesTo(sc)
+
+        tg = spacecraft.Spacecraft()
+        tg.ModelTag = "target"
+        tg.hub.mHub = self.scenario["target"]["mass_kg"]
+        tg.hub.IHubPntBc_B = self.scenario["target"]["inertia_kg_m2"]
+        tg.hub.r_BcB_B = [[0.0], [0.0], [0.0]]
+        tg.hub.r_CN_NInit = r_t.reshape(3, 1).tolist()
+        tg.hub.v_CN_NInit = v_t.reshape(3, 1).tolist()
+        tg.hub.sigma_BNInit = np.array(rbk.C2MRP(quat_to_dcm(q_it).T)).reshape(3, 1).tolist()
+        tg.hub.omega_BN_BInit = w_t.reshape(3, 1).tolist()
+        tg.setIntegrator(svIntegrators.svIntegratorRK4(tg))
+        grav.addBodiesTo(tg)
+        self.sim, self.sc, self.tg, self.arm, self.ext = sim, sc, tg, arm, ext
+        self.models = ((arm, 300), (ext, 300), (sc, 200), (tg, 200))
+
+    def _start_task(self, h_ns):
+        """The task is created at the first step, when the physics step is known."""
+        self.proc.addTask(self.sim.CreateNewTask("step", h_ns))
+        for m, priority in self.models:
+            self.sim.AddModelToTask("step", m, None, priority)
+        self.sim.InitializeSimulation()
+        self.theta_state = self.sc.dynManager.getStateObject(self.arm.getNameOfThetaState())
+        self.theta_dot_state = self.sc.dynManager.getStateObject(self.arm.getNameOfThetaDotState())
+        self.task_step_ns = h_ns
+        if self.t_ns != 0:
+            raise ValueError("the plant starts at t = 0 only")
+
+    def state(self):
+        rbk = self.rbk
+        s = self.sc.scStateOutMsg.read()
+        t = self.tg.scStateOutMsg.read()
+        r_b, v_b = np.array(s.r_BN_N), np.array(s.v_BN_N)
+        r_t, v_t = np.array(t.r_BN_N), np.array(t.v_BN_N)
+        self.q_ib = dcm_to_quat(np.array(rbk.MRP2C(s.sigma_BN)).T, self.q_ib)
+        self.q_it = dcm_to_quat(np.array(rbk.MRP2C(t.sigma_BN)).T, self.q_it)
+        theta = np.array(self.theta_state.getState()).flatten()
+        theta_dot = np.array(self.theta_dot_state.getState()).flatten()
+        return np.concatenate([[self.t_ns * 1e-9], r_t, v_t, self.q_it, np.array(t.omega_BN_B), r_b - r_t, v_b - v_t,
+                               self.q_ib, np.array(s.omega_BN_B), theta, theta_dot])
+
+    def step(self, h, n, u):
+        h_ns = int(round(h * 1e9))
+        if self.task_step_ns is None:
+            self._start_task(h_ns)
+        elif h_ns != self.task_step_ns:
+            raise ValueError(f"physics step changed from {self.task_step_ns} ns to {h_ns} ns")
+        self.ext.extForce_B = [[u[0]], [u[1]], [u[2]]]
+        self.ext.extTorquePntB_B = [[u[3]], [u[4]], [u[5]]]
+        p = self.messaging.ArrayMotorTorqueMsgPayload()
+        p.motorTorque = list(u[6:13])
+        self.torque_msg.write(p)
+        out = []
+        for _ in range(n):
+            self.t_ns += h_ns
+            self.sim.ConfigureStopTime(self.t_ns)
+            self.sim.ExecuteSimulation()
+            out.append(self.state())
+        return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--scenario", default="config/scenario.toml")
+    a = ap.parse_args()
+    out = sys.stdout
+    try:
+        plant = BasiliskPlant(a.scenario)
+        for line in sys.stdin:
+            word, *rest = line.split()
+            if word == "init":
+                x = np.array([float(v) for v in rest])
+                if x.size != 41:
+                    raise ValueError(f"init: {x.size} numbers, 41 expected")
+                plant.init(x)
+                out.write("ready\n")
+            elif word == "step":
+                h, n, u = float(rest[0]), int(rest[1]), [float(v) for v in rest[2:]]
+                if len(u) != 13:
+                    raise ValueError(f"step: {len(u)} command numbers, 13 expected")
+                for x in plant.step(h, n, u):
+                    out.write("state " + " ".join(repr(float(v)) for v in x) + "\n")
+            elif word == "stop":
+                return 0
+            else:
+                raise ValueError(f"unknown message `{word}`")
+            out.flush()
+    except Exception as e:  # reported to the Rust side, which ends the run
+        out.write(f"error {type(e).__name__}: {e}\n".replace("\n", " ").rstrip() + "\n")
+        out.flush()
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
