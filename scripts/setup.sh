@@ -4,15 +4,16 @@
 # used by the Python partner controller. Safe to run repeatedly.
 #
 #   scripts/setup.sh                   the lean set-up every test needs
-#   scripts/setup.sh --with-basilisk   also Basilisk (bsk, ~600 MB) for the opt-in
-#                                      cross-check scripts/basilisk_reference.py
+#   scripts/setup.sh --with-basilisk   also Basilisk (bsk, ~600 MB): `safe-capture run
+#                                      --basilisk` and scripts/basilisk_reference.py
+#                                      (scripts/test.sh installs it: its test needs it)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 WITH_BASILISK=0
 for arg in "$@"; do
   case "$arg" in
     --with-basilisk) WITH_BASILISK=1 ;;
-    -h|--help) sed -n '2,9p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,10p' "$0"; exit 0 ;;
     *) echo "setup: unknown option $arg (see --help)" >&2; exit 2 ;;
   esac
 done

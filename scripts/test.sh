@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
-# The project's test command (README, CI): set-up, fresh Pinocchio reference data, then
-# every Rust test of the workspace.
+# The project's test command (README, CI): set-up (with Basilisk), fresh Pinocchio reference
+# data, then every Rust test of the workspace.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup.sh
+# Basilisk too: the closed-loop cross-check (apps/safe-capture/tests/basilisk.rs) must run
+scripts/setup.sh --with-basilisk
+export SC_REQUIRE_BASILISK=1
 mkdir -p tests/reference
 scripts/.venv/bin/python scripts/pinocchio_reference.py
 # the partition's Python partner controller and the interop tests find the venv here
