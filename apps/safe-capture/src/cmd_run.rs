@@ -207,7 +207,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             "--scenario".to_string(),
             a.scenario.display().to_string(),
         ];
-        Some(Box::new(crate::plant_process::ProcessPlant::spawn(
+        Some(Box::new(sc_partition::plant_process::ProcessPlant::spawn(
             &a.python, &args,
         )?))
     } else {

@@ -15,7 +15,6 @@ mod cmd_simulate;
 mod cmd_verify_qp;
 // `montecarlo --mode partition`: runs through the process partition
 mod montecarlo_partition;
-mod plant_process;
 mod redteam_partition;
 
 use clap::{Parser, Subcommand};

@@ -1,7 +1,8 @@
 //! Basilisk in the loop (`safe-capture run --basilisk`): the default mission with
 //! Basilisk propagating the true state against the same mission on our simulator.
 //! Over the first 60 s the Hill position, the base attitude and the joint angles agree
-//! to 1e-6 (m, rad), the outcome is the same, and every barrier holds.
+//! to 1e-6 (m, rad), the outcome is the same, and every barrier holds. Through the
+//! partition (config/partition_basilisk.toml) the result is the same byte for byte.
 //!
 //! Needs a Python with Basilisk (`scripts/setup.sh --with-basilisk`, which
 //! scripts/test.sh runs): `SC_PYTHON`, else scripts/.venv/bin/python. Where Basilisk is
@@ -129,6 +130,58 @@ fn the_mission_with_basilisk_as_the_plant_matches_ours() {
     }
     eprintln!("first 60 s: Hill position {dp:.2e} m, attitude {dq:.2e} rad, joints {dj:.2e} rad");
     assert!(dp <= 1e-6 && dq <= 1e-6 && dj <= 1e-6, "{dp} {dq} {dj}");
+
+    // the same through the partition, Basilisk behind the simulator role
+    // (config/partition_basilisk.toml, with this interpreter): lock-step gives the
+    // in-process result byte for byte, and nothing is left in shared memory
+    let _cpu = exclusive();
+    let text_cfg = std::fs::read_to_string(root().join("config/partition_basilisk.toml"))
+        .unwrap()
+        .replace(
+            "scenario = \"scenario.toml\"",
+            &format!(
+                "scenario = \"{}\"",
+                root().join("config/scenario.toml").display()
+            ),
+        )
+        .replace(
+            "plant = [\"../scripts/.venv/bin/python\", \"../scripts/basilisk_plant.py\"]",
+            &format!(
+                "plant = [\"{}\", \"{}\"]",
+                py.display(),
+                root().join("scripts/basilisk_plant.py").display()
+            ),
+        );
+    assert!(
+        text_cfg.contains(&format!("plant = [\"{}\"", py.display())),
+        "config/partition_basilisk.toml: plant line not as expected"
+    );
+    let cfg = d.join("partition_basilisk.toml");
+    std::fs::write(&cfg, text_cfg).unwrap();
+    let part = d.join("partition");
+    let (o, _) = cli_partition(
+        &[
+            "launch",
+            "--config",
+            cfg.to_str().unwrap(),
+            "--out",
+            part.to_str().unwrap(),
+        ],
+        &[],
+    );
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    assert!(
+        t.contains("captured") && t.contains("shm leftovers: 0"),
+        "{t}"
+    );
+    let log = std::fs::read_to_string(part.join("logs/simulator.log")).unwrap();
+    assert!(log.contains("basilisk_plant.py` propagates"), "{log}");
+    assert!(
+        std::fs::read(part.join("telemetry.csv")).unwrap()
+            == std::fs::read(theirs.join("telemetry.csv")).unwrap(),
+        "the partition's telemetry differs from run --basilisk"
+    );
     let _ = std::fs::remove_dir_all(&d);
 }
 

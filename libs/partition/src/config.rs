@@ -133,9 +133,25 @@ pub struct PartitionConfig {
     pub deadlines: Deadlines,
     pub lock_step: LockStep,
     pub roles: BTreeMap<String, RoleExec>,
+    /// The simulator role's options (absent: our own simulator propagates).
+    #[serde(default)]
+    pub simulator: SimulatorOptions,
     /// Directory of the config file (set by [`PartitionConfig::load`]).
     #[serde(skip)]
     pub base_dir: PathBuf,
+}
+
+/// `[simulator]`: what propagates the true state behind the simulator role.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SimulatorOptions {
+    /// A plant process, program and arguments (paths relative to this file), started by
+    /// the simulator role with `--scenario FILE` appended; it propagates the true state
+    /// instead of our RK4, while the role keeps the handshake, the admission of safe
+    /// commands, the barrier monitor and everything it publishes
+    /// (`sc_partition::plant_process`, docs/SIMULATOR.md). Empty: our own simulator.
+    #[serde(default)]
+    pub plant: Vec<String>,
 }
 
 /// A configuration problem, one line naming it.

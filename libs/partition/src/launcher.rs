@@ -251,6 +251,16 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
             }
         }
     }
+    // the plant's program and files, relative to the config directory like a role's
+    for (i, a) in cfg.simulator.plant.iter_mut().enumerate() {
+        if !a.starts_with('-')
+            && (i == 0 || a.contains('/'))
+            && !Path::new(a).is_absolute()
+            && base.join(&*a).exists()
+        {
+            *a = base.join(&*a).display().to_string();
+        }
+    }
     cfg.validate()?;
     let eff = out.join("partition.effective.toml");
     std::fs::write(

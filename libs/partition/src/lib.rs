@@ -20,6 +20,7 @@ pub mod hop_cost;
 pub mod latency;
 pub mod launcher;
 pub mod mcap_out;
+pub mod plant_process;
 pub mod pm_qos;
 pub mod process;
 pub mod recorder;

@@ -59,6 +59,24 @@ pub fn simulator() -> anyhow::Result<i32> {
     let scenario = p.scenario_with_period(p.schedule.base_period_s);
     let mut sim =
         Simulator::new(&scenario, p.setup.robot.clone()).map_err(|e| anyhow::anyhow!("{e}"))?;
+    // another propagator behind this role (e.g. Basilisk), started before the handshake
+    let mut plant = match p.cfg.simulator.plant.split_first() {
+        Some((program, args)) => {
+            let mut args = args.to_vec();
+            args.push("--scenario".into());
+            args.push(p.cfg.scenario_path().display().to_string());
+            let mut child =
+                crate::plant_process::ProcessPlant::spawn(std::path::Path::new(program), &args)?;
+            sc_sim::Plant::start(&mut child, sim.state())
+                .map_err(|e| anyhow::anyhow!("simulator: {e}"))?;
+            eprintln!(
+                "simulator: the plant `{}` propagates",
+                p.cfg.simulator.plant.join(" ")
+            );
+            Some(child)
+        }
+        None => None,
+    };
     let mut layer = SafetyLayer::from_scenario(&scenario, p.setup.robot.clone());
     let robot = p.setup.robot.clone();
     let monitor = sc_cbf::monitor::Monitor::from_scenario(&scenario, robot.clone());
@@ -305,12 +323,16 @@ pub fn simulator() -> anyhow::Result<i32> {
         // and the scheduler stops after exactly max_ticks
         if res.end == end::RUNNING || keep_going {
             let mut min: sc_cbf::monitor::Barriers = [f64::INFINITY; sc_cbf::monitor::N_ALL];
-            let stepped = sim.step_with(&held, |b| {
+            let at_physics_step = |b: &sc_sim::BarrierState| {
                 sc_cbf::monitor::min_into(
                     &mut min,
                     &monitor.evaluate(&stages::monitor_state_between(b)),
                 )
-            });
+            };
+            let stepped = match plant.as_mut() {
+                Some(pl) => sim.step_with_plant(pl, &held, at_physics_step),
+                None => sim.step_with(&held, at_physics_step),
+            };
             between = Some(min);
             if let Err(e) = stepped {
                 eprintln!("simulator: {e}");

@@ -1,6 +1,6 @@
-//! A plant in a child process (`safe-capture run --basilisk`): Basilisk propagates the
-//! true state, this process keeps everything else (docs/SIMULATOR.md, "Basilisk in the
-//! loop").
+//! A plant in a child process (`safe-capture run --basilisk`, the partition's simulator
+//! with `[simulator] plant`): Basilisk propagates the true state, the process that started
+//! it keeps everything else (docs/SIMULATOR.md, "Basilisk in the loop").
 //!
 //! Protocol, one line per message over the child's stdin/stdout, numbers as shortest
 //! round-trip decimals (Rust `{:?}`, Python `repr`), so nothing is lost in transit:
