@@ -6,6 +6,7 @@ mod cmd_bench;
 mod cmd_bench_filters;
 mod cmd_bench_latency;
 mod cmd_bounds;
+mod cmd_compare;
 mod cmd_launch;
 mod cmd_model;
 mod cmd_montecarlo;
@@ -55,6 +56,9 @@ enum Command {
     /// Check every QP a run dumped (`run --dump-qp`) independently: KKT conditions and
     /// Clarabel's solution of the same data.
     VerifyQp(cmd_verify_qp::Args),
+    /// Compare two runs of the same mission step by step (e.g. Basilisk as the plant
+    /// against our simulator): position, attitude and joint differences, CSV and figure.
+    Compare(cmd_compare::Args),
 }
 
 /// Default scenario path (relative to the working directory).
@@ -74,6 +78,7 @@ fn main() -> ExitCode {
         Command::Redteam(a) => cmd_redteam::run(a),
         Command::Bounds(a) => cmd_bounds::run(a),
         Command::VerifyQp(a) => cmd_verify_qp::run(a),
+        Command::Compare(a) => cmd_compare::run(a),
     };
     match result {
         Ok(code) => code,

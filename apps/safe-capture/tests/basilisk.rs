@@ -130,6 +130,20 @@ fn the_mission_with_basilisk_as_the_plant_matches_ours() {
     }
     eprintln!("first 60 s: Hill position {dp:.2e} m, attitude {dq:.2e} rad, joints {dj:.2e} rad");
     assert!(dp <= 1e-6 && dq <= 1e-6 && dj <= 1e-6, "{dp} {dq} {dj}");
+    // `compare` says the same, and fails a tolerance the runs do not meet
+    let (sa, sb) = (ours.to_str().unwrap(), theirs.to_str().unwrap());
+    let o = cli(&["compare", sa, sb, "--tolerance", "1e-6"], &[]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(
+        text(&o).contains("compare: first 60.0 s (601 steps)"),
+        "{}",
+        text(&o)
+    );
+    for f in ["compare.csv", "compare.json", "compare.svg"] {
+        assert!(theirs.join("compare").join(f).is_file(), "{f}");
+    }
+    let o = cli(&["compare", sa, sb, "--tolerance", "1e-12"], &[]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
 
     // the same through the partition, Basilisk behind the simulator role
     // (config/partition_basilisk.toml, with this interpreter): lock-step gives the

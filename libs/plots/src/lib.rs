@@ -19,6 +19,7 @@
 mod campaign;
 mod chart;
 mod colour;
+mod compare;
 mod redteam;
 mod run;
 
@@ -26,6 +27,7 @@ pub use campaign::{
     BarrierMinima, CampaignFigures, RunPoint, RuntimeBar, TracePoint, campaign_figures,
 };
 pub use colour::viridis;
+pub use compare::difference_figure;
 pub use redteam::{RedTeamMargins, redteam_margins};
 pub use run::{los_angles_deg, run_figures};
 
