@@ -95,6 +95,22 @@ fn coloured_runs(pts: &[(f64, f64, f64)], lo: f64, hi: f64) -> Vec<(usize, Vec<(
     out
 }
 
+/// A log axis's tick as people write it: 0.1, 1, 10, 100, 1000, 1e4 (not `10000.0`).
+pub(crate) fn log_tick(v: f64) -> String {
+    if !(v.is_finite() && v > 0.0) {
+        return String::new();
+    }
+    let e = v.log10().round();
+    if (v.log10() - e).abs() > 1e-9 {
+        // a tick between decades: plain, with as few digits as it needs
+        return format!("{}", (v * 1e6).round() / 1e6);
+    }
+    match e as i32 {
+        -2..=3 => format!("{}", 10f64.powi(e as i32)),
+        k => format!("1e{k}"),
+    }
+}
+
 fn level_colour(l: usize) -> RGBColor {
     viridis(l as f64 / (LEVELS - 1) as f64)
 }
@@ -319,6 +335,7 @@ fn runtime(area: &Area, f: &CampaignFigures) -> DrawResult {
                     String::new()
                 }
             })
+            .y_label_formatter(&|v| log_tick(*v))
             .y_desc("solve time per control step [µs]")
             .draw()
             .map_err(e)?;
@@ -476,4 +493,21 @@ pub fn campaign_figures(dir: &Path, f: &CampaignFigures) -> Result<Vec<PathBuf>,
     let rows = f.minima.len().div_ceil(7).max(1) as u32;
     emit("barrier_minima.svg", (1400, 160 * rows), &|a| minima(a, f))?;
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::log_tick;
+
+    #[test]
+    fn log_ticks_read_like_numbers() {
+        let t: Vec<String> = [0.01, 0.1, 1.0, 10.0, 1000.0, 1e4, 1e5, 2.0, 0.0, f64::NAN]
+            .iter()
+            .map(|v| log_tick(*v))
+            .collect();
+        assert_eq!(
+            t,
+            ["0.01", "0.1", "1", "10", "1000", "1e4", "1e5", "2", "", ""]
+        );
+    }
 }
