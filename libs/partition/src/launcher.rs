@@ -147,6 +147,47 @@ pub fn clean_stale_runs(except: &str) -> usize {
 }
 
 /// The executable a role's `exec` names: a path relative to the config directory
+/// What a partition run writes into its output directory (besides `logs/`).
+pub const RUN_OUTPUTS: [&str; 17] = [
+    "summary.json",
+    "telemetry.csv",
+    "timing.csv",
+    "recording.mcap",
+    "launch.json",
+    "recorder.json",
+    "scheduler.json",
+    "partition.effective.toml",
+    "latency.csv",
+    "latency.svg",
+    "latency_report.json",
+    "latency_report.md",
+    "latency_timeline.svg",
+    "latency_whole_tick.hgrm",
+    "steal.csv",
+    "compare",
+    "figures",
+];
+
+/// Removes what an earlier run left in `out` (only the files a run writes, never anything
+/// else), so that a run that fails early cannot be reported with an old run's results.
+fn clear_previous_run(out: &Path) {
+    for name in RUN_OUTPUTS {
+        let p = out.join(name);
+        let _ = if p.is_dir() {
+            std::fs::remove_dir_all(&p)
+        } else {
+            std::fs::remove_file(&p)
+        };
+    }
+    if let Ok(logs) = std::fs::read_dir(out.join("logs")) {
+        for e in logs.flatten() {
+            if e.path().extension().is_some_and(|x| x == "log") {
+                let _ = std::fs::remove_file(e.path());
+            }
+        }
+    }
+}
+
 /// `base_dir`, or a bare name looked up in `bin_dir`, `SC_PARTITION_BIN_DIR` and the
 /// launcher's own directory; a bare name found in none of them is returned as is
 /// (then `PATH` decides).
@@ -231,6 +272,7 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
         e.args = args.clone();
     }
     let out = abs(&opts.out);
+    clear_previous_run(&out);
     std::fs::create_dir_all(out.join("logs"))
         .with_context(|| format!("cannot create {}", out.display()))?;
     // the effective config, with absolute paths, is what every process reads
