@@ -196,6 +196,14 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         no_filter: a.no_filter,
     };
     let started = std::time::Instant::now();
+    // an earlier run's comparison in this folder would be taken for this run's
+    if a.no_filter || a.no_compare || a.basilisk {
+        let stale = a.out.join("nominal");
+        if stale.join("summary.json").is_file() {
+            std::fs::remove_dir_all(&stale)
+                .with_context(|| format!("cannot remove the stale {}", stale.display()))?;
+        }
+    }
     let scenario = setup.scenario.clone();
     let compare_setup = setup.clone();
     let nominals = Nominals::from_args(&a)?;

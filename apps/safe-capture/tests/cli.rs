@@ -395,6 +395,15 @@ fn default_mission_is_safe_with_filters_and_unsafe_without() {
         violated.contains(&"approach_corridor") || violated.contains(&"line_of_sight"),
         "{violated:?}"
     );
+    // a run without comparison into the first run's folder leaves no stale nominal/
+    assert!(d.join("f/nominal/summary.json").is_file());
+    let out = bin()
+        .args(["run", "--quiet", "--no-filter", "--no-figures", "--out"])
+        .arg(d.join("f"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(!d.join("f/nominal").exists(), "stale nominal/ left behind");
 }
 
 #[test]
