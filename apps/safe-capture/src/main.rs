@@ -66,8 +66,56 @@ pub fn default_scenario() -> PathBuf {
     PathBuf::from(sc_scenario::DEFAULT_SCENARIO)
 }
 
+/// The command line with each subcommand's whole description in its `--help`: the
+/// enum's doc comments give the one-line summaries of `safe-capture --help`, and would
+/// otherwise replace the long descriptions (outputs, columns, exit codes) the commands'
+/// `Args` carry.
+fn command() -> clap::Command {
+    use clap::{Args as _, CommandFactory};
+    let mut c = Cli::command();
+    let mut long = |name: &str, args: clap::Command| {
+        if let Some(l) = args.get_long_about().or(args.get_about()).cloned() {
+            c = std::mem::take(&mut c).mut_subcommand(name, |s| s.long_about(l));
+        }
+    };
+    long(
+        "run",
+        cmd_run::Args::augment_args(clap::Command::new("run")),
+    );
+    long(
+        "simulate",
+        cmd_simulate::Args::augment_args(clap::Command::new("simulate")),
+    );
+    long(
+        "model",
+        cmd_model::Args::augment_args(clap::Command::new("model")),
+    );
+    long(
+        "launch",
+        cmd_launch::Args::augment_args(clap::Command::new("launch")),
+    );
+    long(
+        "redteam",
+        cmd_redteam::Args::augment_args(clap::Command::new("redteam")),
+    );
+    long(
+        "bounds",
+        cmd_bounds::Args::augment_args(clap::Command::new("bounds")),
+    );
+    long(
+        "verify-qp",
+        cmd_verify_qp::Args::augment_args(clap::Command::new("verify-qp")),
+    );
+    long(
+        "compare",
+        cmd_compare::Args::augment_args(clap::Command::new("compare")),
+    );
+    c
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    use clap::FromArgMatches;
+    let cli = Cli::from_arg_matches(&command().get_matches()).unwrap_or_else(|e| e.exit());
     let result = match cli.command {
         Command::Run(a) => cmd_run::run(a),
         Command::Simulate(a) => cmd_simulate::run(a),

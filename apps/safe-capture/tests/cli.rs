@@ -79,6 +79,19 @@ fn help_on_every_subcommand() {
             "{sub:?}"
         );
     }
+    // `--help` shows each command's whole description: outputs, columns, exit codes
+    for (sub, needle) in [
+        ("simulate", "TRAJ.csv: one row per control step"),
+        ("model", "mass_matrix"),
+        ("run", "Exit code 0 when the run was safe"),
+        ("redteam", "Exit codes: 0 every case safe"),
+        ("compare", "Exit codes: 0 compared"),
+        ("verify-qp", "Exit codes: 0 every check"),
+    ] {
+        let out = bin().args([sub, "--help"]).output().unwrap();
+        let t = String::from_utf8_lossy(&out.stdout);
+        assert!(t.contains(needle), "{sub} --help lacks `{needle}`:\n{t}");
+    }
 }
 
 /// `bounds` samples the envelope and compares every configured bound; with a bound cut
