@@ -49,8 +49,25 @@ fn lock_step_telemetry_is_identical_to_in_process_run() {
     }
     assert_eq!(a, b);
     assert_eq!(b["end"], "captured");
-    // MCAP and counts
-    assert!(std::fs::metadata(out.join("recording.mcap")).unwrap().len() > 1000);
+    // MCAP and counts; the MCAP's log time is mission time (Foxglove's timeline shows the
+    // mission, not the host's uptime), the host's clock stays in publish_time
+    let bytes = std::fs::read(out.join("recording.mcap")).unwrap();
+    assert!(bytes.len() > 1000);
+    let (mut states, mut last) = (0u64, 0u64);
+    for m in mcap::MessageStream::new(&bytes).unwrap() {
+        let m = m.unwrap();
+        if m.channel.topic != "safe_capture/sim/state" {
+            continue;
+        }
+        let v: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
+        let tick = v["tick"].as_u64().unwrap();
+        assert_eq!(m.log_time, tick * 100_000_000, "tick {tick}");
+        assert_ne!(m.publish_time, m.log_time);
+        states += 1;
+        last = last.max(m.log_time);
+    }
+    assert_eq!(states, b["steps"].as_u64().unwrap());
+    assert_eq!(last as f64 * 1e-9, b["final_time_s"].as_f64().unwrap());
     let r: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("recorder.json")).unwrap()).unwrap();
     assert_eq!(

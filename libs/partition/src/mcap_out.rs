@@ -263,8 +263,16 @@ impl McapOut {
         })
     }
 
-    /// Writes one message on topic `topic` at `log_ns` (monotonic clock).
-    pub fn write<T: JsonMsg>(&mut self, topic: &str, log_ns: u64, msg: &T) -> anyhow::Result<()> {
+    /// Writes one message on topic `topic`: `log_ns` is its mission time [ns since the
+    /// mission's start] (what Foxglove's timeline shows), `publish_ns` the host's monotonic
+    /// clock when it was published (kept in the record's `publish_time`).
+    pub fn write<T: JsonMsg>(
+        &mut self,
+        topic: &str,
+        log_ns: u64,
+        publish_ns: u64,
+        msg: &T,
+    ) -> anyhow::Result<()> {
         let id = match self.channels.get(topic) {
             Some(id) => *id,
             None => {
@@ -290,7 +298,7 @@ impl McapOut {
                     channel_id: id,
                     sequence: self.seq,
                     log_time: log_ns,
-                    publish_time: log_ns,
+                    publish_time: publish_ns,
                 },
                 &self.buf,
             )
@@ -332,9 +340,9 @@ mod tests {
         let mut out = McapOut::create(&path).unwrap();
         for k in 0..3u64 {
             state.tick = k;
-            out.write("sim/state", 100 + k, &state).unwrap();
+            out.write("sim/state", 100 + k, 5000 + k, &state).unwrap();
         }
-        out.write("safe/robotic", 200, &safe).unwrap();
+        out.write("safe/robotic", 200, 6000, &safe).unwrap();
         out.finish().unwrap();
         assert_eq!(out.written["sim/state"], 3);
         drop(out);
@@ -356,6 +364,10 @@ mod tests {
                 obj.keys().collect::<Vec<_>>()
             );
             seen.push((m.channel.topic.clone(), m.log_time, v));
+            assert!(
+                m.publish_time >= 5000,
+                "publish_time keeps the host's clock"
+            );
         }
         assert_eq!(seen.len(), 4);
         let (topic, log_time, v) = &seen[2];

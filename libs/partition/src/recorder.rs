@@ -53,6 +53,10 @@ struct Tickset {
 /// The recorder process.
 pub fn recorder() -> anyhow::Result<i32> {
     let p = Proc::start("recorder")?;
+    // MCAP log time: the mission's own clock (tick × base period), so that a recording
+    // plays back at mission time in Foxglove; the host's clock stays in publish_time
+    let period_ns = (p.schedule.base_period_s * 1e9).round() as u64;
+    let mission_ns = move |tick: u64| tick.saturating_mul(period_ns);
     let q = qos();
     let partner_q = partner_qos();
     let tick_rx = Subscriber::<Tick>::polled(&p.node, services::TICK, &q)?;
@@ -148,7 +152,7 @@ pub fn recorder() -> anyhow::Result<i32> {
                     if absent_at_write.remove(&($svc.as_str(), m.tick)) {
                         *rep.late.entry($svc.as_str().into()).or_default() += 1;
                     }
-                    mcap.write($svc.as_str(), m.publish_ns, &m)?;
+                    mcap.write($svc.as_str(), mission_ns(m.tick), m.publish_ns, &m)?;
                     pending.entry(m.tick).or_default().$field = Some(m);
                 }
             }};
@@ -165,7 +169,7 @@ pub fn recorder() -> anyhow::Result<i32> {
         tick_rx.receive_all(&mut ticks)?;
         count(&mut rep, services::TICK.as_str(), ticks.len());
         for t in &ticks {
-            mcap.write(services::TICK.as_str(), t.send_ns, t)?;
+            mcap.write(services::TICK.as_str(), mission_ns(t.tick), t.send_ns, t)?;
             if t.command == tick_command::STOP {
                 stop = true;
             }
@@ -209,7 +213,12 @@ pub fn recorder() -> anyhow::Result<i32> {
             }
         }
         for r in results {
-            mcap.write(services::STEP_RESULT.as_str(), r.publish_ns, &r)?;
+            mcap.write(
+                services::STEP_RESULT.as_str(),
+                mission_ns(r.tick),
+                r.publish_ns,
+                &r,
+            )?;
             let set = pending.remove(&r.tick).unwrap_or_default();
             // this step is taken care of (written below, or skipped and reported)
             crate::process::send(
