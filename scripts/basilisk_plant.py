@@ -32,7 +32,7 @@ import tomllib
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from basilisk_reference import com_offset, parse_urdf, quat_to_dcm  # noqa: E402
+from basilisk_reference import BasiliskModel, parse_urdf  # noqa: E402
 
 
 def dcm_to_quat(m, previous):
@@ -65,91 +65,33 @@ class BasiliskPlant:
         self.sim = None
 
     def init(self, x):
-        from Basilisk.architecture import messaging
-        from Basilisk.simulation import extForceTorque, spacecraft, spinningBodyNDOFStateEffector, svIntegrators
-        from Basilisk.utilities import RigidBodyKinematics as rbk
-        from Basilisk.utilities import SimulationBaseClass, macros, simIncludeGravBody
+        from Basilisk.utilities import SimulationBaseClass
 
-        self.rbk, self.macros, self.messaging = rbk, macros, messaging
         t, r_t, v_t, q_it, w_t = x[0], x[1:4], x[4:7], x[7:11], x[11:14]
         dr, dv, q_ib, w_b, theta, theta_dot = x[14:17], x[17:20], x[20:24], x[24:27], x[27:34], x[34:41]
+        if t != 0.0:
+            raise ValueError("the plant starts at t = 0 only")
         self.q_it, self.q_ib = q_it, q_ib
-        self.t_ns = int(round(t * 1e9))
-
-        sim = SimulationBaseClass.SimBaseClass()
-        self.proc = sim.CreateNewProcess("dynamics")
+        self.t_ns = 0
+        self.sim = SimulationBaseClass.SimBaseClass()
+        self.proc = self.sim.CreateNewProcess("dynamics")
         self.task_step_ns = None
-        grav = simIncludeGravBody.gravBodyFactory()
-        earth = grav.createEarth()
-        earth.isCentralBody = True
-        earth.mu = self.scenario["orbit"]["earth_mu_m3_s2"]
-
-        sc = spacecraft.Spacecraft()
-        sc.ModelTag = "servicer"
-        m0, c0, i0 = self.model["base"]
-        sc.hub.mHub = m0
-        sc.hub.r_BcB_B = c0.reshape(3, 1).tolist()
-        sc.hub.IHubPntBc_B = i0.tolist()
-        arm = spinningBodyNDOFStateEffector.SpinningBodyNDOFStateEffector()
-        arm.ModelTag = "arm"
-        for b, th, thd in zip(self.model["chain"], theta, theta_dot):
-            s = spinningBodyNDOFStateEffector.SpinningBody()
-            s.setMass(b["mass"])
-            s.setISPntSc_S(b["inertia"].tolist())
-            s.setDCM_S0P(b["rot"].T.tolist())
-            s.setR_ScS_S(b["com"].reshape(3, 1).tolist())
-            s.setR_SP_P(b["pos"].reshape(3, 1).tolist())
-            s.setSHat_S((b["axis"] / np.linalg.norm(b["axis"])).reshape(3, 1).tolist())
-            s.setThetaInit(float(th))
-            s.setThetaDotInit(float(thd))
-            arm.addSpinningBody(s)
-        sc.addStateEffector(arm)
-        ext = extForceTorque.ExtForceTorque()
-        ext.ModelTag = "wrench"
-        sc.addDynamicEffector(ext)
-        self.torque_msg = messaging.ArrayMotorTorqueMsg()
-        arm.motorTorqueInMsg.subscribeTo(self.torque_msg)
-
-        r_ib = quat_to_dcm(q_ib)
-        c_b, c_dot_b = com_offset(self.model, theta, theta_dot)
-        r_b, v_b = r_t + dr, v_t + dv
-        sc.hub.r_CN_NInit = (r_b + r_ib @ c_b).reshape(3, 1).tolist()
-        sc.hub.v_CN_NInit = (v_b + r_ib @ (np.cross(w_b, c_b) + c_dot_b)).reshape(3, 1).tolist()
-        sc.hub.sigma_BNInit = np.array(rbk.C2MRP(r_ib.T)).reshape(3, 1).tolist()
-        sc.hub.omega_BN_BInit = w_b.reshape(3, 1).tolist()
-        sc.setIntegrator(svIntegrators.svIntegratorRK4(sc))
-        grav.addBodiesTo(sc)
-
-        tg = spacecraft.Spacecraft()
-        tg.ModelTag = "target"
-        tg.hub.mHub = self.scenario["target"]["mass_kg"]
-        tg.hub.IHubPntBc_B = self.scenario["target"]["inertia_kg_m2"]
-        tg.hub.r_BcB_B = [[0.0], [0.0], [0.0]]
-        tg.hub.r_CN_NInit = r_t.reshape(3, 1).tolist()
-        tg.hub.v_CN_NInit = v_t.reshape(3, 1).tolist()
-        tg.hub.sigma_BNInit = np.array(rbk.C2MRP(quat_to_dcm(q_it).T)).reshape(3, 1).tolist()
-        tg.hub.omega_BN_BInit = w_t.reshape(3, 1).tolist()
-        tg.setIntegrator(svIntegrators.svIntegratorRK4(tg))
-        grav.addBodiesTo(tg)
-        self.sim, self.sc, self.tg, self.arm, self.ext = sim, sc, tg, arm, ext
-        self.models = ((arm, 300), (ext, 300), (sc, 200), (tg, 200))
+        self.bm = BasiliskModel(self.scenario, self.model, dict(
+            r_b=r_t + dr, v_b=v_t + dv, q_ib=q_ib, w_b=w_b, theta=theta, theta_dot=theta_dot,
+            r_t=r_t, v_t=v_t, q_it=q_it, w_t=w_t))
 
     def _start_task(self, h_ns):
         """The task is created at the first step, when the physics step is known."""
         self.proc.addTask(self.sim.CreateNewTask("step", h_ns))
-        for m, priority in self.models:
-            self.sim.AddModelToTask("step", m, None, priority)
+        self.bm.add_to(self.sim, "step")
         self.sim.InitializeSimulation()
-        self.theta_state = self.sc.dynManager.getStateObject(self.arm.getNameOfThetaState())
-        self.theta_dot_state = self.sc.dynManager.getStateObject(self.arm.getNameOfThetaDotState())
+        self.theta_state, self.theta_dot_state = self.bm.joint_states()
         self.task_step_ns = h_ns
-        if self.t_ns != 0:
-            raise ValueError("the plant starts at t = 0 only")
 
     def state(self):
-        rbk = self.rbk
-        s = self.sc.scStateOutMsg.read()
-        t = self.tg.scStateOutMsg.read()
+        rbk = self.bm.rbk
+        s = self.bm.sc.scStateOutMsg.read()
+        t = self.bm.tg.scStateOutMsg.read()
         r_b, v_b = np.array(s.r_BN_N), np.array(s.v_BN_N)
         r_t, v_t = np.array(t.r_BN_N), np.array(t.v_BN_N)
         self.q_ib = dcm_to_quat(np.array(rbk.MRP2C(s.sigma_BN)).T, self.q_ib)
@@ -165,11 +107,7 @@ class BasiliskPlant:
             self._start_task(h_ns)
         elif h_ns != self.task_step_ns:
             raise ValueError(f"physics step changed from {self.task_step_ns} ns to {h_ns} ns")
-        self.ext.extForce_B = [[u[0]], [u[1]], [u[2]]]
-        self.ext.extTorquePntB_B = [[u[3]], [u[4]], [u[5]]]
-        p = self.messaging.ArrayMotorTorqueMsgPayload()
-        p.motorTorque = list(u[6:13])
-        self.torque_msg.write(p)
+        self.bm.command(u)
         out = []
         for _ in range(n):
             self.t_ns += h_ns

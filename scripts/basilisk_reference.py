@@ -189,90 +189,126 @@ def write_profile(path, duration, dt):
 
 
 # ----------------------------------------------------------- Basilisk ----
-def run_basilisk(scenario, model, ours, profile, dt_ctrl, dt_phys, steps):
-    from Basilisk.architecture import messaging
-    from Basilisk.simulation import extForceTorque, spacecraft, spinningBodyNDOFStateEffector, svIntegrators
-    from Basilisk.utilities import RigidBodyKinematics as rbk
-    from Basilisk.utilities import SimulationBaseClass, macros, simIncludeGravBody
+class BasiliskModel:
+    """The servicer (hub + arm) and the target in Basilisk, from the initial state `x` (dict:
+    servicer base origin r_b, v_b [inertial], q_ib, w_b, theta, theta_dot; target CoM r_t,
+    v_t, q_it, w_t; quaternions scalar first) — shared by this cross-check and the plant of
+    `safe-capture run --basilisk` (scripts/basilisk_plant.py). `add_to(sim, task)` puts the
+    models in a task in the order that makes the arm integrate this step's torques;
+    `command(u)` writes a 13-vector [f_B, tau_B, tau_M] for the next step."""
 
+    def __init__(self, scenario, model, x):
+        from Basilisk.architecture import messaging
+        from Basilisk.simulation import extForceTorque, spacecraft, spinningBodyNDOFStateEffector, svIntegrators
+        from Basilisk.utilities import RigidBodyKinematics as rbk
+        from Basilisk.utilities import simIncludeGravBody
+
+        self.messaging, self.rbk = messaging, rbk
+        grav = simIncludeGravBody.gravBodyFactory()
+        earth = grav.createEarth()
+        earth.isCentralBody = True
+        earth.mu = scenario["orbit"]["earth_mu_m3_s2"]
+
+        # servicer: hub + arm
+        sc = spacecraft.Spacecraft()
+        sc.ModelTag = "servicer"
+        m0, c0, i0 = model["base"]
+        sc.hub.mHub = m0
+        sc.hub.r_BcB_B = c0.reshape(3, 1).tolist()
+        sc.hub.IHubPntBc_B = i0.tolist()
+        arm = spinningBodyNDOFStateEffector.SpinningBodyNDOFStateEffector()
+        arm.ModelTag = "arm"
+        for b, th, thd in zip(model["chain"], x["theta"], x["theta_dot"]):
+            s = spinningBodyNDOFStateEffector.SpinningBody()
+            s.setMass(b["mass"])
+            s.setISPntSc_S(b["inertia"].tolist())
+            s.setDCM_S0P(b["rot"].T.tolist())
+            s.setR_ScS_S(b["com"].reshape(3, 1).tolist())
+            s.setR_SP_P(b["pos"].reshape(3, 1).tolist())
+            s.setSHat_S((b["axis"] / np.linalg.norm(b["axis"])).reshape(3, 1).tolist())
+            s.setThetaInit(float(th))
+            s.setThetaDotInit(float(thd))
+            arm.addSpinningBody(s)
+        sc.addStateEffector(arm)
+        ext = extForceTorque.ExtForceTorque()
+        ext.ModelTag = "wrench"
+        sc.addDynamicEffector(ext)
+        self.torque_msg = messaging.ArrayMotorTorqueMsg()
+        arm.motorTorqueInMsg.subscribeTo(self.torque_msg)
+
+        # the hub's initial position and velocity are the system's centre of mass
+        r_ib = quat_to_dcm(x["q_ib"])
+        c_b, c_dot_b = com_offset(model, x["theta"], x["theta_dot"])
+        sc.hub.r_CN_NInit = (x["r_b"] + r_ib @ c_b).reshape(3, 1).tolist()
+        sc.hub.v_CN_NInit = (x["v_b"] + r_ib @ (np.cross(x["w_b"], c_b) + c_dot_b)).reshape(3, 1).tolist()
+        sc.hub.sigma_BNInit = np.array(rbk.C2MRP(r_ib.T)).reshape(3, 1).tolist()
+        sc.hub.omega_BN_BInit = np.asarray(x["w_b"]).reshape(3, 1).tolist()
+        sc.setIntegrator(svIntegrators.svIntegratorRK4(sc))
+        grav.addBodiesTo(sc)
+
+        # target: a torque-free rigid body
+        tg = spacecraft.Spacecraft()
+        tg.ModelTag = "target"
+        tg.hub.mHub = scenario["target"]["mass_kg"]
+        tg.hub.IHubPntBc_B = scenario["target"]["inertia_kg_m2"]
+        tg.hub.r_BcB_B = [[0.0], [0.0], [0.0]]
+        tg.hub.r_CN_NInit = np.asarray(x["r_t"]).reshape(3, 1).tolist()
+        tg.hub.v_CN_NInit = np.asarray(x["v_t"]).reshape(3, 1).tolist()
+        tg.hub.sigma_BNInit = np.array(rbk.C2MRP(quat_to_dcm(x["q_it"]).T)).reshape(3, 1).tolist()
+        tg.hub.omega_BN_BInit = np.asarray(x["w_t"]).reshape(3, 1).tolist()
+        tg.setIntegrator(svIntegrators.svIntegratorRK4(tg))
+        grav.addBodiesTo(tg)
+        self.sc, self.tg, self.arm, self.ext = sc, tg, arm, ext
+
+    def add_to(self, sim, task):
+        # the arm reads the motor torques before the spacecraft integrate with them (its output
+        # message would then be a physics step old: the joint states are read from the states)
+        for m, priority in ((self.arm, 300), (self.ext, 300), (self.sc, 200), (self.tg, 200)):
+            sim.AddModelToTask(task, m, None, priority)
+
+    def joint_states(self):
+        """The arm's theta and thetaDot state objects (after InitializeSimulation)."""
+        dm = self.sc.dynManager
+        return dm.getStateObject(self.arm.getNameOfThetaState()), dm.getStateObject(self.arm.getNameOfThetaDotState())
+
+    def command(self, u):
+        self.ext.extForce_B = [[u[0]], [u[1]], [u[2]]]
+        self.ext.extTorquePntB_B = [[u[3]], [u[4]], [u[5]]]
+        p = self.messaging.ArrayMotorTorqueMsgPayload()
+        p.motorTorque = list(u[6:13])
+        self.torque_msg.write(p)
+
+
+def run_basilisk(scenario, model, ours, profile, dt_ctrl, dt_phys, steps):
+    from Basilisk.utilities import SimulationBaseClass, macros
+
+    row0 = ours[0]
+    col = lambda stem, axes: np.array([row0[f"{stem}{a}"] for a in axes])  # noqa: E731
+    x = dict(
+        theta=col("theta_", [f"{i}_rad" for i in range(1, 8)]),
+        theta_dot=col("theta_dot_", [f"{i}_rad_s" for i in range(1, 8)]),
+        q_ib=col("servicer_q", ["0_ib", "1_ib", "2_ib", "3_ib"]),
+        w_b=col("servicer_w", ["x_b_rad_s", "y_b_rad_s", "z_b_rad_s"]),
+        r_b=col("servicer_", ["x_i_m", "y_i_m", "z_i_m"]),
+        v_b=col("servicer_v", ["x_i_m_s", "y_i_m_s", "z_i_m_s"]),
+        q_it=col("target_q", ["0_it", "1_it", "2_it", "3_it"]),
+        r_t=col("target_", ["x_i_m", "y_i_m", "z_i_m"]),
+        v_t=col("target_v", ["x_i_m_s", "y_i_m_s", "z_i_m_s"]),
+        w_t=col("target_w", ["x_t_rad_s", "y_t_rad_s", "z_t_rad_s"]),
+    )
     sim = SimulationBaseClass.SimBaseClass()
     proc = sim.CreateNewProcess("dynamics")
     proc.addTask(sim.CreateNewTask("step", macros.sec2nano(dt_phys)))
-    row0 = ours[0]
-    col = lambda stem, axes: np.array([row0[f"{stem}{a}"] for a in axes])  # noqa: E731
-
-    grav = simIncludeGravBody.gravBodyFactory()
-    earth = grav.createEarth()
-    earth.isCentralBody = True
-    earth.mu = scenario["orbit"]["earth_mu_m3_s2"]
-
-    # servicer: hub + arm
-    sc = spacecraft.Spacecraft()
-    sc.ModelTag = "servicer"
-    m0, c0, i0 = model["base"]
-    sc.hub.mHub = m0
-    sc.hub.r_BcB_B = c0.reshape(3, 1).tolist()
-    sc.hub.IHubPntBc_B = i0.tolist()
-    arm = spinningBodyNDOFStateEffector.SpinningBodyNDOFStateEffector()
-    arm.ModelTag = "arm"
-    theta0 = col("theta_", [f"{i}_rad" for i in range(1, 8)])
-    theta_dot0 = col("theta_dot_", [f"{i}_rad_s" for i in range(1, 8)])
-    for b, th, thd in zip(model["chain"], theta0, theta_dot0):
-        s = spinningBodyNDOFStateEffector.SpinningBody()
-        s.setMass(b["mass"])
-        s.setISPntSc_S(b["inertia"].tolist())
-        s.setDCM_S0P(b["rot"].T.tolist())
-        s.setR_ScS_S(b["com"].reshape(3, 1).tolist())
-        s.setR_SP_P(b["pos"].reshape(3, 1).tolist())
-        s.setSHat_S((b["axis"] / np.linalg.norm(b["axis"])).reshape(3, 1).tolist())
-        s.setThetaInit(float(th))
-        s.setThetaDotInit(float(thd))
-        arm.addSpinningBody(s)
-    sc.addStateEffector(arm)
-    ext = extForceTorque.ExtForceTorque()
-    ext.ModelTag = "wrench"
-    sc.addDynamicEffector(ext)
-    torque_msg = messaging.ArrayMotorTorqueMsg()
-    arm.motorTorqueInMsg.subscribeTo(torque_msg)
-
-    q_ib = col("servicer_q", ["0_ib", "1_ib", "2_ib", "3_ib"])
-    r_ib = quat_to_dcm(q_ib)
-    w_b = col("servicer_w", ["x_b_rad_s", "y_b_rad_s", "z_b_rad_s"])
-    r_b = col("servicer_", ["x_i_m", "y_i_m", "z_i_m"])
-    v_b = col("servicer_v", ["x_i_m_s", "y_i_m_s", "z_i_m_s"])
-    c_b, c_dot_b = com_offset(model, theta0, theta_dot0)
-    sc.hub.r_CN_NInit = (r_b + r_ib @ c_b).reshape(3, 1).tolist()
-    sc.hub.v_CN_NInit = (v_b + r_ib @ (np.cross(w_b, c_b) + c_dot_b)).reshape(3, 1).tolist()
-    sc.hub.sigma_BNInit = np.array(rbk.C2MRP(r_ib.T)).reshape(3, 1).tolist()
-    sc.hub.omega_BN_BInit = w_b.reshape(3, 1).tolist()
-    sc.setIntegrator(svIntegrators.svIntegratorRK4(sc))
-    grav.addBodiesTo(sc)
-
-    # target: a torque-free rigid body
-    tg = spacecraft.Spacecraft()
-    tg.ModelTag = "target"
-    tg.hub.mHub = scenario["target"]["mass_kg"]
-    tg.hub.IHubPntBc_B = scenario["target"]["inertia_kg_m2"]
-    tg.hub.r_BcB_B = [[0.0], [0.0], [0.0]]
-    q_it = col("target_q", ["0_it", "1_it", "2_it", "3_it"])
-    tg.hub.r_CN_NInit = col("target_", ["x_i_m", "y_i_m", "z_i_m"]).reshape(3, 1).tolist()
-    tg.hub.v_CN_NInit = col("target_v", ["x_i_m_s", "y_i_m_s", "z_i_m_s"]).reshape(3, 1).tolist()
-    tg.hub.sigma_BNInit = np.array(rbk.C2MRP(quat_to_dcm(q_it).T)).reshape(3, 1).tolist()
-    tg.hub.omega_BN_BInit = col("target_w", ["x_t_rad_s", "y_t_rad_s", "z_t_rad_s"]).reshape(3, 1).tolist()
-    tg.setIntegrator(svIntegrators.svIntegratorRK4(tg))
-    grav.addBodiesTo(tg)
-
-    # the arm reads the motor torques before the spacecraft integrate with them (its output
-    # message would then be a physics step old: the joint states are read from the states)
-    for m, priority in ((arm, 300), (ext, 300), (sc, 200), (tg, 200)):
-        sim.AddModelToTask("step", m, None, priority)
+    bm = BasiliskModel(scenario, model, x)
+    bm.add_to(sim, "step")
     sim.InitializeSimulation()
-    theta_state = sc.dynManager.getStateObject(arm.getNameOfThetaState())
+    theta_state, _ = bm.joint_states()
+    rbk = bm.rbk
 
     rows = []
     for k in range(steps + 1):
-        s = sc.scStateOutMsg.read()
-        t = tg.scStateOutMsg.read()
+        s = bm.sc.scStateOutMsg.read()
+        t = bm.tg.scStateOutMsg.read()
         rows.append(dict(
             r_b=np.array(s.r_BN_N), v_b=np.array(s.v_BN_N), c_bn=np.array(rbk.MRP2C(s.sigma_BN)),
             r_t=np.array(t.r_BN_N), v_t=np.array(t.v_BN_N), c_tn=np.array(rbk.MRP2C(t.sigma_BN)),
@@ -280,12 +316,7 @@ def run_basilisk(scenario, model, ours, profile, dt_ctrl, dt_phys, steps):
         ))
         if k == steps:
             break
-        u = profile[k]
-        ext.extForce_B = [[u[0]], [u[1]], [u[2]]]
-        ext.extTorquePntB_B = [[u[3]], [u[4]], [u[5]]]
-        p = messaging.ArrayMotorTorqueMsgPayload()
-        p.motorTorque = list(u[6:13])
-        torque_msg.write(p)
+        bm.command(profile[k])
         sim.ConfigureStopTime(macros.sec2nano((k + 1) * dt_ctrl))
         sim.ExecuteSimulation()
     return rows
