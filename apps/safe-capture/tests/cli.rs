@@ -6,37 +6,13 @@ use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
+mod common;
+use common::{TmpDir, root};
 
 fn bin() -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_safe-capture"));
     c.current_dir(root());
     c
-}
-
-/// A scratch directory, removed when the test ends (passed or failed).
-struct TmpDir(PathBuf);
-
-impl std::ops::Deref for TmpDir {
-    type Target = Path;
-    fn deref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl AsRef<Path> for TmpDir {
-    fn as_ref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for TmpDir {
-    fn drop(&mut self) {
-        // a test may have made it a file
-        let _ = std::fs::remove_dir_all(&self.0).or_else(|_| std::fs::remove_file(&self.0));
-    }
 }
 
 fn tmp(name: &str) -> TmpDir {

@@ -11,7 +11,7 @@ pub fn root() -> PathBuf {
 }
 
 /// A scratch directory, removed when the test ends (passed or failed).
-pub struct TmpDir(PathBuf);
+pub struct TmpDir(pub PathBuf);
 
 impl std::ops::Deref for TmpDir {
     type Target = Path;
@@ -28,7 +28,8 @@ impl AsRef<Path> for TmpDir {
 
 impl Drop for TmpDir {
     fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
+        // a test may have made it a file
+        let _ = std::fs::remove_dir_all(&self.0).or_else(|_| std::fs::remove_file(&self.0));
     }
 }
 
