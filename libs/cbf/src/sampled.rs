@@ -258,41 +258,56 @@ mod tests {
         )
     }
 
+    /// A random μ, sample bounds and a state inside `{h ≥ 0, H ≥ 0}` (terms with `b = 1`).
+    fn random_state(seed: &mut u64) -> (f64, SampleBounds, RelDeg2<1>) {
+        let mut r = || lcg(seed);
+        let mu = 0.001 + r();
+        let b = SampleBounds {
+            period: 0.01 + 0.2 * r(),
+            m2: 0.1 * r(),
+            m3: r() * r(),
+        };
+        let hdot = 2.0 * r() - 1.0;
+        let h = hdot.min(0.0).powi(2) / (2.0 * mu) + r() * r();
+        let x = RelDeg2 {
+            h,
+            hdot,
+            a: 0.0,
+            b: Vector1::new(1.0),
+        };
+        (mu, b, x)
+    }
+
+    /// Under the worst case for `φ`, `h ≥ 0` all through the sample and `H(T) ≥ κ`.
+    fn assert_worst_case_holds(x: &RelDeg2<1>, b: &SampleBounds, mu: f64, phi: f64, kappa: f64) {
+        for k in 0..=200 {
+            let s = b.period * k as f64 / 200.0;
+            let (p, _) = worst(x, b, phi, s);
+            assert!(
+                p >= -1e-12 * (1.0 + x.h),
+                "h({s}) = {p} (h {}, hdot {})",
+                x.h,
+                x.hdot
+            );
+        }
+        let (p, v) = worst(x, b, phi, b.period);
+        assert!(
+            braking_barrier(p, v, mu) >= kappa - 1e-9 * (1.0 + kappa.abs()),
+            "H(T) = {} < {kappa}",
+            braking_barrier(p, v, mu)
+        );
+    }
+
     #[test]
     fn rel_deg_two_row_keeps_h_and_next_braking_barrier_on_the_worst_case() {
         let mut seed = 1;
         for _ in 0..20000 {
-            let mut r = || lcg(&mut seed);
-            let mu = 0.001 + r();
-            let b = SampleBounds {
-                period: 0.01 + 0.2 * r(),
-                m2: 0.1 * r(),
-                m3: r() * r(),
-            };
-            let hdot = 2.0 * r() - 1.0;
-            // a state inside {h ≥ 0, H ≥ 0}
-            let h = hdot.min(0.0).powi(2) / (2.0 * mu) + r() * r();
-            let x = RelDeg2 {
-                h,
-                hdot,
-                a: 0.0,
-                b: Vector1::new(1.0),
-            };
-            let gamma = 2.0 * r();
+            let (mu, b, x) = random_state(&mut seed);
+            let gamma = 2.0 * lcg(&mut seed);
             let phi = x.phi_required(&b, mu, gamma);
             assert!(phi.is_finite());
-            for k in 0..=200 {
-                let s = b.period * k as f64 / 200.0;
-                let (p, _) = worst(&x, &b, phi, s);
-                assert!(p >= -1e-12 * (1.0 + h), "h({s}) = {p} (h {h}, hdot {hdot})");
-            }
-            let (p, v) = worst(&x, &b, phi, b.period);
-            let kappa = (-gamma * b.period).exp() * braking_barrier(h, hdot, mu);
-            assert!(
-                braking_barrier(p, v, mu) >= kappa - 1e-9 * (1.0 + kappa.abs()),
-                "H(T) = {} < {kappa}",
-                braking_barrier(p, v, mu)
-            );
+            let kappa = (-gamma * b.period).exp() * braking_barrier(x.h, x.hdot, mu);
+            assert_worst_case_holds(&x, &b, mu, phi, kappa);
             // feasible by braking: the requirement never exceeds μ + M₂ + M₃T
             assert!(
                 phi <= braking_requirement(&b, mu) + 1e-9,
@@ -306,28 +321,15 @@ mod tests {
     fn a_knee_only_relaxes_the_row_above_it_and_keeps_the_set_invariant() {
         let mut seed = 3;
         for _ in 0..20000 {
+            let (mu, b, x) = random_state(&mut seed);
             let mut r = || lcg(&mut seed);
-            let mu = 0.001 + r();
-            let b = SampleBounds {
-                period: 0.01 + 0.2 * r(),
-                m2: 0.1 * r(),
-                m3: r() * r(),
-            };
-            let hdot = 2.0 * r() - 1.0;
-            let h = hdot.min(0.0).powi(2) / (2.0 * mu) + r() * r();
-            let x = RelDeg2 {
-                h,
-                hdot,
-                a: 0.0,
-                b: Vector1::new(1.0),
-            };
             let gamma = 2.0 * r();
             let decay = Decay {
                 gamma,
                 knee: r() * r(),
                 gamma_inner: gamma + 20.0 * r(),
             };
-            let big_h = braking_barrier(h, hdot, mu);
+            let big_h = braking_barrier(x.h, x.hdot, mu);
             let kappa = decay.target(big_h, b.period);
             assert!((0.0..=big_h).contains(&kappa), "κ({big_h}) = {kappa}");
             let linear = x.phi_required(&b, mu, gamma);
@@ -338,13 +340,7 @@ mod tests {
                 assert_eq!(phi, linear);
             }
             // the worst case still keeps h ≥ 0 inside the sample and H(T) ≥ κ(H) ≥ 0
-            for k in 0..=200 {
-                let s = b.period * k as f64 / 200.0;
-                let (p, _) = worst(&x, &b, phi, s);
-                assert!(p >= -1e-12 * (1.0 + h), "h({s}) = {p}");
-            }
-            let (p, v) = worst(&x, &b, phi, b.period);
-            assert!(braking_barrier(p, v, mu) >= kappa - 1e-9 * (1.0 + kappa.abs()));
+            assert_worst_case_holds(&x, &b, mu, phi, kappa);
         }
     }
 
