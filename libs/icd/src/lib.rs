@@ -2,7 +2,8 @@
 //! messages that the processes exchange over iceoryx2 shared memory.
 //!
 //! Rules every message follows (checked by compile-time guards here and by
-//! `tests/python_layout.rs` against the Python mirror `scripts/python/sc_icd.py`):
+//! `tests/python_layout.rs` against the Python mirror `scripts/python/sc_partner/icd.py`,
+//! and by `tests/c_header.rs` against the generated C header `include/safe_capture_icd.h`):
 //! - `#[repr(C)]`, `Copy`, derives `ZeroCopySend` with an explicit, versioned
 //!   `#[type_name("safe_capture::v1::...")]` (the name iceoryx2 uses to match types
 //!   across processes and languages; a mismatch fails cleanly at open time).
@@ -23,6 +24,7 @@
 
 use iceoryx2::prelude::ZeroCopySend;
 
+pub mod c_header;
 pub mod services;
 pub use services::ServiceName;
 
@@ -476,7 +478,8 @@ pub fn type_name_of<T: ZeroCopySend>() -> &'static str {
     unsafe { <T as ZeroCopySend>::type_name() }
 }
 
-// Size guards: change them only together with scripts/python/sc_icd.py and docs/ICD.md.
+// Size guards: change them only together with scripts/python/sc_partner/icd.py,
+// the C header (`c_header`) and docs/ICD.md.
 const _: () = assert!(core::mem::size_of::<Tick>() == 40);
 const _: () = assert!(core::mem::size_of::<SimState>() == 1568);
 const _: () = assert!(core::mem::size_of::<NominalTranslational>() == 64);
