@@ -146,7 +146,6 @@ pub fn clean_stale_runs(except: &str) -> usize {
     removed
 }
 
-/// The executable a role's `exec` names: a path relative to the config directory
 /// What a partition run writes into its output directory (besides `logs/`).
 pub const RUN_OUTPUTS: [&str; 17] = [
     "summary.json",
@@ -188,6 +187,7 @@ fn clear_previous_run(out: &Path) {
     }
 }
 
+/// The executable a role's `exec` names: a path relative to the config directory
 /// `base_dir`, or a bare name looked up in `bin_dir`, `SC_PARTITION_BIN_DIR` and the
 /// launcher's own directory; a bare name found in none of them is returned as is
 /// (then `PATH` decides).
@@ -245,11 +245,9 @@ struct Proc {
     exit: Option<ProcessExit>,
 }
 
-/// Starts, supervises and tears down one run of the partition.
-pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
-    install_signal_handlers();
-    INTERRUPTED.store(false, Ordering::SeqCst);
-    let started = Instant::now();
+/// The config `opts` names, with the options' overrides applied (scenario, clock,
+/// ticks, deadline scale, role executables); paths still relative to its directory.
+pub fn configured(opts: &LaunchOptions) -> anyhow::Result<PartitionConfig> {
     let mut cfg = PartitionConfig::load(&opts.config)?;
     if let Some(sc) = &opts.scenario {
         cfg.scenario = abs(sc);
@@ -271,6 +269,15 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
         e.exec = exec.clone();
         e.args = args.clone();
     }
+    Ok(cfg)
+}
+
+/// Starts, supervises and tears down one run of the partition.
+pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
+    install_signal_handlers();
+    INTERRUPTED.store(false, Ordering::SeqCst);
+    let started = Instant::now();
+    let mut cfg = configured(opts)?;
     let out = abs(&opts.out);
     clear_previous_run(&out);
     std::fs::create_dir_all(out.join("logs"))
@@ -377,9 +384,10 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
                     signal: st.signal(),
                     killed_by_launcher: termed,
                 };
-                // a process that ended well is counted in the verdict line; one that did
-                // not is named here as it happens
-                if !opts.quiet && !ex.ended_well() {
+                // a process that ended well is counted in the verdict line, and so is one
+                // the teardown stopped; one that failed by itself is named here as it
+                // happens
+                if !opts.quiet && !ex.ended_well() && !termed {
                     eprintln!(
                         "launch: {} (pid {}) exited: {}",
                         p.role,

@@ -22,6 +22,7 @@ pub mod launcher;
 pub mod mcap_out;
 pub mod plant_process;
 pub mod pm_qos;
+pub mod preflight;
 pub mod process;
 pub mod recorder;
 pub mod roles;

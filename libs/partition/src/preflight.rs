@@ -1,0 +1,393 @@
+//! Checks before any process starts: what would otherwise fail only once the partition
+//! is running (a process that cannot start, a scenario every process rejects, a partner
+//! script the interpreter cannot open while the scheduler waits for the handshake).
+//! Every error is one line naming the key or role, the cause and the fix.
+//!
+//! Programs are found exactly as the launcher finds them ([`resolve_exec`]: a path
+//! relative to the config's directory, a bare name next to the launcher or in
+//! `SC_PARTITION_BIN_DIR`, then `PATH`).
+
+use crate::config::{ConfigError, PartitionConfig, ROLES};
+use crate::launcher::{BIN_DIR_ENV, resolve_exec};
+use std::os::unix::fs::PermissionsExt;
+use std::path::{Path, PathBuf};
+
+/// The command that builds the partition's own executables.
+pub const BUILD_COMMAND: &str = "cargo build --release -p sc-partition-apps";
+
+/// The executables of package sc-partition-apps that serve the roles (`apps/partition`).
+pub const PARTITION_EXECUTABLES: [&str; 9] = [
+    "sc-scheduler",
+    "sc-simulator",
+    "sc-nominal-translational",
+    "sc-nominal-attitude",
+    "sc-nominal-robotic",
+    "sc-safety-translational",
+    "sc-safety-attitude",
+    "sc-safety-robotic",
+    "sc-recorder",
+];
+
+/// Mode bits that make a file executable by someone.
+const ANY_EXECUTE: u32 = 0o111;
+
+/// What the pre-flight check found in a valid config.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Preflight {
+    /// Roles whose program was found.
+    pub roles: usize,
+    /// The scenario the config names, resolved.
+    pub scenario: PathBuf,
+}
+
+fn err<T>(msg: String) -> Result<T, ConfigError> {
+    Err(ConfigError(msg))
+}
+
+/// The scenario, every role's program and the simulator's plant program.
+pub fn preflight(
+    cfg: &PartitionConfig,
+    bin_dir: &Option<PathBuf>,
+) -> Result<Preflight, ConfigError> {
+    let scenario = check_scenario(cfg)?;
+    let roles = check_programs(cfg, bin_dir)?;
+    Ok(Preflight { roles, scenario })
+}
+
+/// Loads and validates the scenario the config names; returns its path.
+pub fn check_scenario(cfg: &PartitionConfig) -> Result<PathBuf, ConfigError> {
+    let path = cfg.scenario_path();
+    match sc_scenario::Scenario::load(&path) {
+        Ok(_) => Ok(path),
+        Err(e @ sc_scenario::ScenarioError::Io { .. }) => err(format!(
+            "scenario = {:?}: {e}; point `scenario` at a scenario file (a relative path is relative to the config's directory {})",
+            cfg.scenario,
+            shown_dir(&cfg.base_dir)
+        )),
+        Err(e) => err(format!(
+            "scenario = {:?}: {e}; correct the scenario or point `scenario` at another",
+            cfg.scenario
+        )),
+    }
+}
+
+/// Every role's program (and the partner script its arguments name), and the
+/// simulator's plant program if any. Returns the number of roles checked.
+pub fn check_programs(
+    cfg: &PartitionConfig,
+    bin_dir: &Option<PathBuf>,
+) -> Result<usize, ConfigError> {
+    let mut n = 0;
+    for role in ROLES {
+        let Some(e) = cfg.roles.get(role) else {
+            return err(format!(
+                "roles.{role}: missing (every role needs an executable)"
+            ));
+        };
+        let key = format!("roles.{role}.exec");
+        check_role_program(&format!("role `{role}`"), &key, &e.exec, cfg, bin_dir)?;
+        check_script(
+            &format!("role `{role}`"),
+            &format!("roles.{role}.args"),
+            &e.args,
+            &cfg.base_dir,
+        )?;
+        n += 1;
+    }
+    if let Some((program, args)) = cfg.simulator.plant.split_first() {
+        check_plant_program(program, &cfg.base_dir)?;
+        check_script(
+            "the simulator's plant",
+            "simulator.plant",
+            args,
+            &cfg.base_dir,
+        )?;
+    }
+    Ok(n)
+}
+
+fn shown_dir(d: &Path) -> String {
+    if d.as_os_str().is_empty() {
+        ".".into()
+    } else {
+        d.display().to_string()
+    }
+}
+
+/// How to get a missing program: build ours, create the Python environment, or
+/// correct the path.
+fn fix_for(program: &Path, key: &str) -> String {
+    let name = program
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_default();
+    if PARTITION_EXECUTABLES.contains(&name.as_str()) {
+        format!("build it with `{BUILD_COMMAND}` or correct `{key}`")
+    } else if program.ends_with(".venv/bin/python") {
+        format!("create the Python environment with `scripts/setup.sh` or correct `{key}`")
+    } else {
+        format!("install it or correct `{key}`")
+    }
+}
+
+fn is_executable(p: &Path) -> bool {
+    p.metadata()
+        .is_ok_and(|m| m.is_file() && m.permissions().mode() & ANY_EXECUTE != 0)
+}
+
+/// A bare program name on `PATH`.
+fn on_path(name: &Path) -> Option<PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path)
+        .map(|d| d.join(name))
+        .find(|c| c.is_file())
+}
+
+/// A role's program, found as the launcher finds it.
+fn check_role_program(
+    who: &str,
+    key: &str,
+    exec: &str,
+    cfg: &PartitionConfig,
+    bin_dir: &Option<PathBuf>,
+) -> Result<(), ConfigError> {
+    let resolved = resolve_exec(exec, &cfg.base_dir, bin_dir);
+    let bare = !exec.contains('/');
+    let found = if bare && resolved.components().count() == 1 {
+        on_path(&resolved)
+    } else {
+        Some(resolved.clone()).filter(|p| p.is_file())
+    };
+    match found {
+        Some(p) if is_executable(&p) => Ok(()),
+        Some(p) => err(format!(
+            "{who}: {} is not executable; make it so with `chmod +x {}` or correct `{key}`",
+            p.display(),
+            p.display()
+        )),
+        None if bare => {
+            let me = std::env::current_exe().ok();
+            let here = me
+                .as_ref()
+                .and_then(|p| Some((p.file_name()?, p.parent()?)))
+                .map(|(n, d)| format!("{} ({})", n.to_string_lossy(), d.display()))
+                .unwrap_or_else(|| "the launcher".into());
+            err(format!(
+                "{who}: the executable `{exec}` was found neither next to {here}, nor in ${BIN_DIR_ENV}, nor on PATH; {}",
+                fix_for(Path::new(exec), key)
+            ))
+        }
+        None => err(format!(
+            "{who}: the executable {} does not exist ({key} = {exec:?}{}); {}",
+            resolved.display(),
+            if Path::new(exec).is_absolute() {
+                String::new()
+            } else {
+                format!(
+                    ", relative to the config's directory {}",
+                    shown_dir(&cfg.base_dir)
+                )
+            },
+            fix_for(&resolved, key)
+        )),
+    }
+}
+
+/// The plant program: relative to the config's directory when it is there (as the
+/// launcher rewrites it), else as the simulator will start it (a path relative to the
+/// working directory, a bare name on `PATH`).
+fn check_plant_program(program: &str, base_dir: &Path) -> Result<(), ConfigError> {
+    let key = "simulator.plant";
+    let p = Path::new(program);
+    let in_base = base_dir.join(p);
+    let found = if in_base.is_file() {
+        Some(in_base.clone())
+    } else if program.contains('/') {
+        Some(p.to_path_buf()).filter(|p| p.is_file())
+    } else {
+        on_path(p)
+    };
+    match found {
+        Some(f) if is_executable(&f) => Ok(()),
+        Some(f) => err(format!(
+            "the simulator's plant: {} is not executable; make it so with `chmod +x {}` or correct `{key}`",
+            f.display(),
+            f.display()
+        )),
+        None => err(format!(
+            "the simulator's plant: the program {program:?} exists neither relative to the config's directory {} nor {}; {}",
+            shown_dir(base_dir),
+            if program.contains('/') {
+                "relative to the working directory"
+            } else {
+                "on PATH"
+            },
+            fix_for(&in_base, key)
+        )),
+    }
+}
+
+/// The script an interpreter is asked to run: the first argument that is not an option,
+/// when it names a path (contains `/`), must exist relative to the config's directory
+/// (where the launcher looks first) or to the working directory.
+fn check_script(who: &str, key: &str, args: &[String], base_dir: &Path) -> Result<(), ConfigError> {
+    let Some(script) = args.iter().find(|a| !a.starts_with('-')) else {
+        return Ok(());
+    };
+    if !script.contains('/') {
+        return Ok(());
+    }
+    let p = Path::new(script);
+    if base_dir.join(p).is_file() || p.is_file() {
+        return Ok(());
+    }
+    err(format!(
+        "{who}: the script {script:?} in `{key}` exists neither relative to the config's directory {} nor to the working directory; correct the path in `{key}`",
+        shown_dir(base_dir)
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn config(dir: &Path, roles: &str, extra: &str) -> PartitionConfig {
+        let mut s = format!(
+            "scenario = \"scenario.toml\"\nclock = \"lock_step\"\nhandshake_timeout_s = 30\n{extra}[[rate_groups]]\nname = \"c\"\nperiod_s = 0.1\nmembers = [\"translational\", \"attitude\", \"robotic\"]\n[deadlines]\nsafety_translational_ms = 40\nsafety_attitude_ms = 60\nsafety_robotic_ms = 80\nsimulator_ms = 90\n[lock_step]\ndeadline_scale = 20\nrecorder_window_ticks = 8\n"
+        );
+        s += roles;
+        PartitionConfig::from_toml_str(&s, dir).unwrap()
+    }
+
+    fn roles_all(exec: &str) -> String {
+        ROLES
+            .iter()
+            .map(|r| format!("[roles.{r}]\nexec = \"{exec}\"\n"))
+            .collect()
+    }
+
+    struct Scratch(PathBuf);
+    impl Drop for Scratch {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+
+    fn scratch(name: &str) -> Scratch {
+        let d = std::env::temp_dir().join(format!("sc-preflight-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        Scratch(d)
+    }
+
+    fn write_program(p: &Path, mode: u32) {
+        std::fs::write(p, "#!/bin/sh\n").unwrap();
+        std::fs::set_permissions(p, std::fs::Permissions::from_mode(mode)).unwrap();
+    }
+
+    #[test]
+    fn a_missing_program_names_its_role_and_the_fix() {
+        let d = scratch("missing");
+        write_program(&d.0.join("prog"), 0o755);
+        let roles = roles_all("./prog").replace(
+            "[roles.simulator]\nexec = \"./prog\"",
+            "[roles.simulator]\nexec = \"bin/sc-simulator\"",
+        );
+        let e = check_programs(&config(&d.0, &roles, ""), &None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("role `simulator`: the executable")
+                && e.contains("bin/sc-simulator does not exist")
+                && e.contains(BUILD_COMMAND),
+            "{e}"
+        );
+        assert_eq!(
+            check_programs(&config(&d.0, &roles_all("./prog"), ""), &None).unwrap(),
+            ROLES.len()
+        );
+    }
+
+    #[test]
+    fn a_bare_name_found_nowhere_is_named_with_where_it_was_looked_for() {
+        let d = scratch("bare");
+        let e = check_programs(&config(&d.0, &roles_all("sc-no-such-program"), ""), &None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with(
+                "role `scheduler`: the executable `sc-no-such-program` was found neither next to "
+            ) && e.contains(BIN_DIR_ENV)
+                && e.contains("install it or correct `roles.scheduler.exec`"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_file_that_is_not_executable_is_refused() {
+        let d = scratch("mode");
+        write_program(&d.0.join("prog"), 0o644);
+        let e = check_programs(&config(&d.0, &roles_all("./prog"), ""), &None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("is not executable") && e.contains("chmod +x"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_missing_partner_script_and_plant_are_named() {
+        let d = scratch("script");
+        write_program(&d.0.join("prog"), 0o755);
+        std::fs::write(d.0.join("partner.py"), "").unwrap();
+        let with_args = |script: &str| {
+            roles_all("./prog").replace(
+                "[roles.nominal_attitude]\nexec = \"./prog\"\n",
+                &format!(
+                    "[roles.nominal_attitude]\nexec = \"./prog\"\nargs = [\"-u\", \"{script}\", \"--strategy\", \"a/b\"]\n"
+                ),
+            )
+        };
+        assert!(check_programs(&config(&d.0, &with_args("./partner.py"), ""), &None).is_ok());
+        let e = check_programs(&config(&d.0, &with_args("./gone.py"), ""), &None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with(
+                "role `nominal_attitude`: the script \"./gone.py\" in `roles.nominal_attitude.args`"
+            ),
+            "{e}"
+        );
+        let plant = |p: &str| format!("[simulator]\nplant = [\"{p}\", \"./partner.py\"]\n");
+        let roles = roles_all("./prog") + &plant("./prog");
+        assert!(check_programs(&config(&d.0, &roles, ""), &None).is_ok());
+        let roles = roles_all("./prog") + &plant("./venv/.venv/bin/python");
+        let e = check_programs(&config(&d.0, &roles, ""), &None)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("the simulator's plant: the program \"./venv/.venv/bin/python\"")
+                && e.contains("scripts/setup.sh"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_missing_or_invalid_scenario_is_named_with_the_key() {
+        let d = scratch("scenario");
+        let cfg = config(&d.0, &roles_all("./prog"), "");
+        let e = check_scenario(&cfg).unwrap_err().to_string();
+        assert!(
+            e.starts_with("scenario = \"scenario.toml\": cannot read")
+                && e.contains("point `scenario` at a scenario file"),
+            "{e}"
+        );
+        std::fs::write(d.0.join("scenario.toml"), "[mission]\n").unwrap();
+        let e = check_scenario(&cfg).unwrap_err().to_string();
+        assert!(
+            e.starts_with("scenario = \"scenario.toml\": ") && !e.contains('\n'),
+            "{e}"
+        );
+    }
+}
