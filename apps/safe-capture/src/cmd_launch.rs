@@ -1,5 +1,7 @@
 //! `safe-capture launch`: the mission as a process partition (logic in sc-partition).
 
+use sc_partition::launcher::configured;
+use sc_partition::preflight::preflight;
 use sc_partition::{ClockMode, LaunchOptions, launch};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -8,7 +10,16 @@ use std::process::ExitCode;
 /// config/partition.toml: starts every process, waits for all to be ready, runs
 /// the mission, tears everything down. Writes the same telemetry.csv, timing.csv and
 /// summary.json as `run`, plus recording.mcap, latency.csv, logs/<role>.log.
-/// Exit code 0: captured safely; 1: not captured safely; 3: a process failed.
+///
+/// Before anything starts, the config, the scenario it names, every role's program,
+/// partner scripts and the simulator's plant program are checked as `safe-capture
+/// check` does: a problem is one line naming the role or key, the cause and the fix.
+///
+/// Exit codes, the mission's verdict: 0 captured safely, 1 the mission ended but not
+/// captured safely. The infrastructure's (no mission result): 2 bad configuration or
+/// arguments (nothing was started), 3 a process failed (did not start, crashed, was
+/// killed or hung) or the run was interrupted, 4 every process ended well but
+/// flight-side samples were lost in transport.
 #[derive(clap::Args)]
 pub struct Args {
     /// Partition config.
@@ -42,6 +53,10 @@ pub struct Args {
     partner: PathBuf,
 }
 
+/// The launcher's codes from this one on are the infrastructure's (a process failed,
+/// samples lost): the run is no mission result.
+const INFRASTRUCTURE_FAILURE: i32 = 3;
+
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let mut opts = LaunchOptions {
         config: a.config.clone(),
@@ -50,6 +65,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         max_ticks: a.max_ticks,
         ..Default::default()
     };
+    let mut partners = None;
     if let Some(h) = &a.hostile {
         let case = crate::redteam_partition::parse_hostile(h)?;
         let cfg = sc_partition::PartitionConfig::load(&a.config)?;
@@ -62,10 +78,27 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             None,
             opts.clock.unwrap_or(ClockMode::LockStep),
         )?;
-        p.check(&case)?;
         opts.role_override = p.overrides(&case);
+        partners = Some((p, case));
+    }
+    // nothing starts unless the scenario and every program are there
+    let cfg = configured(&opts)?;
+    preflight(&cfg, &opts.bin_dir).map_err(|e| anyhow::anyhow!("{}: {e}", a.config.display()))?;
+    if let Some((p, case)) = &partners {
+        p.check(case)?;
     }
     let rep = launch(&opts)?;
+    if rep.code >= INFRASTRUCTURE_FAILURE {
+        // no mission result: say why, in one line
+        println!(
+            "partition: infrastructure failure (exit {}), no mission result: {}; wall {:.2} s -> {}",
+            rep.code,
+            crate::montecarlo_partition::failure_reason(&rep, &a.out),
+            rep.wall_s,
+            a.out.display()
+        );
+        return Ok(ExitCode::from(rep.code.clamp(0, 255) as u8));
+    }
     let failed: Vec<String> = rep
         .exits
         .iter()

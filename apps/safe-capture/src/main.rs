@@ -6,6 +6,7 @@ mod cmd_bench;
 mod cmd_bench_filters;
 mod cmd_bench_latency;
 mod cmd_bounds;
+mod cmd_check;
 mod cmd_compare;
 mod cmd_launch;
 mod cmd_model;
@@ -59,6 +60,9 @@ enum Command {
     /// Compare two runs of the same mission step by step (e.g. Basilisk as the plant
     /// against our simulator): position, attitude and joint differences, CSV and figure.
     Compare(cmd_compare::Args),
+    /// Validate scenario, partition and Monte Carlo configs before anything runs (a
+    /// partition config with its scenario and every role's program).
+    Check(cmd_check::Args),
 }
 
 /// Default scenario path (relative to the working directory).
@@ -71,46 +75,49 @@ pub fn default_scenario() -> PathBuf {
 /// otherwise replace the long descriptions (outputs, columns, exit codes) the commands'
 /// `Args` carry.
 fn command() -> clap::Command {
-    use clap::{Args as _, CommandFactory};
+    use clap::CommandFactory;
+    fn args<A: clap::Args>(name: &'static str) -> clap::Command {
+        A::augment_args(clap::Command::new(name))
+    }
     let mut c = Cli::command();
-    let mut long = |name: &str, args: clap::Command| {
+    for (path, args) in [
+        (&["run"][..], args::<cmd_run::Args>("run")),
+        (&["simulate"], args::<cmd_simulate::Args>("simulate")),
+        (&["model"], args::<cmd_model::Args>("model")),
+        (&["launch"], args::<cmd_launch::Args>("launch")),
+        (&["bench"], args::<cmd_bench::Args>("bench")),
+        (
+            &["bench", "filters"],
+            args::<cmd_bench_filters::Args>("filters"),
+        ),
+        (
+            &["bench", "latency"],
+            args::<cmd_bench_latency::Args>("latency"),
+        ),
+        (&["montecarlo"], args::<cmd_montecarlo::Args>("montecarlo")),
+        (&["redteam"], args::<cmd_redteam::Args>("redteam")),
+        (&["bounds"], args::<cmd_bounds::Args>("bounds")),
+        (&["verify-qp"], args::<cmd_verify_qp::Args>("verify-qp")),
+        (&["compare"], args::<cmd_compare::Args>("compare")),
+        (&["check"], args::<cmd_check::Args>("check")),
+    ] {
         if let Some(l) = args.get_long_about().or(args.get_about()).cloned() {
-            c = std::mem::take(&mut c).mut_subcommand(name, |s| s.long_about(l));
+            c = with_long_about(c, path, l);
         }
-    };
-    long(
-        "run",
-        cmd_run::Args::augment_args(clap::Command::new("run")),
-    );
-    long(
-        "simulate",
-        cmd_simulate::Args::augment_args(clap::Command::new("simulate")),
-    );
-    long(
-        "model",
-        cmd_model::Args::augment_args(clap::Command::new("model")),
-    );
-    long(
-        "launch",
-        cmd_launch::Args::augment_args(clap::Command::new("launch")),
-    );
-    long(
-        "redteam",
-        cmd_redteam::Args::augment_args(clap::Command::new("redteam")),
-    );
-    long(
-        "bounds",
-        cmd_bounds::Args::augment_args(clap::Command::new("bounds")),
-    );
-    long(
-        "verify-qp",
-        cmd_verify_qp::Args::augment_args(clap::Command::new("verify-qp")),
-    );
-    long(
-        "compare",
-        cmd_compare::Args::augment_args(clap::Command::new("compare")),
-    );
+    }
     c
+}
+
+/// `c` with the long description of its subcommand at `path` (e.g. `bench filters`).
+fn with_long_about(
+    c: clap::Command,
+    path: &[&str],
+    long: clap::builder::StyledStr,
+) -> clap::Command {
+    match path {
+        [] => c.long_about(long),
+        [name, rest @ ..] => c.mut_subcommand(*name, |s| with_long_about(s, rest, long)),
+    }
 }
 
 fn main() -> ExitCode {
@@ -127,6 +134,7 @@ fn main() -> ExitCode {
         Command::Bounds(a) => cmd_bounds::run(a),
         Command::VerifyQp(a) => cmd_verify_qp::run(a),
         Command::Compare(a) => cmd_compare::run(a),
+        Command::Check(a) => cmd_check::run(a),
     };
     match result {
         Ok(code) => code,

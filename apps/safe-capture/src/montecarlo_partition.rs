@@ -16,7 +16,7 @@ use sc_mission::{MissionEnd, Setup, StepRecord, parse_telemetry};
 use sc_montecarlo::campaign::PARTITION_DIR;
 use sc_montecarlo::{Execution, Executor};
 use sc_partition::config::ROLES;
-use sc_partition::launcher::{LaunchReport, interrupted, resolve_exec};
+use sc_partition::launcher::{LaunchReport, interrupted};
 use sc_partition::recorder::RecorderReport;
 use sc_partition::{ClockMode, LaunchOptions, PartitionConfig, launch};
 use std::path::{Path, PathBuf};
@@ -56,27 +56,10 @@ impl PartitionExecutor {
     ) -> anyhow::Result<(Self, Option<String>)> {
         let cfg = PartitionConfig::load(config).context("--partition-config")?;
         let schedule = cfg.schedule().context("--partition-config")?;
-        for role in ROLES {
-            let Some(e) = cfg.roles.get(role) else {
-                anyhow::bail!("{}: no executable for role `{role}`", config.display());
-            };
-            let exe = resolve_exec(&e.exec, &cfg.base_dir, &None);
-            if executable_exists(&exe) {
-                continue;
-            }
-            if e.exec.contains('/') {
-                anyhow::bail!(
-                    "{}: the executable {} of role `{role}` does not exist",
-                    config.display(),
-                    exe.display()
-                );
-            }
-            anyhow::bail!(
-                "--mode partition: the executable `{}` of role `{role}` was found neither next to safe-capture, nor in {}, nor on PATH; build it with `cargo build --release -p sc-partition-apps`",
-                e.exec,
-                sc_partition::launcher::BIN_DIR_ENV
-            );
-        }
+        // every role's program, as the launcher will find it (the scenario is the
+        // campaign's, checked by the campaign)
+        sc_partition::preflight::check_programs(&cfg, &None)
+            .map_err(|e| anyhow::anyhow!("--partition-config {}: {e}", config.display()))?;
         let period = sc_scenario::Scenario::load(scenario)
             .map(|s| s.mission.control_period_s)
             .ok();
@@ -112,14 +95,6 @@ impl PartitionExecutor {
     }
 }
 
-fn executable_exists(p: &Path) -> bool {
-    if p.components().count() > 1 || p.is_absolute() {
-        return p.is_file();
-    }
-    std::env::var_os("PATH")
-        .is_some_and(|path| std::env::split_paths(&path).any(|d| d.join(p).is_file()))
-}
-
 /// The last non-empty line of a log (for a failed run's error), shortened.
 fn last_line(log: &Path) -> Option<String> {
     let text = std::fs::read_to_string(log).ok()?;
@@ -133,8 +108,18 @@ fn last_line(log: &Path) -> Option<String> {
 
 /// Why a launch failed, in one line.
 fn failure(rep: &LaunchReport, out: &Path) -> String {
+    match &rep.error {
+        Some(e) => format!("partition: {e}"),
+        None => format!("partition failed: {}", failure_reason(rep, out)),
+    }
+}
+
+/// Why a launch failed, in one line: the launcher's error, or the processes that failed
+/// by themselves (with the last line of their logs), then those the launcher stopped,
+/// the roles never started and files left in /dev/shm.
+pub fn failure_reason(rep: &LaunchReport, out: &Path) -> String {
     if let Some(e) = &rep.error {
-        return format!("partition: {e}");
+        return e.clone();
     }
     let bad = |e: &&sc_partition::launcher::ProcessExit| !e.ended_well();
     // the processes that failed by themselves, with the last line of their log
@@ -182,7 +167,7 @@ fn failure(rep: &LaunchReport, out: &Path) -> String {
         parts.push("the launch reported a failure".into());
     }
     format!(
-        "partition failed: {}; see {}",
+        "{}; see {}",
         parts.join("; ").replace('\n', " "),
         out.join("logs").display()
     )

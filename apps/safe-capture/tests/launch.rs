@@ -3,10 +3,167 @@
 mod common;
 use common::*;
 
-/// A launch that fails at start into the folder of an earlier run reports no summary
-/// instead of the old run's, and removes only what a run writes (issue #16).
+/// A partition config for a launch from `dir`: config/partition.toml with the default
+/// scenario (absolute), a short handshake, and `from` replaced by `to`.
+fn partition_with(dir: &std::path::Path, from: &str, to: &str) -> std::path::PathBuf {
+    let cfg = std::fs::read_to_string(root().join("config/partition.toml"))
+        .unwrap()
+        .replace(
+            "scenario = \"scenario.toml\"",
+            &format!(
+                "scenario = \"{}\"",
+                std::path::absolute(root().join("config/scenario.toml"))
+                    .unwrap()
+                    .display()
+            ),
+        )
+        .replace("handshake_timeout_s = 30.0", "handshake_timeout_s = 2.0");
+    assert!(cfg.contains(from) && cfg.contains("handshake_timeout_s = 2.0"));
+    let p = dir.join("partition.toml");
+    std::fs::write(&p, cfg.replacen(from, to, 1)).unwrap();
+    p
+}
+
+/// Files of this CLI process's runs in /dev/shm (their run ids hold its pid).
+fn shm_files_of(pid: u32) -> Vec<String> {
+    std::fs::read_dir("/dev/shm")
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with("sc_") && n.contains(&format!("-{pid}-")))
+        .collect()
+}
+
+/// A launch whose config names a missing scenario or program stops before anything
+/// starts: exit 2, one line naming the key or role, the cause and the fix, no verdict
+/// line, no output folder, nothing in /dev/shm (issue #16).
+#[test]
+fn a_missing_scenario_or_program_stops_the_launch_before_anything_starts() {
+    let d = tmp("launch-preflight");
+    for (from, to, needles) in [
+        (
+            "exec = \"sc-simulator\"",
+            "exec = \"bin/sc-simulator\"",
+            &[
+                "role `simulator`: the executable",
+                "bin/sc-simulator does not exist",
+                "cargo build --release -p sc-partition-apps",
+            ][..],
+        ),
+        (
+            "exec = \"sc-recorder\"",
+            "exec = \"sc-recorder-v2\"",
+            &["role `recorder`: the executable `sc-recorder-v2` was found neither"],
+        ),
+        (
+            "exec = \"sc-nominal-attitude\"",
+            "exec = \"sh\"\nargs = [\"partners/attitude.sh\"]",
+            &["role `nominal_attitude`: the script \"partners/attitude.sh\""],
+        ),
+        (
+            "handshake_timeout_s = 2.0",
+            "handshake_timeout_s = 2.0\nscenario_override = 1",
+            &["unknown field `scenario_override`"],
+        ),
+    ] {
+        let cfg = partition_with(&d, from, to);
+        let out = d.join("out");
+        let (o, pid) = cli_partition(
+            &[
+                "launch",
+                "--config",
+                cfg.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            &[],
+        );
+        let t = text(&o);
+        assert_eq!(o.status.code(), Some(2), "{t}");
+        assert!(o.stdout.is_empty(), "a verdict line: {t}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+        assert_eq!(lines.len(), 1, "{t}");
+        assert!(lines[0].starts_with("error: "), "{t}");
+        for n in needles {
+            assert!(lines[0].contains(n), "`{n}` not in: {t}");
+        }
+        assert!(!out.exists(), "{t}");
+        assert_eq!(shm_files_of(pid), Vec::<String>::new());
+    }
+    // a scenario that is not there, or not valid
+    for (scenario, needle) in [
+        ("missing.toml", "scenario = \"missing.toml\": cannot read"),
+        ("../partition.toml", "scenario = \"../partition.toml\": "),
+    ] {
+        let cfg = std::fs::read_to_string(root().join("config/partition.toml"))
+            .unwrap()
+            .replace(
+                "scenario = \"scenario.toml\"",
+                &format!("scenario = \"{scenario}\""),
+            );
+        let sub = d.join("sub");
+        std::fs::create_dir_all(&sub).unwrap();
+        std::fs::write(sub.join("partition.toml"), cfg).unwrap();
+        let (o, pid) = cli_partition(
+            &[
+                "launch",
+                "--config",
+                sub.join("partition.toml").to_str().unwrap(),
+                "--out",
+                d.join("out").to_str().unwrap(),
+            ],
+            &[],
+        );
+        let t = text(&o);
+        assert_eq!(o.status.code(), Some(2), "{t}");
+        assert_eq!(t.lines().count(), 1, "{t}");
+        assert!(t.starts_with("error: ") && t.contains(needle), "{t}");
+        assert!(!d.join("out").exists(), "{t}");
+        assert_eq!(shm_files_of(pid), Vec::<String>::new());
+    }
+}
+
+/// A process that starts but fails before the handshake: exit 3, and one verdict line
+/// that says the run is no mission result and names the role that never joined — by
+/// name, not by number — beside the process that failed (issue #16).
+#[test]
+fn a_process_that_fails_at_start_is_named_in_an_infrastructure_verdict() {
+    let _cpu = exclusive();
+    let d = tmp("launch-fails-at-start");
+    let cfg = partition_with(&d, "exec = \"sc-nominal-robotic\"", "exec = \"false\"");
+    let out = d.join("out");
+    let (o, pid) = cli_partition(
+        &[
+            "launch",
+            "--config",
+            cfg.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(3), "{t}");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let verdict: Vec<&str> = stdout.lines().collect();
+    assert_eq!(verdict.len(), 1, "{t}");
+    assert!(
+        verdict[0].starts_with("partition: infrastructure failure (exit 3), no mission result: ")
+            && verdict[0].contains("nominal_robotic (exit code 1)")
+            && verdict[0].contains("never joined: nominal_robotic")
+            && !verdict[0].contains("no summary"),
+        "{t}"
+    );
+    assert_eq!(json(&out.join("launch.json"))["code"], 3);
+    assert_eq!(shm_files_of(pid), Vec::<String>::new());
+}
+
+/// A launch that fails at start into the folder of an earlier run reports no mission
+/// result instead of the old run's, and removes only what a run writes (issue #16).
 #[test]
 fn a_failed_launch_never_reports_an_old_run() {
+    let _cpu = exclusive();
     let d = tmp("stale-launch");
     let cfg = std::fs::read_to_string(root().join("config/partition.toml"))
         .unwrap()
@@ -17,11 +174,9 @@ fn a_failed_launch_never_reports_an_old_run() {
                 root().join("config/scenario.toml").display()
             ),
         )
-        .replace(
-            "exec = \"sc-simulator\"",
-            "exec = \"/no/such/sc-simulator\"",
-        );
-    assert!(cfg.contains("/no/such/sc-simulator"));
+        .replace("handshake_timeout_s = 30.0", "handshake_timeout_s = 2.0")
+        .replace("exec = \"sc-nominal-robotic\"", "exec = \"false\"");
+    assert!(cfg.contains("exec = \"false\"") && cfg.contains("handshake_timeout_s = 2.0"));
     std::fs::write(d.join("partition.toml"), cfg).unwrap();
     let out = d.join("out");
     std::fs::create_dir_all(out.join("logs")).unwrap();
@@ -44,7 +199,10 @@ fn a_failed_launch_never_reports_an_old_run() {
     );
     let t = text(&o);
     assert!(!o.status.success(), "{t}");
-    assert!(t.contains("no summary") && !t.contains("captured"), "{t}");
+    assert!(
+        t.contains("infrastructure failure") && !t.contains("captured"),
+        "{t}"
+    );
     assert!(!out.join("summary.json").exists());
     assert_ne!(
         std::fs::read_to_string(out.join("logs/simulator.log")).unwrap_or_default(),

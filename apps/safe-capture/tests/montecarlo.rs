@@ -226,7 +226,7 @@ fn bad_montecarlo_arguments_are_one_line_errors() {
     ];
     let expect = [
         "/nonexistent/partition.toml",
-        "the executable /nonexistent/sc-scheduler of role `scheduler` does not exist",
+        "role `scheduler`: the executable /nonexistent/sc-scheduler does not exist",
         "--keep-recordings needs --mode partition",
         "2/2",
         "/nonexistent/mc.toml",

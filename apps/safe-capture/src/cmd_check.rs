@@ -1,0 +1,193 @@
+//! `safe-capture check FILE…`: configuration files validated before anything runs.
+
+use sc_montecarlo::MonteCarloConfig;
+use sc_partition::PartitionConfig;
+use sc_scenario::{Scenario, ScenarioError};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Validates configuration files before anything runs, with the loaders the commands
+/// use: scenarios (`run`, `--scenario`), partition configs (`launch`, `--partition-config`)
+/// and Monte Carlo configs (`montecarlo --config`). A partition config is checked as
+/// `launch` checks it before starting any process: the scenario it names, every role's
+/// program (found as the launcher finds it: a path relative to the config's directory,
+/// a bare name next to safe-capture, in $SC_PARTITION_BIN_DIR or on PATH), the partner
+/// script a role's arguments name and the simulator's plant program. A Monte Carlo
+/// config is also checked against the scenario it disperses (--scenario).
+///
+/// The kind of each file is told by its keys (`roles`/`rate_groups`: partition;
+/// `initial_position`/`target_rate`: Monte Carlo; `servicer`/`target`/`mission`:
+/// scenario); --kind overrides. Prints one line per file, `FILE: ok (…)` on stdout or
+/// `FILE: <the problem, naming the key or role, the cause and the fix>` on stderr.
+///
+/// Exit codes: 0 every file valid, 2 a file invalid or unreadable, or bad arguments.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Files to check.
+    #[arg(value_name = "FILE", required = true)]
+    files: Vec<PathBuf>,
+    /// The kind of every file, instead of telling it by its keys.
+    #[arg(long, value_enum)]
+    kind: Option<Kind>,
+    /// The scenario a Monte Carlo config is checked against.
+    #[arg(long, value_name = "FILE", default_value_os_t = crate::default_scenario())]
+    scenario: PathBuf,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum Kind {
+    /// A mission scenario (config/scenario.toml).
+    Scenario,
+    /// A partition config (config/partition.toml).
+    Partition,
+    /// A Monte Carlo dispersion config (config/montecarlo.toml).
+    Montecarlo,
+}
+
+/// Top-level keys that tell a file's kind (each one belongs to that kind only).
+const KIND_KEYS: [(Kind, &[&str]); 3] = [
+    (Kind::Partition, &["roles", "rate_groups"]),
+    (Kind::Montecarlo, &["initial_position", "target_rate"]),
+    (Kind::Scenario, &["servicer", "target", "mission"]),
+];
+
+/// The problem with a file, one line (without the file's name).
+type Problem = String;
+
+pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    let mut all_ok = true;
+    for f in &a.files {
+        match check_file(f, a.kind, &a.scenario) {
+            Ok(what) => println!("{}: ok ({what})", f.display()),
+            Err(p) => {
+                all_ok = false;
+                eprintln!("{}: {}", f.display(), p.replace('\n', " "));
+            }
+        }
+    }
+    Ok(if all_ok {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(2)
+    })
+}
+
+/// Validates one file; returns what it is.
+fn check_file(path: &Path, kind: Option<Kind>, mc_scenario: &Path) -> Result<String, Problem> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read: {e}"))?;
+    let kind = match kind {
+        Some(k) => k,
+        None => kind_of(&text)?,
+    };
+    let in_file = |msg: String| without_prefix(path, msg);
+    match kind {
+        Kind::Scenario => {
+            let s = Scenario::load(path).map_err(|e| scenario_problem(&e))?;
+            Ok(format!(
+                "scenario: {} phases, {} s at most, control period {} s",
+                s.mission.phases.len(),
+                s.mission.duration_s,
+                s.mission.control_period_s
+            ))
+        }
+        Kind::Partition => {
+            let cfg = PartitionConfig::load(path).map_err(|e| in_file(e.to_string()))?;
+            let p = sc_partition::preflight::preflight(&cfg, &None).map_err(|e| e.to_string())?;
+            Ok(format!(
+                "partition: {} roles, scenario {}",
+                p.roles,
+                p.scenario.display()
+            ))
+        }
+        Kind::Montecarlo => {
+            let c = MonteCarloConfig::load(path).map_err(|e| in_file(e.to_string()))?;
+            let s = Scenario::load(mc_scenario).map_err(|e| {
+                format!(
+                    "cannot be checked against the scenario {} (--scenario): {}",
+                    mc_scenario.display(),
+                    e.root()
+                )
+            })?;
+            c.check_against(&s).map_err(|e| {
+                format!(
+                    "{e} (with the scenario {}, --scenario)",
+                    mc_scenario.display()
+                )
+            })?;
+            Ok(format!(
+                "montecarlo: distance {}–{} m, tumbling rate {}–{} rad/s; fits the scenario {}",
+                c.initial_position.distance_min_m,
+                c.initial_position.distance_max_m,
+                c.target_rate.rate_min_rad_s,
+                c.target_rate.rate_max_rad_s,
+                mc_scenario.display()
+            ))
+        }
+    }
+}
+
+/// A scenario error without the file's name (the line starts with it).
+fn scenario_problem(e: &ScenarioError) -> Problem {
+    match e {
+        ScenarioError::Io { message, .. } => format!("cannot read: {message}"),
+        e => e.root().to_string(),
+    }
+}
+
+/// A loader's message without the `FILE: ` it starts with (the line starts with it).
+fn without_prefix(path: &Path, msg: String) -> Problem {
+    let prefix = format!("{}: ", path.display());
+    match msg.strip_prefix(&prefix) {
+        Some(rest) => rest.to_string(),
+        None => msg,
+    }
+}
+
+/// The kind of a file, told by its top-level keys.
+fn kind_of(text: &str) -> Result<Kind, Problem> {
+    let table: toml::Table = toml::from_str(text).map_err(|e| {
+        let line = e
+            .span()
+            .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1)
+            .unwrap_or(0);
+        format!(
+            "parse error at line {line}: {}",
+            e.message().replace('\n', " ").trim()
+        )
+    })?;
+    let kinds: Vec<Kind> = KIND_KEYS
+        .iter()
+        .filter(|(_, keys)| keys.iter().any(|k| table.contains_key(*k)))
+        .map(|(k, _)| *k)
+        .collect();
+    match kinds[..] {
+        [k] => Ok(k),
+        _ => {
+            let keys: Vec<&str> = table.keys().map(String::as_str).collect();
+            Err(format!(
+                "cannot tell whether this is a scenario, a partition config or a Monte Carlo config from its keys ({}); give --kind",
+                if keys.is_empty() {
+                    "none".to_string()
+                } else {
+                    keys.join(", ")
+                }
+            ))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_kind_is_told_by_the_keys() {
+        assert_eq!(kind_of("[roles.x]\nexec = \"a\"\n"), Ok(Kind::Partition));
+        assert_eq!(kind_of("[target_rate]\n"), Ok(Kind::Montecarlo));
+        assert_eq!(kind_of("[mission]\n[servicer]\n"), Ok(Kind::Scenario));
+        let e = kind_of("[roles.x]\n[mission]\n").unwrap_err();
+        assert!(e.contains("mission, roles") && e.contains("--kind"), "{e}");
+        let e = kind_of("a = \n").unwrap_err();
+        assert!(e.starts_with("parse error at line 1"), "{e}");
+    }
+}

@@ -1,0 +1,259 @@
+//! `safe-capture check FILE…`: every configuration a user can give, validated before
+//! anything runs, one line per file, exit 0 only when all are valid (issue #16).
+
+mod common;
+use common::*;
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+/// The build command a missing partition executable's line names.
+const BUILD: &str = "cargo build --release -p sc-partition-apps";
+
+/// `check` with the partition's executables of this build next to it.
+fn check(args: &[&str]) -> Output {
+    let mut a = vec!["check"];
+    a.extend_from_slice(args);
+    cli_partition(&a, &[]).0
+}
+
+/// Asserts an invalid file: exit 2, no panic, nothing on stdout, one line on stderr
+/// that starts with the file and contains every needle.
+fn assert_invalid(o: &Output, file: &Path, needles: &[&str]) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{}", text(o));
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(o.stdout.is_empty(), "{}", text(o));
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "expected one line: {err}");
+    assert!(
+        lines[0].starts_with(&format!("{}: ", file.display())),
+        "{err}"
+    );
+    for n in needles {
+        assert!(lines[0].contains(n), "`{n}` not in: {err}");
+    }
+}
+
+/// A copy of a shipped config in `dir` with `from` replaced by `to` (once), its
+/// relative paths made absolute so that it is valid where it is.
+fn shipped_with(dir: &Path, name: &str, from: &str, to: &str) -> PathBuf {
+    let text = std::fs::read_to_string(root().join("config").join(name)).unwrap();
+    assert!(text.contains(from), "`{from}` not in config/{name}");
+    let config = std::path::absolute(root().join("config")).unwrap();
+    let text = text
+        .replacen(from, to, 1)
+        .replace(
+            "urdf = \"servicer.urdf\"",
+            &format!("urdf = \"{}\"", config.join("servicer.urdf").display()),
+        )
+        .replace(
+            "scenario = \"scenario.toml\"",
+            &format!("scenario = \"{}\"", config.join("scenario.toml").display()),
+        );
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn the_shipped_configs_are_valid() {
+    let o = check(&[
+        "config/scenario.toml",
+        "config/partition.toml",
+        "config/montecarlo.toml",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(
+        lines,
+        [
+            "config/scenario.toml: ok (scenario: 3 phases, 240 s at most, control period 0.1 s)",
+            "config/partition.toml: ok (partition: 9 roles, scenario config/scenario.toml)",
+            "config/montecarlo.toml: ok (montecarlo: distance 7–11 m, tumbling rate 0–0.15 rad/s; fits the scenario config/scenario.toml)",
+        ],
+        "{}",
+        text(&o)
+    );
+    assert!(o.stderr.is_empty(), "{}", text(&o));
+}
+
+#[test]
+fn a_scenario_with_a_bad_value_names_the_key_and_the_rule() {
+    let d = tmp("check-bad-value");
+    let s = shipped_with(&d, "scenario.toml", "mass_kg = 800.0", "mass_kg = -800.0");
+    let o = check(&[s.to_str().unwrap()]);
+    assert_invalid(&o, &s, &["`target.mass_kg` = -800.0", "must be"]);
+}
+
+#[test]
+fn an_unknown_key_is_named() {
+    let d = tmp("check-unknown-key");
+    let s = shipped_with(
+        &d,
+        "scenario.toml",
+        "duration_s = 240.0",
+        "duration_s = 240.0\nduration_max_s = 300.0",
+    );
+    let o = check(&[s.to_str().unwrap()]);
+    assert_invalid(&o, &s, &["unknown field `duration_max_s`"]);
+    let p = shipped_with(
+        &d,
+        "partition.toml",
+        "handshake_timeout_s = 30.0",
+        "handshake_timeout_s = 30.0\nhandshake_retries = 3",
+    );
+    let o = check(&[p.to_str().unwrap()]);
+    assert_invalid(&o, &p, &["unknown field `handshake_retries`"]);
+}
+
+#[test]
+fn a_partition_config_naming_a_missing_scenario_is_invalid() {
+    let d = tmp("check-missing-scenario");
+    let p = shipped_with(
+        &d,
+        "partition.toml",
+        "scenario = \"scenario.toml\"",
+        "scenario = \"missing.toml\"",
+    );
+    let o = check(&[p.to_str().unwrap()]);
+    assert_invalid(
+        &o,
+        &p,
+        &[
+            "scenario = \"missing.toml\": cannot read",
+            "missing.toml",
+            "point `scenario` at a scenario file",
+        ],
+    );
+    // and one naming a scenario with a bad value says what is wrong in it
+    let s = shipped_with(&d, "scenario.toml", "mass_kg = 800.0", "mass_kg = -800.0");
+    let p = shipped_with(
+        &d,
+        "partition.toml",
+        "scenario = \"scenario.toml\"",
+        &format!("scenario = \"{}\"", s.display()),
+    );
+    let o = check(&[p.to_str().unwrap()]);
+    assert_invalid(&o, &p, &["`target.mass_kg` = -800.0"]);
+}
+
+#[test]
+fn a_missing_role_executable_names_the_role_and_the_fix() {
+    let d = tmp("check-missing-exec");
+    // a path that does not exist
+    let p = shipped_with(
+        &d,
+        "partition.toml",
+        "exec = \"sc-simulator\"",
+        "exec = \"bin/sc-simulator\"",
+    );
+    let o = check(&[p.to_str().unwrap()]);
+    assert_invalid(
+        &o,
+        &p,
+        &[
+            "role `simulator`: the executable",
+            "bin/sc-simulator does not exist",
+            BUILD,
+        ],
+    );
+    // a bare name found nowhere
+    let p = shipped_with(
+        &d,
+        "partition.toml",
+        "exec = \"sc-safety-attitude\"",
+        "exec = \"sc-safety-attitude-v2\"",
+    );
+    let o = check(&[p.to_str().unwrap()]);
+    assert_invalid(
+        &o,
+        &p,
+        &[
+            "role `safety_attitude`: the executable `sc-safety-attitude-v2` was found neither",
+            "SC_PARTITION_BIN_DIR",
+            "correct `roles.safety_attitude.exec`",
+        ],
+    );
+    // a partner's script that is not there (its interpreter is)
+    let p = shipped_with(
+        &d,
+        "partition.toml",
+        "exec = \"sc-nominal-translational\"",
+        "exec = \"sh\"\nargs = [\"partners/no_such_partner.sh\"]",
+    );
+    let o = check(&[p.to_str().unwrap()]);
+    assert_invalid(
+        &o,
+        &p,
+        &[
+            "role `nominal_translational`: the script \"partners/no_such_partner.sh\" in `roles.nominal_translational.args`",
+            "correct the path",
+        ],
+    );
+    std::fs::create_dir_all(d.join("partners")).unwrap();
+    std::fs::write(d.join("partners/no_such_partner.sh"), "").unwrap();
+    let o = check(&[p.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+}
+
+#[test]
+fn a_malformed_montecarlo_config_is_invalid() {
+    let d = tmp("check-montecarlo");
+    let m = shipped_with(
+        &d,
+        "montecarlo.toml",
+        "distance_max_m = 11.0",
+        "distance_max_m = 5.0",
+    );
+    let o = check(&[m.to_str().unwrap()]);
+    assert_invalid(&o, &m, &["initial_position.distance_max_m"]);
+    let m = shipped_with(
+        &d,
+        "montecarlo.toml",
+        "rate_max_rad_s = 0.15",
+        "rate_max_rad_s = ",
+    );
+    let o = check(&[m.to_str().unwrap()]);
+    assert_invalid(&o, &m, &["parse error at line"]);
+    let m = shipped_with(
+        &d,
+        "montecarlo.toml",
+        "trace_every_steps = 5",
+        "trace_every_steps = 5\ntrace_columns = 3",
+    );
+    let o = check(&[m.to_str().unwrap()]);
+    assert_invalid(&o, &m, &["unknown field `trace_columns`"]);
+}
+
+/// Several files: each gets its line, one invalid file makes the exit code 2; a file
+/// whose kind its keys do not tell asks for --kind, which then decides.
+#[test]
+fn every_file_gets_its_line_and_the_kind_can_be_given() {
+    let d = tmp("check-several");
+    let bad = shipped_with(&d, "scenario.toml", "mass_kg = 800.0", "mass_kg = -800.0");
+    let o = check(&["config/montecarlo.toml", bad.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stdout).starts_with("config/montecarlo.toml: ok (montecarlo"),
+        "{}",
+        text(&o)
+    );
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("`target.mass_kg` = -800.0"),
+        "{}",
+        text(&o)
+    );
+    let odd = d.join("odd.toml");
+    std::fs::write(&odd, "name = \"x\"\n").unwrap();
+    let o = check(&[odd.to_str().unwrap()]);
+    assert_invalid(&o, &odd, &["from its keys (name); give --kind"]);
+    let o = check(&["--kind", "scenario", odd.to_str().unwrap()]);
+    assert_invalid(&o, &odd, &["unknown field `name`"]);
+    let o = check(&["/nonexistent/partition.toml"]);
+    assert_invalid(
+        &o,
+        Path::new("/nonexistent/partition.toml"),
+        &["cannot read"],
+    );
+}
