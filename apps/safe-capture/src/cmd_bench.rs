@@ -4,6 +4,9 @@ use clap::Subcommand;
 use std::process::ExitCode;
 
 /// Benchmarks (run them on an otherwise idle machine; build with --release).
+///
+/// Exit codes: 0 measured, 2 bad arguments or configuration (each benchmark's --help
+/// says more).
 #[derive(clap::Args)]
 pub struct Args {
     #[command(subcommand)]

@@ -9,6 +9,9 @@ use std::process::ExitCode;
 /// simulator): N, min/p50/p90/p99/p99.9/max, cycle slips, deadline misses, an HDR
 /// histogram (latency_whole_tick.hgrm), a log-scale plot (latency.svg) and the
 /// machine's facts. Writes latency_report.{json,md} into OUT.
+///
+/// Exit codes: 0 measured, 2 bad arguments or configuration, or the partition did not
+/// run.
 #[derive(clap::Args)]
 pub struct Args {
     /// Measured ticks (after the warm-up).

@@ -21,6 +21,8 @@ use std::process::ExitCode;
 /// Featherstone and Pinocchio. `mass_matrix` (13×13, rows as nested arrays), `bias` (13,
 /// Pinocchio's nonLinearEffects) and `nu_dot` (13, Pinocchio's aba) are in that basis.
 /// No gravity acts inside the model (orbital gravity moves the whole system).
+///
+/// Exit codes: 0 printed, 2 bad arguments, an invalid state or scenario.
 #[derive(clap::Args)]
 pub struct Args {
     /// State JSON file (see above).

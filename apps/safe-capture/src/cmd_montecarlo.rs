@@ -8,6 +8,9 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+/// Partition config of --mode partition unless --partition-config is given.
+const DEFAULT_PARTITION_CONFIG: &str = "config/partition.toml";
+
 /// Monte Carlo campaign over dispersed initial positions (inside the approach corridor)
 /// and target tumbling rates (config/montecarlo.toml). Runs in parallel in one process,
 /// or with --mode partition each run through the process partition (one process per
@@ -15,11 +18,11 @@ use std::process::ExitCode;
 /// seed derives from (--seed, run index), so shards and reruns reproduce exactly.
 ///
 /// Writes to OUT: runs/K/ (scenario.toml, result.json, trace.csv, timing.json per run),
-/// runs.csv, runs_timing.csv, summary.json, report.md, figures/*.svg. Exit code 0 when
-/// every run completed safe and captured, 1 otherwise, 2 on errors.
-/// Partition config of --mode partition unless --partition-config is given.
-const DEFAULT_PARTITION_CONFIG: &str = "config/partition.toml";
-
+/// runs.csv, runs_timing.csv, summary.json, report.md, figures/*.svg.
+///
+/// Exit codes (a campaign, and `merge`): 0 every run completed safe and captured, 1 a
+/// run unsafe, not captured or failed (a partition run that could not be launched is a
+/// failed run), 2 bad arguments or configuration (checked before any run starts).
 #[derive(clap::Args)]
 #[command(args_conflicts_with_subcommands = true)]
 pub struct Args {
@@ -33,8 +36,14 @@ pub struct Args {
 enum Action {
     /// Rerun one run of a campaign from its saved scenario and check that it reproduces
     /// the saved result exactly; writes its telemetry, summary and figures.
+    ///
+    /// Exit codes: 0 reproduced exactly, 1 it differs from the saved run, 2 bad
+    /// arguments or an unreadable campaign.
     Rerun(RerunArgs),
     /// Merge shard directories into one campaign (same outputs as an unsharded run).
+    ///
+    /// Exit codes: 0 every run safe and captured, 1 a run unsafe, not captured or
+    /// failed, 2 bad arguments or shards that do not fit together.
     Merge(MergeArgs),
 }
 

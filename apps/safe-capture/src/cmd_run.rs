@@ -15,8 +15,10 @@ use std::process::ExitCode;
 /// interventions, solve_time_us, faults), and the figures into OUT/figures (SVG): approach
 /// trajectory with corridor and sphere, every barrier over time, range rate, sync error,
 /// joint torques, line of sight. The figures compare with a nominal-only run (dashed),
-/// which is run too and written to OUT/nominal (skip with --no-compare). Exit code 0 when the run was safe (every barrier
-/// ≥ 0, no fault) and captured, 1 otherwise.
+/// which is run too and written to OUT/nominal (skip with --no-compare).
+///
+/// Exit code 0 when the run was safe (every barrier ≥ 0, no fault) and captured, 1
+/// otherwise, 2 bad arguments or configuration (nothing was run).
 #[derive(clap::Args)]
 pub struct Args {
     /// Scenario file.

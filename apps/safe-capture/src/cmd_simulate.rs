@@ -18,6 +18,9 @@ use std::process::ExitCode;
 /// (servicer base origin position/velocity, quaternion base→inertial scalar-first, body
 /// rate; target likewise), θ, θ̇, Hill-frame relative position/velocity, grasp distance,
 /// end-effector and grasping point in the base frame. SI units; see docs/SIMULATOR.md.
+///
+/// Exit codes: 0 the trajectory was written, 2 bad arguments, an unreadable or invalid
+/// profile or scenario.
 #[derive(clap::Args)]
 pub struct Args {
     /// Command profile CSV.
