@@ -9,17 +9,19 @@ use std::process::ExitCode;
 
 /// Runs the mission REPEAT times in one process and reports the solve time of each filter
 /// and of the whole safety layer per control step (µs): N, geomean, p50, p90, p99, p99.9,
-/// max — as wall time (what a deadline sees, preemption included) and as the thread's CPU
-/// time (the filter's own work) — and, over the steps where a QP was solved, the solver's
-/// iterations and the number of active barrier rows. Also the wall time per mission.
+/// max — as wall time (what a deadline sees, preemption included), as the thread's CPU
+/// time (the filter's own work), and as the wall time inside the QP solver alone (`qp`:
+/// every solve of the step, without building the rows or certifying the command) — and,
+/// over the steps where a QP was solved, the solver's iterations and the number of active
+/// barrier rows. Also the wall time per mission.
 ///
 /// With --solve-all the filters' skip path is off: every step solves its QP although the
 /// nominal command may already be safe (the worst case a flight processor must budget for).
 ///
 /// --json FILE writes {"total"|"translational"|"attitude"|"robotic": {"n", "geomean_us",
-/// "p50_us", "p90_us", "p99_us", "p999_us", "max_us", "cpu": {same keys}, "solved_steps",
-/// "iterations": {"mean", "max"}, "active_rows": {"mean", "max"}}, "solve_all",
-/// "mission_wall_s"}.
+/// "p50_us", "p90_us", "p99_us", "p999_us", "max_us", "cpu": {same keys}, "qp": {same
+/// keys}, "solved_steps", "iterations": {"mean", "max"}, "active_rows": {"mean", "max"}},
+/// "solve_all", "mission_wall_s"}.
 ///
 /// Exit codes: 0 done, 2 bad arguments or configuration.
 #[derive(clap::Args)]
@@ -93,6 +95,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let setup = Setup::load(&a.scenario)?;
     let mut wall: [Vec<f64>; 4] = Default::default();
     let mut cpu: [Vec<f64>; 4] = Default::default();
+    let mut qp: [Vec<f64>; 4] = Default::default();
     let mut work: [SolverWork; 3] = Default::default();
     let mut mission_wall = Vec::new();
     let tty = std::io::IsTerminal::is_terminal(&std::io::stderr());
@@ -105,10 +108,11 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             m.safety.robotic.set_skip_enabled(false);
         }
         m.run(|_, r| {
-            let (t, c) = (r.solve_time_us(), r.solve_cpu_us());
+            let (t, c, q) = (r.solve_time_us(), r.solve_cpu_us(), r.qp_time_us());
             for i in 0..4 {
                 wall[i].push(t[i]);
                 cpu[i].push(c[i]);
+                qp[i].push(q[i]);
             }
             let tr = &r.translational.report;
             let at = &r.attitude.report;
@@ -145,7 +149,8 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     for (i, n) in names.iter().enumerate() {
         let w = stats(&mut wall[i]);
         let c = stats(&mut cpu[i]);
-        for (clock, s) in [("wall", &w), ("cpu", &c)] {
+        let q = stats(&mut qp[i]);
+        for (clock, s) in [("wall", &w), ("cpu", &c), ("qp", &q)] {
             println!(
                 "{:<14} {:<5} {:>7} {:>9.2} {:>9.2} {:>9.2} {:>9.2} {:>9.2} {:>9.2}",
                 n,
@@ -161,6 +166,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         }
         let mut entry = json_stats(&w, wall[i].len());
         entry["cpu"] = json_stats(&c, cpu[i].len());
+        entry["qp"] = json_stats(&q, qp[i].len());
         if i < 3 {
             let (im, ix) = SolverWork::mean_max(&work[i].iterations);
             let (am, ax) = SolverWork::mean_max(&work[i].active_rows);

@@ -25,7 +25,7 @@ use crate::common::{
     unit_quat,
 };
 use crate::engine::{Engine, Kind, LastProblem};
-use crate::sampled::{Decay, RateBounds, RelDeg1, RelDeg2, SampleBounds};
+use crate::sampled::{Decay, RateBounds, RateDecay, RelDeg1, RelDeg2, SampleBounds};
 use crate::{Formulation, qp::SolverParams};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use sc_models::quat::{self, Quat};
@@ -586,12 +586,16 @@ impl AttitudeFilter {
     ) -> [Row<3>; ROWS] {
         let p = &self.params;
         let (b_los, b_rate, b_w) = self.sample_bounds(x, rho, accel);
-        let mut rows = [RelDeg2::from(t.los).row_with(&b_los, p.u_max_att, &p.decay); ROWS];
+        // every bound is for one control period: the decays evaluated once
+        let los = p.decay.at(p.period);
+        let omega = RateDecay::new(p.gamma_omega, p.eps_omega, p.period);
+        let boresight = RateDecay::new(p.gamma_boresight, p.eps_omega, p.period);
+        let mut rows = [RelDeg2::from(t.los).row_at(&b_los, p.u_max_att, &los); ROWS];
         for (k, o) in t.omega.iter().enumerate() {
-            rows[1 + k] = RelDeg1::from(*o).row(&b_rate[k], p.gamma_omega, p.eps_omega);
+            rows[1 + k] = RelDeg1::from(*o).row_at(&b_rate[k], &omega);
         }
         for (k, o) in t.boresight.iter().enumerate() {
-            rows[N + k] = RelDeg1::from(*o).row(&b_w[k], p.gamma_boresight, p.eps_omega);
+            rows[N + k] = RelDeg1::from(*o).row_at(&b_w[k], &boresight);
         }
         rows
     }
@@ -654,8 +658,10 @@ impl AttitudeFilter {
         // the thread's CPU clock inside the wall interval: CPU ≤ wall
         let c0 = crate::common::thread_cpu_ns();
         let mut report = FilterReport::<N>::default();
+        self.engine.take_qp_ns();
         let u = self.filter_inner(x, tau_nom, &mut report);
         report.solve_cpu_ns = crate::common::thread_cpu_ns().saturating_sub(c0);
+        report.qp_time_ns = self.engine.take_qp_ns();
         report.solve_time_ns = t0.elapsed().as_nanos().min(u64::MAX as u128) as u64;
         FilterOutput {
             u,
@@ -737,10 +743,9 @@ impl AttitudeFilter {
                         c: cap + x.r[i],
                     };
                 }
-                let out = self
-                    .engine
-                    .solve_tiered(&u_nom, &r_cap, &p.weights, &TIERS, &with_cap);
-                if matches!(out.kind, Kind::Skipped | Kind::Solved) {
+                // only a hard solution is taken here (a relaxed one is not certified):
+                // an infeasible cap costs no relaxation
+                if let Some(out) = self.engine.solve_hard(&u_nom, &r_cap, &with_cap) {
                     if k == 0 {
                         best = Some((0.0, out, r_cap, with_cap));
                         break;
@@ -748,6 +753,10 @@ impl AttitudeFilter {
                     let dist = (out.u - u_nom).norm();
                     if best.as_ref().is_none_or(|b| dist < b.0) {
                         best = Some((dist, out, r_cap, with_cap));
+                    }
+                    if dist == 0.0 {
+                        // the nominal itself: no later cap can come nearer
+                        break;
                     }
                 }
             }

@@ -94,6 +94,9 @@ pub struct FilterReport<const N: usize> {
     /// CPU time the calling thread spent in the filter call [ns] (`CLOCK_THREAD_CPUTIME_ID`):
     /// the filter's own work, without the time the thread was preempted.
     pub solve_cpu_ns: u64,
+    /// Wall time spent inside the QP solver [ns]: every solve of the call (certification
+    /// and verification rounds included), without building the rows — nondeterministic.
+    pub qp_time_ns: u64,
     /// [`faults`] bitset.
     pub faults: u32,
     /// Least violation `t*` of the relaxed problem (0 otherwise), as a fraction of each
@@ -111,6 +114,7 @@ impl<const N: usize> Default for FilterReport<N> {
             iterations: 0,
             solve_time_ns: 0,
             solve_cpu_ns: 0,
+            qp_time_ns: 0,
             faults: 0,
             violation: 0.0,
         }
@@ -195,7 +199,8 @@ pub fn clamp_box<const M: usize>(v: &SVector<f64, M>, limit: f64) -> (SVector<f6
 
 /// All components finite.
 pub fn finite<const R: usize, const C: usize>(m: &nalgebra::SMatrix<f64, R, C>) -> bool {
-    m.iter().all(|x| x.is_finite())
+    // without early exit, so that it vectorises
+    m.as_slice().iter().fold(true, |ok, x| ok & x.is_finite())
 }
 
 /// All components finite and `‖v‖₂ ≤ max`.

@@ -69,6 +69,8 @@ pub struct Engine<const M: usize, const N: usize> {
     w: [f64; N],
     tier: [u8; N],
     skip_enabled: bool,
+    /// Wall time spent in [`Self::solve_tiered`] since the last [`Self::take_qp_ns`] [ns].
+    qp_ns: u64,
 }
 
 impl<const M: usize, const N: usize> Default for Engine<M, N> {
@@ -86,12 +88,18 @@ impl<const M: usize, const N: usize> Engine<M, N> {
             w: [0.0; N],
             tier: [0; N],
             skip_enabled: true,
+            qp_ns: 0,
         }
     }
 
     /// Verification only: with `false` the solver runs even for a feasible nominal.
     pub fn set_skip_enabled(&mut self, on: bool) {
         self.skip_enabled = on;
+    }
+
+    /// The wall time spent solving since the last call [ns] (and restarts the count).
+    pub fn take_qp_ns(&mut self) -> u64 {
+        std::mem::take(&mut self.qp_ns)
     }
 
     /// Solves for `u_nom` with barrier `rows` (physical weights `weights`, > 0) and hard
@@ -116,6 +124,40 @@ impl<const M: usize, const N: usize> Engine<M, N> {
         tiers: &[u8],
         bounds: &[Row<M>],
     ) -> Outcome<M> {
+        self.timed(|e| e.solve_inner(u_nom, rows, weights, tiers, bounds, true))
+    }
+
+    /// The hard problem only: the command when every row and bound can hold (`Skipped` or
+    /// `Solved`), `None` otherwise — no relaxation is computed (for a caller that would
+    /// discard it and try other rows).
+    pub fn solve_hard(
+        &mut self,
+        u_nom: &SVector<f64, M>,
+        rows: &[Row<M>],
+        bounds: &[Row<M>],
+    ) -> Option<Outcome<M>> {
+        let out = self.timed(|e| e.solve_inner(u_nom, rows, &[], &[], bounds, false));
+        matches!(out.kind, Kind::Skipped | Kind::Solved).then_some(out)
+    }
+
+    fn timed(&mut self, f: impl FnOnce(&mut Self) -> Outcome<M>) -> Outcome<M> {
+        let t0 = std::time::Instant::now();
+        let out = f(self);
+        self.qp_ns = self
+            .qp_ns
+            .saturating_add(t0.elapsed().as_nanos().min(u64::MAX as u128) as u64);
+        out
+    }
+
+    fn solve_inner(
+        &mut self,
+        u_nom: &SVector<f64, M>,
+        rows: &[Row<M>],
+        weights: &[f64],
+        tiers: &[u8],
+        bounds: &[Row<M>],
+        relax: bool,
+    ) -> Outcome<M> {
         let mut out = Outcome {
             kind: Kind::Failed,
             u: *u_nom,
@@ -125,18 +167,22 @@ impl<const M: usize, const N: usize> Engine<M, N> {
         };
         let nb = rows.len();
         let n = nb + bounds.len();
-        if n > N || weights.len() != nb || nb > 64 || !(tiers.is_empty() || tiers.len() == nb) {
+        let weights_ok = weights.len() == nb || (!relax && weights.is_empty());
+        if n > N || !weights_ok || nb > 64 || !(tiers.is_empty() || tiers.len() == nb) {
             return out;
         }
-        let feasible = rows.iter().chain(bounds).all(|r| r.phi(u_nom) >= 0.0);
-        if feasible && self.skip_enabled {
+        if self.skip_enabled && rows.iter().chain(bounds).all(|r| r.phi(u_nom) >= 0.0) {
             out.kind = Kind::Skipped;
             return out;
         }
         for (i, r) in rows.iter().chain(bounds).enumerate() {
             self.a[i].copy_from_slice(r.a.as_slice());
             self.b[i] = -r.c;
-            self.w[i] = if i < nb { weights[i] } else { 0.0 };
+            self.w[i] = if i < nb {
+                weights.get(i).copied().unwrap_or(0.0)
+            } else {
+                0.0
+            };
             self.tier[i] = if i < nb {
                 tiers.get(i).copied().unwrap_or(0)
             } else {
@@ -152,6 +198,7 @@ impl<const M: usize, const N: usize> Engine<M, N> {
                 out.u = SVector::from(hard.x);
                 out.row_duals[..nb].copy_from_slice(&hard.lambda[..nb]);
             }
+            Status::Infeasible if !relax => {}
             Status::Infeasible => {
                 if let Some((sol, t, iters)) = self.relaxed(&x0, nb, n) {
                     out.kind = Kind::Relaxed;

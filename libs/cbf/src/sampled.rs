@@ -73,11 +73,35 @@ impl Decay {
 
     /// `κ(H)` for a sample of length `t` [s].
     pub fn target(&self, big_h: f64, t: f64) -> f64 {
-        let below = (-self.gamma * t).exp();
+        self.at(t).target(big_h)
+    }
+
+    /// The decay over a sample of length `t` [s], its exponentials computed once (a
+    /// filter builds dozens of rows with the same `γ` and `T`).
+    pub fn at(&self, t: f64) -> DecayAt {
+        DecayAt {
+            below: (-self.gamma * t).exp(),
+            inner: (-self.gamma_inner * t).exp(),
+            knee: self.knee,
+        }
+    }
+}
+
+/// [`Decay`] for one sample length: `e^{−γT}`, `e^{−γ_in T}` and the knee.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DecayAt {
+    below: f64,
+    inner: f64,
+    knee: f64,
+}
+
+impl DecayAt {
+    /// `κ(H) = e^{−γT} min(H, H_k) + e^{−γ_in T} max(H − H_k, 0)`.
+    pub fn target(&self, big_h: f64) -> f64 {
         if big_h <= self.knee {
-            below * big_h
+            self.below * big_h
         } else {
-            below * self.knee + (-self.gamma_inner * t).exp() * (big_h - self.knee)
+            self.below * self.knee + self.inner * (big_h - self.knee)
         }
     }
 }
@@ -175,10 +199,15 @@ impl<const M: usize> RelDeg2<M> {
 
     /// [`Self::phi_required`] with the decay of (C2) given by `decay`.
     pub fn phi_required_with(&self, bounds: &SampleBounds, mu: f64, decay: &Decay) -> f64 {
+        self.phi_required_at(bounds, mu, &decay.at(bounds.period))
+    }
+
+    /// [`Self::phi_required_with`] with the decay already evaluated for `bounds.period`.
+    pub fn phi_required_at(&self, bounds: &SampleBounds, mu: f64, decay: &DecayAt) -> f64 {
         let t = bounds.period;
         let (h, hd) = (self.h, self.hdot);
         let c1 = bounds.m2 + bounds.m3 * t / 3.0 + c1_requirement(h, hd, t);
-        let kappa = decay.target(braking_barrier(h, hd, mu), t);
+        let kappa = decay.target(braking_barrier(h, hd, mu));
         let p0 = h + hd * t - bounds.m3 * t * t * t / 6.0;
         let v0 = hd - 0.5 * bounds.m3 * t * t;
         let c2 = bounds.m2 + c2_requirement(p0, v0, t, mu, kappa);
@@ -192,9 +221,14 @@ impl<const M: usize> RelDeg2<M> {
 
     /// [`Self::row`] with the decay of (C2) given by `decay`.
     pub fn row_with(&self, bounds: &SampleBounds, mu: f64, decay: &Decay) -> Row<M> {
+        self.row_at(bounds, mu, &decay.at(bounds.period))
+    }
+
+    /// [`Self::row_with`] with the decay already evaluated for `bounds.period`.
+    pub fn row_at(&self, bounds: &SampleBounds, mu: f64, decay: &DecayAt) -> Row<M> {
         Row {
             a: self.b,
-            c: self.a - self.phi_required_with(bounds, mu, decay),
+            c: self.a - self.phi_required_at(bounds, mu, decay),
         }
     }
 }
@@ -218,21 +252,51 @@ pub struct RateBounds {
     pub j: f64,
 }
 
+/// The exact discretisation of the paper's `ḣ ≥ −γh + ε` over a sample of length `T`:
+/// `h(T) ≥ e^{−γT}(h − ε/γ) + ε/γ`, its exponential computed once.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RateDecay {
+    e: f64,
+    floor: f64,
+}
+
+impl RateDecay {
+    /// For class-K gain `γ` [1/s], margin `ε` and sample length `t` [s].
+    pub fn new(gamma: f64, eps: f64, t: f64) -> Self {
+        Self {
+            e: (-gamma * t).exp(),
+            floor: if gamma > 0.0 { eps / gamma } else { 0.0 },
+        }
+    }
+
+    /// The least `h(T)` allowed from `h`.
+    pub fn target(&self, h: f64) -> f64 {
+        self.e * (h - self.floor) + self.floor
+    }
+}
+
 impl<const M: usize> RelDeg1<M> {
     /// `ḣ` required at the sample: `D + ½JT + (e^{−γT}(h − ε/γ) + ε/γ − h)/T`.
     pub fn hdot_required(&self, bounds: &RateBounds, gamma: f64, eps: f64) -> f64 {
+        self.hdot_required_at(bounds, &RateDecay::new(gamma, eps, bounds.period))
+    }
+
+    /// [`Self::hdot_required`] with the decay already evaluated for `bounds.period`.
+    pub fn hdot_required_at(&self, bounds: &RateBounds, decay: &RateDecay) -> f64 {
         let t = bounds.period;
-        let e = (-gamma * t).exp();
-        let floor = if gamma > 0.0 { eps / gamma } else { 0.0 };
-        let target = e * (self.h - floor) + floor;
-        bounds.d + 0.5 * bounds.j * t + (target - self.h) / t
+        bounds.d + 0.5 * bounds.j * t + (decay.target(self.h) - self.h) / t
     }
 
     /// The row `b·u + (a − ḣ_req) ≥ 0`.
     pub fn row(&self, bounds: &RateBounds, gamma: f64, eps: f64) -> Row<M> {
+        self.row_at(bounds, &RateDecay::new(gamma, eps, bounds.period))
+    }
+
+    /// [`Self::row`] with the decay already evaluated for `bounds.period`.
+    pub fn row_at(&self, bounds: &RateBounds, decay: &RateDecay) -> Row<M> {
         Row {
             a: self.b,
-            c: self.a - self.hdot_required(bounds, gamma, eps),
+            c: self.a - self.hdot_required_at(bounds, decay),
         }
     }
 }

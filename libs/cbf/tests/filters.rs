@@ -702,6 +702,12 @@ fn engine_relaxation_matches_clarabel_on_random_infeasible_problems() {
                 Vec::new()
             };
             let first = eng.solve_tiered(&dir, &barrier, &w, &tiers, &hard);
+            // the hard problem alone: the same command where it has one, none otherwise
+            match (first.kind, eng.solve_hard(&dir, &barrier, &hard)) {
+                (Kind::Skipped | Kind::Solved, Some(h)) => assert_eq!(h, first),
+                (Kind::Relaxed | Kind::Failed, None) => {}
+                (k, h) => panic!("solve_hard {h:?} against {k:?}"),
+            }
             if first.kind != Kind::Relaxed {
                 continue;
             }

@@ -34,6 +34,11 @@ pub struct ActiveSetQp<const M: usize, const N: usize> {
     pub(crate) rhs: [f64; N],
     /// Bit `i`: row `i` is a zero row (never enters the iteration).
     pub(crate) zero: u64,
+    /// The caller's rows of the last [`prepare`](Self::prepare), for reuse: a row equal
+    /// (bit for bit) to the one before keeps its scaling, only `b` and `w` are rescaled.
+    raw: [[f64; M]; N],
+    /// `1/‖a_i‖` of `raw[i]` when its scaling may be reused (0: scale again).
+    inv: [f64; N],
     /// Rows in use.
     pub(crate) n: usize,
     // ---- the factorisation of the active rows: [â_act[0] … â_act[q−1]] = J[:, ..q] R ----
@@ -75,6 +80,8 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
             wn: [0.0; N],
             rhs: [0.0; N],
             zero: 0,
+            raw: [[0.0; M]; N],
+            inv: [0.0; N],
             n: 0,
             jc: [[0.0; M]; M],
             rc: [[0.0; M]; M],
@@ -142,6 +149,18 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
                 return false;
             }
             let row = &a[i];
+            if self.inv[i] > 0.0 && same_bits(row, &self.raw[i]) {
+                // the same row as last time: its unit row and norm are in place; the
+                // right-hand side and weight scale exactly as in the branch below
+                let inv = self.inv[i];
+                self.bn[i] = b[i] * inv;
+                self.wn[i] = wi * inv;
+                if !self.bn[i].is_finite() || !self.wn[i].is_finite() {
+                    return false;
+                }
+                continue;
+            }
+            self.inv[i] = 0.0;
             if !row.iter().all(|v| v.is_finite()) {
                 return false;
             }
@@ -149,6 +168,9 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
             if m == 0.0 {
                 self.zero |= 1 << i;
                 self.an[i] = [0.0; M];
+                for k in 0..M {
+                    self.at[k][i] = 0.0;
+                }
                 self.nu[i] = 0.0;
                 self.bn[i] = b[i];
                 self.wn[i] = wi;
@@ -164,10 +186,15 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
                 let inv = 1.0 / nu;
                 for k in 0..M {
                     self.an[i][k] = row[k] * inv;
+                    self.at[k][i] = self.an[i][k];
                 }
                 self.nu[i] = nu;
                 self.bn[i] = b[i] * inv;
                 self.wn[i] = wi * inv;
+                if inv.is_finite() && nu.is_finite() {
+                    self.raw[i] = *row;
+                    self.inv[i] = inv;
+                }
             } else {
                 // ‖a‖ = m·h with h = ‖a/m‖ ∈ [1, √M]: no overflow or underflow.
                 let mut s = 0.0;
@@ -178,18 +205,15 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
                 let h = s.sqrt();
                 for k in 0..M {
                     self.an[i][k] = (row[k] / m) / h;
+                    self.at[k][i] = self.an[i][k];
                 }
                 self.nu[i] = m * h;
                 self.bn[i] = (b[i] / m) / h;
                 self.wn[i] = (wi / m) / h;
             }
             if !self.nu[i].is_finite() || !self.bn[i].is_finite() || !self.wn[i].is_finite() {
+                self.inv[i] = 0.0;
                 return false;
-            }
-        }
-        for k in 0..M {
-            for i in 0..n {
-                self.at[k][i] = self.an[i][k];
             }
         }
         true
@@ -523,6 +547,10 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
     /// keeps the result when it is at least as accurate as the iterated point.
     fn refine(&mut self, x0: &[f64; M]) {
         let q = self.q;
+        if q == 0 && same_bits(&self.x, x0) {
+            // no active row and the iterate is x0 itself: the refined point is x0 again
+            return;
+        }
         let mut lam = [0.0; M];
         for j in 0..q {
             let i = self.act[j];
@@ -597,6 +625,14 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
             };
         }
     }
+}
+
+/// Bit-for-bit equality (so `-0.0 ≠ 0.0` and a NaN is never equal).
+#[inline]
+fn same_bits<const M: usize>(u: &[f64; M], v: &[f64; M]) -> bool {
+    u.iter()
+        .zip(v)
+        .fold(true, |same, (x, y)| same & (x.to_bits() == y.to_bits()))
 }
 
 /// The rotation `(c, s)` with `c·a + s·b = h ≥ 0`, `−s·a + c·b = 0`; `None` when `b` is
