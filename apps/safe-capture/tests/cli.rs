@@ -70,6 +70,7 @@ fn help_on_every_subcommand() {
         &["montecarlo", "--help"],
         &["redteam", "--help"],
         &["bounds", "--help"],
+        &["check", "--help"],
     ] {
         let out = bin().args(sub).output().unwrap();
         assert!(out.status.success(), "{sub:?}");
@@ -90,6 +91,51 @@ fn help_on_every_subcommand() {
         let out = bin().args([sub, "--help"]).output().unwrap();
         let t = String::from_utf8_lossy(&out.stdout);
         assert!(t.contains(needle), "{sub} --help lacks `{needle}`:\n{t}");
+    }
+    // every command says what its exit codes mean; launch tells the mission's verdict
+    // from the infrastructure's (issue #16)
+    for (sub, needles) in [
+        (
+            &["run"][..],
+            &["0 when the run was safe", "2 bad arguments"][..],
+        ),
+        (&["simulate"], &["Exit codes: 0", "2 bad arguments"]),
+        (&["model"], &["Exit codes: 0", "2 bad arguments"]),
+        (
+            &["launch"],
+            &[
+                "the mission's verdict: 0 captured safely, 1 the mission ended but not captured safely",
+                "The infrastructure's (no mission result): 2 bad configuration",
+                "3 a process failed",
+                "4 every process ended well",
+            ],
+        ),
+        (&["bench"], &["Exit codes: 0"]),
+        (&["bench", "filters"], &["Exit codes: 0", "2 bad arguments"]),
+        (&["bench", "latency"], &["Exit codes: 0", "2 bad arguments"]),
+        (
+            &["montecarlo"],
+            &["Exit codes", "0 every run", "1 a run", "2 bad"],
+        ),
+        (
+            &["montecarlo", "rerun"],
+            &["Exit codes: 0 reproduced", "1 it differs"],
+        ),
+        (&["montecarlo", "merge"], &["Exit codes: 0", "2 bad"]),
+        (&["redteam"], &["Exit codes: 0"]),
+        (&["bounds"], &["Exit codes: 0", "1 a bound", "2 bad"]),
+        (&["verify-qp"], &["Exit codes: 0"]),
+        (&["compare"], &["Exit codes: 0"]),
+        (
+            &["check"],
+            &["Exit codes: 0 every file valid, 2 a file invalid"],
+        ),
+    ] {
+        let out = bin().args(sub).arg("--help").output().unwrap();
+        let t = String::from_utf8_lossy(&out.stdout).replace('\n', " ");
+        for n in needles {
+            assert!(t.contains(n), "{sub:?} --help lacks `{n}`:\n{t}");
+        }
     }
 }
 
