@@ -19,8 +19,8 @@ import time
 import iceoryx2 as iox2
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import sc_bus  # noqa: E402
-import sc_icd  # noqa: E402
+from sc_partner import bus as sc_bus  # noqa: E402
+from sc_partner import icd as sc_icd  # noqa: E402
 
 TIMEOUT_S = 60.0
 

@@ -1,4 +1,4 @@
-//! The Python mirror (`scripts/python/sc_icd.py`) must have exactly the Rust layout:
+//! The Python mirror (`scripts/python/sc_partner/icd.py`) must have exactly the Rust layout:
 //! same size, alignment, field names, offsets and sizes, and the same iceoryx2 type name.
 
 use core::mem::{align_of, offset_of, size_of};
@@ -210,15 +210,16 @@ fn rust_field_lists_cover_every_byte() {
 
 #[test]
 fn python_mirror_matches_rust_layout() {
-    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scripts/python/sc_icd.py");
+    // the module of the partner package, run from its source tree (standard library only)
+    let package = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scripts/python");
     let out = Command::new("python3")
-        .arg(&script)
-        .arg("--layout-json")
+        .current_dir(&package)
+        .args(["-m", "sc_partner.icd", "--layout-json"])
         .output()
         .expect("python3 must be installed to check the Python ICD mirror");
     assert!(
         out.status.success(),
-        "sc_icd.py failed: {}",
+        "sc_partner.icd failed: {}",
         String::from_utf8_lossy(&out.stderr)
     );
     let py: serde_json::Value = serde_json::from_slice(&out.stdout).expect("layout JSON");
@@ -232,7 +233,7 @@ fn python_mirror_matches_rust_layout() {
     for l in rust {
         let p = py
             .get(l.name)
-            .unwrap_or_else(|| panic!("{} missing in sc_icd.py", l.name));
+            .unwrap_or_else(|| panic!("{} missing in sc_partner.icd", l.name));
         assert_eq!(
             p["type_name"].as_str(),
             Some(l.type_name),

@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Python counterpart of the Rust crate ``sc-bus``: how a partner process opens the
 partition's iceoryx2 services with the same settings as the Rust processes, and
 joins the start-up handshake (docs/ICD.md, docs/PARTITION.md).
@@ -8,15 +7,12 @@ part of the shared-memory names). Whoever creates a service first fixes its sett
 so every process must ask for the same ones.
 """
 
-import os
-import sys
 import time
-import tomllib
 
 import iceoryx2 as iox2
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import sc_icd  # noqa: E402
+from . import icd as sc_icd
+from .config import load_scenario  # noqa: F401  (the scripts' entry point to the scenario)
 
 # sc_bus::ServiceSettings::lock_step()
 LOCK_STEP = dict(buffer=4, history=0, max_publishers=2, max_subscribers=8, max_nodes=16, safe_overflow=False)
@@ -44,17 +40,6 @@ def run_config(run_id):
     cfg.global_cfg.prefix = iox2.FileName.new(sc_icd.run_prefix(run_id))
     cfg.global_cfg.creation_timeout = iox2.Duration.from_secs(CREATION_TIMEOUT_S)
     return cfg
-
-
-def load_scenario(config_path):
-    """The scenario of a partition config (its `scenario` key, relative to the config file)."""
-    with open(config_path, "rb") as f:
-        cfg = tomllib.load(f)
-    sc_path = cfg["scenario"]
-    if not os.path.isabs(sc_path):
-        sc_path = os.path.join(os.path.dirname(os.path.abspath(config_path)), sc_path)
-    with open(sc_path, "rb") as f:
-        return tomllib.load(f)
 
 
 def open_pubsub(node, name, ctype, qos):

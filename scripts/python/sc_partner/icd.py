@@ -1,16 +1,17 @@
-#!/usr/bin/env python3
-"""Python mirror of the safe-capture ICD (Rust crate ``sc-icd``, see docs/ICD.md).
+"""The safe-capture ICD in Python (mirror of the Rust crate ``sc-icd``, docs/ICD.md).
 
-Each class is a ``ctypes.Structure`` with exactly the ``#[repr(C)]`` layout of the
-Rust type of the same name, and a static ``type_name()`` that returns the Rust
+Each message class is a ``ctypes.Structure`` with exactly the ``#[repr(C)]`` layout of
+the Rust type of the same name, and a static ``type_name()`` that returns the Rust
 ``#[type_name]`` (the iceoryx2 PyPI package matches types across languages by it).
+Beside the messages: service names, event ids, role ids, due-mask bits and the tick
+commands, each with the value of the Rust constant of the same meaning.
 
 The Rust test ``libs/icd/tests/python_layout.rs`` runs
-``python3 scripts/python/sc_icd.py --layout-json`` and compares size, alignment,
-every field offset and every type name with the Rust types.
+``python3 -m sc_partner.icd --layout-json`` and compares size, alignment, every field
+offset and every type name with the Rust types.
 
-Only the standard library is needed; iceoryx2 itself is imported by the users
-of these types (e.g. ``interop_check.py``), not here.
+Only the standard library is needed (the layout check runs with a bare ``python3``);
+iceoryx2 is imported by :mod:`sc_partner.bus`, not here.
 """
 
 import ctypes

@@ -28,6 +28,27 @@ pub fn tmp(tag: &str) -> PathBuf {
     d
 }
 
+/// A scratch directory that is removed when the test ends, passed or failed.
+pub struct Scratch(pub PathBuf);
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// A fresh temp directory, removed when the returned guard is dropped.
+pub fn scratch(tag: &str) -> Scratch {
+    Scratch(tmp(tag))
+}
+
 /// Writes a scenario copy with `duration_s` (None = unchanged) and a partition config
 /// into `dir`; `groups` replaces the rate groups if given; returns the config path.
 pub fn write_config(

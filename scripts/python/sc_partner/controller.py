@@ -1,0 +1,266 @@
+"""The base class of a partner's nominal controller.
+
+A subclass says which subsystem it commands and implements ``step(state) ->
+command``; :func:`run_partition` (or ``MyController.main()``) does everything else
+that the partition expects of a nominal controller process (docs/PARTITION.md,
+docs/ICD.md):
+
+1. join the run: iceoryx2 ``global.prefix`` = ``sc_<SC_RUN_ID>_`` (the launcher sets
+   ``SC_RUN_ID``), the scenario and rate groups from ``--config`` /
+   ``SC_PARTITION_CONFIG``;
+2. create its ports before announcing itself: subscriber + listener on
+   ``safe_capture/partner/state`` (newest wins), a subscriber without listener on
+   ``safe_capture/scheduler/control`` (the stop), publisher + notifier on
+   ``safe_capture/nominal/<subsystem>``;
+3. announce the role on the start-up handshake until the scheduler's ``go``;
+4. for every state whose ``due_mask`` has the subsystem's bit: call ``step`` and
+   publish its command with the state's ``tick``, ``t`` and mission phase, then
+   notify (the safety filter wakes on it);
+5. on the stop: notify once more (the filter wakes and sees the stop too), log how
+   many states it handled, delete its ports.
+
+A step that raises, returns ``None``, a vector of the wrong length or a non-finite
+value publishes ``valid = 0``: the safety filter then filters the subsystem's
+substitute nominal (its braking law) for that tick. The first such failure is
+logged with its reason, the count at the end.
+
+The same subclass runs offline on recorded states (:mod:`sc_partner.harness`).
+"""
+
+import argparse
+import ctypes
+import os
+import sys
+import time
+import traceback
+
+import numpy as np
+
+from . import config as sc_config
+from . import icd
+
+# per subsystem: role id, service, message class, command field, due bit, command length
+_SUBSYSTEM = {
+    "translational": (
+        icd.ROLE_NOMINAL_TRANSLATIONAL,
+        icd.SERVICE_NOMINAL_TRANSLATIONAL,
+        icd.NominalTranslational,
+        "f_h",
+        icd.DUE_TRANSLATIONAL,
+        3,
+    ),
+    "attitude": (
+        icd.ROLE_NOMINAL_ATTITUDE,
+        icd.SERVICE_NOMINAL_ATTITUDE,
+        icd.NominalAttitude,
+        "tau_b",
+        icd.DUE_ATTITUDE,
+        3,
+    ),
+    "robotic": (
+        icd.ROLE_NOMINAL_ROBOTIC,
+        icd.SERVICE_NOMINAL_ROBOTIC,
+        icd.NominalRobotic,
+        "tau_m",
+        icd.DUE_ROBOTIC,
+        icd.N_JOINTS,
+    ),
+}
+
+HANDSHAKE_TIMEOUT_S = 60.0
+# the longest sleep between two looks at the stop (only matters if the simulator died)
+WAIT_MS = 100
+
+
+class State:
+    """One state of the mission as a controller sees it (a copy of ``SimState``).
+
+    Every ``SimState`` field is an attribute (docs/ICD.md, ``sc_partner.icd``): the
+    scalars as Python numbers (``tick``, ``t``, ``due_mask``, ``mean_motion``, ...),
+    the vectors as read-only ``numpy`` float64 arrays (``r_h``, ``v_h``, ``q_hr``,
+    ``theta``, ``barriers``, ...). ``phase`` is the index of the mission phase at
+    ``t`` (scenario order), ``raw`` the ``SimState`` itself.
+    """
+
+    __slots__ = ("raw", "phase")
+
+    def __init__(self, raw, phase):
+        self.raw = raw
+        self.phase = phase
+
+    def __getattr__(self, name):
+        if name.startswith("_"):
+            raise AttributeError(name)
+        value = getattr(self.raw, name)
+        if isinstance(value, ctypes.Array):
+            array = np.ctypeslib.as_array(value)
+            array.flags.writeable = False
+            return array
+        return value
+
+    def __repr__(self):
+        return f"State(tick={self.raw.tick}, t={self.raw.t}, phase={self.phase})"
+
+
+class NominalController:
+    """Base class of a nominal controller; subclasses set ``subsystem`` and implement ``step``.
+
+    ``subsystem``: ``"translational"`` (command f_H, Hill frame [N], 3 values),
+    ``"attitude"`` (τ_B, base frame [N m], 3) or ``"robotic"`` (τ_M, joints [N m], 7).
+    ``name``: the prefix of the process's log lines (default: the class name).
+    """
+
+    subsystem = None
+    name = None
+
+    def setup(self, scenario, period_s):
+        """Called once before the first state: `scenario` is the mission's scenario
+        (config/scenario.toml as a dict), `period_s` the period of the subsystem's rate
+        group (the controller's step). Optional."""
+
+    def step(self, state):
+        """The command for `state` (a :class:`State`): a sequence of floats of the
+        subsystem's length, or ``None`` for no command (``valid = 0``)."""
+        raise NotImplementedError(f"{type(self).__name__}.step")
+
+    # ----------------------------------------------------------------- helpers
+
+    @property
+    def label(self):
+        """The log prefix."""
+        return self.name or type(self).__name__
+
+    def spec(self):
+        """(role id, service, message class, command field, due bit, length) of the subsystem."""
+        if self.subsystem not in _SUBSYSTEM:
+            raise ValueError(
+                f"{type(self).__name__}.subsystem = {self.subsystem!r}: one of {', '.join(_SUBSYSTEM)}"
+            )
+        return _SUBSYSTEM[self.subsystem]
+
+    def due(self, state):
+        """Whether the subsystem is due in `state`'s tick (its bit of ``due_mask``)."""
+        return bool(state.due_mask & self.spec()[4])
+
+    def command(self, state):
+        """Runs ``step`` on `state`; returns (values as a float64 array of the
+        subsystem's length, None) or (zeros, the reason it is not a valid command)."""
+        n = self.spec()[5]
+        zeros = np.zeros(n)
+        try:
+            out = self.step(state)
+        except Exception:
+            return zeros, "step raised:\n" + traceback.format_exc().rstrip()
+        if out is None:
+            return zeros, "step returned None"
+        try:
+            values = np.asarray(out, dtype=np.float64).reshape(-1)
+        except (TypeError, ValueError) as e:
+            return zeros, f"step returned {out!r}, not numbers ({e})"
+        if values.shape != (n,):
+            return zeros, f"step returned {values.size} values, the {self.subsystem} command has {n}"
+        if not np.all(np.isfinite(values)):
+            return zeros, f"step returned a non-finite command {values.tolist()}"
+        return values, None
+
+    def message(self, state, recv_ns=0):
+        """The ICD message answering `state`, and the reason it is invalid (None if valid)."""
+        _, _, msg_cls, field, _, _ = self.spec()
+        values, reason = self.command(state)
+        msg = msg_cls(tick=state.tick, t=state.t, valid=int(reason is None), phase=state.phase, recv_ns=recv_ns)
+        getattr(msg, field)[:] = values.tolist()
+        return msg, reason
+
+    @classmethod
+    def main(cls, argv=None):
+        """Entry point of a controller script: ``sys.exit(MyController.main())``."""
+        return run_partition(cls(), argv)
+
+
+def run_partition(controller, argv=None):
+    """Runs `controller` as the partition's nominal controller of its subsystem until
+    the stop. Returns the process exit code (0 stopped normally, 1 handshake timeout,
+    2 usage)."""
+    import iceoryx2 as iox2
+
+    from . import bus
+
+    label = controller.label
+    parser = argparse.ArgumentParser(prog=label, description=f"nominal {controller.subsystem} controller")
+    parser.add_argument("--config", default=os.environ.get("SC_PARTITION_CONFIG"), help="partition config")
+    parser.add_argument("--out", help="the run's output directory (given by the launcher)")
+    parser.add_argument("--handshake-timeout-s", type=float, default=HANDSHAKE_TIMEOUT_S)
+    # the launcher may pass more options to every role; a controller needs none of them
+    args, _ = parser.parse_known_args(argv)
+    run_id = os.environ.get("SC_RUN_ID")
+    if not run_id or not args.config:
+        print(f"{label}: SC_RUN_ID and --config are required", file=sys.stderr)
+        return 2
+    role, service, msg_cls, _, due_bit, _ = controller.spec()
+    partition = sc_config.read_toml(args.config)
+    scenario = sc_config.read_toml(sc_config.scenario_path(args.config, partition))
+    period_s, _ = sc_config.group_periods(partition, controller.subsystem)
+    controller.setup(scenario, period_s)
+
+    iox2.set_log_level_from_env_or(iox2.LogLevel.Warn)
+    node = (
+        iox2.NodeBuilder.new()
+        .name(iox2.NodeName.new(f"nominal_{controller.subsystem}"))
+        .config(bus.run_config(run_id))
+        .create(iox2.ServiceType.Ipc)
+    )
+    state_svc = bus.open_pubsub(node, icd.SERVICE_PARTNER_STATE, icd.SimState, bus.NOMINAL)
+    state_ev = bus.data_event(node, icd.SERVICE_PARTNER_STATE, bus.NOMINAL)
+    control_svc = bus.open_pubsub(node, icd.SERVICE_CONTROL, icd.Tick, bus.PARTITION)
+    cmd_svc = bus.open_pubsub(node, service, msg_cls, bus.NOMINAL)
+    cmd_ev = bus.data_event(node, service, bus.NOMINAL)
+    state_sub = state_svc.subscriber_builder().create()
+    state_listener = state_ev.listener_builder().create()
+    # the stop comes on the control service; no listener: it is read at every
+    # wake-up (the simulator notifies the state service once more when it stops)
+    control_sub = control_svc.subscriber_builder().create()
+    publisher = cmd_svc.publisher_builder().create()
+    notifier = cmd_ev.notifier_builder().default_event_id(iox2.EventId.new(icd.EVENT_SAMPLE)).create()
+    ports = [state_sub, state_listener, control_sub, publisher, notifier]
+    handled = invalid = 0
+    try:
+        if not bus.handshake(node, role, args.handshake_timeout_s):
+            print(f"{label}: handshake timed out", file=sys.stderr)
+            return 1
+        while True:
+            state_listener.timed_wait(iox2.Duration.from_millis(WAIT_MS))
+            while True:
+                sample = state_sub.receive()
+                if sample is None:
+                    break
+                raw = icd.SimState.from_buffer_copy(sample.payload().contents)
+                sample.delete()
+                if not raw.due_mask & due_bit:
+                    continue
+                recv_ns = time.monotonic_ns()
+                state = State(raw, sc_config.phase_index(scenario, raw.t))
+                msg, reason = controller.message(state, recv_ns)
+                if reason is not None:
+                    invalid += 1
+                    if invalid == 1:
+                        print(f"{label}: tick {raw.tick}: no valid command: {reason}", file=sys.stderr, flush=True)
+                msg.publish_ns = time.monotonic_ns()
+                publisher.loan_uninit().write_payload(msg).send()
+                notifier.notify()
+                handled += 1
+            stop = False
+            while True:
+                sample = control_sub.receive()
+                if sample is None:
+                    break
+                stop |= sample.payload().contents.command == icd.TICK_STOP
+                sample.delete()
+            if stop:
+                notifier.notify()  # wake the safety filter once so that it sees the stop too
+                print(f"{label}: handled {handled} states ({invalid} without a valid command)", file=sys.stderr)
+                return 0
+    finally:
+        for p in ports:
+            p.delete()
+        del state_svc, state_ev, control_svc, cmd_svc, cmd_ev
+        del node

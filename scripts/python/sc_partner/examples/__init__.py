@@ -1,0 +1,1 @@
+"""Worked examples of partner controllers on :class:`sc_partner.NominalController`."""

@@ -1,0 +1,283 @@
+"""Offline harness: a partner's controller on the states of a recorded run, no partition.
+
+Feeds the states recorded in a run's ``telemetry.csv`` (``safe-capture run --out DIR``
+or a partition run, ``safe-capture launch --out DIR``) to a
+:class:`sc_partner.NominalController` exactly as the partition would — ``setup``
+once, then ``step`` for every state whose tick the subsystem is due in — and returns
+(or writes) its commands, one per due step, with the same validity rules as in the
+partition (:meth:`NominalController.command`). So a controller can be unit-tested
+without iceoryx2 processes::
+
+    python -m sc_partner.harness my_pkg.my_module:MyController \\
+        --telemetry out/run/telemetry.csv --config config/partition.toml --out commands.csv
+
+or from Python::
+
+    states = states_from_telemetry("out/run/telemetry.csv")
+    commands = run_offline(MyController(), states, scenario, period_s=0.1)
+
+What ``telemetry.csv`` holds of a state: time, step, phase, the Hill- and
+reference-frame positions and velocities of the base and of the system centre of
+mass, the attitudes and rates of both spacecraft, the joints, the end-effector and
+grasping point in F_R and every barrier (``barriers``) with its minimum since the
+previous row (``barriers_between``). Derived here: ``q_hr`` (from the same two
+vectors in F_R and F_H, the base position and the centre of mass; exact to ~1e-14),
+``grasp_b`` and ``ee_b`` (rotated into F_B). Not recorded, hence NaN: ``omega_h``,
+``omega_dot_h``, ``mean_motion``, ``omega_dot_t``, ``grasp_v_r``, ``grasp_a_r``,
+``ee_v_r``; the ``*_ns`` stamps are 0. ``due_mask`` comes from the partition config's
+rate groups (``--config``); without one every subsystem is due at every step (the
+schedule of ``safe-capture run``).
+"""
+
+import argparse
+import csv
+import importlib
+import importlib.util
+import inspect
+import math
+import os
+import sys
+from collections import namedtuple
+
+import numpy as np
+
+from . import config as sc_config
+from . import icd
+from .controller import NominalController, State
+
+#: One command of an offline run: the state's tick, time and phase, whether the
+#: command is valid (1/0), its values and, if invalid, why.
+OfflineCommand = namedtuple("OfflineCommand", "tick t phase valid values reason")
+
+_AXES = ("x", "y", "z")
+# SimState vector field -> its telemetry.csv columns
+_VECTOR_COLUMNS = {
+    "r_h": [f"r_h_{a}_m" for a in _AXES],
+    "v_h": [f"v_h_{a}_m_s" for a in _AXES],
+    "r_r": [f"r_r_{a}_m" for a in _AXES],
+    "v_r": [f"v_r_{a}_m_s" for a in _AXES],
+    "com_r": [f"com_r_{a}_m" for a in _AXES],
+    "com_v_r": [f"com_v_r_{a}_m_s" for a in _AXES],
+    "com_h": [f"com_h_{a}_m" for a in _AXES],
+    "com_v_h": [f"com_v_h_{a}_m_s" for a in _AXES],
+    "q_rb": [f"q{i}_rb" for i in range(4)],
+    "omega_b": [f"omega_b_{a}_rad_s" for a in _AXES],
+    "theta": [f"theta_{i}_rad" for i in range(1, icd.N_JOINTS + 1)],
+    "theta_dot": [f"theta_dot_{i}_rad_s" for i in range(1, icd.N_JOINTS + 1)],
+    "q_rt": [f"q{i}_rt" for i in range(4)],
+    "omega_t": [f"omega_t_{a}_rad_s" for a in _AXES],
+    "ee_r": [f"ee_r_{a}_m" for a in _AXES],
+    "grasp_r": [f"grasp_r_{a}_m" for a in _AXES],
+}
+_NOT_RECORDED = ("omega_h", "omega_dot_h", "mean_motion", "omega_dot_t", "grasp_v_r", "grasp_a_r", "ee_v_r")
+# the recorded nominal command of each subsystem (to compare a controller with)
+NOMINAL_COLUMNS = {
+    "translational": [f"f_h_nom_{a}_n" for a in _AXES],
+    "attitude": [f"tau_b_nom_{a}_nm" for a in _AXES],
+    "robotic": [f"tau_m_nom_{i}_nm" for i in range(1, icd.N_JOINTS + 1)],
+}
+
+
+def quaternion_from_matrix(m):
+    """Scalar-first unit quaternion of the rotation matrix `m` (w >= 0)."""
+    m = np.asarray(m, dtype=float)
+    tr = m[0, 0] + m[1, 1] + m[2, 2]
+    if tr > 0.0:
+        s = 2.0 * math.sqrt(1.0 + tr)
+        q = [0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s]
+    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2])
+        q = [(m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s]
+    elif m[1, 1] > m[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2])
+        q = [(m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s]
+    else:
+        s = 2.0 * math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1])
+        q = [(m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s]
+    q = np.asarray(q)
+    q /= np.linalg.norm(q)
+    return -q if q[0] < 0.0 else q
+
+
+def rotation_between(a_from, b_from, a_to, b_to):
+    """The rotation R with R a_from ∥ a_to and R (a_from × b_from) ∥ (a_to × b_to) (TRIAD):
+    exact when the two pairs are the same two vectors in two frames."""
+
+    def triad(a, b):
+        a = np.asarray(a, dtype=float)
+        t1 = a / np.linalg.norm(a)
+        t2 = np.cross(a, b)
+        t2 /= np.linalg.norm(t2)
+        return np.column_stack([t1, t2, np.cross(t1, t2)])
+
+    return triad(a_to, b_to) @ triad(a_from, b_from).T
+
+
+def _conj(q):
+    return [q[0], -q[1], -q[2], -q[3]]
+
+
+def states_from_telemetry(path, partition=None):
+    """The states recorded in `path` (a ``telemetry.csv``), as :class:`State` objects.
+
+    `partition`: a partition config (dict, or a path to one) whose rate groups give
+    each state's ``due_mask``; None = every subsystem due at every step.
+    """
+    if isinstance(partition, (str, os.PathLike)):
+        partition = sc_config.read_toml(partition)
+    every = {}
+    for name in sc_config.SUBSYSTEMS:
+        if partition is None:
+            every[name] = 1
+        else:
+            period, base = sc_config.group_periods(partition, name)
+            every[name] = max(1, round(period / base))
+    bits = {"translational": icd.DUE_TRANSLATIONAL, "attitude": icd.DUE_ATTITUDE, "robotic": icd.DUE_ROBOTIC}
+    states = []
+    with open(path, newline="") as f:
+        reader = csv.reader(f)
+        header = next(reader, None)
+        if header is None:
+            raise ValueError(f"{path}: empty")
+        col = {name: i for i, name in enumerate(header)}
+        needed = ["step", "t_s", "phase"] + [c for cols in _VECTOR_COLUMNS.values() for c in cols]
+        missing = [c for c in needed if c not in col]
+        if missing:
+            raise ValueError(f"{path}: not a safe-capture telemetry.csv (no column {missing[0]})")
+        h_cols = [i for i, name in enumerate(header) if name.startswith("h_")]
+        hmin_cols = [i for i, name in enumerate(header) if name.startswith("hmin_")]
+        if len(h_cols) != icd.N_BARRIERS or len(hmin_cols) != icd.N_BARRIERS:
+            raise ValueError(f"{path}: {len(h_cols)} h_* and {len(hmin_cols)} hmin_* columns, expected {icd.N_BARRIERS}")
+        for n, row in enumerate(reader, start=2):
+            if len(row) != len(header):
+                raise ValueError(f"{path} line {n}: {len(row)} fields, the header has {len(header)}")
+            raw = icd.SimState()
+            raw.step = raw.tick = int(row[col["step"]])
+            raw.t = float(row[col["t_s"]])
+            raw.due_mask = sum(bit for name, bit in bits.items() if raw.tick % every[name] == 0)
+            for field, cols in _VECTOR_COLUMNS.items():
+                getattr(raw, field)[:] = [float(row[col[c]]) for c in cols]
+            raw.barriers[:] = [float(row[i]) for i in h_cols]
+            raw.barriers_between[:] = [float(row[i]) for i in hmin_cols]
+            for field in _NOT_RECORDED:
+                value = getattr(raw, field)
+                if isinstance(value, float):
+                    setattr(raw, field, math.nan)
+                else:
+                    value[:] = [math.nan] * len(value)
+            rot_hr = rotation_between(raw.r_r, raw.com_r, raw.r_h, raw.com_h)
+            raw.q_hr[:] = quaternion_from_matrix(rot_hr).tolist()
+            q_br = _conj(list(raw.q_rb))
+            raw.grasp_b[:] = icd.rotate(q_br, [g - r for g, r in zip(raw.grasp_r, raw.r_r)])
+            raw.ee_b[:] = icd.rotate(q_br, [e - r for e, r in zip(raw.ee_r, raw.r_r)])
+            states.append(State(raw, int(row[col["phase"]])))
+    return states
+
+
+def run_offline(controller, states, scenario, period_s):
+    """Runs `controller` on `states` as the partition would: ``setup(scenario,
+    period_s)`` once, then one command per state whose tick the subsystem is due in.
+    Returns the :data:`OfflineCommand` list in state order."""
+    controller.setup(scenario, period_s)
+    out = []
+    for state in states:
+        if not controller.due(state):
+            continue
+        values, reason = controller.command(state)
+        out.append(OfflineCommand(state.tick, state.t, state.phase, int(reason is None), values, reason))
+    return out
+
+
+def write_commands(path, controller, commands):
+    """Writes `commands` as CSV: step, t_s, phase, valid and the command's columns
+    (named as the recorded nominal command in telemetry.csv)."""
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["step", "t_s", "phase", "valid"] + NOMINAL_COLUMNS[controller.subsystem])
+        for c in commands:
+            w.writerow([c.tick, repr(c.t), c.phase, c.valid] + [repr(float(v)) for v in c.values])
+
+
+def recorded_nominal(path, subsystem):
+    """{step: the nominal command recorded in telemetry.csv `path`} of `subsystem`."""
+    with open(path, newline="") as f:
+        reader = csv.DictReader(f)
+        return {
+            int(row["step"]): np.array([float(row[c]) for c in NOMINAL_COLUMNS[subsystem]])
+            for row in reader
+        }
+
+
+def load_controller(spec):
+    """The controller class named by `spec`: ``package.module:Class`` or
+    ``path/to/file.py:Class``; without ``:Class`` the module's one subclass of
+    :class:`NominalController`."""
+    target, _, cls_name = spec.partition(":")
+    if target.endswith(".py") or os.sep in target:
+        name = os.path.splitext(os.path.basename(target))[0]
+        loader_spec = importlib.util.spec_from_file_location(name, target)
+        if loader_spec is None:
+            raise ValueError(f"{target}: cannot load")
+        module = importlib.util.module_from_spec(loader_spec)
+        loader_spec.loader.exec_module(module)
+    else:
+        module = importlib.import_module(target)
+    if cls_name:
+        return getattr(module, cls_name)
+    found = [
+        c
+        for c in vars(module).values()
+        if inspect.isclass(c) and issubclass(c, NominalController) and c is not NominalController
+        and c.__module__ == module.__name__
+    ]
+    if len(found) != 1:
+        names = ", ".join(c.__name__ for c in found) or "none"
+        raise ValueError(f"{spec}: name the class (module:Class); NominalController subclasses found: {names}")
+    return found[0]
+
+
+def main(argv=None):
+    """Command line: see the module's documentation (``--help``)."""
+    p = argparse.ArgumentParser(
+        prog="python -m sc_partner.harness",
+        description="Run a nominal controller offline on the states of a recorded telemetry.csv.",
+    )
+    p.add_argument("controller", help="package.module:Class or path/to/file.py:Class")
+    p.add_argument("--telemetry", required=True, help="telemetry.csv of a recorded run")
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--config", help="partition config (scenario and rate groups)")
+    src.add_argument("--scenario", help="scenario.toml (every subsystem due at every control step)")
+    p.add_argument("--out", help="write the commands to this CSV")
+    p.add_argument("--strict", action="store_true", help="exit 1 if any due step has no valid command")
+    args = p.parse_args(argv)
+
+    controller = load_controller(args.controller)()
+    if args.config:
+        partition = sc_config.read_toml(args.config)
+        scenario = sc_config.read_toml(sc_config.scenario_path(args.config, partition))
+        period_s, _ = sc_config.group_periods(partition, controller.subsystem)
+    else:
+        partition = None
+        scenario = sc_config.read_toml(args.scenario)
+        period_s = float(scenario["mission"]["control_period_s"])
+    states = states_from_telemetry(args.telemetry, partition)
+    commands = run_offline(controller, states, scenario, period_s)
+    if args.out:
+        write_commands(args.out, controller, commands)
+    invalid = [c for c in commands if not c.valid]
+    recorded = recorded_nominal(args.telemetry, controller.subsystem)
+    diffs = [float(np.max(np.abs(c.values - recorded[c.tick]))) for c in commands if c.valid and c.tick in recorded]
+    largest = max((d for d in diffs if math.isfinite(d)), default=math.nan)
+    print(
+        f"harness: {type(controller).__name__} ({controller.subsystem}) on {len(states)} states: "
+        f"{len(commands)} commands, {len(invalid)} without a valid one"
+        + (f" -> {args.out}" if args.out else "")
+        + f"; largest difference to the recorded nominal command: {largest:.6g}"
+    )
+    for c in invalid[:1]:
+        print(f"harness: first invalid, tick {c.tick}: {c.reason}", file=sys.stderr)
+    return 1 if args.strict and invalid else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
