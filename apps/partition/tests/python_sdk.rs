@@ -2,8 +2,8 @@
 //! - installed with `pip install ./scripts/python` into a fresh venv, without
 //!   Pinocchio, its worked example replaces the Rust nominal translational controller
 //!   and the mission runs through the partition to capture, every barrier kept; the
-//!   offline harness then gives, from that run's telemetry.csv, the very commands the
-//!   controller sent in the partition;
+//!   offline harness then gives, from that run's recording.mcap and telemetry.csv, the
+//!   very commands the controller sent in the partition;
 //! - the offline harness gives one command per due step on the telemetry of the
 //!   in-process mission, equal to the law evaluated on the true states, and reports
 //!   steps without a valid command.
@@ -169,37 +169,46 @@ fn installed_sdk_example_runs_the_mission_without_pinocchio() {
         serde_json::from_str(&std::fs::read_to_string(out.join("recorder.json")).unwrap()).unwrap();
     assert_eq!(r["missing"]["safe_capture/nominal/translational"], 0, "{r}");
 
-    // offline, on the run's own telemetry, the installed harness gives back what the
-    // controller sent in the partition (the states' q_hr is reconstructed from the
-    // recorded vectors: equal to ~1e-14, not bit for bit)
-    let cmds = dir.join("commands.csv");
-    let o = Command::new(venv.join("bin/sc-partner-harness"))
-        .arg("sc_partner.examples.nominal_translational")
-        .arg("--telemetry")
-        .arg(out.join("telemetry.csv"))
-        .arg("--config")
-        .arg(&config)
-        .arg("--out")
-        .arg(&cmds)
-        .arg("--strict")
-        .current_dir(&*dir)
-        .env_remove("PYTHONPATH")
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", text(&o));
-    let got = commands(&cmds);
+    // offline, on the run's own recordings, the installed harness gives back what the
+    // controller sent in the partition: from the MCAP (every state field the law uses,
+    // exactly) bit for bit; from telemetry.csv, whose states lack q_hr (the harness
+    // reconstructs it from two recorded vectors, to ~1e-14), to 1e-9
+    let harness = |source: &str, recording: &str, tag: &str| {
+        let cmds = dir.join(format!("commands-{tag}.csv"));
+        let o = Command::new(venv.join("bin/sc-partner-harness"))
+            .arg("sc_partner.examples.nominal_translational")
+            .arg(source)
+            .arg(out.join(recording))
+            .arg("--config")
+            .arg(&config)
+            .arg("--out")
+            .arg(&cmds)
+            .arg("--strict")
+            .current_dir(&*dir)
+            .env_remove("PYTHONPATH")
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", text(&o));
+        commands(&cmds)
+    };
     let (h, rows) = read_csv(&out.join("telemetry.csv"));
-    assert_eq!(got.len(), rows.len(), "one command per recorded step");
     let f: Vec<usize> = F_H.iter().map(|c| col(&h, c)).collect();
-    for ((step, _, valid, cmd), row) in got.iter().zip(&rows) {
-        assert_eq!(step.to_string(), row[0]);
-        assert_eq!(*valid, 1);
-        for i in 0..3 {
-            let sent: f64 = row[f[i]].parse().unwrap();
-            assert!(
-                (cmd[i] - sent).abs() <= 1e-9 * sent.abs().max(1.0),
-                "step {step}: harness {cmd:?}, sent in the partition {sent} (axis {i})"
-            );
+    for (source, recording, tol) in [
+        ("--mcap", "recording.mcap", 0.0),
+        ("--telemetry", "telemetry.csv", 1e-9),
+    ] {
+        let got = harness(source, recording, &source[2..]);
+        assert_eq!(got.len(), rows.len(), "{source}: one command per step");
+        for ((step, _, valid, cmd), row) in got.iter().zip(&rows) {
+            assert_eq!(step.to_string(), row[0]);
+            assert_eq!(*valid, 1);
+            for i in 0..3 {
+                let sent: f64 = row[f[i]].parse().unwrap();
+                assert!(
+                    (cmd[i] - sent).abs() <= tol * sent.abs().max(1.0),
+                    "{source}, step {step}: harness {cmd:?}, sent in the partition {sent} (axis {i})"
+                );
+            }
         }
     }
 }

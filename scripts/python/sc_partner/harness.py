@@ -1,7 +1,8 @@
 """Offline harness: a partner's controller on the states of a recorded run, no partition.
 
 Feeds the states recorded in a run's ``telemetry.csv`` (``safe-capture run --out DIR``
-or a partition run, ``safe-capture launch --out DIR``) to a
+or a partition run, ``safe-capture launch --out DIR``) or a partition run's
+``recording.mcap`` to a
 :class:`sc_partner.NominalController` exactly as the partition would — ``setup``
 once, then ``step`` for every state whose tick the subsystem is due in — and returns
 (or writes) its commands, one per due step, with the same validity rules as in the
@@ -10,6 +11,8 @@ without iceoryx2 processes::
 
     python -m sc_partner.harness my_pkg.my_module:MyController \\
         --telemetry out/run/telemetry.csv --config config/partition.toml --out commands.csv
+    python -m sc_partner.harness my_pkg.my_module:MyController \\
+        --mcap out/partition/recording.mcap --config config/partition.toml
 
 or from Python::
 
@@ -27,6 +30,13 @@ vectors in F_R and F_H, the base position and the centre of mass; exact to ~1e-1
 ``ee_v_r``; the ``*_ns`` stamps are 0. ``due_mask`` comes from the partition config's
 rate groups (``--config``); without one every subsystem is due at every step (the
 schedule of ``safe-capture run``).
+
+``recording.mcap`` holds every ``SimState`` the simulator published (channel
+``safe_capture/sim/state``, the same states the partners get) with its exact
+``due_mask``, ``q_hr``, ``omega_h``, ``mean_motion``, velocities and accelerations;
+the recorder leaves out the centre of mass (``com_*``) and the barriers
+(``barriers``, ``barriers_between``), which are NaN here (``telemetry.csv`` has them).
+The phase comes from the scenario.
 """
 
 import argparse
@@ -43,6 +53,7 @@ import numpy as np
 
 from . import config as sc_config
 from . import icd
+from . import mcap
 from .controller import NominalController, State
 
 #: One command of an offline run: the state's tick, time and phase, whether the
@@ -174,6 +185,40 @@ def states_from_telemetry(path, partition=None):
     return states
 
 
+def _json_number(x):
+    return math.nan if x is None else float(x)
+
+
+# SimState fields the recorder leaves out of the MCAP (telemetry.csv has them)
+_NOT_IN_MCAP = ("com_h", "com_v_h", "com_r", "com_v_r", "barriers", "barriers_between")
+
+
+def states_from_mcap(path, scenario):
+    """The states the simulator published in a partition run's ``recording.mcap``
+    (channel ``safe_capture/sim/state``), as :class:`State` objects with the phase of
+    `scenario` (a dict) at their time."""
+    states = []
+    names = [name for name, _ in icd.SimState._fields_]
+    for _, _, m in mcap.messages(path, {icd.SERVICE_SIM_STATE}):
+        raw = icd.SimState()
+        for name in names:
+            if name.startswith("_"):  # padding, not recorded
+                continue
+            value = m.get(name)
+            if value is None and name in _NOT_IN_MCAP:
+                value = [None] * len(getattr(raw, name))
+            elif name not in m:
+                raise ValueError(f"{path}: a {icd.SERVICE_SIM_STATE} message without `{name}`")
+            if isinstance(value, list):
+                getattr(raw, name)[:] = [_json_number(x) for x in value]
+            elif isinstance(getattr(raw, name), float):
+                setattr(raw, name, _json_number(value))
+            else:
+                setattr(raw, name, int(value))
+        states.append(State(raw, sc_config.phase_index(scenario, raw.t)))
+    return states
+
+
 def run_offline(controller, states, scenario, period_s):
     """Runs `controller` on `states` as the partition would: ``setup(scenario,
     period_s)`` once, then one command per state whose tick the subsystem is due in.
@@ -199,13 +244,27 @@ def write_commands(path, controller, commands):
 
 
 def recorded_nominal(path, subsystem):
-    """{step: the nominal command recorded in telemetry.csv `path`} of `subsystem`."""
+    """{step: the nominal command of `subsystem` recorded in `path`}: a telemetry.csv
+    (the command the filter used) or a recording.mcap (the commands published)."""
+    if str(path).endswith(".mcap"):
+        service, _, field = _SERVICE_FIELD[subsystem]
+        return {
+            int(m["tick"]): np.array([_json_number(x) for x in m[field]])
+            for _, _, m in mcap.messages(path, {service})
+        }
     with open(path, newline="") as f:
         reader = csv.DictReader(f)
         return {
             int(row["step"]): np.array([float(row[c]) for c in NOMINAL_COLUMNS[subsystem]])
             for row in reader
         }
+
+
+_SERVICE_FIELD = {
+    "translational": (icd.SERVICE_NOMINAL_TRANSLATIONAL, icd.NominalTranslational, "f_h"),
+    "attitude": (icd.SERVICE_NOMINAL_ATTITUDE, icd.NominalAttitude, "tau_b"),
+    "robotic": (icd.SERVICE_NOMINAL_ROBOTIC, icd.NominalRobotic, "tau_m"),
+}
 
 
 def load_controller(spec):
@@ -240,10 +299,12 @@ def main(argv=None):
     """Command line: see the module's documentation (``--help``)."""
     p = argparse.ArgumentParser(
         prog="python -m sc_partner.harness",
-        description="Run a nominal controller offline on the states of a recorded telemetry.csv.",
+        description="Run a nominal controller offline on the states of a recorded telemetry.csv or recording.mcap.",
     )
     p.add_argument("controller", help="package.module:Class or path/to/file.py:Class")
-    p.add_argument("--telemetry", required=True, help="telemetry.csv of a recorded run")
+    rec = p.add_mutually_exclusive_group(required=True)
+    rec.add_argument("--telemetry", help="telemetry.csv of a recorded run")
+    rec.add_argument("--mcap", help="recording.mcap of a partition run")
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--config", help="partition config (scenario and rate groups)")
     src.add_argument("--scenario", help="scenario.toml (every subsystem due at every control step)")
@@ -260,12 +321,15 @@ def main(argv=None):
         partition = None
         scenario = sc_config.read_toml(args.scenario)
         period_s = float(scenario["mission"]["control_period_s"])
-    states = states_from_telemetry(args.telemetry, partition)
+    if args.mcap:
+        states = states_from_mcap(args.mcap, scenario)
+    else:
+        states = states_from_telemetry(args.telemetry, partition)
     commands = run_offline(controller, states, scenario, period_s)
     if args.out:
         write_commands(args.out, controller, commands)
     invalid = [c for c in commands if not c.valid]
-    recorded = recorded_nominal(args.telemetry, controller.subsystem)
+    recorded = recorded_nominal(args.mcap or args.telemetry, controller.subsystem)
     diffs = [float(np.max(np.abs(c.values - recorded[c.tick]))) for c in commands if c.valid and c.tick in recorded]
     largest = max((d for d in diffs if math.isfinite(d)), default=math.nan)
     print(
