@@ -355,3 +355,28 @@ fn offline_harness_gives_one_command_per_due_step() {
     let o = harness(&[&spec, "--telemetry", &tel, "--scenario", &sc, "--strict"]);
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
 }
+
+/// The SDK's Python unit tests (scripts/python/tests: rotations, the base class's
+/// validity rules, config helpers, the LZ4 decoder of the MCAP reader).
+#[test]
+fn python_unit_tests_pass() {
+    let Some(py) = python() else {
+        return;
+    };
+    let o = Command::new(&py)
+        .args(["-m", "unittest", "discover", "-s", "tests"])
+        .current_dir(repo().join("scripts/python"))
+        .env("PYTHONPATH", repo().join("scripts/python"))
+        .env("PYTHONDONTWRITEBYTECODE", "1")
+        .output()
+        .unwrap();
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    let ran: usize = t
+        .split("Ran ")
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(0);
+    assert!(ran >= 10, "{t}");
+}

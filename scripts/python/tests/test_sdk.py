@@ -1,0 +1,145 @@
+"""Unit tests of the partner SDK's pure-Python parts (no partition, no iceoryx2 process).
+
+Run: ``PYTHONPATH=scripts/python python -m unittest discover -s scripts/python/tests``
+(``apps/partition/tests/python_sdk.rs`` does).
+"""
+
+import math
+import struct
+import unittest
+
+import numpy as np
+
+from sc_partner import NominalController, State, icd
+from sc_partner import mcap
+from sc_partner.config import group_periods, phase_index
+from sc_partner.harness import quaternion_from_matrix, rotation_between
+
+
+def rotation_matrix(q):
+    """R(q) of a scalar-first unit quaternion, column by column through icd.rotate."""
+    return np.column_stack([icd.rotate(q, e) for e in np.eye(3)])
+
+
+class Rotations(unittest.TestCase):
+    def test_quaternion_round_trip(self):
+        rng = np.random.default_rng(7)
+        for _ in range(200):
+            q = rng.normal(size=4)
+            q /= np.linalg.norm(q)
+            q = -q if q[0] < 0 else q
+            back = quaternion_from_matrix(rotation_matrix(q))
+            self.assertLess(np.max(np.abs(back - q)), 1e-12)
+
+    def test_triad_recovers_the_rotation_from_two_vector_pairs(self):
+        rng = np.random.default_rng(3)
+        q = rng.normal(size=4)
+        q /= np.linalg.norm(q)
+        r = rotation_matrix(q)
+        a, b = rng.normal(size=3) * 10.0, rng.normal(size=3) * 10.0
+        est = rotation_between(a, b, r @ a, r @ b)
+        self.assertLess(np.max(np.abs(est - r)), 1e-13)
+
+
+class Controllers(unittest.TestCase):
+    class Echo(NominalController):
+        subsystem = "attitude"
+
+        def __init__(self, output):
+            self.output = output
+
+        def step(self, state):
+            if isinstance(self.output, Exception):
+                raise self.output
+            return self.output
+
+    def state(self, tick=4, due=icd.DUE_ATTITUDE):
+        raw = icd.SimState(tick=tick, t=0.4, due_mask=due)
+        raw.r_h[:] = [1.0, 2.0, 3.0]
+        return State(raw, 1)
+
+    def test_state_fields_are_read_only_arrays_and_numbers(self):
+        s = self.state()
+        self.assertEqual((s.tick, s.t, s.phase), (4, 0.4, 1))
+        np.testing.assert_array_equal(s.r_h, [1.0, 2.0, 3.0])
+        self.assertEqual(s.theta.shape, (icd.N_JOINTS,))
+        with self.assertRaises(ValueError):
+            s.r_h[0] = 5.0
+        with self.assertRaises(AttributeError):
+            s.no_such_field
+
+    def test_valid_command_and_message(self):
+        c = self.Echo([0.1, -0.2, 0.3])
+        values, reason = c.command(self.state())
+        self.assertIsNone(reason)
+        msg, reason = c.message(self.state(), recv_ns=9)
+        self.assertIsNone(reason)
+        self.assertEqual((msg.tick, msg.valid, msg.phase, msg.recv_ns), (4, 1, 1, 9))
+        self.assertEqual(list(msg.tau_b), [0.1, -0.2, 0.3])
+        self.assertEqual(msg.type_name(), icd.NominalAttitude.type_name())
+
+    def test_invalid_commands_publish_valid_zero(self):
+        for output, why in [
+            (None, "None"),
+            ([1.0, 2.0], "2 values"),
+            ([1.0, math.nan, 0.0], "non-finite"),
+            ("abc", "not numbers"),
+            (RuntimeError("boom"), "RuntimeError: boom"),
+        ]:
+            msg, reason = self.Echo(output).message(self.state())
+            self.assertEqual(msg.valid, 0, output)
+            self.assertEqual(list(msg.tau_b), [0.0, 0.0, 0.0])
+            self.assertIn(why, reason)
+
+    def test_due_follows_the_subsystem_bit(self):
+        c = self.Echo([0.0] * 3)
+        self.assertTrue(c.due(self.state(due=icd.DUE_TRANSLATIONAL | icd.DUE_ATTITUDE | icd.DUE_ROBOTIC)))
+        self.assertFalse(c.due(self.state(due=icd.DUE_TRANSLATIONAL | icd.DUE_ROBOTIC)))
+
+    def test_unknown_subsystem_is_refused(self):
+        class Bad(NominalController):
+            subsystem = "orbital"
+
+        with self.assertRaises(ValueError):
+            Bad().spec()
+
+
+class Config(unittest.TestCase):
+    def test_phase_index_and_group_periods(self):
+        sc = {"mission": {"phases": [{"start_s": 0.0}, {"start_s": 60.0}, {"start_s": 120.0}]}}
+        self.assertEqual([phase_index(sc, t) for t in (0.0, 59.9, 60.0 - 1e-10, 60.0, 200.0)], [0, 0, 1, 1, 2])
+        part = {
+            "rate_groups": [
+                {"period_s": 0.2, "members": ["translational"]},
+                {"period_s": 0.1, "members": ["attitude", "robotic"]},
+            ]
+        }
+        self.assertEqual(group_periods(part, "translational"), (0.2, 0.1))
+        self.assertEqual(group_periods(part, "robotic"), (0.1, 0.1))
+
+
+class Lz4(unittest.TestCase):
+    def frame(self, *blocks, raw_last=False):
+        out = bytearray(struct.pack("<I", 0x184D2204)) + bytes([0x40 | 0x20, 0x40, 0x00])  # FLG, BD, HC
+        for i, b in enumerate(blocks):
+            size = len(b) | (0x80000000 if raw_last and i == len(blocks) - 1 else 0)
+            out += struct.pack("<I", size) + b
+        return bytes(out + struct.pack("<I", 0))
+
+    def test_literals_matches_overlap_and_raw_blocks(self):
+        # "abcabcabcabcX": 3 literals, then a match of 9 at offset 3 (overlapping), then "X"
+        block = bytes([0x35]) + b"abc" + struct.pack("<H", 3) + bytes([0x10]) + b"X"
+        self.assertEqual(mcap.lz4_frame(self.frame(block)), b"abcabcabcabcX")
+        # a long literal run (length 15 + 255 + 5 = 275) and a raw second block
+        text = bytes(range(256)) + b"0123456789abcdefghi"
+        block = bytes([0xF0, 255, 5]) + text
+        self.assertEqual(mcap.lz4_frame(self.frame(block, b"raw!", raw_last=True)), text + b"raw!")
+
+    def test_bad_offset_is_refused(self):
+        block = bytes([0x10]) + b"a" + struct.pack("<H", 5) + bytes([0x00])
+        with self.assertRaises(ValueError):
+            mcap.lz4_frame(self.frame(block))
+
+
+if __name__ == "__main__":
+    unittest.main()
