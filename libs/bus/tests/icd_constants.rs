@@ -6,7 +6,10 @@ use sc_icd::c_header::events;
 #[test]
 fn c_header_event_ids_are_sc_bus_ids() {
     assert_eq!(events::SAMPLE as usize, sc_bus::pubsub::EVENT_SAMPLE);
-    assert_eq!(events::NOTIFIER_DEAD as usize, sc_bus::pubsub::EVENT_NOTIFIER_DEAD);
+    assert_eq!(
+        events::NOTIFIER_DEAD as usize,
+        sc_bus::pubsub::EVENT_NOTIFIER_DEAD
+    );
     assert_eq!(
         events::NOTIFIER_DROPPED as usize,
         sc_bus::pubsub::EVENT_NOTIFIER_DROPPED
