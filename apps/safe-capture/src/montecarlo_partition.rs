@@ -16,7 +16,7 @@ use sc_mission::{MissionEnd, Setup, StepRecord, parse_telemetry};
 use sc_montecarlo::campaign::PARTITION_DIR;
 use sc_montecarlo::{Execution, Executor};
 use sc_partition::config::ROLES;
-use sc_partition::launcher::{LaunchReport, interrupted};
+use sc_partition::launcher::{LaunchReport, interrupted, last_log_line};
 use sc_partition::recorder::RecorderReport;
 use sc_partition::{ClockMode, LaunchOptions, PartitionConfig, launch};
 use std::path::{Path, PathBuf};
@@ -95,16 +95,8 @@ impl PartitionExecutor {
     }
 }
 
-/// The last non-empty line of a log (for a failed run's error), shortened.
-fn last_line(log: &Path) -> Option<String> {
-    let text = std::fs::read_to_string(log).ok()?;
-    let line = text.lines().rev().find(|l| !l.trim().is_empty())?.trim();
-    let mut s: String = line.chars().take(200).collect();
-    if s.len() < line.len() {
-        s.push('…');
-    }
-    Some(s)
-}
+/// How much of a log's last line a failed run's error quotes.
+const QUOTED_LOG_CHARS: usize = 200;
 
 /// Why a launch failed, in one line.
 fn failure(rep: &LaunchReport, out: &Path) -> String {
@@ -133,9 +125,12 @@ pub fn failure_reason(rep: &LaunchReport, out: &Path) -> String {
                 (_, Some(s)) => format!("signal {s}"),
                 _ => "unknown end".into(),
             };
-            let log = last_line(&out.join("logs").join(format!("{}.log", e.role)))
-                .map(|l| format!(": {l}"))
-                .unwrap_or_default();
+            let log = last_log_line(
+                &out.join("logs").join(format!("{}.log", e.role)),
+                QUOTED_LOG_CHARS,
+            )
+            .map(|l| format!(": {l}"))
+            .unwrap_or_default();
             format!("{} ({how}){log}", e.role)
         })
         .collect();

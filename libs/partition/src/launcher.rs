@@ -146,8 +146,14 @@ pub fn clean_stale_runs(except: &str) -> usize {
     removed
 }
 
+/// Written by the scheduler into the output directory once every process joined the
+/// start-up handshake. A process that fails by itself before then can never join: the
+/// launcher tears the run down at once instead of waiting for the handshake timeout.
+pub const ALL_READY: &str = "all_ready";
+
 /// What a partition run writes into its output directory (besides `logs/`).
-pub const RUN_OUTPUTS: [&str; 17] = [
+pub const RUN_OUTPUTS: [&str; 18] = [
+    ALL_READY,
     "summary.json",
     "telemetry.csv",
     "timing.csv",
@@ -166,6 +172,20 @@ pub const RUN_OUTPUTS: [&str; 17] = [
     "compare",
     "figures",
 ];
+
+/// The last non-empty line of a log, shortened to `max_chars`.
+pub fn last_log_line(log: &Path, max_chars: usize) -> Option<String> {
+    let text = std::fs::read_to_string(log).ok()?;
+    let line = text.lines().rev().find(|l| !l.trim().is_empty())?.trim();
+    let mut s: String = line.chars().take(max_chars).collect();
+    if s.len() < line.len() {
+        s.push('…');
+    }
+    Some(s)
+}
+
+/// How much of a log's last line an error quotes.
+const QUOTED_LOG_CHARS: usize = 200;
 
 /// Removes what an earlier run left in `out` (only the files a run writes, never anything
 /// else), so that a run that fails early cannot be reported with an old run's results.
@@ -371,6 +391,8 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
     }
     let mut termed = false;
     let mut killed = false;
+    // a process that failed by itself before every process was ready
+    let mut early_err: Option<String> = None;
     loop {
         for p in procs.iter_mut() {
             if p.exit.is_none()
@@ -400,6 +422,27 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
                     );
                 }
                 let ok = ex.code == Some(0) || (p.role == "recorder" && ex.code == Some(1));
+                if !ok && !termed && p.role != "scheduler" && !out.join(ALL_READY).exists() {
+                    // it can never join the handshake: stop now, naming it, instead of
+                    // letting the scheduler wait for it until the handshake timeout
+                    let log = out.join("logs").join(format!("{}.log", p.role));
+                    early_err.get_or_insert_with(|| {
+                        format!(
+                            "role `{}` ended ({}) before every process was ready{}; see {}",
+                            p.role,
+                            match (ex.code, ex.signal) {
+                                (Some(c), _) => format!("exit code {c}"),
+                                (_, Some(s)) => format!("signal {s}"),
+                                _ => "unknown end".into(),
+                            },
+                            last_log_line(&log, QUOTED_LOG_CHARS)
+                                .map(|l| format!(": {l}"))
+                                .unwrap_or_default(),
+                            log.display()
+                        )
+                    });
+                    teardown_at = Some(Instant::now());
+                }
                 if !ok && !termed {
                     failed = true;
                     // the scheduler, simulator and recorder are essential: without
@@ -476,7 +519,7 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
     } else {
         1
     };
-    let mut error = spawn_err;
+    let mut error = spawn_err.or(early_err);
     // every process ended well, yet the flight side lost samples: the transport failed
     // (e.g. a publisher gave up on a full queue under load), not the mission
     let lost = std::fs::read_to_string(out.join("recorder.json"))

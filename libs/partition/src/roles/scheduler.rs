@@ -81,6 +81,9 @@ pub fn scheduler() -> anyhow::Result<i32> {
             e => e.into(),
         })?;
     eprintln!("scheduler: all {} processes ready", ids.len());
+    // from now on a process that dies is a degraded mode, not a failed start
+    let ready = p.out.join(crate::launcher::ALL_READY);
+    std::fs::write(&ready, "").with_context(|| format!("cannot write {}", ready.display()))?;
     let mut monitor = PeerMonitor::new(&peers);
     monitor.poll(&p.run)?;
     let base = p.schedule.base_period_s;
