@@ -228,13 +228,14 @@ fn check_plant_program(program: &str, base_dir: &Path) -> Result<(), ConfigError
 }
 
 /// The script an interpreter is asked to run: the first argument that is not an option,
-/// when it names a path (contains `/`), must exist relative to the config's directory
+/// when it names a path (contains `/`, no blanks), must exist relative to the config's directory
 /// (where the launcher looks first) or to the working directory.
 fn check_script(who: &str, key: &str, args: &[String], base_dir: &Path) -> Result<(), ConfigError> {
     let Some(script) = args.iter().find(|a| !a.starts_with('-')) else {
         return Ok(());
     };
-    if !script.contains('/') {
+    // a path, not a command line (`sh -c "cmd …"`) nor a value
+    if !script.contains('/') || script.contains(char::is_whitespace) {
         return Ok(());
     }
     let p = Path::new(script);
@@ -350,6 +351,8 @@ mod tests {
             )
         };
         assert!(check_programs(&config(&d.0, &with_args("./partner.py"), ""), &None).is_ok());
+        // a command line is no script path
+        assert!(check_programs(&config(&d.0, &with_args("exec ./gone.py --x"), ""), &None).is_ok());
         let e = check_programs(&config(&d.0, &with_args("./gone.py"), ""), &None)
             .unwrap_err()
             .to_string();
