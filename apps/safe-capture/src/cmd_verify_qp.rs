@@ -12,14 +12,17 @@ use std::process::ExitCode;
 
 /// Checks every hard QP of a `run --dump-qp FILE` (JSON lines) independently of the exact
 /// active-set engine that solved it: feasibility of its solution (the largest row
-/// violation) and its distance to Clarabel's interior-point solution of the same data —
-/// both judged — and, for information, the KKT stationarity residual with multipliers
-/// recomputed by non-negative least squares over the active rows (its accuracy is limited
-/// by how well conditioned the active rows are). Lengths are relative to the filter's
-/// input bound.
+/// violation) and its distance to an exact reference — Clarabel's interior-point solution
+/// of the same data, its active set then solved in exact linear algebra and accepted only
+/// as a KKT point of the whole problem (`sc_cbf::verify::exact_reference`) — both judged.
+/// Where no exact reference is found, the distance to Clarabel's own solution is judged
+/// with its looser tolerance (the count is printed). For information, the KKT
+/// stationarity residual with multipliers recomputed by non-negative least squares over
+/// the rows active at the engine's solution. Lengths are relative to the filter's input
+/// bound.
 ///
-/// Prints per filter: QPs checked, largest relative violation, stationarity residual and
-/// distance to Clarabel, and the step of each largest value.
+/// Prints per filter: QPs checked, largest relative violation, stationarity residual,
+/// distance to the exact reference and to Clarabel, and the step of each largest value.
 ///
 /// Exit codes: 0 every check within the tolerances, 1 a check beyond them, 2 bad
 /// arguments or an unreadable dump.
@@ -31,11 +34,19 @@ pub struct Args {
     /// Largest accepted row violation at the solution, relative to the input bound.
     #[arg(long, value_name = "REL", default_value_t = 1e-9)]
     feasibility_tolerance: f64,
-    /// Largest accepted distance to Clarabel's solution, relative to the input bound (an
-    /// interior-point method at tolerance 1e-11 agrees to about this).
+    /// Largest accepted distance to the exact reference, relative to the input bound.
+    #[arg(long, value_name = "REL", default_value_t = 1e-9)]
+    exact_tolerance: f64,
+    /// Largest accepted distance to Clarabel's solution where no exact reference was
+    /// found, relative to the input bound (an interior-point method at tolerance 1e-11
+    /// agrees to about this).
     #[arg(long, value_name = "REL", default_value_t = 1e-6)]
     clarabel_tolerance: f64,
 }
+
+/// The exact reference must be a KKT point to this (relative to the input bound): rows
+/// hold and the stationarity residual is below it — rounding of a 7 × 64 problem.
+const EXACT_KKT_TOLERANCE: f64 = 1e-11;
 
 /// Rows within this distance of their boundary (relative to the input bound) count as
 /// active when the multipliers are recomputed: the engine keeps a rounding room of this
@@ -56,6 +67,10 @@ struct Worst {
     violation: (f64, u64),
     stationarity: (f64, u64),
     clarabel: (f64, u64),
+    exact: (f64, u64),
+    /// QPs without an exact reference: their distance to Clarabel (judged instead).
+    inexact: usize,
+    inexact_clarabel: (f64, u64),
 }
 
 fn raise(slot: &mut (f64, u64), v: f64, step: u64) {
@@ -77,7 +92,12 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         }
         let u_inf = input_bound(&l.qp, 1.0);
         let m = l.qp.u_nom.len().max(1) as f64;
-        let c = check(&l.qp, u_inf * m.sqrt(), ACTIVE_TOLERANCE * u_inf);
+        let c = check(
+            &l.qp,
+            u_inf * m.sqrt(),
+            ACTIVE_TOLERANCE * u_inf,
+            EXACT_KKT_TOLERANCE * u_inf,
+        );
         let w = worst.entry(l.filter).or_default();
         w.checked += 1;
         raise(&mut w.violation, c.violation / u_inf, l.step);
@@ -86,27 +106,47 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             Some(d) => raise(&mut w.clarabel, d / u_inf, l.step),
             None => w.clarabel_failed += 1,
         }
+        match (c.exact_distance, c.clarabel_distance) {
+            (Some(d), _) => raise(&mut w.exact, d / u_inf, l.step),
+            (None, Some(d)) => {
+                w.inexact += 1;
+                raise(&mut w.inexact_clarabel, d / u_inf, l.step);
+            }
+            (None, None) => {}
+        }
     }
     let mut ok = true;
     for (f, w) in &worst {
         let kkt_ok = w.violation.0 <= a.feasibility_tolerance;
-        let cl_ok = w.clarabel.0 <= a.clarabel_tolerance && w.clarabel_failed == 0;
-        ok &= kkt_ok && cl_ok;
+        let exact_ok = w.exact.0 <= a.exact_tolerance;
+        let cl_ok = w.inexact_clarabel.0 <= a.clarabel_tolerance && w.clarabel_failed == 0;
+        ok &= kkt_ok && exact_ok && cl_ok;
         println!(
-            "{f:<14} {:>6} QPs  violation {:.1e} (step {})  stationarity {:.1e} (step {})  distance to Clarabel {:.1e} (step {}){}  {}",
+            "{f:<14} {:>6} QPs  violation {:.1e} (step {})  stationarity {:.1e} (step {})  distance to exact {:.1e} (step {}) on {}  to Clarabel {:.1e} (step {}){}{}  {}",
             w.checked,
             w.violation.0,
             w.violation.1,
             w.stationarity.0,
             w.stationarity.1,
+            w.exact.0,
+            w.exact.1,
+            w.checked - w.inexact - w.clarabel_failed,
             w.clarabel.0,
             w.clarabel.1,
+            if w.inexact > 0 {
+                format!(
+                    ", no exact reference for {} (to Clarabel {:.1e}, step {})",
+                    w.inexact, w.inexact_clarabel.0, w.inexact_clarabel.1
+                )
+            } else {
+                String::new()
+            },
             if w.clarabel_failed > 0 {
                 format!(", Clarabel failed on {}", w.clarabel_failed)
             } else {
                 String::new()
             },
-            if kkt_ok && cl_ok {
+            if kkt_ok && exact_ok && cl_ok {
                 "ok"
             } else {
                 "BEYOND TOLERANCE"
@@ -114,9 +154,14 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         );
     }
     let total: usize = worst.values().map(|w| w.checked).sum();
+    let exact: usize = worst
+        .values()
+        .map(|w| w.checked - w.inexact - w.clarabel_failed)
+        .sum();
     println!(
-        "verify-qp: {total} solved QPs checked (relative to the input bound: violation <= {:e}, distance to Clarabel <= {:e}): {}",
+        "verify-qp: {total} solved QPs checked, {exact} against an exact reference (relative to the input bound: violation <= {:e}, distance to exact <= {:e}, to Clarabel where none <= {:e}): {}",
         a.feasibility_tolerance,
+        a.exact_tolerance,
         a.clarabel_tolerance,
         if ok { "all within" } else { "NOT all within" }
     );

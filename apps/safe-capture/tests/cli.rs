@@ -529,26 +529,43 @@ fn verify_qp_agrees_with_clarabel_on_the_default_mission_and_catches_a_tampered_
     for f in ["translational", "attitude", "robotic"] {
         assert!(stdout.contains(f), "no {f} QP checked: {stdout}");
     }
-    // move one solved translational command by 1 % of the bound: no longer the optimum
+    // every QP was checked against an exact reference (Clarabel's active set solved
+    // exactly and KKT-verified)
+    let summary = stdout.lines().last().unwrap();
+    let total: &str = summary.split_whitespace().nth(1).unwrap();
+    assert!(
+        summary.contains(&format!(
+            "{total} solved QPs checked, {total} against an exact"
+        )),
+        "{stdout}"
+    );
+    // move one solved translational command by 1 % of the bound, and by ±1e-7 of it (well
+    // inside Clarabel's own tolerance, so only the exact reference sees it): no longer the
+    // optimum
     let text = std::fs::read_to_string(&dump).unwrap();
-    let mut tampered = Vec::new();
-    let mut done = false;
-    for l in text.lines() {
-        let mut j: Value = serde_json::from_str(l).unwrap();
-        if !done && j["filter"] == "translational" && j["qp"]["outcome"] == "Solved" {
-            let x = j["qp"]["solution"][0].as_f64().unwrap();
-            j["qp"]["solution"][0] = serde_json::json!(x + 0.07);
-            done = true;
+    for shift in [0.07, 7e-7, -7e-7] {
+        let mut tampered = Vec::new();
+        let mut done = false;
+        for l in text.lines() {
+            let mut j: Value = serde_json::from_str(l).unwrap();
+            if !done && j["filter"] == "translational" && j["qp"]["outcome"] == "Solved" {
+                let x = j["qp"]["solution"][0].as_f64().unwrap();
+                j["qp"]["solution"][0] = serde_json::json!(x + shift);
+                done = true;
+            }
+            tampered.push(j.to_string());
         }
-        tampered.push(j.to_string());
+        assert!(done, "no solved translational QP in the default mission");
+        let bad = d.join("tampered.jsonl");
+        std::fs::write(&bad, tampered.join("\n") + "\n").unwrap();
+        let v = bin().arg("verify-qp").arg(&bad).output().unwrap();
+        let stdout = String::from_utf8_lossy(&v.stdout).to_string();
+        assert_eq!(v.status.code(), Some(1), "shift {shift}: {stdout}");
+        assert!(
+            stdout.contains("BEYOND TOLERANCE"),
+            "shift {shift}: {stdout}"
+        );
     }
-    assert!(done, "no solved translational QP in the default mission");
-    let bad = d.join("tampered.jsonl");
-    std::fs::write(&bad, tampered.join("\n") + "\n").unwrap();
-    let v = bin().arg("verify-qp").arg(&bad).output().unwrap();
-    let stdout = String::from_utf8_lossy(&v.stdout).to_string();
-    assert_eq!(v.status.code(), Some(1), "{stdout}");
-    assert!(stdout.contains("BEYOND TOLERANCE"), "{stdout}");
     let _ = std::fs::remove_dir_all(&d);
 }
 
@@ -565,6 +582,14 @@ fn verify_qp_agrees_with_clarabel_under_a_random_attack() {
     let robotic = stdout.lines().find(|l| l.starts_with("robotic")).unwrap();
     let n: usize = robotic.split_whitespace().nth(1).unwrap().parse().unwrap();
     assert!(n > 2000, "only {n} robotic QPs solved: {robotic}");
+    let summary = stdout.lines().last().unwrap();
+    let total: &str = summary.split_whitespace().nth(1).unwrap();
+    assert!(
+        summary.contains(&format!(
+            "{total} solved QPs checked, {total} against an exact"
+        )),
+        "{stdout}"
+    );
     let _ = std::fs::remove_dir_all(&d);
 }
 
