@@ -175,6 +175,11 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
                 ClockMode::LockStep
             },
         )?;
+        // every role's program, as the launcher will find it, before any case runs
+        let cfg = sc_partition::PartitionConfig::load(&a.partition_config)?;
+        sc_partition::preflight::check_programs(&cfg, &None).map_err(|e| {
+            anyhow::anyhow!("--partition-config {}: {e}", a.partition_config.display())
+        })?;
         for c in &cases {
             p.check(c)?;
         }

@@ -228,3 +228,53 @@ fn hostile_partner_processes_through_the_partition_are_safe() {
     assert!(left.is_empty(), "left in /dev/shm: {left:?}");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// Through the partition, a role's program that is not there stops the campaign before
+/// any case runs: exit 2, one line naming the role and the fix, no output (issue #16).
+#[test]
+fn a_missing_partition_program_stops_the_campaign_before_any_case() {
+    let Some(py) = python() else { return };
+    let d = tmp("redteam-missing-exec");
+    let cfg = std::fs::read_to_string(root().join("config/partition.toml"))
+        .unwrap()
+        .replace(
+            "scenario = \"scenario.toml\"",
+            &format!(
+                "scenario = \"{}\"",
+                std::path::absolute(root().join("config/scenario.toml"))
+                    .unwrap()
+                    .display()
+            ),
+        )
+        .replace(
+            "exec = \"sc-safety-robotic\"",
+            "exec = \"bin/sc-safety-robotic\"",
+        );
+    assert!(cfg.contains("bin/sc-safety-robotic"));
+    let p = d.join("partition.toml");
+    std::fs::write(&p, cfg).unwrap();
+    let out = d.join("out");
+    let (o, _) = cli_partition(
+        &[
+            "redteam",
+            "--partition",
+            "--python",
+            py.to_str().unwrap(),
+            "--partition-config",
+            p.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{t}");
+    assert_eq!(t.lines().count(), 1, "{t}");
+    assert!(
+        t.starts_with("error: --partition-config ")
+            && t.contains("role `safety_robotic`: the executable")
+            && t.contains("cargo build --release -p sc-partition-apps"),
+        "{t}"
+    );
+    assert!(!out.exists(), "{t}");
+}
