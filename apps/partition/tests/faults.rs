@@ -301,6 +301,13 @@ fn a_role_that_never_joins_is_named() {
     assert!(t0.elapsed() < std::time::Duration::from_secs(60), "{rep:?}");
     let log = std::fs::read_to_string(out.join("logs/scheduler.log")).unwrap();
     assert!(log.contains("never joined: safety_robotic"), "{log}");
+    // and the launch's error (on the terminal, in launch.json) says so at once
+    assert!(
+        rep.error.as_deref().is_some_and(|e| e.starts_with(
+            "role `scheduler` ended (exit code 2) before every process was ready: error: handshake timed out"
+        ) && e.contains("never joined: safety_robotic")),
+        "{rep:?}"
+    );
     assert!(rep.leftovers.is_empty(), "{rep:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }

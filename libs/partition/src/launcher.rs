@@ -422,9 +422,11 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
                     );
                 }
                 let ok = ex.code == Some(0) || (p.role == "recorder" && ex.code == Some(1));
-                if !ok && !termed && p.role != "scheduler" && !out.join(ALL_READY).exists() {
-                    // it can never join the handshake: stop now, naming it, instead of
-                    // letting the scheduler wait for it until the handshake timeout
+                if !ok && !termed && !out.join(ALL_READY).exists() {
+                    // the handshake can never complete (a participant that cannot join,
+                    // or the scheduler itself, e.g. at its handshake timeout naming who
+                    // never joined): stop now, naming it, instead of waiting for the
+                    // scheduler's handshake timeout
                     let log = out.join("logs").join(format!("{}.log", p.role));
                     early_err.get_or_insert_with(|| {
                         format!(
