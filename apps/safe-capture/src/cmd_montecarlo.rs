@@ -3,13 +3,29 @@
 use crate::montecarlo_partition::PartitionExecutor;
 use anyhow::Context;
 use sc_mission::{RunOptions, TelemetryWriter, summarize};
-use sc_montecarlo::{CampaignOptions, CampaignSummary, Executor, InProcess, MonteCarloConfig};
+use sc_montecarlo::interrupt::{EXIT_FORCED, StopOnSignal};
+use sc_montecarlo::{
+    CampaignOptions, CampaignSummary, Execution, Executor, InProcess, MonteCarloConfig,
+};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Partition config of --mode partition unless --partition-config is given.
 const DEFAULT_PARTITION_CONFIG: &str = "config/partition.toml";
+
+/// Runs of a new campaign unless --runs is given.
+const DEFAULT_RUNS: usize = 100;
+
+/// Seed of a new campaign unless --seed is given.
+const DEFAULT_SEED: u64 = 1;
+
+/// Exit code of a campaign stopped by SIGINT/SIGTERM (the completed runs aggregated).
+const EXIT_INTERRUPTED: u8 = 3;
+
+// the exit-code table of `--help` (the doc comment of `Args`) names the code of a second
+// signal as 130
+const _: () = assert!(EXIT_FORCED == 130);
 
 /// Monte Carlo campaign over dispersed initial positions (inside the approach corridor)
 /// and target tumbling rates (config/montecarlo.toml). Runs in parallel in one process,
@@ -20,9 +36,19 @@ const DEFAULT_PARTITION_CONFIG: &str = "config/partition.toml";
 /// Writes to OUT: runs/K/ (scenario.toml, result.json, trace.csv, timing.json per run),
 /// runs.csv, runs_timing.csv, summary.json, report.md, figures/*.svg.
 ///
+/// Ctrl-C (SIGINT) or SIGTERM stops the campaign gracefully: no further run starts, the
+/// runs in flight finish, the completed runs are aggregated and summary.json, report.md
+/// and the last line say "interrupted after K of N runs"; `--resume --out DIR` then runs
+/// the rest (a second signal quits at once; a run is only named runs/K once saved).
+/// Every report records the host's load at the start and end (1-minute load average,
+/// CPUs).
+///
 /// Exit codes (a campaign, and `merge`): 0 every run completed safe and captured, 1 a
 /// run unsafe, not captured or failed (a partition run that could not be launched is a
-/// failed run), 2 bad arguments or configuration (checked before any run starts).
+/// failed run), 2 bad arguments or configuration (checked before any run starts; with
+/// --resume also a DIR that holds another campaign), 3 interrupted by SIGINT/SIGTERM
+/// (the completed runs aggregated; --resume completes the campaign), 130 a second
+/// SIGINT/SIGTERM quit at once.
 #[derive(clap::Args)]
 #[command(args_conflicts_with_subcommands = true)]
 pub struct Args {
@@ -59,12 +85,12 @@ enum Mode {
 
 #[derive(clap::Args)]
 struct RunArgs {
-    /// Runs in the whole campaign.
-    #[arg(long, default_value_t = 100)]
-    runs: usize,
-    /// Campaign seed.
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
+    /// Runs in the whole campaign [default: 100; with --resume the campaign's].
+    #[arg(long)]
+    runs: Option<usize>,
+    /// Campaign seed [default: 1; with --resume the campaign's].
+    #[arg(long)]
+    seed: Option<u64>,
     /// Runs at a time (default: all cores in-process; 1 with --mode partition, where a
     /// run is nine processes).
     #[arg(long, short)]
@@ -72,18 +98,27 @@ struct RunArgs {
     /// Output directory.
     #[arg(long, value_name = "DIR", default_value = "out/montecarlo")]
     out: PathBuf,
-    /// Run only shard i of N (0-based): runs k with k mod N = i.
+    /// Run only shard i of N (0-based): runs k with k mod N = i [with --resume default:
+    /// the campaign's].
     #[arg(long, value_name = "i/N")]
     shard: Option<String>,
-    /// Base scenario to disperse.
-    #[arg(long, value_name = "FILE", default_value_os_t = crate::default_scenario())]
-    scenario: PathBuf,
-    /// Dispersion configuration.
-    #[arg(long, value_name = "FILE", default_value = sc_montecarlo::DEFAULT_CONFIG)]
-    config: PathBuf,
-    /// Where the runs execute.
-    #[arg(long, value_enum, default_value_t = Mode::InProcess)]
-    mode: Mode,
+    /// Base scenario to disperse [default: config/scenario.toml; with --resume the
+    /// campaign's base_scenario.toml].
+    #[arg(long, value_name = "FILE")]
+    scenario: Option<PathBuf>,
+    /// Dispersion configuration [default: config/montecarlo.toml; with --resume the
+    /// campaign's].
+    #[arg(long, value_name = "FILE")]
+    config: Option<PathBuf>,
+    /// Where the runs execute [default: in-process; with --resume the campaign's].
+    #[arg(long, value_enum)]
+    mode: Option<Mode>,
+    /// Complete the interrupted campaign in --out: its complete runs that verify against
+    /// their re-derivation (seed, dispersion, scenario) are kept, the others run, and the
+    /// outputs cover the whole campaign. Options not given are the campaign's; one that
+    /// differs from it is refused (exit 2).
+    #[arg(long)]
+    resume: bool,
     /// With --mode partition: the partition config (schedule, deadlines, executables;
     /// default config/partition.toml). Each run replaces its scenario and runs lock-step
     /// to the end of the mission.
@@ -137,8 +172,64 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     }
 }
 
+/// The campaign's parameters: given, else with --resume those of the campaign in --out,
+/// else the defaults.
+struct Params {
+    runs: usize,
+    seed: u64,
+    shard: Option<(usize, usize)>,
+    scenario: PathBuf,
+    config: MonteCarloConfig,
+    mode: Mode,
+}
+
+fn params(a: &RunArgs) -> anyhow::Result<Params> {
+    let shard = a
+        .shard
+        .as_deref()
+        .map(sc_montecarlo::parse_shard)
+        .transpose()
+        .map_err(anyhow::Error::msg)?;
+    let config = a
+        .config
+        .as_deref()
+        .map(MonteCarloConfig::load)
+        .transpose()?;
+    if !a.resume {
+        return Ok(Params {
+            runs: a.runs.unwrap_or(DEFAULT_RUNS),
+            seed: a.seed.unwrap_or(DEFAULT_SEED),
+            shard,
+            scenario: a.scenario.clone().unwrap_or_else(crate::default_scenario),
+            config: match config {
+                Some(c) => c,
+                None => {
+                    MonteCarloConfig::load(std::path::Path::new(sc_montecarlo::DEFAULT_CONFIG))?
+                }
+            },
+            mode: a.mode.unwrap_or(Mode::InProcess),
+        });
+    }
+    let info = sc_montecarlo::campaign_info(&a.out).context("--resume")?;
+    Ok(Params {
+        runs: a.runs.unwrap_or(info.runs),
+        seed: a.seed.unwrap_or(info.seed),
+        shard: shard.or(info.shard.map(|[i, n]| (i, n))),
+        scenario: a
+            .scenario
+            .clone()
+            .unwrap_or_else(|| a.out.join("base_scenario.toml")),
+        config: config.unwrap_or(info.config),
+        mode: a.mode.unwrap_or(match info.execution {
+            Execution::InProcess => Mode::InProcess,
+            Execution::Partition => Mode::Partition,
+        }),
+    })
+}
+
 fn campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
-    if a.mode == Mode::InProcess {
+    let p = params(&a)?;
+    if p.mode == Mode::InProcess {
         if a.partition_config.is_some() {
             anyhow::bail!("--partition-config needs --mode partition");
         }
@@ -146,13 +237,6 @@ fn campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
             anyhow::bail!("--keep-recordings needs --mode partition");
         }
     }
-    let config = MonteCarloConfig::load(&a.config)?;
-    let shard = a
-        .shard
-        .as_deref()
-        .map(sc_montecarlo::parse_shard)
-        .transpose()
-        .map_err(anyhow::Error::msg)?;
     let mut inject = a.inject_panic.clone();
     if let Ok(v) = std::env::var("SC_MONTECARLO_INJECT_PANIC") {
         for k in v.split(',').filter(|s| !s.trim().is_empty()) {
@@ -165,18 +249,22 @@ fn campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
         // keep the injected panics' messages off the progress bar; they are recorded
         std::panic::set_hook(Box::new(|_| {}));
     }
-    let jobs = a.jobs.unwrap_or_else(|| match a.mode {
+    let jobs = a.jobs.unwrap_or_else(|| match p.mode {
         Mode::InProcess => std::thread::available_parallelism().map_or(1, |n| n.get()),
         Mode::Partition => 1,
     });
-    let executor: Box<dyn Executor> = match a.mode {
-        Mode::InProcess => Box::new(InProcess),
+    let executor: Box<dyn Executor> = match p.mode {
+        Mode::InProcess => {
+            // the partition's launcher handles the signals of --mode partition itself
+            sc_montecarlo::interrupt::install().map_err(anyhow::Error::msg)?;
+            Box::new(StopOnSignal(InProcess))
+        }
         Mode::Partition => {
             let config = a
                 .partition_config
                 .clone()
                 .unwrap_or_else(|| PathBuf::from(DEFAULT_PARTITION_CONFIG));
-            let (executor, note) = PartitionExecutor::new(&config, a.keep_recordings, &a.scenario)?;
+            let (executor, note) = PartitionExecutor::new(&config, a.keep_recordings, &p.scenario)?;
             if let Some(n) = note {
                 eprintln!("{n}");
             }
@@ -184,15 +272,16 @@ fn campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
         }
     };
     let opts = CampaignOptions {
-        scenario: a.scenario,
-        config,
-        runs: a.runs,
-        seed: a.seed,
+        scenario: p.scenario,
+        config: p.config,
+        runs: p.runs,
+        seed: p.seed,
         jobs,
-        shard,
+        shard: p.shard,
         out: a.out.clone(),
         inject_panic: inject,
         progress: !a.quiet,
+        resume: a.resume,
     };
     let s = sc_montecarlo::run_campaign_with(&opts, executor.as_ref())?;
     Ok(report(&s, &a.out))
@@ -234,6 +323,15 @@ fn report(s: &CampaignSummary, out: &std::path::Path) -> ExitCode {
     }
     if !s.not_captured_runs.is_empty() {
         println!("  runs without capture: {:?}", s.not_captured_runs);
+    }
+    if let Some(i) = &s.interrupted {
+        println!(
+            "  interrupted after {} of {} runs: only those are aggregated; `safe-capture montecarlo --resume --out {}` runs the rest",
+            i.completed_runs,
+            i.planned_runs,
+            out.display()
+        );
+        return ExitCode::from(EXIT_INTERRUPTED);
     }
     if s.failed_runs == 0 && s.safe_runs == s.runs && s.captured_runs == s.runs {
         ExitCode::SUCCESS

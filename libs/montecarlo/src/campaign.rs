@@ -11,6 +11,7 @@
 //! runs/K/result.json   seed, dispersion, metrics or failure of run K     (deterministic)
 //! runs/K/trace.csv     decimated trajectory for the figures              (deterministic)
 //! runs/K/timing.json   solve-time statistics and histograms             (wall clock)
+//! runs/K.partial/      a run being written (renamed to runs/K once saved; ignored)
 //! runs.csv             one row per run                                   (deterministic)
 //! runs_timing.csv      per-run solve-time geomean and max per filter     (wall clock)
 //! summary.json         counts, worst barriers, ranges; solve_time_us and wall_time_s are wall clock
@@ -19,14 +20,19 @@
 //! ```
 //!
 //! Everything is (re)built from the files by [`aggregate`], so an unsharded campaign and
-//! the merge of its shards produce byte-identical deterministic files.
+//! the merge of its shards produce byte-identical deterministic files. A run's directory
+//! gets its name `runs/K` only once its files are written, so an interrupted or killed
+//! campaign leaves no run that looks complete and is not; `--resume`
+//! ([`CampaignOptions::resume`]) verifies the complete runs against their re-derivation,
+//! runs the others, and the result equals the uninterrupted campaign's.
 
 use crate::config::MonteCarloConfig;
 use crate::hist::LogHistogram;
+use crate::host::{HostLoad, HostSample};
 use crate::run::{
     self, CPU_TIMERS, CampaignBase, Execution, Executor, RunResult, RunTiming, TIMERS,
 };
-use crate::sample::{run_seed, sample};
+use crate::sample::{Dispersion, run_seed, sample};
 use rayon::prelude::*;
 use sc_mission::summary::TimeStats;
 use sc_mission::{MissionEnd, Setup, StepRecord};
@@ -103,6 +109,11 @@ pub struct CampaignOptions {
     pub inject_panic: Vec<usize>,
     /// Show the progress bar on stderr.
     pub progress: bool,
+    /// Complete the (interrupted) campaign already in `out` instead of starting anew:
+    /// its runs that are complete and verified are kept, the others run. Refused when
+    /// `out` holds another campaign (seed, runs, shard, config, base scenario, URDF or
+    /// execution differ).
+    pub resume: bool,
 }
 
 /// Parses `i/N` (0 ≤ i < N).
@@ -186,9 +197,23 @@ pub struct Failure {
     pub error: String,
 }
 
+/// A campaign that stopped early (Ctrl-C): its summary covers the completed runs only.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Interruption {
+    /// Runs completed and aggregated.
+    pub completed_runs: usize,
+    /// Runs of the campaign (of the shard, if it is one).
+    pub planned_runs: usize,
+}
+
 /// `summary.json` of a campaign.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CampaignSummary {
+    /// The program's version and git commit (`sc_mission::build`).
+    #[serde(default)]
+    pub version: String,
+    #[serde(default)]
+    pub git_commit: String,
     /// Runs in this directory.
     pub runs: usize,
     /// Runs of the whole campaign and the shard, if this is one.
@@ -221,8 +246,28 @@ pub struct CampaignSummary {
     /// Thread CPU time: filter → statistics over every step of every run [µs].
     #[serde(default)]
     pub solve_cpu_us: BTreeMap<String, TimeStats>,
-    /// Wall clock: the campaign's wall time (merged: sum over the shards) [s].
+    /// Wall clock: the campaign's wall time (merged: sum over the shards; resumed: sum
+    /// over the interrupted campaign and its resumes) [s].
     pub wall_time_s: f64,
+    /// The host's load at the start and end of each session that ran runs (one for a
+    /// campaign; one per shard of a merge; the interrupted campaign's, then each
+    /// resume's). Wall-clock maxima are inflated when the load exceeds the CPUs.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub host_load: Vec<HostLoad>,
+    /// Present when the campaign stopped early (Ctrl-C): completed of planned runs.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub interrupted: Option<Interruption>,
+}
+
+/// What a summary records beside the runs: the wall time and host load of the sessions
+/// that ran them, and whether the campaign stopped early.
+#[derive(Debug, Clone, Default)]
+pub struct Sessions {
+    /// Wall time of every session together [s].
+    pub wall_time_s: f64,
+    pub host_load: Vec<HostLoad>,
+    /// `Some(planned runs)` when the campaign stopped before completing them.
+    pub interrupted_of: Option<usize>,
 }
 
 /// Keys of [`CampaignSummary::trend_with_tumble_rate`]: the grasping phase's peak
@@ -232,7 +277,8 @@ pub const TREND_TORQUE_RMS: &str = "joint_torque_norm_rms_grasp_nm";
 pub const TREND_TORQUE_PEAK: &str = "joint_torque_norm_peak_grasp_nm";
 
 /// Keys of [`CampaignSummary`] that depend on the wall clock.
-pub const WALL_CLOCK_KEYS: [&str; 3] = ["solve_time_us", "solve_cpu_us", "wall_time_s"];
+pub const WALL_CLOCK_KEYS: [&str; 4] =
+    ["solve_time_us", "solve_cpu_us", "wall_time_s", "host_load"];
 
 /// Files of a campaign directory that depend on the wall clock (everything else is
 /// byte-identical between a campaign and the merge of its shards; in `summary.json` only
@@ -246,8 +292,15 @@ fn load_base(scenario: &Path, config: &MonteCarloConfig) -> Result<Setup, McErro
     Ok(setup)
 }
 
+/// What [`aggregate`] writes into a campaign directory besides the figures: removed with
+/// an old campaign's runs, so that they never describe runs of another campaign.
+const AGGREGATE_FILES: [&str; 4] = ["summary.json", "report.md", "runs.csv", "runs_timing.csv"];
+
+/// Suffix of a run's directory while it is being written (`runs/K.partial`).
+const PARTIAL_SUFFIX: &str = ".partial";
+
 /// Creates `out` for a new campaign: refuses a non-empty directory that is not a campaign,
-/// clears the runs and figures of an old one.
+/// clears the runs, figures and aggregated files of an old one.
 fn prepare_out(out: &Path) -> Result<(), McError> {
     if out.exists() {
         let empty = std::fs::read_dir(out).map_err(io(out))?.next().is_none();
@@ -263,19 +316,100 @@ fn prepare_out(out: &Path) -> Result<(), McError> {
                 std::fs::remove_dir_all(&p).map_err(io(&p))?;
             }
         }
+        for f in AGGREGATE_FILES {
+            let p = out.join(f);
+            if p.is_file() {
+                std::fs::remove_file(&p).map_err(io(&p))?;
+            }
+        }
     }
     std::fs::create_dir_all(out.join("runs")).map_err(io(out))
 }
 
-/// Writes the campaign's base files into `out` and returns the base every run shares.
-fn write_base(out: &Path, setup: &Setup, info: &CampaignInfo) -> Result<CampaignBase, McError> {
+/// The URDF's bytes and the text of `base_scenario.toml` a campaign of `setup` saves.
+fn base_files(setup: &Setup, info: &CampaignInfo) -> Result<(Vec<u8>, String), McError> {
     let urdf = setup.scenario.urdf_path();
     let urdf_bytes = std::fs::read(&urdf).map_err(io(&urdf))?;
-    write(&out.join(&info.urdf), urdf_bytes)?;
     let mut base = setup.scenario.clone();
     base.servicer.urdf = PathBuf::from(&info.urdf);
-    let text = base.to_toml_string();
-    write(&out.join("base_scenario.toml"), &text)?;
+    Ok((urdf_bytes, base.to_toml_string()))
+}
+
+/// Reads `campaign.json` of the campaign in `dir`.
+pub fn campaign_info(dir: &Path) -> Result<CampaignInfo, McError> {
+    let p = dir.join("campaign.json");
+    if !p.is_file() {
+        return Err(McError::Invalid(format!(
+            "{} holds no campaign (no campaign.json)",
+            dir.display()
+        )));
+    }
+    json(&p)
+}
+
+/// Refuses to resume the campaign in `out` with another campaign's parameters; one line
+/// naming every difference.
+fn check_resume(
+    out: &Path,
+    info: &CampaignInfo,
+    urdf: &[u8],
+    base_text: &str,
+) -> Result<(), McError> {
+    let saved = campaign_info(out).map_err(|e| McError::Invalid(format!("--resume: {e}")))?;
+    let shard = |s: Option<[usize; 2]>| s.map_or("none".into(), |[i, n]| format!("{i}/{n}"));
+    let mut diff = Vec::new();
+    if saved.seed != info.seed {
+        diff.push(format!("seed {} (not {})", saved.seed, info.seed));
+    }
+    if saved.runs != info.runs {
+        diff.push(format!("{} runs (not {})", saved.runs, info.runs));
+    }
+    if saved.shard != info.shard {
+        diff.push(format!(
+            "shard {} (not {})",
+            shard(saved.shard),
+            shard(info.shard)
+        ));
+    }
+    if saved.config != info.config {
+        diff.push("another dispersion config".into());
+    }
+    if saved.execution != info.execution {
+        diff.push(format!(
+            "execution {:?} (not {:?})",
+            saved.execution, info.execution
+        ));
+    }
+    let saved_urdf = std::fs::read(out.join(&saved.urdf)).ok();
+    if saved.urdf != info.urdf || saved_urdf.as_deref() != Some(urdf) {
+        diff.push("another servicer URDF".into());
+    }
+    if std::fs::read_to_string(out.join("base_scenario.toml"))
+        .ok()
+        .as_deref()
+        != Some(base_text)
+    {
+        diff.push("another base scenario".into());
+    }
+    if diff.is_empty() {
+        return Ok(());
+    }
+    Err(McError::Invalid(format!(
+        "--resume: {} holds another campaign: {}; resume it with its own parameters (omitted ones are taken from its campaign.json) or choose another --out",
+        out.display(),
+        diff.join(", ")
+    )))
+}
+
+/// Writes the campaign's base files into `out` and returns the base every run shares.
+fn write_base(
+    out: &Path,
+    info: &CampaignInfo,
+    urdf_bytes: &[u8],
+    text: &str,
+) -> Result<CampaignBase, McError> {
+    write(&out.join(&info.urdf), urdf_bytes)?;
+    write(&out.join("base_scenario.toml"), text)?;
     let cfg = toml::to_string(&info.config).map_err(|e| McError::Invalid(e.to_string()))?;
     write(&out.join("montecarlo.toml"), cfg)?;
     let info_json =
@@ -307,26 +441,137 @@ fn run_dir(dir: &Path, k: usize) -> PathBuf {
     dir.join("runs").join(k.to_string())
 }
 
+/// Where run `k` is written before it gets its name [`run_dir`].
+fn partial_dir(dir: &Path, k: usize) -> PathBuf {
+    dir.join("runs").join(format!("{k}{PARTIAL_SUFFIX}"))
+}
+
+/// Run `k`'s seed and, unless sampling fails, its dispersion and the text of its
+/// dispersed scenario, re-derived from the campaign.
+fn derive_run(base: &CampaignBase, k: usize) -> (u64, Result<(Dispersion, String), String>) {
+    let seed = run_seed(base.seed, k);
+    let derived = sample(&base.config, &base.scenario, seed)
+        .map(|d| (d, run::run_scenario(base, &d).to_toml_string()));
+    (seed, derived)
+}
+
+/// Checks the saved run `k` of the campaign in `dir` without running it: `result.json`
+/// names run k with its derived seed, the dispersion and `scenario.toml` are the
+/// re-derived ones, and the trace and the timing of a completed run read back.
+fn verify_saved_run(base: &CampaignBase, dir: &Path, k: usize) -> Result<(), String> {
+    let d = run_dir(dir, k);
+    let result: RunResult = json(&d.join("result.json")).map_err(|e| e.to_string())?;
+    let (seed, derived) = derive_run(base, k);
+    if result.run != k || result.seed != seed {
+        return Err(format!(
+            "result.json holds run {} with seed {}, not run {k} with seed {seed}",
+            result.run, result.seed
+        ));
+    }
+    match derived {
+        Ok((disp, text)) => {
+            if result.dispersion != Some(disp) {
+                return Err("the saved dispersion differs from the re-derived one".into());
+            }
+            if read(&d.join("scenario.toml")).map_err(|e| e.to_string())? != text {
+                return Err("scenario.toml differs from the re-derived dispersed scenario".into());
+            }
+        }
+        Err(e) => {
+            if !result.failed() || result.dispersion.is_some() {
+                return Err(format!(
+                    "sampling fails ({e}) but the saved run has a dispersion"
+                ));
+            }
+        }
+    }
+    let tp = d.join("trace.csv");
+    if tp.is_file() {
+        run::parse_trace(&read(&tp).map_err(|e| e.to_string())?)
+            .map_err(|e| format!("{}: {e}", tp.display()))?;
+    }
+    if !result.failed() {
+        json::<RunTiming>(&d.join("timing.json")).map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
+
+/// Prepares a resume of the campaign in `out`: removes the runs being written when it
+/// stopped, keeps the complete runs of `indices` that verify ([`verify_saved_run`]; the
+/// others are removed, with a note on stderr) and returns the runs still to do.
+fn runs_to_resume(
+    out: &Path,
+    base: &CampaignBase,
+    indices: &[usize],
+) -> Result<Vec<usize>, McError> {
+    let runs = out.join("runs");
+    std::fs::create_dir_all(&runs).map_err(io(&runs))?;
+    for e in std::fs::read_dir(&runs).map_err(io(&runs))? {
+        let p = e.map_err(io(&runs))?.path();
+        if p.is_dir()
+            && p.file_name()
+                .is_some_and(|n| n.to_string_lossy().ends_with(PARTIAL_SUFFIX))
+        {
+            std::fs::remove_dir_all(&p).map_err(io(&p))?;
+        }
+    }
+    let mut todo = Vec::new();
+    for &k in indices {
+        let d = run_dir(out, k);
+        if !d.exists() {
+            todo.push(k);
+            continue;
+        }
+        if let Err(why) = verify_saved_run(base, out, k) {
+            eprintln!(
+                "resume: run {k} in {} does not verify ({why}); running it again",
+                d.display()
+            );
+            std::fs::remove_dir_all(&d).map_err(io(&d))?;
+            todo.push(k);
+        }
+    }
+    Ok(todo)
+}
+
+/// Wall time and host load of the earlier sessions of the campaign in `dir`, from its
+/// `summary.json` (none if it has none).
+fn earlier_sessions(dir: &Path) -> (f64, Vec<HostLoad>) {
+    let Ok(v) = json::<serde_json::Value>(&dir.join("summary.json")) else {
+        return (0.0, Vec::new());
+    };
+    let wall = v.get("wall_time_s").and_then(|w| w.as_f64()).unwrap_or(0.0);
+    let load = v
+        .get("host_load")
+        .cloned()
+        .and_then(|l| serde_json::from_value(l).ok())
+        .unwrap_or_default();
+    (wall, load)
+}
+
 /// Runs a campaign (or one shard) in this process into `opts.out` and aggregates it.
 pub fn run_campaign(opts: &CampaignOptions) -> Result<CampaignSummary, McError> {
     run_campaign_with(opts, &run::InProcess)
 }
 
 /// [`run_campaign`] with every run's mission executed by `executor` (on `opts.jobs`
-/// threads). If the executor stops (Ctrl-C), no further run starts, the runs completed
-/// so far are aggregated and the result is an error saying so.
+/// threads). If the executor stops (Ctrl-C), no further run starts, the runs in flight
+/// finish (a run the executor cut short leaves no trace), and the completed runs are
+/// aggregated into a summary that says the campaign was interrupted
+/// ([`CampaignSummary::interrupted`]). Every run is written into `runs/K.partial` and
+/// renamed to `runs/K` once saved.
 pub fn run_campaign_with(
     opts: &CampaignOptions,
     executor: &dyn Executor,
 ) -> Result<CampaignSummary, McError> {
     let started = std::time::Instant::now();
+    let host_start = HostSample::now();
     let setup = load_base(&opts.scenario, &opts.config)?;
     if opts.jobs == 0 {
         return Err(McError::Invalid(
             "--jobs 0: need at least one thread".into(),
         ));
     }
-    prepare_out(&opts.out)?;
     let urdf = setup
         .scenario
         .urdf_path()
@@ -341,10 +586,20 @@ pub fn run_campaign_with(
         config: opts.config.clone(),
         execution: executor.execution(),
     };
-    let base = write_base(&opts.out, &setup, &info)?;
+    let (urdf_bytes, base_text) = base_files(&setup, &info)?;
     let indices = shard_runs(opts.runs, opts.shard);
+    let (base, todo, (earlier_wall, mut host_load)) = if opts.resume {
+        check_resume(&opts.out, &info, &urdf_bytes, &base_text)?;
+        let base = load_campaign_base(&opts.out)?;
+        let todo = runs_to_resume(&opts.out, &base, &indices)?;
+        (base, todo, earlier_sessions(&opts.out))
+    } else {
+        prepare_out(&opts.out)?;
+        let base = write_base(&opts.out, &info, &urdf_bytes, &base_text)?;
+        (base, indices.clone(), (0.0, Vec::new()))
+    };
     let bar = if opts.progress {
-        indicatif::ProgressBar::new(indices.len() as u64)
+        indicatif::ProgressBar::new(todo.len() as u64)
     } else {
         indicatif::ProgressBar::hidden()
     };
@@ -362,23 +617,37 @@ pub fn run_campaign_with(
         .build()
         .map_err(|e| McError::Invalid(format!("cannot start {} threads: {e}", opts.jobs)))?;
     let save_errors: Vec<McError> = pool.install(|| {
-        indices
-            .par_iter()
+        todo.par_iter()
             .filter_map(|&k| {
                 if executor.stopped() {
                     return None;
                 }
-                let dir = run_dir(&opts.out, k);
+                let (dir, partial) = (run_dir(&opts.out, k), partial_dir(&opts.out, k));
+                if partial.exists()
+                    && let Err(e) = std::fs::remove_dir_all(&partial)
+                {
+                    return Some(io(&partial)(e));
+                }
                 let inject = opts.inject_panic.contains(&k);
-                let out = run::execute_with(&base, k, &dir, inject, executor);
+                let out = run::execute_with(&base, k, &partial, inject, executor);
                 if out.result.failed() && executor.stopped() {
                     // cut short, not a result of the run: leave no trace of it
-                    return std::fs::remove_dir_all(&dir).map_err(io(&dir)).err();
+                    return partial
+                        .exists()
+                        .then(|| {
+                            std::fs::remove_dir_all(&partial)
+                                .map_err(io(&partial))
+                                .err()
+                        })
+                        .flatten();
                 }
                 if out.result.failed() {
                     failed.fetch_add(1, Ordering::Relaxed);
                 }
-                let saved = run::save(&out, &dir).map_err(io(&dir)).err();
+                let saved = run::save(&out, &partial)
+                    .map_err(io(&partial))
+                    .and_then(|_| std::fs::rename(&partial, &dir).map_err(io(&dir)))
+                    .err();
                 bar.inc(1);
                 bar.set_message(format!("{} failed", failed.load(Ordering::Relaxed)));
                 saved
@@ -389,16 +658,34 @@ pub fn run_campaign_with(
     if let Some(e) = save_errors.into_iter().next() {
         return Err(e);
     }
-    let s = aggregate(&opts.out, started.elapsed().as_secs_f64())?;
-    if executor.stopped() {
-        return Err(McError::Invalid(format!(
-            "interrupted: {} of {} runs completed, aggregated in {}",
-            s.runs,
-            indices.len(),
-            opts.out.display()
-        )));
-    }
-    Ok(s)
+    let stopped = executor.stopped();
+    let wall = if todo.is_empty() {
+        // nothing ran: the campaign's time and load stay those of its earlier sessions
+        earlier_wall
+    } else {
+        host_load.push(HostLoad {
+            start: host_start,
+            end: HostSample::now(),
+        });
+        earlier_wall + started.elapsed().as_secs_f64()
+    };
+    let complete = count_runs(&opts.out, &indices);
+    aggregate(
+        &opts.out,
+        &Sessions {
+            wall_time_s: wall,
+            host_load,
+            interrupted_of: (stopped && complete < indices.len()).then_some(indices.len()),
+        },
+    )
+}
+
+/// How many of the runs `indices` have their directory in the campaign `dir`.
+fn count_runs(dir: &Path, indices: &[usize]) -> usize {
+    indices
+        .iter()
+        .filter(|k| run_dir(dir, **k).is_dir())
+        .count()
 }
 
 /// One run as read back from its directory.
@@ -579,8 +866,9 @@ fn runs_timing_csv(loaded: &[Loaded]) -> String {
 }
 
 /// (Re)builds runs.csv, runs_timing.csv, summary.json, report.md and the figures of the
-/// campaign directory `dir` from its run directories.
-pub fn aggregate(dir: &Path, wall_time_s: f64) -> Result<CampaignSummary, McError> {
+/// campaign directory `dir` from its run directories; `sessions` gives what the summary
+/// records beside the runs.
+pub fn aggregate(dir: &Path, sessions: &Sessions) -> Result<CampaignSummary, McError> {
     let info: CampaignInfo = json(&dir.join("campaign.json"))?;
     let base = read(&dir.join("base_scenario.toml"))?;
     let scenario = Scenario::from_toml_str(&base, dir).map_err(|e| {
@@ -625,7 +913,10 @@ pub fn aggregate(dir: &Path, wall_time_s: f64) -> Result<CampaignSummary, McErro
     let mut rms = SpreadAcc::default();
     let mut capture = SpreadAcc::default();
     let mut hist: BTreeMap<String, LogHistogram> = BTreeMap::new();
+    let build = sc_mission::build::current();
     let mut s = CampaignSummary {
+        version: build.version,
+        git_commit: build.git_commit,
         runs: loaded.len(),
         campaign_runs: info.runs,
         shard: info.shard,
@@ -645,7 +936,12 @@ pub fn aggregate(dir: &Path, wall_time_s: f64) -> Result<CampaignSummary, McErro
         trend_with_tumble_rate: BTreeMap::new(),
         solve_time_us: BTreeMap::new(),
         solve_cpu_us: BTreeMap::new(),
-        wall_time_s,
+        wall_time_s: sessions.wall_time_s,
+        host_load: sessions.host_load.clone(),
+        interrupted: sessions.interrupted_of.map(|planned| Interruption {
+            completed_runs: loaded.len(),
+            planned_runs: planned,
+        }),
     };
     let mut traces = Vec::new();
     let mut points = Vec::new();
@@ -870,7 +1166,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<CampaignSummary, McError> {
     let text = serde_json::to_string_pretty(&info).map_err(|e| McError::Invalid(e.to_string()))?;
     write(&out.join("campaign.json"), text + "\n")?;
     let mut seen: BTreeMap<usize, PathBuf> = BTreeMap::new();
-    let mut wall = 0.0;
+    let mut sessions = Sessions::default();
     for d in dirs {
         let runs = d.join("runs");
         for e in std::fs::read_dir(&runs).map_err(io(&runs))? {
@@ -895,12 +1191,9 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<CampaignSummary, McError> {
             copy_dir(&e.path(), &run_dir(out, k), false)?;
             seen.insert(k, d.clone());
         }
-        if let Ok(sum) = json::<serde_json::Value>(&d.join("summary.json")) {
-            wall += sum
-                .get("wall_time_s")
-                .and_then(|v| v.as_f64())
-                .unwrap_or(0.0);
-        }
+        let (wall, load) = earlier_sessions(d);
+        sessions.wall_time_s += wall;
+        sessions.host_load.extend(load);
     }
     let missing: Vec<String> = (0..info.runs)
         .filter(|k| !seen.contains_key(k))
@@ -915,7 +1208,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<CampaignSummary, McError> {
             shown.join(", ")
         )));
     }
-    aggregate(out, wall)
+    aggregate(out, &sessions)
 }
 
 /// A rerun of one run and how it compares with the saved one.
@@ -951,12 +1244,11 @@ pub fn rerun(dir: &Path, k: usize) -> Result<Rerun, McError> {
     let saved_text = read(&saved_path)?;
     let saved: RunResult = json(&saved_path)?;
     let mut differences = Vec::new();
-    let seed = run_seed(base.seed, k);
+    let (seed, derived) = derive_run(&base, k);
     if seed != saved.seed {
         differences.push(format!("seed: saved {}, derived {seed}", saved.seed));
     }
-    let d = sample(&base.config, &base.scenario, seed).map_err(McError::Invalid)?;
-    let text = run::run_scenario(&base, &d).to_toml_string();
+    let (d, text) = derived.map_err(McError::Invalid)?;
     let saved_scenario = read(&rd.join("scenario.toml"))?;
     if text != saved_scenario {
         differences

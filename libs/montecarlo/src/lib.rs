@@ -10,19 +10,25 @@
 //! * [`campaign`] — run a campaign or a shard in parallel (rayon, `--jobs` threads, an
 //!   indicatif progress bar), aggregate, merge shards, rerun one run.
 //! * [`report`] — the Markdown report beside the paper's numbers.
+//! * [`interrupt`] — graceful stop on SIGINT/SIGTERM (the runs in flight finish, the
+//!   completed ones are aggregated; `--resume` completes the campaign).
+//! * [`host`] — the host's load at the start and end of a campaign (in the summary).
 //! * [`trend`] — correlation of a result with a dispersed parameter (Pearson, Spearman).
 
 pub mod campaign;
 pub mod config;
 pub mod hist;
+pub mod host;
+pub mod interrupt;
 pub mod report;
 pub mod run;
 pub mod sample;
 pub mod trend;
 
 pub use campaign::{
-    CampaignInfo, CampaignOptions, CampaignSummary, McError, WALL_CLOCK_FILES, WALL_CLOCK_KEYS,
-    aggregate, merge, parse_shard, rerun, run_campaign, run_campaign_with, shard_runs,
+    CampaignInfo, CampaignOptions, CampaignSummary, Interruption, McError, Sessions,
+    WALL_CLOCK_FILES, WALL_CLOCK_KEYS, aggregate, campaign_info, merge, parse_shard, rerun,
+    run_campaign, run_campaign_with, shard_runs,
 };
 pub use config::{ConfigError, DEFAULT_CONFIG, MonteCarloConfig};
 pub use run::{Execution, Executor, InProcess, RunResult};

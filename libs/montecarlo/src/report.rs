@@ -25,6 +25,40 @@ fn spread(s: Option<&Spread>, digits: usize) -> String {
     }
 }
 
+/// One sentence on the host's load during each session, and why it matters.
+fn host_load(load: &[crate::host::HostLoad]) -> String {
+    let sample = |h: &crate::host::HostSample| {
+        format!(
+            "{} on {} CPUs",
+            h.load_avg_1min
+                .map_or("unknown".into(), |l| format!("{l:.2}")),
+            h.cpus
+        )
+    };
+    let sessions: Vec<String> = load
+        .iter()
+        .map(|l| {
+            format!(
+                "{} at the start, {} at the end",
+                sample(&l.start),
+                sample(&l.end)
+            )
+        })
+        .collect();
+    let which = if load.len() == 1 {
+        String::new()
+    } else {
+        format!(
+            " ({} sessions: shards, or an interrupted campaign and its resumes)",
+            load.len()
+        )
+    };
+    format!(
+        "Host load (1-minute load average){which}: {}. Wall-clock maxima (solve times, wall time) are inflated under load: when the load exceeds the CPUs, threads wait for a CPU and that wait counts in them (the thread CPU times do not).",
+        sessions.join("; ")
+    )
+}
+
 /// The Markdown report.
 pub fn report(
     s: &CampaignSummary,
@@ -44,6 +78,16 @@ pub fn report(
         "{} runs (campaign of {}{shard}, seed {}), wall time {:.1} s.\n",
         s.runs, s.campaign_runs, s.seed, s.wall_time_s
     );
+    if let Some(i) = &s.interrupted {
+        let _ = writeln!(
+            o,
+            "**Interrupted** (SIGINT/SIGTERM) after {} of {} runs: only the runs that finished are aggregated here; `safe-capture montecarlo --resume` with the same `--out` runs the rest and completes this report.\n",
+            i.completed_runs, i.planned_runs
+        );
+    }
+    if !s.host_load.is_empty() {
+        let _ = writeln!(o, "{}\n", host_load(&s.host_load));
+    }
     if execution == crate::run::Execution::Partition {
         let _ = writeln!(
             o,

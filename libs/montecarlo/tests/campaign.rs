@@ -53,6 +53,7 @@ fn options(scenario: PathBuf, out: PathBuf, runs: usize) -> CampaignOptions {
         out,
         inject_panic: Vec::new(),
         progress: false,
+        resume: false,
     }
 }
 
@@ -425,37 +426,116 @@ fn runs_rebuilt_from_telemetry_give_the_in_process_results() {
 }
 
 /// A stopped executor (Ctrl-C): no further run starts, the run cut short leaves no
-/// trace, the completed ones are aggregated, and the campaign says it was interrupted.
+/// trace, the completed ones are aggregated, and the summary says the campaign was
+/// interrupted. `resume` then completes it: the kept runs are verified, a run left
+/// half-written (`K.partial`) or one that does not verify runs again, and the result
+/// equals the uninterrupted campaign's.
 #[test]
-fn a_stopped_campaign_keeps_only_completed_runs() {
+fn a_stopped_campaign_keeps_only_completed_runs_and_resumes() {
     let base = tmp("stopped");
     let sc = short_scenario(&base, 1.0);
-    let mut o = options(sc, base.join("c"), 4);
+    let mut o = options(sc.clone(), base.join("c"), 4);
     o.jobs = 1;
     let ex = ViaTelemetry {
         stop_at: 2,
         stopped: AtomicBool::new(false),
     };
-    let m = run_campaign_with(&o, &ex).unwrap_err().to_string();
-    assert_eq!(
-        m,
-        format!(
-            "interrupted: 2 of 4 runs completed, aggregated in {}",
-            o.out.display()
-        )
-    );
-    let mut runs: Vec<String> = std::fs::read_dir(o.out.join("runs"))
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    runs.sort();
-    assert_eq!(runs, ["0", "1"]);
-    let s: serde_json::Value =
+    let s = run_campaign_with(&o, &ex).unwrap();
+    let i = s.interrupted.expect("the summary says it was interrupted");
+    assert_eq!((i.completed_runs, i.planned_runs), (2, 4));
+    let runs = |dir: &Path| {
+        let mut r: Vec<String> = std::fs::read_dir(dir.join("runs"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        r.sort();
+        r
+    };
+    assert_eq!(runs(&o.out), ["0", "1"]);
+    let sj: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(o.out.join("summary.json")).unwrap())
             .unwrap();
     assert_eq!(
-        (s["runs"].as_u64(), s["failed_runs"].as_u64()),
+        (sj["runs"].as_u64(), sj["failed_runs"].as_u64()),
         (Some(2), Some(0))
     );
+    assert_eq!(sj["interrupted"]["completed_runs"], 2);
+    assert_eq!(sj["host_load"].as_array().map(Vec::len), Some(1));
+    let report = std::fs::read_to_string(o.out.join("report.md")).unwrap();
+    assert!(report.contains("**Interrupted**") && report.contains("after 2 of 4 runs"));
+    assert!(report.contains("inflated under load"), "{report}");
+
+    // a run being written when a campaign was killed, and a saved run that does not
+    // verify (its scenario was edited): both run again
+    std::fs::create_dir_all(o.out.join("runs/2.partial")).unwrap();
+    std::fs::write(o.out.join("runs/2.partial/scenario.toml"), "half").unwrap();
+    let edited = o.out.join("runs/1/scenario.toml");
+    let text = std::fs::read_to_string(&edited).unwrap();
+    let changed = text.replacen("duration_s = 1.0", "duration_s = 2.0", 1);
+    assert_ne!(changed, text);
+    std::fs::write(&edited, changed).unwrap();
+    let kept = std::fs::metadata(o.out.join("runs/0/result.json"))
+        .unwrap()
+        .modified()
+        .unwrap();
+    o.resume = true;
+    let ex = ViaTelemetry {
+        stop_at: usize::MAX,
+        stopped: AtomicBool::new(false),
+    };
+    let r = run_campaign_with(&o, &ex).unwrap();
+    assert_eq!((r.runs, r.interrupted), (4, None));
+    assert_eq!(runs(&o.out), ["0", "1", "2", "3"]);
+    let after = std::fs::metadata(o.out.join("runs/0/result.json"))
+        .unwrap()
+        .modified()
+        .unwrap();
+    assert_eq!(kept, after, "a verified run is kept, not run again");
+    assert_eq!(
+        r.host_load.len(),
+        2,
+        "the interrupted session and the resume"
+    );
+
+    let whole = options(sc, base.join("whole"), 4);
+    run_campaign(&whole).unwrap();
+    let (mut fa, mut fb) = (deterministic(&whole.out), deterministic(&o.out));
+    // the execution differs (these runs came through telemetry, as in a partition)
+    fa.remove("campaign.json");
+    fb.remove("campaign.json");
+    assert_eq!(fa.keys().collect::<Vec<_>>(), fb.keys().collect::<Vec<_>>());
+    for (k, v) in &fa {
+        assert!(
+            *v == fb[k],
+            "{k} differs between the resumed and the whole campaign"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&base);
+}
+
+/// `resume` refuses a directory of another campaign, and one with no campaign.
+#[test]
+fn resume_refuses_another_campaign() {
+    let base = tmp("resume-other");
+    let sc = short_scenario(&base, 1.0);
+    let o = options(sc.clone(), base.join("c"), 2);
+    run_campaign(&o).unwrap();
+    let mut other = options(sc.clone(), base.join("c"), 3);
+    other.seed = 8;
+    other.resume = true;
+    let m = run_campaign(&other).unwrap_err().to_string();
+    assert!(
+        m.contains("holds another campaign: seed 7 (not 8), 2 runs (not 3)"),
+        "{m}"
+    );
+    let longer = short_scenario(&base.join("longer"), 2.0);
+    let mut other = options(longer, base.join("c"), 2);
+    other.resume = true;
+    let m = run_campaign(&other).unwrap_err().to_string();
+    assert!(m.contains("another base scenario"), "{m}");
+    let mut none = options(sc, base.join("empty"), 2);
+    none.resume = true;
+    let m = run_campaign(&none).unwrap_err().to_string();
+    assert!(m.contains("holds no campaign"), "{m}");
     let _ = std::fs::remove_dir_all(&base);
 }
