@@ -194,7 +194,7 @@ fn bad_montecarlo_arguments_are_one_line_errors() {
     )
     .unwrap();
     let missing_exec = missing_exec.to_str().unwrap();
-    let cases: [&[&str]; 6] = [
+    let cases: [&[&str]; 7] = [
         &[
             "montecarlo",
             "--mode",
@@ -223,6 +223,7 @@ fn bad_montecarlo_arguments_are_one_line_errors() {
             "1",
         ],
         &["montecarlo", "rerun", "/nonexistent/campaign", "--run", "0"],
+        &["montecarlo", "--resume"],
     ];
     let expect = [
         "/nonexistent/partition.toml",
@@ -231,6 +232,7 @@ fn bad_montecarlo_arguments_are_one_line_errors() {
         "2/2",
         "/nonexistent/mc.toml",
         "/nonexistent/campaign",
+        "holds no campaign (no campaign.json)",
     ];
     for (args, want) in cases.iter().zip(expect) {
         let mut a: Vec<&str> = args.to_vec();
@@ -313,6 +315,16 @@ fn assert_no_shm_leftovers(pid: u32) {
         .filter(|n| n.starts_with("sc_mc") && n.contains(&format!("-{pid}-")))
         .collect();
     assert!(left.is_empty(), "left in /dev/shm: {left:?}");
+}
+
+/// `summary.json` of a campaign without its wall-clock keys (solve times, wall time,
+/// host load).
+fn deterministic_summary(dir: &Path) -> serde_json::Value {
+    let mut v = json(&dir.join("summary.json"));
+    for k in sc_montecarlo::WALL_CLOCK_KEYS {
+        v.as_object_mut().unwrap().remove(k);
+    }
+    v
 }
 
 /// `runs.csv` as run → (column → value).
@@ -414,16 +426,7 @@ fn partition_mode_gives_exactly_the_in_process_results() {
         );
         assert!(!pd.join("telemetry.csv").exists() && !pd.join("recording.mcap").exists());
     }
-    let strip = |mut v: serde_json::Value| {
-        for k in ["solve_time_us", "solve_cpu_us", "wall_time_s"] {
-            v.as_object_mut().unwrap().remove(k);
-        }
-        v
-    };
-    assert_eq!(
-        strip(json(&inp.join("summary.json"))),
-        strip(json(&part.join("summary.json")))
-    );
+    assert_eq!(deterministic_summary(&inp), deterministic_summary(&part));
     for f in [
         "trajectories_xy.svg",
         "attitude_los.svg",
@@ -516,4 +519,176 @@ fn a_failed_partition_launch_is_a_failed_run_and_the_campaign_goes_on() {
         (Some(3), Some(1))
     );
     let _ = std::fs::remove_dir_all(&d);
+}
+
+/// Mission length of the interrupted campaign: long enough that the runs after the
+/// first outlast the time the test takes to see it finish and send the signal.
+const INTERRUPTED_MISSION_S: f64 = 20.0;
+
+/// Runs of the interrupted campaign (one at a time).
+const INTERRUPTED_RUNS: usize = 6;
+
+/// How often the test looks for the first finished run.
+const POLL: std::time::Duration = std::time::Duration::from_millis(10);
+
+/// How long the first run may take before the test gives up.
+const FIRST_RUN_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(120);
+
+/// Exit code of an interrupted campaign (`safe-capture montecarlo --help`).
+const EXIT_INTERRUPTED: i32 = 3;
+
+/// The numbered run directories of a campaign, and every other entry of its `runs/`.
+fn run_dirs(dir: &Path) -> (Vec<usize>, Vec<String>) {
+    let (mut runs, mut other) = (Vec::new(), Vec::new());
+    for e in std::fs::read_dir(dir.join("runs")).unwrap() {
+        let n = e.unwrap().file_name().to_string_lossy().into_owned();
+        match n.parse() {
+            Ok(k) => runs.push(k),
+            Err(_) => other.push(n),
+        }
+    }
+    runs.sort_unstable();
+    (runs, other)
+}
+
+/// Ctrl-C in-process: SIGINT after the first run finished stops the campaign — exit 3,
+/// summary.json, report.md and the terminal say "interrupted after K of N", only the
+/// finished runs are there and aggregated (no run half-written); `--resume` completes
+/// it with the deterministic outputs of an uninterrupted campaign; `--resume` on a
+/// campaign of another seed is refused in one line with exit 2.
+#[test]
+fn ctrl_c_stops_an_in_process_campaign_and_resume_completes_it() {
+    let _cpu = exclusive();
+    let d = tmp("interrupt");
+    let sc = short_scenario(&d, INTERRUPTED_MISSION_S);
+    let sc = sc.to_str().unwrap();
+    let out = d.join("c");
+    let runs = INTERRUPTED_RUNS.to_string();
+    let common = [
+        "montecarlo",
+        "--runs",
+        &runs,
+        "--seed",
+        "5",
+        "--jobs",
+        "1",
+        "-q",
+    ];
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_safe-capture"))
+        .current_dir(root())
+        .args(common)
+        .args(["--scenario", sc, "--out", out.to_str().unwrap()])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while !out.join("runs/0").is_dir() {
+        if let Some(status) = child.try_wait().unwrap() {
+            panic!("the campaign ended before a run finished: {status}");
+        }
+        if started.elapsed() > FIRST_RUN_TIMEOUT {
+            let _ = child.kill();
+            panic!("no run finished within {FIRST_RUN_TIMEOUT:?}");
+        }
+        std::thread::sleep(POLL);
+    }
+    let kill = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let o = child.wait_with_output().unwrap();
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(EXIT_INTERRUPTED), "{t}");
+    let s = json(&out.join("summary.json"));
+    let k = s["interrupted"]["completed_runs"].as_u64().unwrap() as usize;
+    assert_eq!(s["interrupted"]["planned_runs"], INTERRUPTED_RUNS, "{s}");
+    assert!((1..INTERRUPTED_RUNS).contains(&k), "{s}");
+    assert_eq!(s["runs"], k, "{s}");
+    assert!(
+        t.contains(&format!("interrupted after {k} of {INTERRUPTED_RUNS} runs")),
+        "{t}"
+    );
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        report.contains(&format!("after {k} of {INTERRUPTED_RUNS} runs")),
+        "{report}"
+    );
+    // the runs in flight finished; nothing half-written is left, nothing uncounted
+    let (done, other) = run_dirs(&out);
+    assert_eq!(done, (0..k).collect::<Vec<_>>());
+    assert!(other.is_empty(), "{other:?}");
+    for r in &done {
+        assert!(out.join(format!("runs/{r}/result.json")).is_file());
+    }
+    let load = &s["host_load"][0];
+    assert!(load["start"]["cpus"].as_u64().unwrap() >= 1, "{s}");
+    assert!(load["end"]["load_avg_1min"].as_f64().unwrap() >= 0.0, "{s}");
+    assert!(report.contains("inflated under load"), "{report}");
+
+    // another seed: refused, the campaign untouched
+    let o = cli(
+        &[
+            "montecarlo",
+            "--resume",
+            "--seed",
+            "6",
+            "--out",
+            out.to_str().unwrap(),
+            "-q",
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("holds another campaign: seed 5 (not 6)"),
+        "{err}"
+    );
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert_eq!(run_dirs(&out).0, done);
+
+    // --resume takes the rest of the parameters from the campaign
+    let o = cli(
+        &[
+            "montecarlo",
+            "--resume",
+            "--out",
+            out.to_str().unwrap(),
+            "-q",
+        ],
+        &[],
+    );
+    // short missions do not capture: 1, the campaign complete
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(!text(&o).contains("interrupted"), "{}", text(&o));
+    let whole = d.join("whole");
+    let o = cli(
+        &[
+            &common[..],
+            &["--scenario", sc, "--out", whole.to_str().unwrap()],
+        ]
+        .concat(),
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    let resumed = json(&out.join("summary.json"));
+    assert!(resumed.get("interrupted").is_none(), "{resumed}");
+    assert_eq!(resumed["host_load"].as_array().unwrap().len(), 2);
+    assert_eq!(deterministic_summary(&out), deterministic_summary(&whole));
+    assert_eq!(run_dirs(&out), run_dirs(&whole));
+    let mut files = vec!["runs.csv".to_string(), "figures/trajectories_xy.svg".into()];
+    for r in 0..INTERRUPTED_RUNS {
+        for f in ["result.json", "scenario.toml", "trace.csv"] {
+            files.push(format!("runs/{r}/{f}"));
+        }
+    }
+    for f in files {
+        assert_eq!(
+            std::fs::read(out.join(&f)).unwrap(),
+            std::fs::read(whole.join(&f)).unwrap(),
+            "{f} differs between the resumed and the uninterrupted campaign"
+        );
+    }
 }
