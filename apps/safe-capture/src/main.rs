@@ -27,7 +27,7 @@ use std::process::ExitCode;
 /// three coupling-aware CBF safety filters (translational → attitude → robotic) over a
 /// high-fidelity simulator.
 #[derive(Parser)]
-#[command(name = "safe-capture", version, propagate_version = true)]
+#[command(name = "safe-capture", version = VERSION, propagate_version = true)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -64,6 +64,9 @@ enum Command {
     /// partition config with its scenario and every role's program).
     Check(cmd_check::Args),
 }
+
+/// `--version`: the crate version and the git commit of the build (`build.rs`).
+const VERSION: &str = concat!(env!("CARGO_PKG_VERSION"), " (", env!("SC_GIT_COMMIT"), ")");
 
 /// Default scenario path (relative to the working directory).
 pub fn default_scenario() -> PathBuf {
@@ -122,6 +125,8 @@ fn with_long_about(
 
 fn main() -> ExitCode {
     use clap::FromArgMatches;
+    // every summary.json names the build that wrote it
+    sc_mission::build::register(env!("CARGO_PKG_VERSION"), env!("SC_GIT_COMMIT"));
     let cli = Cli::from_arg_matches(&command().get_matches()).unwrap_or_else(|e| e.exit());
     let result = match cli.command {
         Command::Run(a) => cmd_run::run(a),

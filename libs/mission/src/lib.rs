@@ -5,6 +5,7 @@
 //! The partition (one process per module) calls the very same stage functions of
 //! [`stages`], so its results are bit-for-bit those of [`Mission`].
 
+pub mod build;
 pub mod compare;
 pub mod mission;
 pub mod nominal_source;

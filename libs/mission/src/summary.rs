@@ -83,6 +83,11 @@ pub struct Interventions {
 /// The summary of a run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Summary {
+    /// The program's version and git commit (see [`crate::build`]).
+    #[serde(default)]
+    pub version: String,
+    #[serde(default)]
+    pub git_commit: String,
     pub filtered: bool,
     pub captured: bool,
     pub capture_time_s: Option<f64>,
@@ -277,7 +282,10 @@ pub fn summarize(
         _ => (false, None),
     };
     let (end_name, final_time_s) = (end.name(), end.t());
+    let build = crate::build::current();
     Summary {
+        version: build.version,
+        git_commit: build.git_commit,
         filtered,
         captured,
         capture_time_s,
