@@ -37,9 +37,10 @@ const _: () = assert!(EXIT_FORCED == 130);
 /// runs.csv, runs_timing.csv, summary.json, report.md, figures/*.svg.
 ///
 /// Ctrl-C (SIGINT) or SIGTERM stops the campaign gracefully: no further run starts, the
-/// runs in flight finish, the completed runs are aggregated and summary.json, report.md
-/// and the last line say "interrupted after K of N runs"; `--resume --out DIR` then runs
-/// the rest (a second signal quits at once; a run is only named runs/K once saved).
+/// runs in flight finish (with --mode partition: are torn down and left out), the
+/// completed runs are aggregated and summary.json, report.md and the last line say
+/// "interrupted after K of N runs"; `--resume --out DIR` then runs the rest (a second
+/// signal quits at once; a run is only named runs/K once saved).
 /// Every report records the host's load at the start and end (1-minute load average,
 /// CPUs).
 ///
@@ -48,7 +49,7 @@ const _: () = assert!(EXIT_FORCED == 130);
 /// failed run), 2 bad arguments or configuration (checked before any run starts; with
 /// --resume also a DIR that holds another campaign), 3 interrupted by SIGINT/SIGTERM
 /// (the completed runs aggregated; --resume completes the campaign), 130 a second
-/// SIGINT/SIGTERM quit at once.
+/// SIGINT/SIGTERM quit at once (in-process; the runs in flight abandoned).
 #[derive(clap::Args)]
 #[command(args_conflicts_with_subcommands = true)]
 pub struct Args {
