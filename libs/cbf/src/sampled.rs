@@ -79,9 +79,15 @@ impl Decay {
     /// The decay over a sample of length `t` [s], its exponentials computed once (a
     /// filter builds dozens of rows with the same `γ` and `T`).
     pub fn at(&self, t: f64) -> DecayAt {
+        let below = (-self.gamma * t).exp();
         DecayAt {
-            below: (-self.gamma * t).exp(),
-            inner: (-self.gamma_inner * t).exp(),
+            below,
+            // without a knee the inner factor is never used: one exponential, not two
+            inner: if self.knee == f64::INFINITY {
+                below
+            } else {
+                (-self.gamma_inner * t).exp()
+            },
             knee: self.knee,
         }
     }
