@@ -12,7 +12,9 @@ use std::process::ExitCode;
 ///
 /// PROFILE.csv columns (header required): t_s, f_b_x_n, f_b_y_n, f_b_z_n, tau_b_x_nm,
 /// tau_b_y_nm, tau_b_z_nm, tau_m_1_nm … tau_m_7_nm. Forces/torques in the servicer base
-/// frame; a row holds from its time until the next row.
+/// frame; a row holds from its time until the next row. At least one row; every row's
+/// time a multiple of the scenario's control period (to rounding: docs/SIMULATOR.md),
+/// increasing.
 ///
 /// TRAJ.csv: one row per control step with the inertial states of both spacecraft
 /// (servicer base origin position/velocity, quaternion base→inertial scalar-first, body
@@ -41,13 +43,13 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let setup = Setup::load(&a.scenario)?;
     let text = std::fs::read_to_string(&a.commands)
         .with_context(|| format!("cannot read {}", a.commands.display()))?;
-    let profile =
-        CommandProfile::parse(&text).with_context(|| format!("{}", a.commands.display()))?;
+    let period = setup.scenario.mission.control_period_s;
+    let profile = CommandProfile::parse(&text, period)
+        .with_context(|| format!("{}", a.commands.display()))?;
     let duration = a.duration.unwrap_or(setup.scenario.mission.duration_s);
     if !(duration.is_finite() && duration >= 0.0) {
         anyhow::bail!("--duration {duration}: must be a finite number >= 0");
     }
-    let period = setup.scenario.mission.control_period_s;
     let steps = (duration / period).round() as usize;
     let mut sim = Simulator::new(&setup.scenario, setup.robot.clone())?;
     let file = std::fs::File::create(&a.out)

@@ -220,6 +220,62 @@ fn simulate_writes_the_documented_trajectory() {
     assert!(moved > 0.01, "moved {moved}");
 }
 
+/// `simulate` refuses, with one line naming file, line, value and rule, a profile row
+/// between two control steps (it would silently act from the next one) and a profile
+/// without rows; and nothing is written.
+#[test]
+fn simulate_refuses_off_grid_and_empty_profiles() {
+    let d = tmp("grid");
+    let simulate = |profile: &Path| {
+        bin()
+            .args(["simulate", "--commands"])
+            .arg(profile)
+            .arg("--out")
+            .arg(d.join("t.csv"))
+            .args(["--duration", "1"])
+            .output()
+            .unwrap()
+    };
+    let off = d.join("off.csv");
+    std::fs::write(
+        &off,
+        format!("{HEADER}\n0,1,0,0,0,0,0,0,0,0,0,0,0,0\n0.25,0,0,0,0,0,0,0,0,0,0,0,0,0\n"),
+    )
+    .unwrap();
+    let out = simulate(&off);
+    assert_one_line_error(
+        &out,
+        "off.csv: line 3, column `t_s`: time 0.25 s is off the control grid",
+    );
+    assert_one_line_error(&out, "multiple of the control period 0.1 s");
+    let empty = d.join("empty.csv");
+    std::fs::write(&empty, format!("{HEADER}\n")).unwrap();
+    let out = simulate(&empty);
+    assert_one_line_error(&out, "empty.csv: line 1: no row after the header");
+    assert!(!d.join("t.csv").exists());
+    // the same rows on the grid simulate
+    std::fs::write(
+        &off,
+        format!(
+            "{HEADER}\n0,1,0,0,0,0,0,0,0,0,0,0,0,0\n0.30000000000000004,0,0,0,0,0,0,0,0,0,0,0,0,0\n"
+        ),
+    )
+    .unwrap();
+    let out = simulate(&off);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        std::fs::read_to_string(d.join("t.csv"))
+            .unwrap()
+            .lines()
+            .count(),
+        12
+    );
+}
+
 #[test]
 fn bad_inputs_give_one_line_errors() {
     let d = tmp("bad");

@@ -25,6 +25,6 @@ mod state;
 
 pub use observation::{Observation, TRAJECTORY_COLUMNS, TrajectoryRow};
 pub use plant::{Plant, SIM_STATE_LEN};
-pub use profile::{CommandProfile, PROFILE_COLUMNS, ProfileError};
+pub use profile::{CommandProfile, GRID_TOLERANCE_S, PROFILE_COLUMNS, ProfileError};
 pub use report::{ModelReport, ModelState, evaluate_model};
 pub use state::{BarrierState, Command, SimError, SimState, Simulator};

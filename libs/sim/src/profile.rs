@@ -5,6 +5,10 @@
 //! hold); the command applied over the control period starting at `t` is the last row
 //! with `t_s ≤ t` (zero before the first row). Forces/torques in the servicer base
 //! frame [N, N m], joint torques [N m].
+//!
+//! The simulator changes its command only at the control steps, so every row's time must
+//! be a multiple of the control period (within [`GRID_TOLERANCE_S`]): a row between two
+//! steps would silently act from the next one. A profile needs at least one row.
 
 use crate::state::Command;
 use nalgebra::Vector3;
@@ -28,13 +32,20 @@ pub const PROFILE_COLUMNS: [&str; 14] = [
     "tau_m_7_nm",
 ];
 
+/// How far a row's time may lie from the nearest multiple of the control period [s]:
+/// room for the rounding of a time written as `k · period` in decimal (1e-17 s at 0.1 s,
+/// 1e-13 s at 1e4 s), far below any physics step (milliseconds). The same tolerance
+/// decides which row holds at a control step ([`CommandProfile::at`]).
+pub const GRID_TOLERANCE_S: f64 = 1e-9;
+
 /// Why a profile was rejected; every message names the line (and column) at fault.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ProfileError {
     #[error("command profile is empty (expected the header `{}`)", PROFILE_COLUMNS.join(","))]
     Empty,
-    #[error("line 1: header column {index} is `{found}`, expected `{expected}`")]
+    #[error("line {line}: header column {index} is `{found}`, expected `{expected}`")]
     Header {
+        line: usize,
         index: usize,
         found: String,
         expected: String,
@@ -59,6 +70,16 @@ pub enum ProfileError {
     },
     #[error("line {line}: time {t} s does not increase (previous row at {prev} s)")]
     TimeOrder { line: usize, t: f64, prev: f64 },
+    #[error(
+        "line {line}, column `t_s`: time {t} s is off the control grid (every row's time must be a multiple of the control period {period} s within {GRID_TOLERANCE_S:e} s)"
+    )]
+    OffGrid { line: usize, t: f64, period: f64 },
+    #[error(
+        "line {line}: no row after the header (a profile needs at least one row: its time and command)"
+    )]
+    NoRows { line: usize },
+    #[error("control period {0} s: must be a finite number > 0")]
+    Period(f64),
 }
 
 /// A parsed, validated command profile.
@@ -68,18 +89,23 @@ pub struct CommandProfile {
 }
 
 impl CommandProfile {
-    /// Parses the CSV text of a profile.
-    pub fn parse(text: &str) -> Result<Self, ProfileError> {
+    /// Parses the CSV text of a profile whose rows lie on the grid of `period_s` [s]
+    /// (the scenario's control period).
+    pub fn parse(text: &str, period_s: f64) -> Result<Self, ProfileError> {
+        if !(period_s.is_finite() && period_s > 0.0) {
+            return Err(ProfileError::Period(period_s));
+        }
         let mut lines = text
             .lines()
             .enumerate()
             .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
-        let (_, header) = lines.next().ok_or(ProfileError::Empty)?;
+        let (header_index, header) = lines.next().ok_or(ProfileError::Empty)?;
         let names: Vec<&str> = header.split(',').map(str::trim).collect();
         for (i, expected) in PROFILE_COLUMNS.iter().enumerate() {
             let found = names.get(i).copied().unwrap_or("");
             if found != *expected {
                 return Err(ProfileError::Header {
+                    line: header_index + 1,
                     index: i + 1,
                     found: found.into(),
                     expected: (*expected).into(),
@@ -88,7 +114,7 @@ impl CommandProfile {
         }
         if names.len() != PROFILE_COLUMNS.len() {
             return Err(ProfileError::Columns {
-                line: 1,
+                line: header_index + 1,
                 expected: PROFILE_COLUMNS.len(),
                 found: names.len(),
             });
@@ -120,6 +146,14 @@ impl CommandProfile {
                 }
                 v[k] = x;
             }
+            let nearest = (v[0] / period_s).round() * period_s;
+            if (v[0] - nearest).abs() > GRID_TOLERANCE_S {
+                return Err(ProfileError::OffGrid {
+                    line: line_no,
+                    t: v[0],
+                    period: period_s,
+                });
+            }
             if let Some((prev, _)) = rows.last()
                 && v[0] <= *prev
             {
@@ -136,12 +170,19 @@ impl CommandProfile {
             };
             rows.push((v[0], cmd));
         }
+        if rows.is_empty() {
+            return Err(ProfileError::NoRows {
+                line: header_index + 1,
+            });
+        }
         Ok(Self { rows })
     }
 
     /// The command that holds at time `t` [s] (zero before the first row).
     pub fn at(&self, t: f64) -> Command {
-        let idx = self.rows.partition_point(|(ti, _)| *ti <= t + 1e-9);
+        let idx = self
+            .rows
+            .partition_point(|(ti, _)| *ti <= t + GRID_TOLERANCE_S);
         if idx == 0 {
             Command::zero()
         } else {
@@ -181,6 +222,14 @@ impl CommandProfile {
 mod tests {
     use super::*;
 
+    /// The default scenario's control period [s].
+    const PERIOD: f64 = 0.1;
+
+    /// A row at `t` with zero command.
+    fn row(t: &str) -> String {
+        format!("{t},0,0,0,0,0,0,0,0,0,0,0,0,0\n")
+    }
+
     fn header() -> String {
         PROFILE_COLUMNS.join(",")
     }
@@ -191,40 +240,106 @@ mod tests {
             "{}\n0,1,0,0,0,0,0,0,0,0,0,0,0,0\n10,2,0,0,0,0,0,0,0,0,0,0,0,0.5\n",
             header()
         );
-        let p = CommandProfile::parse(&text).unwrap();
+        let p = CommandProfile::parse(&text, PERIOD).unwrap();
         assert_eq!(p.at(-1.0), Command::zero());
         assert_eq!(p.at(0.0).force_b.x, 1.0);
         assert_eq!(p.at(9.95).force_b.x, 1.0);
         assert_eq!(p.at(10.0).force_b.x, 2.0);
         assert_eq!(p.at(100.0).tau[6], 0.5);
-        let again = CommandProfile::parse(&CommandProfile::to_csv(&p.rows)).unwrap();
+        let again = CommandProfile::parse(&CommandProfile::to_csv(&p.rows), PERIOD).unwrap();
         assert_eq!(again, p);
     }
 
     #[test]
     fn errors_name_line_and_column() {
-        let e = CommandProfile::parse(&format!("{}\n0,1,0,0,0,0,0,0,0,0,0,0,0,NaN\n", header()))
-            .unwrap_err();
+        let e = CommandProfile::parse(
+            &format!("{}\n0,1,0,0,0,0,0,0,0,0,0,0,0,NaN\n", header()),
+            PERIOD,
+        )
+        .unwrap_err();
         assert!(
             e.to_string().contains("line 2") && e.to_string().contains("tau_m_7_nm"),
             "{e}"
         );
-        let e = CommandProfile::parse(&format!("{}\n0,1,0,x,0,0,0,0,0,0,0,0,0,0\n", header()))
-            .unwrap_err();
+        let e = CommandProfile::parse(
+            &format!("{}\n0,1,0,x,0,0,0,0,0,0,0,0,0,0\n", header()),
+            PERIOD,
+        )
+        .unwrap_err();
         assert!(
             e.to_string().contains("f_b_z_n") && e.to_string().contains("not a number"),
             "{e}"
         );
-        let e = CommandProfile::parse(&format!("{}\n0,1,0\n", header())).unwrap_err();
+        let e = CommandProfile::parse(&format!("{}\n0,1,0\n", header()), PERIOD).unwrap_err();
         assert!(matches!(e, ProfileError::Columns { line: 2, .. }), "{e}");
-        let e = CommandProfile::parse("t_s,fx\n").unwrap_err();
+        let e = CommandProfile::parse("t_s,fx\n", PERIOD).unwrap_err();
         assert!(matches!(e, ProfileError::Header { index: 2, .. }), "{e}");
-        let e = CommandProfile::parse(&format!(
-            "{}\n5,0,0,0,0,0,0,0,0,0,0,0,0,0\n5,0,0,0,0,0,0,0,0,0,0,0,0,0\n",
-            header()
-        ))
+        let e = CommandProfile::parse(
+            &format!(
+                "{}\n5,0,0,0,0,0,0,0,0,0,0,0,0,0\n5,0,0,0,0,0,0,0,0,0,0,0,0,0\n",
+                header()
+            ),
+            PERIOD,
+        )
         .unwrap_err();
         assert!(matches!(e, ProfileError::TimeOrder { line: 3, .. }), "{e}");
-        assert_eq!(CommandProfile::parse("").unwrap_err(), ProfileError::Empty);
+        assert_eq!(
+            CommandProfile::parse("", PERIOD).unwrap_err(),
+            ProfileError::Empty
+        );
+    }
+
+    #[test]
+    fn rows_off_the_control_grid_are_refused() {
+        // 0.15 s lies between the steps at 0.1 and 0.2 s
+        let text = format!("{}\n{}{}", header(), row("0"), row("0.15"));
+        let e = CommandProfile::parse(&text, PERIOD).unwrap_err();
+        assert!(
+            matches!(e, ProfileError::OffGrid { line: 3, t, .. } if t == 0.15),
+            "{e}"
+        );
+        let msg = e.to_string();
+        assert!(
+            msg.contains("line 3")
+                && msg.contains("0.15")
+                && msg.contains("multiple of the control period 0.1 s"),
+            "{msg}"
+        );
+        // just beyond the tolerance is off, within it on (a time written as k · period)
+        let off = format!("{}", 0.3 + 2.0 * GRID_TOLERANCE_S);
+        let e = CommandProfile::parse(&format!("{}\n{}", header(), row(&off)), PERIOD).unwrap_err();
+        assert!(matches!(e, ProfileError::OffGrid { line: 2, .. }), "{e}");
+        let on = format!("{:?}", 3.0 * PERIOD); // 0.30000000000000004
+        let p = CommandProfile::parse(
+            &format!("{}\n{}{}", header(), row("-0.1"), row(&on)),
+            PERIOD,
+        )
+        .unwrap();
+        assert_eq!(p.len(), 2);
+        // the grid is the period's: 0.15 s is on a 0.05 s grid
+        assert!(CommandProfile::parse(&text, 0.05).is_ok());
+    }
+
+    #[test]
+    fn a_profile_without_rows_is_refused() {
+        let e = CommandProfile::parse(&format!("{}\n", header()), PERIOD).unwrap_err();
+        assert_eq!(e, ProfileError::NoRows { line: 1 });
+        assert!(e.to_string().contains("line 1") && e.to_string().contains("at least one row"));
+        // comments and blank lines are no rows; the header's own line is named
+        let e = CommandProfile::parse(
+            &format!("# made by hand\n\n{}\n# nothing\n", header()),
+            PERIOD,
+        )
+        .unwrap_err();
+        assert_eq!(e, ProfileError::NoRows { line: 3 });
+    }
+
+    #[test]
+    fn a_bad_period_is_an_error_not_a_panic() {
+        for period in [0.0, -0.1, f64::NAN, f64::INFINITY] {
+            let e =
+                CommandProfile::parse(&format!("{}\n{}", header(), row("0")), period).unwrap_err();
+            assert!(matches!(e, ProfileError::Period(_)), "{period}: {e}");
+        }
     }
 }
