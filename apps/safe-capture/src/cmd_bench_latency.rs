@@ -29,6 +29,10 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    // nothing starts unless the scenario and every program are there
+    let cfg = sc_partition::PartitionConfig::load(&a.config)?;
+    sc_partition::preflight::preflight(&cfg, &None)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", a.config.display()))?;
     let r = bench(&BenchOptions {
         config: a.config,
         out: a.out.clone(),

@@ -105,22 +105,28 @@ fn a_missing_scenario_or_program_stops_the_launch_before_anything_starts() {
         let sub = d.join("sub");
         std::fs::create_dir_all(&sub).unwrap();
         std::fs::write(sub.join("partition.toml"), cfg).unwrap();
-        let (o, pid) = cli_partition(
-            &[
-                "launch",
+        // `launch` and `bench latency` check the same before starting anything
+        for cmd in [&["launch"][..], &["bench", "latency", "--ticks", "1"]] {
+            let mut args = cmd.to_vec();
+            let cfg = sub.join("partition.toml");
+            let out = d.join("out");
+            args.extend([
                 "--config",
-                sub.join("partition.toml").to_str().unwrap(),
+                cfg.to_str().unwrap(),
                 "--out",
-                d.join("out").to_str().unwrap(),
-            ],
-            &[],
-        );
-        let t = text(&o);
-        assert_eq!(o.status.code(), Some(2), "{t}");
-        assert_eq!(t.lines().count(), 1, "{t}");
-        assert!(t.starts_with("error: ") && t.contains(needle), "{t}");
-        assert!(!d.join("out").exists(), "{t}");
-        assert_eq!(shm_files_of(pid), Vec::<String>::new());
+                out.to_str().unwrap(),
+            ]);
+            let (o, pid) = cli_partition(&args, &[]);
+            let t = text(&o);
+            assert_eq!(o.status.code(), Some(2), "{cmd:?}: {t}");
+            assert_eq!(t.lines().count(), 1, "{cmd:?}: {t}");
+            assert!(
+                t.starts_with("error: ") && t.contains(needle),
+                "{cmd:?}: {t}"
+            );
+            assert!(!out.exists(), "{cmd:?}: {t}");
+            assert_eq!(shm_files_of(pid), Vec::<String>::new());
+        }
     }
 }
 
