@@ -17,6 +17,10 @@ use std::process::ExitCode;
 ///
 /// With --solve-all the filters' skip path is off: every step solves its QP although the
 /// nominal command may already be safe (the worst case a flight processor must budget for).
+/// --scenario may be given several times (e.g. every `runs/*/scenario.toml` of a Monte
+/// Carlo campaign: each is run REPEAT times), and --redteam CASE replaces the nominal
+/// controllers by an in-process adversary (`safe-capture redteam --list`), so the same
+/// figures cover the campaigns the filters work hardest in.
 ///
 /// --json FILE writes {"total"|"translational"|"attitude"|"robotic": {"n", "geomean_us",
 /// "p50_us", "p90_us", "p99_us", "p999_us", "max_us", "cpu": {same keys}, "qp": {same
@@ -26,9 +30,13 @@ use std::process::ExitCode;
 /// Exit codes: 0 done, 2 bad arguments or configuration.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Scenario file.
-    #[arg(long, value_name = "FILE", default_value_os_t = crate::default_scenario())]
-    scenario: PathBuf,
+    /// Scenario file; several: each one's missions are pooled.
+    #[arg(long, value_name = "FILE", num_args = 1.., default_values_os_t = [crate::default_scenario()])]
+    scenario: Vec<PathBuf>,
+    /// Red team: an in-process adversary in place of the nominal controller(s), e.g.
+    /// `all/random:1` (`safe-capture redteam --list` lists the cases).
+    #[arg(long, value_name = "CASE")]
+    redteam: Option<String>,
     /// Number of missions.
     #[arg(long, default_value_t = 5)]
     repeat: usize,
@@ -92,16 +100,29 @@ impl SolverWork {
 }
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
-    let setup = Setup::load(&a.scenario)?;
+    let case = a
+        .redteam
+        .as_deref()
+        .map(sc_redteam::Case::parse)
+        .transpose()
+        .map_err(|e| anyhow::anyhow!("--redteam: {e}"))?;
+    let setups = a
+        .scenario
+        .iter()
+        .map(|p| Setup::load(p))
+        .collect::<Result<Vec<_>, _>>()?;
     let mut wall: [Vec<f64>; 4] = Default::default();
     let mut cpu: [Vec<f64>; 4] = Default::default();
     let mut qp: [Vec<f64>; 4] = Default::default();
     let mut work: [SolverWork; 3] = Default::default();
     let mut mission_wall = Vec::new();
     let tty = std::io::IsTerminal::is_terminal(&std::io::stderr());
-    for k in 0..a.repeat.max(1) {
+    let missions = a.repeat.max(1) * setups.len();
+    for k in 0..missions {
+        let setup = &setups[k % setups.len()];
         let started = std::time::Instant::now();
         let mut m = Mission::new(setup.clone(), RunOptions::default())?;
+        m.nominal_override = case.map(|c| crate::cmd_run::adversary(setup, c));
         if a.solve_all {
             m.safety.translational.set_skip_enabled(false);
             m.safety.attitude.set_skip_enabled(false);
@@ -123,9 +144,9 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         });
         mission_wall.push(started.elapsed().as_secs_f64());
         if tty {
-            eprint!("\r  mission {}/{}", k + 1, a.repeat.max(1));
+            eprint!("\r  mission {}/{missions}", k + 1);
         } else {
-            eprintln!("  mission {}/{}", k + 1, a.repeat.max(1));
+            eprintln!("  mission {}/{missions}", k + 1);
         }
     }
     if tty {
@@ -134,8 +155,11 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let names = ["translational", "attitude", "robotic", "total"];
     let mut report = serde_json::Map::new();
     println!(
-        "safety-layer solve time per control step [us] ({} missions, {})",
-        a.repeat.max(1),
+        "safety-layer solve time per control step [us] ({missions} missions{}, {})",
+        a.redteam
+            .as_deref()
+            .map(|c| format!(" under red-team case {c}"))
+            .unwrap_or_default(),
         if a.solve_all {
             "every QP solved"
         } else {

@@ -282,7 +282,10 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
 }
 
 /// A red-team adversary for `case` in `setup`'s scenario.
-fn adversary(setup: &Setup, case: sc_redteam::Case) -> Box<dyn sc_mission::NominalOverride> {
+pub(crate) fn adversary(
+    setup: &Setup,
+    case: sc_redteam::Case,
+) -> Box<dyn sc_mission::NominalOverride> {
     Box::new(sc_redteam::Adversary::new(
         &setup.scenario,
         setup.robot.clone(),

@@ -671,3 +671,41 @@ fn run_progress_in_a_log_is_plain_lines() {
     assert_eq!(reports, 2, "one line at t = 10 s and one at 20 s: {err}");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// `bench filters --solve-all` under a red-team adversary, two scenarios pooled: every
+/// step solves, the JSON carries the wall, CPU and solver-only (`qp`) figures per filter,
+/// and the solver's time is part of the filter call's.
+#[test]
+fn bench_filters_reports_the_solver_time_under_attack_over_pooled_scenarios() {
+    let d = tmp("bench-filters");
+    let json = d.join("bench.json");
+    let scenario = root().join("config/scenario.toml");
+    let out = bin()
+        .args(["bench", "filters", "--repeat", "1", "--solve-all"])
+        .args(["--redteam", "all/random:1", "--scenario"])
+        .arg(&scenario)
+        .arg(&scenario)
+        .arg("--json")
+        .arg(&json)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(out.status.success(), "{stdout}");
+    assert!(
+        stdout.contains("(2 missions under red-team case all/random:1, every QP solved)"),
+        "{stdout}"
+    );
+    let j: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    for f in ["translational", "attitude", "robotic", "total"] {
+        let e = &j[f];
+        let (wall, qp) = (&e["p50_us"], &e["qp"]["p50_us"]);
+        assert!(e["n"].as_u64().unwrap() > 4000, "{f}: {e}");
+        assert!(qp.as_f64().unwrap() > 0.0, "{f}: {e}");
+        assert!(qp.as_f64().unwrap() <= wall.as_f64().unwrap(), "{f}: {e}");
+        assert!(e["cpu"]["geomean_us"].as_f64().unwrap() > 0.0, "{f}: {e}");
+    }
+    for f in ["translational", "attitude", "robotic"] {
+        assert_eq!(j[f]["solved_steps"], j[f]["n"], "{f}: every step solves");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
