@@ -199,8 +199,13 @@ pub fn clamp_box<const M: usize>(v: &SVector<f64, M>, limit: f64) -> (SVector<f6
 
 /// All components finite.
 pub fn finite<const R: usize, const C: usize>(m: &nalgebra::SMatrix<f64, R, C>) -> bool {
-    // without early exit, so that it vectorises
-    m.as_slice().iter().fold(true, |ok, x| ok & x.is_finite())
+    // on the magnitudes' bits (every finite one is below infinity's), without early exit,
+    // so that it vectorises
+    const MAGNITUDE: u64 = !(1 << 63);
+    let inf = f64::INFINITY.to_bits();
+    m.as_slice()
+        .iter()
+        .fold(true, |ok, x| ok & (x.to_bits() & MAGNITUDE < inf))
 }
 
 /// All components finite and `‖v‖₂ ≤ max`.

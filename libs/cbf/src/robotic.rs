@@ -249,14 +249,29 @@ pub fn joint_velocity(i: usize, x: &RoboticInput, theta_dot_max: f64) -> [RelDeg
 pub fn link_base(s: &SphereTerms, x: &RoboticInput) -> RelDegTwo<NJ> {
     let d = s.center - x.base_center;
     let v = s.jacobian * x.theta_dot;
-    let jtd = s.jacobian.transpose() * d;
+    let jtd = tr_mul(&s.jacobian, &d);
     let rr = s.radius + x.base_radius;
     RelDegTwo {
         h: d.dot(&d) - rr * rr,
         hdot: 2.0 * d.dot(&v),
         hddot_drift: 2.0 * v.dot(&v) + 2.0 * jtd.dot(&(x.drift + x.xi)) + 2.0 * d.dot(&s.jdot_qdot),
-        hddot_u: x.a.transpose() * jtd * 2.0,
+        hddot_u: tr_mul(&x.a, &jtd) * 2.0,
     }
+}
+
+/// `mᵀ v` without forming `mᵀ` (21 of these per step), summed in the order of
+/// `m.transpose() * v`, so the bits are the same.
+fn tr_mul<const R: usize, const C: usize>(
+    m: &SMatrix<f64, R, C>,
+    v: &SVector<f64, R>,
+) -> SVector<f64, C> {
+    SVector::from_fn(|i, _| {
+        let mut s = m[(0, i)] * v[0];
+        for k in 1..R {
+            s += m[(k, i)] * v[k];
+        }
+        s
+    })
 }
 
 /// All barrier terms of one step.
@@ -329,13 +344,22 @@ pub struct RoboticFilter {
     last: LastProblem<NJ>,
 }
 
-/// Every entry finite and `|m_ij| ≤ max` (`max` finite). Without early exit, so that it
-/// vectorises: the filter checks ~800 numbers of its input every step.
+/// Every entry finite and `|m_ij| ≤ max`. Compares the magnitudes' bit patterns (for
+/// non-negative floats their order is the numbers' order, and infinity and NaN lie above
+/// every finite value), without early exit, so that it vectorises: the filter checks ~900
+/// numbers of its input every step.
 fn finite_in<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>, max: f64) -> bool {
+    if max.is_nan() || max < 0.0 {
+        return false;
+    }
+    let limit = max.min(f64::MAX).to_bits();
     m.as_slice()
         .iter()
-        .fold(true, |ok, v| ok & v.is_finite() & (v.abs() <= max))
+        .fold(true, |ok, v| ok & (v.to_bits() & !SIGN_BIT <= limit))
 }
+
+/// The sign bit of an `f64`.
+const SIGN_BIT: u64 = 1 << 63;
 
 impl RoboticFilter {
     pub fn new(params: RoboticParams) -> Self {
@@ -1036,4 +1060,42 @@ pub fn robotic_input_from_model(
         force_b: *f_b_sf,
         torque_b: *tau_b_sf,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The bit-pattern checks equal their definitions on the awkward values.
+    #[test]
+    fn input_checks_equal_their_definitions() {
+        let vals = [
+            0.0,
+            -0.0,
+            f64::MIN_POSITIVE,
+            5e-324,
+            1.0,
+            -1.0,
+            2.0,
+            2.0f64.next_up(),
+            -2.0f64.next_up(),
+            f64::MAX,
+            f64::MIN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            -f64::NAN,
+        ];
+        for &a in &vals {
+            for &b in &vals {
+                let m = nalgebra::Vector2::new(a, b);
+                let finite = a.is_finite() && b.is_finite();
+                assert_eq!(common::finite(&m), finite, "{a} {b}");
+                for max in [0.0, 2.0, f64::MAX, f64::INFINITY, -1.0, f64::NAN] {
+                    let want = finite && m.amax() <= max;
+                    assert_eq!(finite_in(&m, max), want, "{a} {b} max {max}");
+                }
+            }
+        }
+    }
 }
