@@ -276,6 +276,105 @@ fn simulate_refuses_off_grid_and_empty_profiles() {
     );
 }
 
+/// μ = 0 (zero gravity): `simulate` with no command moves the servicer on a straight
+/// line relative to the resting target (constant Hill-frame velocity, to rounding), and a
+/// short `run` completes, every output finite.
+#[test]
+fn zero_gravity_simulates_straight_lines_and_runs() {
+    let d = tmp("zero-g");
+    let s = scenario_with(
+        &d,
+        "earth_mu_m3_s2 = 3.986004418e14",
+        "earth_mu_m3_s2 = 0.0",
+    );
+    let text = std::fs::read_to_string(&s).unwrap();
+    std::fs::write(
+        &s,
+        text.replacen("duration_s = 240.0", "duration_s = 20.0", 1),
+    )
+    .unwrap();
+    let profile = d.join("zero.csv");
+    std::fs::write(&profile, format!("{HEADER}\n0,0,0,0,0,0,0,0,0,0,0,0,0,0\n")).unwrap();
+    let traj = d.join("traj.csv");
+    let out = bin()
+        .args(["simulate", "--scenario"])
+        .arg(&s)
+        .arg("--commands")
+        .arg(&profile)
+        .arg("--out")
+        .arg(&traj)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&traj).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 201);
+    assert!(rows.iter().flatten().all(|x| x.is_finite()));
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (r0, v0) = (col("r_h_x_m"), col("v_h_x_m_s"));
+    // the default scenario starts the servicer moving: the line is not a point
+    assert!((0..3).any(|i| rows[0][v0 + i].abs() > 1e-3));
+    for r in &rows {
+        let t = r[col("t_s")];
+        for i in 0..3 {
+            assert!(
+                (r[v0 + i] - rows[0][v0 + i]).abs() < 1e-12,
+                "t = {t}: {r:?}"
+            );
+            let line = rows[0][r0 + i] + rows[0][v0 + i] * t;
+            assert!(
+                (r[r0 + i] - line).abs() < 1e-9,
+                "t = {t}: {} vs {line}",
+                r[r0 + i]
+            );
+        }
+    }
+    // the target rests: its inertial position does not move
+    let tx = col("target_x_i_m");
+    assert!((0..3).all(|i| rows[200][tx + i] == rows[0][tx + i]));
+    let out = bin()
+        .args([
+            "run",
+            "--quiet",
+            "--no-compare",
+            "--no-figures",
+            "--scenario",
+        ])
+        .arg(&s)
+        .arg("--out")
+        .arg(d.join("o"))
+        .output()
+        .unwrap();
+    // 20 s end in a timeout (exit 0 or 1 by safety, never 2)
+    assert_ne!(
+        out.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let sum: Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("o/summary.json")).unwrap()).unwrap();
+    assert_eq!(sum["end"], "timeout", "{sum}");
+    assert_eq!(sum["steps"], 201, "{sum}");
+    assert!(sum["min_margin"][1].as_f64().unwrap().is_finite(), "{sum}");
+    let tel = std::fs::read_to_string(d.join("o/telemetry.csv")).unwrap();
+    for l in tel.lines().skip(1) {
+        for x in l.split(',') {
+            if let Ok(v) = x.parse::<f64>() {
+                assert!(v.is_finite(), "{l}");
+            }
+        }
+    }
+}
+
 #[test]
 fn bad_inputs_give_one_line_errors() {
     let d = tmp("bad");

@@ -42,9 +42,18 @@ impl ClohessyWiltshire {
         self.a() * x + self.b() * f
     }
 
-    /// Closed-form state-transition matrix Φ(t) of the unforced motion.
+    /// Closed-form state-transition matrix Φ(t) of the unforced motion. With n = 0 (zero
+    /// gravity) the model is a double integrator, `Φ = [I, t I; 0, I]`, the limit of
+    /// the formula below (which would divide 0 by 0).
     pub fn transition(&self, t: f64) -> Matrix6<f64> {
         let n = self.n;
+        if n == 0.0 {
+            let mut m = Matrix6::identity();
+            for i in 0..3 {
+                m[(i, i + 3)] = t;
+            }
+            return m;
+        }
         let (s, c) = (n * t).sin_cos();
         #[rustfmt::skip]
         let m = Matrix6::new(
@@ -108,5 +117,32 @@ mod tests {
             x += (k1 + 2.0 * k2 + 2.0 * k3 + k4) * (h / 6.0);
         }
         assert!((ad * x0 + bd * f - x).norm() < 1e-12);
+    }
+
+    #[test]
+    fn zero_gravity_is_a_double_integrator() {
+        let cw = ClohessyWiltshire {
+            n: 0.0,
+            mass: 250.0,
+        };
+        let dt = 0.1;
+        let (ad, bd) = cw.discretize(dt);
+        let phi = cw.transition(dt);
+        assert!(
+            ad.iter()
+                .chain(bd.iter())
+                .chain(phi.iter())
+                .all(|x| x.is_finite())
+        );
+        assert!((ad - phi).norm() < 1e-15, "{ad} {phi}");
+        for i in 0..3 {
+            assert_eq!(phi[(i, i + 3)], dt);
+            assert!((bd[(i, i)] - 0.5 * dt * dt / cw.mass).abs() < 1e-18);
+            assert!((bd[(i + 3, i)] - dt / cw.mass).abs() < 1e-18);
+        }
+        // the closed form tends to the double integrator as n → 0 (Coriolis terms 2 n t)
+        let n = 1e-9;
+        let small = ClohessyWiltshire { n, mass: 250.0 }.transition(dt);
+        assert!((small - phi).norm() < 3.0 * n * dt, "{small}");
     }
 }

@@ -33,6 +33,15 @@ impl TwoBody {
         (self.mu / (a * a * a)).sqrt()
     }
 
+    /// Unit normal of the orbital plane with inclination `inc` and right ascension of
+    /// the ascending node `raan` [rad]: the direction of `r × v` of
+    /// [`Self::circular_state`], defined by the geometry alone (also for μ = 0).
+    pub fn orbit_normal(inc: f64, raan: f64) -> Vec3 {
+        let (si, ci) = inc.sin_cos();
+        let (so, co) = raan.sin_cos();
+        Vec3::new(si * so, -si * co, ci)
+    }
+
     /// Specific orbital energy `v²/2 − μ/|r|` [J/kg].
     pub fn specific_energy(&self, r: &Vec3, v: &Vec3) -> f64 {
         0.5 * v.norm_squared() - self.mu / r.norm()
@@ -40,7 +49,8 @@ impl TwoBody {
 
     /// Inertial position and velocity on a circular orbit of radius `a` [m] with
     /// inclination `inc`, right ascension of the ascending node `raan` and
-    /// argument of latitude `u` [rad].
+    /// argument of latitude `u` [rad]. With μ = 0 (zero gravity) the speed is 0: the
+    /// body rests at that position.
     pub fn circular_state(&self, a: f64, inc: f64, raan: f64, u: f64) -> (Vec3, Vec3) {
         let (su, cu) = u.sin_cos();
         let (si, ci) = inc.sin_cos();

@@ -162,7 +162,8 @@ impl Scenario {
     /// Checks every rule; returns the first broken one.
     pub fn validate(&self) -> Result<(), ScenarioError> {
         let o = &self.orbit;
-        positive("orbit.earth_mu_m3_s2", o.earth_mu_m3_s2)?;
+        // 0 is zero gravity (docs/SCENARIO.md): the target rests, the Hill frame is fixed
+        non_negative("orbit.earth_mu_m3_s2", o.earth_mu_m3_s2)?;
         positive("orbit.earth_radius_m", o.earth_radius_m)?;
         positive("orbit.altitude_m", o.altitude_m)?;
         finite("orbit.inclination_deg", o.inclination_deg)?;

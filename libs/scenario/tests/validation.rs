@@ -174,3 +174,17 @@ fn load_error_names_the_file() {
     assert!(matches!(e, ScenarioError::Io { .. }));
     assert!(e.to_string().contains("/nonexistent/scenario.toml"));
 }
+
+#[test]
+fn zero_gravity_is_allowed_negative_gravity_is_not() {
+    let s = Scenario::from_toml_str(&with("orbit", "earth_mu_m3_s2", "0.0"), &config_dir())
+        .expect("μ = 0 (zero gravity) is a valid scenario");
+    assert_eq!(s.orbit.earth_mu_m3_s2, 0.0);
+    let msg = reject(&with("orbit", "earth_mu_m3_s2", "-1.0"));
+    assert!(
+        msg.contains("orbit.earth_mu_m3_s2") && msg.contains(">= 0"),
+        "{msg}"
+    );
+    let msg = reject(&with("orbit", "earth_mu_m3_s2", "nan"));
+    assert!(msg.contains("orbit.earth_mu_m3_s2"), "{msg}");
+}

@@ -96,7 +96,7 @@ impl Simulator {
     /// The observation of the current state.
     pub fn observe(&self) -> Observation {
         let s = &self.state;
-        let hill = HillFrame::from_inertial(&s.r_t, &s.v_t);
+        let hill = HillFrame::from_inertial_or(&s.r_t, &s.v_t, &self.p.orbit_normal);
         let (r_h, v_h) = hill.relative_to_hill(&s.dr, &s.dv);
         let q_ri = quat::conj(&self.p.q_ir);
         let r_ri = quat::to_matrix(&q_ri);

@@ -135,6 +135,9 @@ impl SimState {
 #[derive(Debug, Clone)]
 pub(crate) struct Params {
     pub gravity: TwoBody,
+    /// Unit normal of the target's orbital plane (from inclination and RAAN): Ĥ of the
+    /// Hill frame when the orbit has none (μ = 0, the target at rest).
+    pub orbit_normal: Vector3<f64>,
     pub target_inertia: Matrix3<f64>,
     pub target_inertia_inv: Matrix3<f64>,
     /// `q_IR`: the reference frame's (constant) attitude in the inertial frame.
@@ -167,7 +170,9 @@ impl Simulator {
             o.raan_deg.to_radians(),
             o.argument_of_latitude_deg.to_radians(),
         );
-        let hill = HillFrame::from_inertial(&r_t, &v_t);
+        let orbit_normal =
+            TwoBody::orbit_normal(o.inclination_deg.to_radians(), o.raan_deg.to_radians());
+        let hill = HillFrame::from_inertial_or(&r_t, &v_t, &orbit_normal);
         let q_ih = quat::from_matrix(&hill.c_hi.transpose());
         let q_hr =
             quat::normalized(&scenario.reference_frame.attitude_in_hill).ok_or_else(|| {
@@ -199,6 +204,7 @@ impl Simulator {
         };
         let p = Params {
             gravity,
+            orbit_normal,
             target_inertia: ti,
             target_inertia_inv: ti_inv,
             q_ir,
