@@ -1,12 +1,12 @@
 //! Every output names the build that wrote it: `--version` gives the crate version and
 //! the git commit embedded by build.rs, and a run's summary.json carries both as
-//! `version` and `git_commit`.
+//! `version` and `git_commit`, and so does a Monte Carlo campaign's.
 
 use serde_json::Value;
 use std::process::Command;
 
 mod common;
-use common::{root, short_scenario, tmp};
+use common::{cli, root, short_scenario, tmp};
 
 /// The commit as build.rs embedded it for this build (the test is built by the same
 /// build script as the binary).
@@ -68,6 +68,38 @@ fn run_summary_names_version_and_commit() {
         }),
     )
     .unwrap();
+    assert_eq!(s["version"], env!("CARGO_PKG_VERSION"), "{s}");
+    assert_eq!(s["git_commit"], COMMIT, "{s}");
+}
+
+#[test]
+fn campaign_summary_names_version_and_commit() {
+    let d = tmp("build-info-mc");
+    let scenario = short_scenario(&d, 1.0);
+    let out = d.join("c");
+    let o = cli(
+        &[
+            "montecarlo",
+            "--runs",
+            "1",
+            "--jobs",
+            "1",
+            "-q",
+            "--scenario",
+            scenario.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_ne!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let s: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(s["version"], env!("CARGO_PKG_VERSION"), "{s}");
     assert_eq!(s["git_commit"], COMMIT, "{s}");
 }
