@@ -32,11 +32,16 @@ pub mod faults {
     /// No nominal command arrived (silent, dead or late controller): the QP ran on the
     /// subsystem's substitute nominal.
     pub const NOMINAL_MISSING: u32 = 1 << 7;
+    /// The exact active-set solver stopped at its iteration limit (degeneracy or cycling)
+    /// and Clarabel's solution of the same QP is the command (it holds every row to 1e-9
+    /// of the input bound); without one the backup law is used
+    /// ([`QP_FAILED_FALLBACK`]).
+    pub const QP_SECOND_OPINION: u32 = 1 << 8;
     /// All flags, for masks.
-    pub const ALL: u32 = (1 << 8) - 1;
+    pub const ALL: u32 = (1 << 9) - 1;
 
     /// Names of the flags in bit order.
-    pub const NAMES: [&str; 8] = [
+    pub const NAMES: [&str; 9] = [
         "invalid_state",
         "invalid_nominal",
         "invalid_coupling",
@@ -45,6 +50,7 @@ pub mod faults {
         "upstream_missing",
         "output_clamped",
         "nominal_missing",
+        "qp_second_opinion",
     ];
 }
 

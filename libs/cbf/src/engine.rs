@@ -57,8 +57,12 @@ pub struct Outcome<const M: usize> {
     pub violation: f64,
     /// Active-set changes (all stages).
     pub iterations: u32,
-    /// Multipliers of the barrier rows (0 when skipped).
+    /// Multipliers of the barrier rows (0 when skipped; 0 from the second opinion).
     pub row_duals: [f64; 64],
+    /// The active-set solver stopped at its iteration limit (degeneracy or cycling) and
+    /// the command is Clarabel's solution of the same hard problem (flagged by the
+    /// filters as [`crate::faults::QP_SECOND_OPINION`]).
+    pub second_opinion: bool,
 }
 
 /// The QP of one filter: `M` inputs, at most `N` rows (barrier rows + bound rows).
@@ -71,6 +75,8 @@ pub struct Engine<const M: usize, const N: usize> {
     skip_enabled: bool,
     /// Wall time spent in [`Self::solve_tiered`] since the last [`Self::take_qp_ns`] [ns].
     qp_ns: u64,
+    /// A solve since the last [`Self::take_qp_ns`] took Clarabel's second opinion.
+    second_opinion: bool,
 }
 
 impl<const M: usize, const N: usize> Default for Engine<M, N> {
@@ -81,14 +87,21 @@ impl<const M: usize, const N: usize> Default for Engine<M, N> {
 
 impl<const M: usize, const N: usize> Engine<M, N> {
     pub fn new() -> Self {
+        Self::with_settings(Settings::default())
+    }
+
+    /// With the active-set solver's settings (tests: a small iteration limit exercises
+    /// the second opinion).
+    pub fn with_settings(settings: Settings) -> Self {
         Self {
-            qp: ActiveSetQp::new(Settings::default()),
+            qp: ActiveSetQp::new(settings),
             a: [[0.0; M]; N],
             b: [0.0; N],
             w: [0.0; N],
             tier: [0; N],
             skip_enabled: true,
             qp_ns: 0,
+            second_opinion: false,
         }
     }
 
@@ -100,6 +113,11 @@ impl<const M: usize, const N: usize> Engine<M, N> {
     /// The wall time spent solving since the last call [ns] (and restarts the count).
     pub fn take_qp_ns(&mut self) -> u64 {
         std::mem::take(&mut self.qp_ns)
+    }
+
+    /// Whether a solve since the last call took Clarabel's second opinion (and resets).
+    pub fn take_second_opinion(&mut self) -> bool {
+        std::mem::take(&mut self.second_opinion)
     }
 
     /// Solves for `u_nom` with barrier `rows` (physical weights `weights`, > 0) and hard
@@ -155,6 +173,7 @@ impl<const M: usize, const N: usize> Engine<M, N> {
             violation: 0.0,
             iterations: 0,
             row_duals: [0.0; 64],
+            second_opinion: false,
         };
         let nb = rows.len();
         let n = nb + bounds.len();
@@ -221,13 +240,56 @@ impl<const M: usize, const N: usize> Engine<M, N> {
                     out.iterations += iters;
                 }
             }
-            Status::IterationLimit | Status::InvalidInput => {}
+            Status::IterationLimit => {
+                // degeneracy or cycling: Clarabel solves the same hard problem (allocates;
+                // a fault path), its answer accepted only if it holds every row
+                if let Some(u) = second_opinion(&u_nom, rows, bounds) {
+                    out.kind = Kind::Solved;
+                    out.u = u;
+                    out.second_opinion = true;
+                    self.second_opinion = true;
+                }
+            }
+            Status::InvalidInput => {}
         }
         if !out.u.iter().all(|x| x.is_finite()) {
             out.kind = Kind::Failed;
             out.u = u_nom;
         }
     }
+}
+
+/// Rows hold at the second opinion's command to this much of the input bound (Clarabel's
+/// tolerance is 1e-11; its point is pulled into the box by the filter's last clamp).
+const SECOND_OPINION_FEASIBILITY: f64 = 1e-9;
+
+/// Clarabel's solution of the hard problem (`None` when it fails, or when its point
+/// violates a row by more than [`SECOND_OPINION_FEASIBILITY`] of the input bound).
+fn second_opinion<const M: usize>(
+    u_nom: &SVector<f64, M>,
+    rows: &[Row<M>],
+    bounds: &[Row<M>],
+) -> Option<SVector<f64, M>> {
+    let qp = crate::verify::Qp::from_rows(u_nom, rows, bounds);
+    // the box's half-width: the largest c/‖a‖ of the bound rows (each a ≥ 0 half-space)
+    let half = bounds
+        .iter()
+        .filter_map(|r| {
+            let n = r.a.norm();
+            (n > 0.0 && r.c.is_finite()).then(|| r.c.abs() / n)
+        })
+        .fold(0.0f64, f64::max);
+    if half <= 0.0 {
+        return None;
+    }
+    let u = crate::verify::clarabel(&qp, half * (M as f64).sqrt())?;
+    let u = SVector::<f64, M>::from_iterator(u.iter().copied());
+    let tol = SECOND_OPINION_FEASIBILITY * half;
+    let holds = rows
+        .iter()
+        .chain(bounds)
+        .all(|r| r.phi(&u) >= -tol * r.a.norm().max(1.0));
+    (u.iter().all(|x| x.is_finite()) && holds).then_some(u)
 }
 
 impl<const M: usize, const N: usize> Engine<M, N> {

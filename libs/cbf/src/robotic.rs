@@ -615,9 +615,13 @@ impl RoboticFilter {
         let c0 = crate::common::thread_cpu_ns();
         let mut report = FilterReport::<N>::default();
         self.engine.take_qp_ns();
+        self.engine.take_second_opinion();
         let u = self.filter_inner(x, tau_nom, &mut report);
         report.solve_cpu_ns = crate::common::thread_cpu_ns().saturating_sub(c0);
         report.qp_time_ns = self.engine.take_qp_ns();
+        if self.engine.take_second_opinion() {
+            report.faults |= faults::QP_SECOND_OPINION;
+        }
         report.solve_time_ns = t0.elapsed().as_nanos().min(u64::MAX as u128) as u64;
         FilterOutput {
             u,
@@ -760,6 +764,7 @@ impl RoboticFilter {
             violation: report.violation,
             iterations: report.iterations,
             row_duals: [0.0; 64],
+            second_opinion: false,
         };
         self.last
             .record(&u_nom, &solved_rows, &weights, &hard, &outcome);

@@ -491,9 +491,13 @@ impl TranslationalFilter {
         let c0 = crate::common::thread_cpu_ns();
         let mut report = FilterReport::<N>::default();
         self.engine.take_qp_ns();
+        self.engine.take_second_opinion();
         let out = self.filter_inner(x, f_nom_h, &mut report);
         report.solve_cpu_ns = crate::common::thread_cpu_ns().saturating_sub(c0);
         report.qp_time_ns = self.engine.take_qp_ns();
+        if self.engine.take_second_opinion() {
+            report.faults |= faults::QP_SECOND_OPINION;
+        }
         report.solve_time_ns = t0.elapsed().as_nanos().min(u64::MAX as u128) as u64;
         FilterOutput {
             u: out.0,

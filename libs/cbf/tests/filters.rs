@@ -906,8 +906,10 @@ fn report_names_are_unique_and_dumps_serialise() {
     all.sort();
     all.dedup();
     assert_eq!(all.len(), 51, "names are unique");
-    assert_eq!(faults::NAMES.len(), 8);
+    assert_eq!(faults::NAMES.len(), 9);
     assert_eq!(faults::NOMINAL_MISSING, 1 << 7);
+    assert_eq!(faults::QP_SECOND_OPINION, 1 << 8);
+    assert_eq!(faults::ALL, (1 << faults::NAMES.len()) - 1);
     let s = scenario();
     // the safety layer: the servicer's mass, the robotic filter with the model
     let layer = sc_cbf::SafetyLayer::from_scenario(&s, robot());
@@ -923,4 +925,56 @@ fn report_names_are_unique_and_dumps_serialise() {
     assert_eq!(back.u_nom.len(), 3);
     assert_eq!(back.rows_a.len(), 3);
     assert_eq!(back.bounds_g.len(), 6);
+}
+
+/// When the active-set solver stops at its iteration limit, Clarabel's solution of the
+/// same hard problem is the command, flagged; it agrees with the exact solution.
+#[test]
+fn iteration_limit_takes_clarabels_second_opinion() {
+    let mut rng = Lcg(7);
+    let mut used = 0;
+    for _ in 0..50 {
+        // a random box-bounded problem whose nominal violates several rows
+        let barrier: Vec<Row<3>> = (0..6)
+            .map(|_| Row {
+                a: Vector3::new(rng.next(), rng.next(), rng.next()),
+                c: -0.5 * rng.next().abs(),
+            })
+            .collect();
+        let hard: Vec<Row<3>> = (0..6)
+            .map(|k| {
+                let mut a = Vector3::zeros();
+                a[k / 2] = if k % 2 == 0 { -1.0 } else { 1.0 };
+                Row { a, c: 2.0 }
+            })
+            .collect();
+        let u_nom = Vector3::new(rng.next(), rng.next(), rng.next()) * 1.5;
+        let w = vec![1.0; barrier.len()];
+        let mut exact = Engine::<3, 16>::new();
+        let want = exact.solve(&u_nom, &barrier, &w, &hard);
+        if want.kind != Kind::Solved || want.iterations < 2 {
+            continue;
+        }
+        let settings = sc_qp::Settings {
+            max_iterations: Some(1),
+            ..Default::default()
+        };
+        let mut limited = Engine::<3, 16>::with_settings(settings);
+        let got = limited.solve(&u_nom, &barrier, &w, &hard);
+        assert_eq!(got.kind, Kind::Solved, "{got:?}");
+        assert!(got.second_opinion && limited.take_second_opinion());
+        assert!(!limited.take_second_opinion(), "the flag resets");
+        assert!(
+            (got.u - want.u).amax() < 1e-7,
+            "{:?} vs {:?}",
+            got.u,
+            want.u
+        );
+        assert!(!want.second_opinion);
+        used += 1;
+    }
+    assert!(
+        used >= 5,
+        "only {used} problems needed two or more iterations"
+    );
 }
