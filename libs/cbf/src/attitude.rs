@@ -663,9 +663,8 @@ impl AttitudeFilter {
         let u = self.filter_inner(x, tau_nom, &mut report);
         report.solve_cpu_ns = crate::common::thread_cpu_ns().saturating_sub(c0);
         report.qp_time_ns = self.engine.take_qp_ns();
-        if self.engine.take_second_opinion() {
-            report.faults |= faults::QP_SECOND_OPINION;
-        }
+        // (the flag comes from the outcome whose command is used)
+        self.engine.take_second_opinion();
         report.solve_time_ns = t0.elapsed().as_nanos().min(u64::MAX as u128) as u64;
         FilterOutput {
             u,
@@ -781,6 +780,9 @@ impl AttitudeFilter {
             .record(&u_nom, &rows, &p.weights, &solved_hard[..n_hard], &res);
         report.iterations = res.iterations;
         report.violation = res.violation;
+        if res.second_opinion {
+            report.faults |= faults::QP_SECOND_OPINION;
+        }
         let mut tau = res.u;
         match res.kind {
             Kind::Skipped => report.status = FilterStatus::Skipped,

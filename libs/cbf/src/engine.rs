@@ -75,7 +75,8 @@ pub struct Engine<const M: usize, const N: usize> {
     skip_enabled: bool,
     /// Wall time spent in [`Self::solve_tiered`] since the last [`Self::take_qp_ns`] [ns].
     qp_ns: u64,
-    /// A solve since the last [`Self::take_qp_ns`] took Clarabel's second opinion.
+    /// A solve since the last [`Self::take_second_opinion`] took Clarabel's second
+    /// opinion (then no further one is taken before the next call: one per filter step).
     second_opinion: bool,
 }
 
@@ -240,9 +241,10 @@ impl<const M: usize, const N: usize> Engine<M, N> {
                     out.iterations += iters;
                 }
             }
-            Status::IterationLimit => {
-                // degeneracy or cycling: Clarabel solves the same hard problem (allocates;
-                // a fault path), its answer accepted only if it holds every row
+            // degeneracy or cycling: Clarabel solves the same hard problem (allocates; a
+            // fault path, so at most once between two `take_second_opinion` calls — once
+            // per filter step), its answer accepted only if it holds every row
+            Status::IterationLimit if !self.second_opinion => {
                 if let Some(u) = second_opinion(&u_nom, rows, bounds) {
                     out.kind = Kind::Solved;
                     out.u = u;
@@ -250,7 +252,7 @@ impl<const M: usize, const N: usize> Engine<M, N> {
                     self.second_opinion = true;
                 }
             }
-            Status::InvalidInput => {}
+            Status::IterationLimit | Status::InvalidInput => {}
         }
         if !out.u.iter().all(|x| x.is_finite()) {
             out.kind = Kind::Failed;
@@ -284,11 +286,16 @@ fn second_opinion<const M: usize>(
     }
     let u = crate::verify::clarabel(&qp, half * (M as f64).sqrt())?;
     let u = SVector::<f64, M>::from_iterator(u.iter().copied());
+    // in distance: φ/‖a‖ (a zero row holds when its constant does)
     let tol = SECOND_OPINION_FEASIBILITY * half;
-    let holds = rows
-        .iter()
-        .chain(bounds)
-        .all(|r| r.phi(&u) >= -tol * r.a.norm().max(1.0));
+    let holds = rows.iter().chain(bounds).all(|r| {
+        let n = r.a.norm();
+        if n > 0.0 {
+            r.phi(&u) / n >= -tol
+        } else {
+            r.c >= 0.0
+        }
+    });
     (u.iter().all(|x| x.is_finite()) && holds).then_some(u)
 }
 

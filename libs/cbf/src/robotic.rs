@@ -352,7 +352,8 @@ fn finite_in<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>, max: f64) -
     if max.is_nan() || max < 0.0 {
         return false;
     }
-    let limit = max.min(f64::MAX).to_bits();
+    // `abs`: −0.0 would keep its sign bit and let every magnitude through
+    let limit = max.abs().min(f64::MAX).to_bits();
     m.as_slice()
         .iter()
         .fold(true, |ok, v| ok & (v.to_bits() & !SIGN_BIT <= limit))
@@ -619,9 +620,8 @@ impl RoboticFilter {
         let u = self.filter_inner(x, tau_nom, &mut report);
         report.solve_cpu_ns = crate::common::thread_cpu_ns().saturating_sub(c0);
         report.qp_time_ns = self.engine.take_qp_ns();
-        if self.engine.take_second_opinion() {
-            report.faults |= faults::QP_SECOND_OPINION;
-        }
+        // (the flag comes from the outcome whose command is used)
+        self.engine.take_second_opinion();
         report.solve_time_ns = t0.elapsed().as_nanos().min(u64::MAX as u128) as u64;
         FilterOutput {
             u,
@@ -711,6 +711,9 @@ impl RoboticFilter {
         }
         let mut tau = res.u;
         if certified {
+            if res.second_opinion {
+                report.faults |= faults::QP_SECOND_OPINION;
+            }
             report.status = if res.kind == Kind::Skipped {
                 FilterStatus::Skipped
             } else {
@@ -792,7 +795,7 @@ impl RoboticFilter {
     ) -> Option<(Vector7, [Row<NJ>; N], f64)> {
         let robot = self.robot.clone()?;
         let mut margin = [0.0; N];
-        let mut best: Option<(f64, Vector7, [Row<NJ>; N])> = None;
+        let mut best: Option<(f64, Vector7, [Row<NJ>; N], bool)> = None;
         for _ in 0..MAX_VERIFY_ROUNDS {
             let rows = self.barrier_rows(x, terms, Level::Local, &margin);
             let res = self.engine.solve(u_nom, &rows, weights, hard);
@@ -808,10 +811,13 @@ impl RoboticFilter {
                 } else {
                     0.0
                 };
+                if res.second_opinion {
+                    report.faults |= faults::QP_SECOND_OPINION;
+                }
                 return Some((res.u, rows, violation));
             }
             if best.as_ref().is_none_or(|b| v.worst > b.0) {
-                best = Some((v.worst, res.u, rows));
+                best = Some((v.worst, res.u, rows, res.second_opinion));
             }
             for (m, s) in margin.iter_mut().zip(&v.shortfall) {
                 *m += VERIFY_GAIN * s;
@@ -819,7 +825,10 @@ impl RoboticFilter {
         }
         // a sample whose integration failed reports a full violation (the command itself
         // is still inside the box: the relaxed problem's hard rows hold)
-        best.map(|(worst, u, rows)| {
+        best.map(|(worst, u, rows, second_opinion)| {
+            if second_opinion {
+                report.faults |= faults::QP_SECOND_OPINION;
+            }
             let v = if worst.is_finite() {
                 (-worst).max(f64::MIN_POSITIVE)
             } else {
@@ -1096,7 +1105,7 @@ mod tests {
                 let m = nalgebra::Vector2::new(a, b);
                 let finite = a.is_finite() && b.is_finite();
                 assert_eq!(common::finite(&m), finite, "{a} {b}");
-                for max in [0.0, 2.0, f64::MAX, f64::INFINITY, -1.0, f64::NAN] {
+                for max in [0.0, -0.0, 2.0, f64::MAX, f64::INFINITY, -1.0, f64::NAN] {
                     let want = finite && m.amax() <= max;
                     assert_eq!(finite_in(&m, max), want, "{a} {b} max {max}");
                 }

@@ -495,9 +495,8 @@ impl TranslationalFilter {
         let out = self.filter_inner(x, f_nom_h, &mut report);
         report.solve_cpu_ns = crate::common::thread_cpu_ns().saturating_sub(c0);
         report.qp_time_ns = self.engine.take_qp_ns();
-        if self.engine.take_second_opinion() {
-            report.faults |= faults::QP_SECOND_OPINION;
-        }
+        // (the flag comes from the outcome whose command is used)
+        self.engine.take_second_opinion();
         report.solve_time_ns = t0.elapsed().as_nanos().min(u64::MAX as u128) as u64;
         FilterOutput {
             u: out.0,
@@ -524,6 +523,9 @@ impl TranslationalFilter {
         let (u_nom, flag) = common::resolve_nominal(f_nom_h, fmax, || self.brake_prepared(x, &p).0);
         report.faults |= flag;
         let res = self.engine.solve(&u_nom, &p.rows, &p.weights, &p.bounds);
+        if res.second_opinion {
+            report.faults |= faults::QP_SECOND_OPINION;
+        }
         self.last
             .record(&u_nom, &p.rows, &p.weights, &p.bounds, &res);
         report.iterations = res.iterations;

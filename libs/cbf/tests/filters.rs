@@ -962,8 +962,13 @@ fn iteration_limit_takes_clarabels_second_opinion() {
         let mut limited = Engine::<3, 16>::with_settings(settings);
         let got = limited.solve(&u_nom, &barrier, &w, &hard);
         assert_eq!(got.kind, Kind::Solved, "{got:?}");
+        // one second opinion per filter step: a second limited solve before the reset
+        // gets none (the filter's braking law then)
+        let again = limited.solve(&u_nom, &barrier, &w, &hard);
+        assert_eq!(again.kind, Kind::Failed, "{again:?}");
         assert!(got.second_opinion && limited.take_second_opinion());
         assert!(!limited.take_second_opinion(), "the flag resets");
+        assert!(limited.solve(&u_nom, &barrier, &w, &hard).second_opinion);
         assert!(
             (got.u - want.u).amax() < 1e-7,
             "{:?} vs {:?}",

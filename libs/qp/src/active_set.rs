@@ -627,7 +627,8 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
     }
 }
 
-/// Bit-for-bit equality (so `-0.0 ≠ 0.0` and a NaN is never equal).
+/// Bit-for-bit equality (so `-0.0 ≠ 0.0`; the cached rows never hold a NaN: a row with one
+/// is refused before it is cached).
 #[inline]
 fn same_bits<const M: usize>(u: &[f64; M], v: &[f64; M]) -> bool {
     u.iter()
