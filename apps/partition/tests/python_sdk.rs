@@ -271,6 +271,8 @@ fn offline_harness_gives_one_command_per_due_step() {
             .args(args)
             .current_dir(&*dir)
             .env("PYTHONPATH", repo().join("scripts/python"))
+            // no __pycache__ left in the checkout
+            .env("PYTHONDONTWRITEBYTECODE", "1")
             .output()
             .unwrap()
     };
