@@ -92,6 +92,10 @@ pub struct CampaignInfo {
     /// How the runs executed (absent: in-process).
     #[serde(default, skip_serializing_if = "Execution::is_in_process")]
     pub execution: Execution,
+    /// The build that ran the campaign (version and git commit): `--resume` and `merge`
+    /// refuse to mix runs of different builds. Absent in campaigns of earlier versions.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub build: Option<sc_mission::build::BuildInfo>,
 }
 
 /// How a campaign is run.
@@ -380,6 +384,18 @@ fn check_resume(
             saved.execution, info.execution
         ));
     }
+    if saved.build != info.build {
+        let name = |b: &Option<sc_mission::build::BuildInfo>| {
+            b.as_ref().map_or("an unrecorded build".into(), |b| {
+                format!("build {} ({})", b.version, b.git_commit)
+            })
+        };
+        diff.push(format!(
+            "runs of {} (this is {})",
+            name(&saved.build),
+            name(&info.build)
+        ));
+    }
     let saved_urdf = std::fs::read(out.join(&saved.urdf)).ok();
     if saved.urdf != info.urdf || saved_urdf.as_deref() != Some(urdf) {
         diff.push("another servicer URDF".into());
@@ -585,6 +601,7 @@ pub fn run_campaign_with(
         urdf,
         config: opts.config.clone(),
         execution: executor.execution(),
+        build: Some(sc_mission::build::current()),
     };
     let (urdf_bytes, base_text) = base_files(&setup, &info)?;
     let indices = shard_runs(opts.runs, opts.shard);
@@ -1144,11 +1161,12 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<CampaignSummary, McError> {
             && info.config == info0.config
             && info.urdf == info0.urdf
             && info.execution == info0.execution
+            && info.build == info0.build
             && read(&d.join("base_scenario.toml"))? == base0
             && std::fs::read(d.join(&info.urdf)).map_err(io(&d.join(&info.urdf)))? == urdf0;
         if !same {
             return Err(McError::Invalid(format!(
-                "merge: {} belongs to a different campaign than {} (seed, runs, config, scenario or execution mode differ)",
+                "merge: {} belongs to a different campaign than {} (seed, runs, config, scenario, execution mode or build differ)",
                 d.display(),
                 first.display()
             )));

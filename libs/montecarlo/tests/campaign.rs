@@ -533,6 +533,19 @@ fn resume_refuses_another_campaign() {
     other.resume = true;
     let m = run_campaign(&other).unwrap_err().to_string();
     assert!(m.contains("another base scenario"), "{m}");
+    // runs of another build (here: campaign.json names another commit)
+    let json = base.join("c/campaign.json");
+    let text = std::fs::read_to_string(&json).unwrap();
+    let mut j: serde_json::Value = serde_json::from_str(&text).unwrap();
+    j["build"]["git_commit"] = serde_json::json!("0000000");
+    std::fs::write(&json, serde_json::to_string_pretty(&j).unwrap()).unwrap();
+    let mut same = options(sc.clone(), base.join("c"), 2);
+    same.resume = true;
+    let m = run_campaign(&same).unwrap_err().to_string();
+    assert!(
+        m.contains("runs of build") && m.contains("(0000000)"),
+        "{m}"
+    );
     let mut none = options(sc, base.join("empty"), 2);
     none.resume = true;
     let m = run_campaign(&none).unwrap_err().to_string();
