@@ -358,7 +358,19 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
     let mut spawn_err = None;
     for role in ROLES {
         let e = &cfg.roles[role];
-        let log = std::fs::File::create(out.join("logs").join(format!("{role}.log")))?;
+        // a log that cannot be opened stops the start like a process that cannot start:
+        // the processes already running are torn down below, not left behind
+        let path = out.join("logs").join(format!("{role}.log"));
+        let log = match std::fs::File::create(&path).and_then(|l| Ok((l.try_clone()?, l))) {
+            Ok(l) => l,
+            Err(err) => {
+                spawn_err = Some(format!(
+                    "cannot open the log of role `{role}` ({}): {err}",
+                    path.display()
+                ));
+                break;
+            }
+        };
         let mut cmd = Command::new(&e.exec);
         cmd.args(&e.args);
         if !e.no_standard_args {
@@ -368,8 +380,8 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
             .env(crate::process::CONFIG_ENV, &eff)
             .env(crate::process::OUT_ENV, &out)
             .stdin(Stdio::null())
-            .stdout(log.try_clone()?)
-            .stderr(log);
+            .stdout(log.0)
+            .stderr(log.1);
         match cmd.spawn() {
             Ok(child) => procs.push(Proc {
                 role: role.to_string(),
