@@ -227,11 +227,22 @@ fn check_plant_program(program: &str, base_dir: &Path) -> Result<(), ConfigError
     }
 }
 
-/// The script an interpreter is asked to run: the first argument that is not an option,
-/// when it names a path (contains `/`, no blanks), must exist relative to the config's directory
-/// (where the launcher looks first) or to the working directory.
+/// File extensions of the scripts a role's interpreter may be asked to run.
+const SCRIPT_EXTENSIONS: [&str; 2] = ["py", "sh"];
+
+/// The script an interpreter is asked to run: the first argument that is not an option
+/// and has a script extension ([`SCRIPT_EXTENSIONS`]; an option's value such as a log
+/// path is not taken for one), when it names a path (contains `/`, no blanks), must exist
+/// relative to the config's directory (where the launcher looks first) or to the working
+/// directory.
 fn check_script(who: &str, key: &str, args: &[String], base_dir: &Path) -> Result<(), ConfigError> {
-    let Some(script) = args.iter().find(|a| !a.starts_with('-')) else {
+    let is_script = |a: &&String| {
+        !a.starts_with('-')
+            && Path::new(a.as_str())
+                .extension()
+                .is_some_and(|e| SCRIPT_EXTENSIONS.iter().any(|s| e == *s))
+    };
+    let Some(script) = args.iter().find(is_script) else {
         return Ok(());
     };
     // a path, not a command line (`sh -c "cmd …"`) nor a value
@@ -353,6 +364,20 @@ mod tests {
         assert!(check_programs(&config(&d.0, &with_args("./partner.py"), ""), &None).is_ok());
         // a command line is no script path
         assert!(check_programs(&config(&d.0, &with_args("exec ./gone.py --x"), ""), &None).is_ok());
+        // an option's value with a path is not taken for the script: the script after it is
+        let log_first = |script: &str| {
+            roles_all("./prog").replace(
+                "[roles.nominal_attitude]\nexec = \"./prog\"\n",
+                &format!(
+                    "[roles.nominal_attitude]\nexec = \"./prog\"\nargs = [\"--log\", \"out/partner.log\", \"{script}\"]\n"
+                ),
+            )
+        };
+        assert!(check_programs(&config(&d.0, &log_first("./partner.py"), ""), &None).is_ok());
+        let e = check_programs(&config(&d.0, &log_first("./gone.py"), ""), &None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("the script \"./gone.py\""), "{e}");
         let e = check_programs(&config(&d.0, &with_args("./gone.py"), ""), &None)
             .unwrap_err()
             .to_string();
