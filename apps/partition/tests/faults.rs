@@ -309,5 +309,7 @@ fn a_role_that_never_joins_is_named() {
         "{rep:?}"
     );
     assert!(rep.leftovers.is_empty(), "{rep:?}");
+    // a start that failed leaves no (empty) recording behind
+    assert!(!out.join("recording.mcap").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }

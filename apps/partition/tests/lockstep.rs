@@ -70,6 +70,26 @@ fn lock_step_telemetry_is_identical_to_in_process_run() {
     }
     assert_eq!(states, b["steps"].as_u64().unwrap());
     assert_eq!(last as f64 * 1e-9, b["final_time_s"].as_f64().unwrap());
+    // the run's metadata record: the build and the scenario and config it ran
+    let summ = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let idx = summ
+        .metadata_indexes
+        .iter()
+        .find(|i| i.name == sc_partition::recorder::MCAP_METADATA_NAME)
+        .expect("metadata record");
+    let meta = mcap::read::metadata(&bytes, idx).unwrap().metadata;
+    assert_eq!(meta["version"], b["version"].as_str().unwrap());
+    assert_eq!(meta["git_commit"], b["git_commit"].as_str().unwrap());
+    // the config the processes ran: the launcher's resolved copy of `config`
+    assert_eq!(
+        meta["partition_config"],
+        std::fs::read_to_string(&meta["partition_config_path"]).unwrap()
+    );
+    assert!(meta["partition_config"].contains("clock = \"lock_step\""));
+    assert_eq!(
+        meta["scenario"],
+        std::fs::read_to_string(&meta["scenario_path"]).unwrap()
+    );
     let r: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("recorder.json")).unwrap()).unwrap();
     assert_eq!(

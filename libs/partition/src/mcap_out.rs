@@ -307,6 +307,22 @@ impl McapOut {
         Ok(())
     }
 
+    /// Writes an MCAP `Metadata` record `name` with the key/value pairs `entries`
+    /// (Foxglove shows them in its "Metadata" panel of the file).
+    pub fn write_metadata(
+        &mut self,
+        name: &str,
+        entries: BTreeMap<String, String>,
+    ) -> anyhow::Result<()> {
+        self.w
+            .write_metadata(&mcap::records::Metadata {
+                name: name.to_string(),
+                metadata: entries,
+            })
+            .context("mcap metadata")?;
+        Ok(())
+    }
+
     /// Writes the summary section and closes the file.
     pub fn finish(&mut self) -> anyhow::Result<()> {
         self.w.finish().context("mcap finish")?;
@@ -384,6 +400,38 @@ mod tests {
             sc_icd::N_CONSTRAINTS_ROBOTIC
         );
         assert_eq!(v["h"][41], 0.5);
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// A metadata record reads back by name with its key/value pairs, beside messages.
+    #[test]
+    fn metadata_record_reads_back() {
+        let dir = std::env::temp_dir().join(format!("sc-mcap-meta-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("m.mcap");
+        let entries = BTreeMap::from([
+            ("version".to_string(), "1.2.3".to_string()),
+            (
+                "scenario".to_string(),
+                "[mission]\nname = \"x\"\n".to_string(),
+            ),
+        ]);
+        let mut out = McapOut::create(&path).unwrap();
+        out.write_metadata("safe-capture", entries.clone()).unwrap();
+        let state = sc_icd::SimState::default();
+        out.write("sim/state", 0, 1, &state).unwrap();
+        out.finish().unwrap();
+        drop(out);
+
+        let bytes = std::fs::read(&path).unwrap();
+        let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+        assert_eq!(summary.metadata_indexes.len(), 1);
+        let idx = &summary.metadata_indexes[0];
+        assert_eq!(idx.name, "safe-capture");
+        let m = mcap::read::metadata(&bytes, idx).unwrap();
+        assert_eq!(m.name, "safe-capture");
+        assert_eq!(m.metadata, entries);
+        assert_eq!(mcap::MessageStream::new(&bytes).unwrap().count(), 1);
         std::fs::remove_dir_all(&dir).ok();
     }
 }

@@ -20,6 +20,8 @@ pub struct Proc {
     pub run: RunScope,
     pub node: BusNode,
     pub cfg: PartitionConfig,
+    /// The partition config file this process was started with (`--config`).
+    pub config_path: PathBuf,
     pub schedule: Schedule,
     pub setup: Setup,
     pub out: PathBuf,
@@ -92,6 +94,7 @@ impl Proc {
             run,
             node,
             cfg,
+            config_path: config,
             schedule,
             setup,
             out,

@@ -51,6 +51,34 @@ struct Tickset {
 }
 
 /// The recorder process.
+/// Name of the MCAP `Metadata` record describing the run ([`run_metadata`]).
+pub const MCAP_METADATA_NAME: &str = "safe-capture";
+
+/// The run as MCAP metadata: the build (`version`, `git_commit`), the scenario (its
+/// resolved path and full text, so a recording replays without the file) and the
+/// partition config (its path and full text).
+fn run_metadata(p: &Proc) -> anyhow::Result<BTreeMap<String, String>> {
+    let build = sc_mission::build::current();
+    let scenario_path = p.cfg.scenario_path();
+    let read = |path: &std::path::Path| {
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
+    };
+    Ok(BTreeMap::from([
+        ("version".to_string(), build.version),
+        ("git_commit".to_string(), build.git_commit),
+        (
+            "scenario_path".to_string(),
+            scenario_path.display().to_string(),
+        ),
+        ("scenario".to_string(), read(&scenario_path)?),
+        (
+            "partition_config_path".to_string(),
+            p.config_path.display().to_string(),
+        ),
+        ("partition_config".to_string(), read(&p.config_path)?),
+    ]))
+}
+
 pub fn recorder() -> anyhow::Result<i32> {
     let p = Proc::start("recorder")?;
     // MCAP log time: the mission's own clock (tick × base period), so that a recording
@@ -97,7 +125,6 @@ pub fn recorder() -> anyhow::Result<i32> {
         latency,
         "tick,tick_send_ns,sim_recv_ns,state_publish_ns,nom_t_publish_ns,nom_a_publish_ns,nom_r_publish_ns,safe_t_recv_ns,safe_t_publish_ns,safe_a_recv_ns,safe_a_publish_ns,safe_r_recv_ns,safe_r_publish_ns,sim_safe_recv_ns,result_publish_ns,fallback_mask,held_mask,upstream_missing_mask"
     )?;
-    let mut mcap = crate::mcap_out::McapOut::create(&p.out.join("recording.mcap"))?;
     let mut layer = SafetyLayer::from_scenario(&p.setup.scenario, p.setup.robot.clone());
     let robot = p.setup.robot.clone();
     let phase_names: Vec<String> = p
@@ -109,6 +136,11 @@ pub fn recorder() -> anyhow::Result<i32> {
         .map(|x| x.name.clone())
         .collect();
     p.handshake()?;
+    // The MCAP is created only once the partition has started: a start that fails
+    // (or a recorder killed in the handshake) leaves no recording.mcap behind, rather
+    // than an empty one (its header sits in the write buffer until the first chunk).
+    let mut mcap = crate::mcap_out::McapOut::create(&p.out.join("recording.mcap"))?;
+    mcap.write_metadata(MCAP_METADATA_NAME, run_metadata(&p)?)?;
     let mut rep = RecorderReport::default();
     let mut pending: BTreeMap<u64, Tickset> = BTreeMap::new();
     let mut queued: Vec<StepResult> = Vec::new();
