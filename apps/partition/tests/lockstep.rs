@@ -55,9 +55,15 @@ fn lock_step_telemetry_is_identical_to_in_process_run() {
     // mission, not the host's uptime), the host's clock stays in publish_time
     let bytes = std::fs::read(out.join("recording.mcap")).unwrap();
     assert!(bytes.len() > 1000);
-    let (mut states, mut last) = (0u64, 0u64);
+    let (mut states, mut last, mut frames) = (0u64, 0u64, 0u64);
     for m in mcap::MessageStream::new(&bytes).unwrap() {
         let m = m.unwrap();
+        if m.channel.topic == sc_partition::mcap_out::TF_TOPIC {
+            let s = m.channel.schema.as_ref().unwrap();
+            assert_eq!(s.name, "foxglove.FrameTransform");
+            frames += 1;
+            continue;
+        }
         if m.channel.topic != "safe_capture/sim/state" {
             continue;
         }
@@ -69,6 +75,8 @@ fn lock_step_telemetry_is_identical_to_in_process_run() {
         last = last.max(m.log_time);
     }
     assert_eq!(states, b["steps"].as_u64().unwrap());
+    // reference → servicer body, reference → target body, body → end effector
+    assert_eq!(frames, 3 * states);
     assert_eq!(last as f64 * 1e-9, b["final_time_s"].as_f64().unwrap());
     // the run's metadata record: the build and the scenario and config it ran
     let summ = mcap::Summary::read(&bytes).unwrap().unwrap();

@@ -231,6 +231,125 @@ json_msg!(StepResult {
     tau
 });
 
+/// Topic of the frame transforms (Foxglove's 3D panel reads `foxglove.FrameTransform`).
+pub const TF_TOPIC: &str = "/tf";
+/// Frame id of the reference frame F_R (origin at the target's centre of mass).
+pub const FRAME_REFERENCE: &str = "reference";
+/// Frame id of the servicer body frame F_B (origin at the base origin).
+pub const FRAME_SERVICER: &str = "servicer_body";
+/// Frame id of the target body frame F_T (origin at the target's centre of mass).
+pub const FRAME_TARGET: &str = "target_body";
+/// Frame id of the end effector (its position only: see [`FrameTransform`]).
+pub const FRAME_END_EFFECTOR: &str = "end_effector";
+/// Nanoseconds per second, for Foxglove's `{sec, nsec}` timestamps.
+const NS_PER_S: u64 = 1_000_000_000;
+
+/// One `foxglove.FrameTransform`: the pose of `child` in `parent`. `rotation` is
+/// Foxglove's `[x, y, z, w]`, rotating child-frame vectors into the parent frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrameTransform {
+    /// Mission time [ns].
+    pub log_ns: u64,
+    pub parent: &'static str,
+    pub child: &'static str,
+    /// Child origin in the parent frame [m].
+    pub translation: [f64; 3],
+    /// Unit quaternion `[x, y, z, w]` [-].
+    pub rotation: [f64; 4],
+}
+
+/// A project quaternion q_AB (scalar first, rotates F_B vectors into F_A) as
+/// Foxglove's rotation of child B in parent A: the same rotation, scalar last.
+pub fn foxglove_rotation(q_ab: [f64; 4]) -> [f64; 4] {
+    [q_ab[1], q_ab[2], q_ab[3], q_ab[0]]
+}
+
+impl FrameTransform {
+    /// The frames a state message carries: reference → servicer body (`r_r`, `q_rb`),
+    /// reference → target body (the target's centre of mass is F_R's origin; `q_rt`) and
+    /// servicer body → end effector (`ee_b`; the state carries no end-effector
+    /// attitude, so this frame keeps the body's orientation).
+    pub fn of_state(s: &sc_icd::SimState, log_ns: u64) -> [Self; 3] {
+        const IDENTITY: [f64; 4] = [0.0, 0.0, 0.0, 1.0];
+        [
+            Self {
+                log_ns,
+                parent: FRAME_REFERENCE,
+                child: FRAME_SERVICER,
+                translation: s.r_r,
+                rotation: foxglove_rotation(s.q_rb),
+            },
+            Self {
+                log_ns,
+                parent: FRAME_REFERENCE,
+                child: FRAME_TARGET,
+                translation: [0.0; 3],
+                rotation: foxglove_rotation(s.q_rt),
+            },
+            Self {
+                log_ns,
+                parent: FRAME_SERVICER,
+                child: FRAME_END_EFFECTOR,
+                translation: s.ee_b,
+                rotation: IDENTITY,
+            },
+        ]
+    }
+}
+
+impl JsonMsg for FrameTransform {
+    fn write_json(&self, out: &mut Vec<u8>) {
+        let [x, y, z] = self.translation;
+        let [qx, qy, qz, qw] = self.rotation;
+        let _ = serde_json::to_writer(
+            &mut *out,
+            &json!({
+                "timestamp": {"sec": self.log_ns / NS_PER_S, "nsec": self.log_ns % NS_PER_S},
+                "parent_frame_id": self.parent,
+                "child_frame_id": self.child,
+                "translation": {"x": x, "y": y, "z": z},
+                "rotation": {"x": qx, "y": qy, "z": qz, "w": qw},
+            }),
+        );
+    }
+    /// Foxglove's `foxglove.FrameTransform` JSON schema (docs.foxglove.dev).
+    fn json_schema() -> Value {
+        let num = |d: &str| json!({"type": "number", "description": d});
+        let int = |d: &str| json!({"type": "integer", "minimum": 0, "description": d});
+        let string = |d: &str| json!({"type": "string", "description": d});
+        json!({
+            "title": "foxglove.FrameTransform",
+            "description": "A transform between two reference frames in 3D space",
+            "type": "object",
+            "properties": {
+                "timestamp": {
+                    "type": "object",
+                    "title": "time",
+                    "description": "Timestamp of transform (mission time)",
+                    "properties": {"sec": int("seconds"), "nsec": int("nanoseconds")}
+                },
+                "parent_frame_id": string("Name of the parent frame"),
+                "child_frame_id": string("Name of the child frame"),
+                "translation": {
+                    "type": "object",
+                    "title": "foxglove.Vector3",
+                    "description": "Translation component of the transform [m]",
+                    "properties": {"x": num("x [m]"), "y": num("y [m]"), "z": num("z [m]")}
+                },
+                "rotation": {
+                    "type": "object",
+                    "title": "foxglove.Quaternion",
+                    "description": "Rotation component of the transform (rotates child-frame vectors into the parent frame)",
+                    "properties": {"x": num("x [-]"), "y": num("y [-]"), "z": num("z [-]"), "w": num("w [-]")}
+                }
+            }
+        })
+    }
+    fn name() -> &'static str {
+        "foxglove.FrameTransform"
+    }
+}
+
 /// The MCAP file being written.
 pub struct McapOut {
     w: mcap::Writer<BufWriter<std::fs::File>>,
@@ -304,6 +423,19 @@ impl McapOut {
             )
             .context("mcap write")?;
         *self.written.entry(topic.to_string()).or_default() += 1;
+        Ok(())
+    }
+
+    /// Writes the frame transforms of state `s` on [`TF_TOPIC`] ([`FrameTransform::of_state`]).
+    pub fn write_frames(
+        &mut self,
+        log_ns: u64,
+        publish_ns: u64,
+        s: &sc_icd::SimState,
+    ) -> anyhow::Result<()> {
+        for f in FrameTransform::of_state(s, log_ns) {
+            self.write(TF_TOPIC, log_ns, publish_ns, &f)?;
+        }
         Ok(())
     }
 
@@ -432,6 +564,93 @@ mod tests {
         assert_eq!(m.name, "safe-capture");
         assert_eq!(m.metadata, entries);
         assert_eq!(mcap::MessageStream::new(&bytes).unwrap().count(), 1);
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// Foxglove's rotation of a child frame, `[x, y, z, w]` applied as `v' = q v q*`
+    /// (its convention: child-frame vectors into the parent frame).
+    fn foxglove_rotate(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
+        let [x, y, z, w] = q;
+        let u = nalgebra::Vector3::new(x, y, z);
+        let v = nalgebra::Vector3::new(v[0], v[1], v[2]);
+        let t = 2.0 * u.cross(&v);
+        let r = v + w * t + u.cross(&t);
+        [r[0], r[1], r[2]]
+    }
+
+    /// The frames of a state: the project's q_AB (scalar first) rotates a child (B)
+    /// vector into the parent (A) exactly as Foxglove's rotation does; the positions are
+    /// the state's; the channel reads back as `foxglove.FrameTransform` JSON.
+    #[test]
+    fn state_frames_follow_foxglove_convention_and_read_back() {
+        let n = (0.3f64 * 0.3 + 0.5 * 0.5 + 0.1 * 0.1 + 0.8 * 0.8).sqrt();
+        let q_rb = [0.8 / n, 0.3 / n, -0.5 / n, 0.1 / n];
+        let q_rt = [0.6, 0.0, 0.8, 0.0];
+        let state = sc_icd::SimState {
+            tick: 12,
+            r_r: [1.0, -2.0, 3.5],
+            q_rb,
+            q_rt,
+            ee_b: [0.25, 0.5, -0.75],
+            ..Default::default()
+        };
+        let log_ns = 1_200_000_123;
+        let frames = FrameTransform::of_state(&state, log_ns);
+        let v = [0.2, -1.0, 0.7];
+        for (f, q) in [(&frames[0], q_rb), (&frames[1], q_rt)] {
+            let ours = sc_models::quat::rotate(&q, &nalgebra::Vector3::new(v[0], v[1], v[2]));
+            let theirs = foxglove_rotate(f.rotation, v);
+            for k in 0..3 {
+                assert!((ours[k] - theirs[k]).abs() < 1e-12, "{ours:?} {theirs:?}");
+            }
+        }
+        assert_eq!(
+            (frames[0].parent, frames[0].child),
+            (FRAME_REFERENCE, FRAME_SERVICER)
+        );
+        assert_eq!(frames[0].translation, state.r_r);
+        assert_eq!(
+            (frames[1].parent, frames[1].child),
+            (FRAME_REFERENCE, FRAME_TARGET)
+        );
+        assert_eq!(frames[1].translation, [0.0; 3]);
+        assert_eq!(
+            (frames[2].parent, frames[2].child),
+            (FRAME_SERVICER, FRAME_END_EFFECTOR)
+        );
+        assert_eq!(frames[2].translation, state.ee_b);
+
+        let dir = std::env::temp_dir().join(format!("sc-mcap-tf-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("tf.mcap");
+        let mut out = McapOut::create(&path).unwrap();
+        out.write_frames(log_ns, 7, &state).unwrap();
+        out.finish().unwrap();
+        assert_eq!(out.written[TF_TOPIC], 3);
+        drop(out);
+        let bytes = std::fs::read(&path).unwrap();
+        let msgs: Vec<_> = mcap::MessageStream::new(&bytes)
+            .unwrap()
+            .map(|m| m.unwrap())
+            .collect();
+        assert_eq!(msgs.len(), 3);
+        let m = &msgs[0];
+        assert_eq!(m.channel.topic, TF_TOPIC);
+        let schema = m.channel.schema.as_ref().unwrap();
+        assert_eq!(schema.name, "foxglove.FrameTransform");
+        let v: Value = serde_json::from_slice(&m.data).unwrap();
+        assert_eq!(v["timestamp"], json!({"sec": 1, "nsec": 200_000_123}));
+        assert_eq!(v["parent_frame_id"], FRAME_REFERENCE);
+        assert_eq!(v["child_frame_id"], FRAME_SERVICER);
+        assert_eq!(v["translation"], json!({"x": 1.0, "y": -2.0, "z": 3.5}));
+        assert_eq!(v["rotation"]["w"], q_rb[0]);
+        assert_eq!(v["rotation"]["x"], q_rb[1]);
+        let sch: Value = serde_json::from_slice(&schema.data).unwrap();
+        let props = sch["properties"].as_object().unwrap();
+        assert_eq!(
+            props.keys().collect::<Vec<_>>(),
+            v.as_object().unwrap().keys().collect::<Vec<_>>()
+        );
         std::fs::remove_dir_all(&dir).ok();
     }
 }

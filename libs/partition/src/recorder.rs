@@ -175,7 +175,7 @@ pub fn recorder() -> anyhow::Result<i32> {
             queued.len() - n_before,
         );
         macro_rules! take {
-            ($rx:expr, $field:ident, $svc:expr) => {{
+            ($rx:expr, $field:ident, $svc:expr $(, $also:ident)?) => {{
                 $rx.drain_events()?;
                 let mut v = Vec::new();
                 $rx.receive_all(&mut v)?;
@@ -185,11 +185,13 @@ pub fn recorder() -> anyhow::Result<i32> {
                         *rep.late.entry($svc.as_str().into()).or_default() += 1;
                     }
                     mcap.write($svc.as_str(), mission_ns(m.tick), m.publish_ns, &m)?;
+                    $( mcap.$also(mission_ns(m.tick), m.publish_ns, &m)?; )?
                     pending.entry(m.tick).or_default().$field = Some(m);
                 }
             }};
         }
-        take!(state_rx, state, services::SIM_STATE);
+        // the 3D panel's frames, from each state
+        take!(state_rx, state, services::SIM_STATE, write_frames);
         take!(nt_rx, nt, services::NOMINAL_TRANSLATIONAL);
         take!(na_rx, na, services::NOMINAL_ATTITUDE);
         take!(nr_rx, nr, services::NOMINAL_ROBOTIC);
