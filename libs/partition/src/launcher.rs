@@ -133,8 +133,8 @@ pub fn clean_stale_runs(except: &str) -> usize {
         let Ok(run) = RunScope::new(&id) else {
             continue;
         };
-        match sc_bus::reap_dead_nodes(&run) {
-            Ok(r) if r.alive.is_empty() => {
+        match reap_bounded(&run) {
+            Some(Ok(r)) if r.alive.is_empty() => {
                 let n = run.leftovers().len();
                 if run.force_remove_files().is_ok() {
                     removed += n;
@@ -144,6 +144,27 @@ pub fn clean_stale_runs(except: &str) -> usize {
         }
     }
     removed
+}
+
+/// How long the launcher waits for iceoryx2's cleanup of a run's dead nodes.
+const REAP_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// [`sc_bus::reap_dead_nodes`] with a bounded wait. iceoryx2 waits without limit to open
+/// a service whose creator was stopped while creating it (its dynamic config is never
+/// marked initialised): a process torn down in its first milliseconds — the early stop
+/// of a launch whose partner fails at start — hung the launcher there (measured: a test
+/// stuck for minutes in `AdaptiveWait`). `None` when the cleanup did not finish in time;
+/// its thread is left behind, sleeping, and the caller removes the run's files by name.
+fn reap_bounded(run: &RunScope) -> Option<sc_bus::Result<sc_bus::NodeReport>> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    let scope = run.clone();
+    std::thread::Builder::new()
+        .name("reap-dead-nodes".into())
+        .spawn(move || {
+            let _ = tx.send(sc_bus::reap_dead_nodes(&scope));
+        })
+        .ok()?;
+    rx.recv_timeout(REAP_TIMEOUT).ok()
 }
 
 /// Written by the scheduler into the output directory once every process joined the
@@ -353,7 +374,7 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
         eprintln!("launch: warning: CPU wake-up latency not set ({e})");
     }
     let stale_removed = clean_stale_runs(run.run_id());
-    let _ = sc_bus::reap_dead_nodes(&run);
+    let _ = reap_bounded(&run);
     let mut procs: Vec<Proc> = Vec::new();
     let mut spawn_err = None;
     for role in ROLES {
@@ -518,7 +539,11 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
         std::thread::sleep(Duration::from_millis(20));
     }
     // every process of the run is gone: remove what the run left behind
-    let _ = sc_bus::reap_dead_nodes(&run);
+    if reap_bounded(&run).is_none() && !opts.quiet {
+        eprintln!(
+            "launch: warning: iceoryx2's cleanup of the run's dead nodes did not finish within {REAP_TIMEOUT:?} (a process was stopped while creating a service); the run's files are removed by name"
+        );
+    }
     let _ = run.force_remove_files();
     let leftovers = run.leftovers();
     let exits: Vec<ProcessExit> = procs.into_iter().filter_map(|p| p.exit).collect();
