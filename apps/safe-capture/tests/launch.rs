@@ -6,17 +6,7 @@ use common::*;
 /// A partition config for a launch from `dir`: config/partition.toml with the default
 /// scenario (absolute), a short handshake, and `from` replaced by `to`.
 fn partition_with(dir: &std::path::Path, from: &str, to: &str) -> std::path::PathBuf {
-    let cfg = std::fs::read_to_string(root().join("config/partition.toml"))
-        .unwrap()
-        .replace(
-            "scenario = \"scenario.toml\"",
-            &format!(
-                "scenario = \"{}\"",
-                std::path::absolute(root().join("config/scenario.toml"))
-                    .unwrap()
-                    .display()
-            ),
-        )
+    let cfg = partition_toml_absolute_scenario()
         .replace("handshake_timeout_s = 30.0", "handshake_timeout_s = 2.0");
     assert!(cfg.contains(from) && cfg.contains("handshake_timeout_s = 2.0"));
     let p = dir.join("partition.toml");
@@ -186,15 +176,7 @@ fn a_process_that_fails_at_start_is_named_in_an_infrastructure_verdict() {
 fn a_failed_launch_never_reports_an_old_run() {
     let _cpu = exclusive();
     let d = tmp("stale-launch");
-    let cfg = std::fs::read_to_string(root().join("config/partition.toml"))
-        .unwrap()
-        .replace(
-            "scenario = \"scenario.toml\"",
-            &format!(
-                "scenario = \"{}\"",
-                root().join("config/scenario.toml").display()
-            ),
-        )
+    let cfg = partition_toml_absolute_scenario()
         .replace("handshake_timeout_s = 30.0", "handshake_timeout_s = 2.0")
         .replace("exec = \"sc-nominal-robotic\"", "exec = \"false\"");
     assert!(cfg.contains("exec = \"false\"") && cfg.contains("handshake_timeout_s = 2.0"));

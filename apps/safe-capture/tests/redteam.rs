@@ -235,21 +235,10 @@ fn hostile_partner_processes_through_the_partition_are_safe() {
 fn a_missing_partition_program_stops_the_campaign_before_any_case() {
     let Some(py) = python() else { return };
     let d = tmp("redteam-missing-exec");
-    let cfg = std::fs::read_to_string(root().join("config/partition.toml"))
-        .unwrap()
-        .replace(
-            "scenario = \"scenario.toml\"",
-            &format!(
-                "scenario = \"{}\"",
-                std::path::absolute(root().join("config/scenario.toml"))
-                    .unwrap()
-                    .display()
-            ),
-        )
-        .replace(
-            "exec = \"sc-safety-robotic\"",
-            "exec = \"bin/sc-safety-robotic\"",
-        );
+    let cfg = partition_toml_absolute_scenario().replace(
+        "exec = \"sc-safety-robotic\"",
+        "exec = \"bin/sc-safety-robotic\"",
+    );
     assert!(cfg.contains("bin/sc-safety-robotic"));
     let p = d.join("partition.toml");
     std::fs::write(&p, cfg).unwrap();

@@ -170,3 +170,20 @@ pub fn python() -> Option<PathBuf> {
     );
     None
 }
+
+/// config/partition.toml's text with its scenario as an absolute path, so that a copy
+/// written into a scratch folder still finds it.
+#[allow(dead_code)] // not every test binary uses it
+pub fn partition_toml_absolute_scenario() -> String {
+    std::fs::read_to_string(root().join("config/partition.toml"))
+        .unwrap()
+        .replace(
+            "scenario = \"scenario.toml\"",
+            &format!(
+                "scenario = \"{}\"",
+                std::path::absolute(root().join("config/scenario.toml"))
+                    .unwrap()
+                    .display()
+            ),
+        )
+}
