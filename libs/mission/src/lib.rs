@@ -9,6 +9,7 @@ pub mod build;
 pub mod compare;
 pub mod mission;
 pub mod nominal_source;
+pub mod out_dir;
 pub mod record;
 pub mod replay;
 pub mod setup;
