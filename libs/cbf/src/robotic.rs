@@ -33,7 +33,8 @@ use crate::common::{
 };
 use crate::engine::{Engine, Kind, LastProblem, Outcome};
 use crate::sampled::{
-    Decay, RateBounds, RateDecay, RelDeg1, RelDeg2, SampleBounds, braking_barrier,
+    Decay, RateBounds, RateDecay, SampleBounds, braking_barrier, hdot_required_of,
+    phi_required_of,
 };
 use crate::{Formulation, qp::SolverParams};
 use nalgebra::{SMatrix, SVector, Vector3, Vector6};
@@ -259,19 +260,26 @@ pub fn link_base(s: &SphereTerms, x: &RoboticInput) -> RelDegTwo<NJ> {
     }
 }
 
+/// `rows` with their offsets replaced by `c` (the same normals).
+fn with_offsets(rows: &[Row<NJ>; N], c: &[f64; N]) -> [Row<NJ>; N] {
+    std::array::from_fn(|j| Row { a: rows[j].a, c: c[j] })
+}
+
 /// `mᵀ v` without forming `mᵀ` (21 of these per step), summed in the order of
 /// `m.transpose() * v`, so the bits are the same.
 fn tr_mul<const R: usize, const C: usize>(
     m: &SMatrix<f64, R, C>,
     v: &SVector<f64, R>,
 ) -> SVector<f64, C> {
-    SVector::from_fn(|i, _| {
-        let mut s = m[(0, i)] * v[0];
-        for k in 1..R {
-            s += m[(k, i)] * v[k];
+    // the sums of all columns advance together (independent chains, each in the order
+    // `k = 0, 1, …` of the dot product)
+    let mut s: SVector<f64, C> = SVector::from_fn(|i, _| m[(0, i)] * v[0]);
+    for k in 1..R {
+        for i in 0..C {
+            s[i] += m[(k, i)] * v[k];
         }
-        s
-    })
+    }
+    s
 }
 
 /// All barrier terms of one step.
@@ -284,6 +292,20 @@ pub struct RoboticTerms {
 }
 
 impl RoboticTerms {
+    /// The normal `a_j` of sampled-data row `j` ([`NAMES`] order) at every level:
+    /// `∂ḧ/∂τ_M` or `∂ḣ/∂τ_M`.
+    fn normal(&self, j: usize) -> Vector7 {
+        if j < NJ {
+            self.theta[j].hddot_u
+        } else if j < 2 * NJ {
+            self.theta_dot_max[j - NJ].hdot_u
+        } else if j < 3 * NJ {
+            self.theta_dot_min[j - 2 * NJ].hdot_u
+        } else {
+            self.link_base[j - 3 * NJ].hddot_u
+        }
+    }
+
     /// `h` of every constraint in [`NAMES`] order.
     pub fn h(&self) -> [f64; N] {
         let mut h = [0.0; N];
@@ -519,39 +541,10 @@ impl RoboticFilter {
                 }
             }),
             Formulation::SampledData => {
-                let (bt, br, blb) = match level {
-                    Level::Certified(qdd) => self.certified_bounds(x, &qdd),
-                    Level::Local => {
-                        let z = SampleBounds {
-                            period: p.period,
-                            m2: 0.0,
-                            m3: 0.0,
-                        };
-                        let zr = RateBounds {
-                            period: p.period,
-                            d: 0.0,
-                            j: 0.0,
-                        };
-                        ([z; NJ], [zr; NJ], [z; NS])
-                    }
-                };
-                // the decays of (C2) and of the rate rows, evaluated once for all rows
-                let decay = Decay::linear(p.gamma).at(p.period);
-                let rate = RateDecay::new(p.gamma_theta_dot, p.eps_theta_dot, p.period);
-                std::array::from_fn(|j| {
-                    if j < NJ {
-                        RelDeg2::from(t.theta[j]).row_at(&bt[j], p.u_max_theta, &decay)
-                    } else if j < 2 * NJ {
-                        RelDeg1::from(t.theta_dot_max[j - NJ]).row_at(&br[j - NJ], &rate)
-                    } else if j < 3 * NJ {
-                        RelDeg1::from(t.theta_dot_min[j - 2 * NJ]).row_at(&br[j - 2 * NJ], &rate)
-                    } else {
-                        RelDeg2::from(t.link_base[j - 3 * NJ]).row_at(
-                            &blb[j - 3 * NJ],
-                            p.u_max_lb,
-                            &decay,
-                        )
-                    }
+                let c = self.sampled_offsets(x, t, level);
+                std::array::from_fn(|j| Row {
+                    a: t.normal(j),
+                    c: c[j],
                 })
             }
         };
@@ -559,6 +552,58 @@ impl RoboticFilter {
             r.c -= m;
         }
         rows
+    }
+
+    /// The offsets `c` of the 42 barrier rows at `level` (untightened). Only the offsets
+    /// depend on the level — the normals are the terms' `∂ḧ/∂τ` and `∂ḣ/∂τ` — so the
+    /// a-posteriori certificate checks a command against the rows of another level
+    /// without building them: `c_j + a_j·τ` with the normals of any level.
+    fn barrier_offsets(&self, x: &RoboticInput, t: &RoboticTerms, level: Level) -> [f64; N] {
+        match self.params.formulation {
+            Formulation::Paper => self.barrier_rows(x, t, level, &[0.0; N]).map(|r| r.c),
+            Formulation::SampledData => self.sampled_offsets(x, t, level),
+        }
+    }
+
+    /// The sampled-data rows' offsets `ḧ_drift − φ_req` and `ḣ_drift − ḣ_req` at `level`.
+    fn sampled_offsets(&self, x: &RoboticInput, t: &RoboticTerms, level: Level) -> [f64; N] {
+        let p = &self.params;
+        let (bt, br, blb) = match level {
+            Level::Certified(qdd) => self.certified_bounds(x, &qdd),
+            Level::Local => {
+                let z = SampleBounds {
+                    period: p.period,
+                    m2: 0.0,
+                    m3: 0.0,
+                };
+                let zr = RateBounds {
+                    period: p.period,
+                    d: 0.0,
+                    j: 0.0,
+                };
+                ([z; NJ], [zr; NJ], [z; NS])
+            }
+        };
+        // the decays of (C2) and of the rate rows, evaluated once for all rows
+        let decay = Decay::linear(p.gamma).at(p.period);
+        let rate = RateDecay::new(p.gamma_theta_dot, p.eps_theta_dot, p.period);
+        let rel2 = |r: &RelDegTwo<NJ>, b: &SampleBounds, mu: f64| {
+            r.hddot_drift - phi_required_of(r.h, r.hdot, b, mu, &decay)
+        };
+        let rel1 = |r: &RelDegOne<NJ>, b: &RateBounds| {
+            r.hdot_drift - hdot_required_of(r.h, b, &rate)
+        };
+        std::array::from_fn(|j| {
+            if j < NJ {
+                rel2(&t.theta[j], &bt[j], p.u_max_theta)
+            } else if j < 2 * NJ {
+                rel1(&t.theta_dot_max[j - NJ], &br[j - NJ])
+            } else if j < 3 * NJ {
+                rel1(&t.theta_dot_min[j - 2 * NJ], &br[j - 2 * NJ])
+            } else {
+                rel2(&t.link_base[j - 3 * NJ], &blb[j - 3 * NJ], p.u_max_lb)
+            }
+        })
     }
 
     /// Input bounds and the contract rows `β_i ∓ (Q (τ_M − τ_hold))_i ≥ 0`, with
@@ -663,8 +708,9 @@ impl RoboticFilter {
         report.iterations = res.iterations;
         // the rows the returned command was solved with (the dump's problem) and the rows
         // that certify it (evaluated into the report)
-        let mut solved_rows = local;
-        let mut final_rows = local;
+        // (`None`: the local rows, not copied)
+        let mut solved_rows: Option<[Row<NJ>; N]> = None;
+        let mut final_rows: Option<[Row<NJ>; N]> = None;
         let mut certified = false;
         // the accelerations the rows `res` was solved with were built for (None: the
         // sample's own prediction, the loosest rows); the bounds grow with them joint by
@@ -674,15 +720,21 @@ impl RoboticFilter {
             for _ in 0..CERTIFY_ROUNDS {
                 let own = accel(&res.u).abs();
                 let cap = solved_cap.map_or(own, |c| c.sup(&own));
-                let rows = self.barrier_rows(x, &terms, Level::Certified(cap), &zero);
-                if rows.iter().all(|r| r.phi(&res.u) >= 0.0) {
+                // the certifying rows' offsets with the normals every level shares: `phi`
+                // of the certifying rows, bit for bit, without building them
+                let off = self.barrier_offsets(x, &terms, Level::Certified(cap));
+                if local
+                    .iter()
+                    .zip(&off)
+                    .all(|(r, c)| c + r.a.dot(&res.u) >= 0.0)
+                {
                     // inside rows valid for its own accelerations: certified. It is the
                     // minimiser of the rows it was solved with (`solved_rows`, the dump's
                     // problem), not necessarily of the certifying rows (`safe-capture
                     // verify-qp` measured up to 3e-2 of the bound between the two under
                     // attack when the dump held the certifying rows).
                     certified = true;
-                    final_rows = rows;
+                    final_rows = Some(with_offsets(&local, &off));
                     break;
                 }
                 // the next candidate may accelerate more; bound it by twice as much
@@ -694,7 +746,7 @@ impl RoboticFilter {
                     break;
                 }
                 res = next;
-                solved_rows = rows;
+                solved_rows = Some(rows);
                 solved_cap = Some(grown);
                 if accel(&res.u)
                     .abs()
@@ -704,7 +756,7 @@ impl RoboticFilter {
                 {
                     // the rows' bounds cover the new command's accelerations
                     certified = true;
-                    final_rows = rows;
+                    final_rows = Some(rows);
                     break;
                 }
             }
@@ -729,8 +781,8 @@ impl RoboticFilter {
             match verified {
                 Some((u, rows, relaxed_violation)) => {
                     tau = u;
-                    solved_rows = rows;
-                    final_rows = rows;
+                    solved_rows = Some(rows);
+                    final_rows = Some(rows);
                     if relaxed_violation > 0.0 {
                         report.status = FilterStatus::Relaxed;
                         report.faults |= faults::QP_INFEASIBLE_RELAXED;
@@ -769,13 +821,15 @@ impl RoboticFilter {
             row_duals: [0.0; 64],
             second_opinion: false,
         };
+        let solved_rows = solved_rows.as_ref().unwrap_or(&local);
+        let final_rows = final_rows.as_ref().unwrap_or(&local);
         self.last
-            .record(&u_nom, &solved_rows, &weights, &hard, &outcome);
+            .record(&u_nom, solved_rows, &weights, &hard, &outcome);
         let (tau, clamped) = clamp_box(&tau, tmax);
         if clamped {
             report.faults |= faults::OUTPUT_CLAMPED;
         }
-        common::evaluate_rows(&final_rows, &tau, report);
+        common::evaluate_rows(final_rows, &tau, report);
         tau
     }
 
@@ -1108,6 +1162,67 @@ mod tests {
                 for max in [0.0, -0.0, 2.0, f64::MAX, f64::INFINITY, -1.0, f64::NAN] {
                     let want = finite && m.amax() <= max;
                     assert_eq!(finite_in(&m, max), want, "{a} {b} max {max}");
+                }
+            }
+        }
+    }
+
+    /// `tr_mul` is `mᵀ v` bit for bit (the link rows' normals and telemetry depend on it).
+    #[test]
+    fn tr_mul_equals_the_transpose_product_bitwise() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            // wide magnitudes and both signs: rounding differs with the summation order
+            let u = (seed >> 11) as f64 / (1u64 << 53) as f64;
+            (u - 0.5) * 10f64.powi(((seed >> 3) % 9) as i32 - 4)
+        };
+        for _ in 0..2000 {
+            let m = Matrix7::from_fn(|_, _| next());
+            let v = Vector7::from_fn(|_, _| next());
+            let j = Matrix3x7::from_fn(|_, _| next());
+            let d = Vector3::from_fn(|_, _| next());
+            let want = m.transpose() * v;
+            let got = tr_mul(&m, &v);
+            assert!(want.iter().zip(got.iter()).all(|(a, b)| a.to_bits() == b.to_bits()));
+            let want = j.transpose() * d;
+            let got = tr_mul(&j, &d);
+            assert!(want.iter().zip(got.iter()).all(|(a, b)| a.to_bits() == b.to_bits()));
+        }
+    }
+
+    /// The certificate's offsets with the shared normals are the rows of that level, bit
+    /// for bit, at every level (what lets the filter check a command without building them).
+    #[test]
+    fn offsets_and_normals_are_the_rows_of_every_level() {
+        let s = sc_scenario::Scenario::load(std::path::Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../config/scenario.toml"
+        )))
+        .unwrap();
+        let robot = Robot::from_urdf_file(&s.urdf_path()).unwrap();
+        let f = RoboticFilter::new(RoboticParams::from_scenario(&s));
+        // a moving arm near its limits, the base turning and pushed: every term non-zero
+        let theta = Vector7::from(s.safety.robotic.theta_max_rad) * 0.8;
+        let theta_dot = Vector7::from_fn(|i, _| 0.05 * (i as f64 - 3.0));
+        let (w, fb, tb) = (
+            Vector3::new(0.01, -0.02, 0.03),
+            Vector3::new(1.0, -2.0, 0.5),
+            Vector3::new(0.3, 0.1, -0.2),
+        );
+        let x = robotic_input_from_model(&robot, &theta, &theta_dot, &w, &fb, &tb).unwrap();
+        let t = f.terms(&x).ok().unwrap();
+        let local = f.barrier_rows(&x, &t, Level::Local, &[0.0; N]);
+        for qdd in [Vector7::zeros(), Vector7::repeat(3.0), Vector7::from_fn(|i, _| i as f64)] {
+            for level in [Level::Local, Level::Certified(qdd)] {
+                let rows = f.barrier_rows(&x, &t, level, &[0.0; N]);
+                let off = f.barrier_offsets(&x, &t, level);
+                let rebuilt = with_offsets(&local, &off);
+                for (a, b) in rows.iter().zip(&rebuilt) {
+                    assert_eq!(a.c.to_bits(), b.c.to_bits());
+                    assert!(a.a.iter().zip(b.a.iter()).all(|(p, q)| p.to_bits() == q.to_bits()));
                 }
             }
         }

@@ -210,14 +210,7 @@ impl<const M: usize> RelDeg2<M> {
 
     /// [`Self::phi_required_with`] with the decay already evaluated for `bounds.period`.
     pub fn phi_required_at(&self, bounds: &SampleBounds, mu: f64, decay: &DecayAt) -> f64 {
-        let t = bounds.period;
-        let (h, hd) = (self.h, self.hdot);
-        let c1 = bounds.m2 + bounds.m3 * t / 3.0 + c1_requirement(h, hd, t);
-        let kappa = decay.target(braking_barrier(h, hd, mu));
-        let p0 = h + hd * t - bounds.m3 * t * t * t / 6.0;
-        let v0 = hd - 0.5 * bounds.m3 * t * t;
-        let c2 = bounds.m2 + c2_requirement(p0, v0, t, mu, kappa);
-        c1.max(c2)
+        phi_required_of(self.h, self.hdot, bounds, mu, decay)
     }
 
     /// The row `b·u + (a − φ_req) ≥ 0`.
@@ -237,6 +230,25 @@ impl<const M: usize> RelDeg2<M> {
             c: self.a - self.phi_required_at(bounds, mu, decay),
         }
     }
+}
+
+/// [`RelDeg2::phi_required_at`] from the barrier's value `h` and rate `ḣ` alone: the
+/// requirement does not depend on the row's normal, so a filter that re-evaluates its rows
+/// for other in-sample bounds needs only these offsets.
+pub fn phi_required_of(h: f64, hd: f64, bounds: &SampleBounds, mu: f64, decay: &DecayAt) -> f64 {
+    let t = bounds.period;
+    let c1 = bounds.m2 + bounds.m3 * t / 3.0 + c1_requirement(h, hd, t);
+    let kappa = decay.target(braking_barrier(h, hd, mu));
+    let p0 = h + hd * t - bounds.m3 * t * t * t / 6.0;
+    let v0 = hd - 0.5 * bounds.m3 * t * t;
+    let c2 = bounds.m2 + c2_requirement(p0, v0, t, mu, kappa);
+    c1.max(c2)
+}
+
+/// [`RelDeg1::hdot_required_at`] from the barrier's value `h` alone.
+pub fn hdot_required_of(h: f64, bounds: &RateBounds, decay: &RateDecay) -> f64 {
+    let t = bounds.period;
+    bounds.d + 0.5 * bounds.j * t + (decay.target(h) - h) / t
 }
 
 /// The `ḧ` a command must produce at the sample to brake a relative-degree-two barrier
@@ -289,8 +301,7 @@ impl<const M: usize> RelDeg1<M> {
 
     /// [`Self::hdot_required`] with the decay already evaluated for `bounds.period`.
     pub fn hdot_required_at(&self, bounds: &RateBounds, decay: &RateDecay) -> f64 {
-        let t = bounds.period;
-        bounds.d + 0.5 * bounds.j * t + (decay.target(self.h) - self.h) / t
+        hdot_required_of(self.h, bounds, decay)
     }
 
     /// The row `b·u + (a − ḣ_req) ≥ 0`.
