@@ -141,6 +141,8 @@ pub fn recorder() -> anyhow::Result<i32> {
     // than an empty one (its header sits in the write buffer until the first chunk).
     let mut mcap = crate::mcap_out::McapOut::create(&p.out.join("recording.mcap"))?;
     mcap.write_metadata(MCAP_METADATA_NAME, run_metadata(&p)?)?;
+    // the scenario's corridor, zone, line of sight and grasping point for the 3D panel
+    mcap.set_scene(&p.setup.scenario);
     let mut rep = RecorderReport::default();
     let mut pending: BTreeMap<u64, Tickset> = BTreeMap::new();
     let mut queued: Vec<StepResult> = Vec::new();
@@ -190,8 +192,8 @@ pub fn recorder() -> anyhow::Result<i32> {
                 }
             }};
         }
-        // the 3D panel's frames, from each state
-        take!(state_rx, state, services::SIM_STATE, write_frames);
+        // the 3D panel's frames (and scene), from each state
+        take!(state_rx, state, services::SIM_STATE, write_3d);
         take!(nt_rx, nt, services::NOMINAL_TRANSLATIONAL);
         take!(na_rx, na, services::NOMINAL_ATTITUDE);
         take!(nr_rx, nr, services::NOMINAL_ROBOTIC);
