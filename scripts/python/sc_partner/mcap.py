@@ -6,7 +6,10 @@ infinities as ``null``), in LZ4-compressed chunks. This module reads exactly tha
 the MCAP records (https://mcap.dev/spec) and the LZ4 frame format, without the
 ``mcap`` and ``lz4`` packages, so that the partner SDK keeps needing only iceoryx2 and
 numpy. Uncompressed chunks and chunks outside any compression are read as well; other
-compressions (zstd) raise ``ValueError``.
+compressions (zstd) raise ``ValueError``. Records other than channels, messages and
+chunks (the header, schemas, the run's ``Metadata`` record, the summary section's
+indexes and statistics, the footer) are skipped; ``scripts/mcap_check.py`` checks on a
+real recording that this reader yields exactly the messages the ``mcap`` package reads.
 """
 
 import json
