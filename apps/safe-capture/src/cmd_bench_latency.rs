@@ -23,9 +23,10 @@ pub struct Args {
     /// Partition config (its rate groups set the period).
     #[arg(long, value_name = "FILE", default_value = "config/partition.toml")]
     config: PathBuf,
-    /// Output directory.
-    #[arg(long, value_name = "DIR", default_value = "out/bench-latency")]
+    #[arg(long, value_name = "DIR", default_value = "out/bench-latency", help = crate::out_help!())]
     out: PathBuf,
+    #[arg(long, help = crate::out_folder::FORCE_HELP)]
+    force: bool,
 }
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
@@ -33,14 +34,16 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let cfg = sc_partition::PartitionConfig::load(&a.config)?;
     sc_partition::preflight::preflight(&cfg, &None)
         .map_err(|e| anyhow::anyhow!("{}: {e}", a.config.display()))?;
+    let staged = crate::out_folder::stage(&a.out, "bench latency", a.force)?;
     let r = bench(&BenchOptions {
         config: a.config,
-        out: a.out.clone(),
+        out: staged.path().to_path_buf(),
         ticks: a.ticks,
         warmup: a.warmup,
         bin_dir: None,
         run_id: None,
     })?;
+    staged.commit()?;
     print!("{}", markdown(&r));
     println!("-> {}", a.out.display());
     Ok(ExitCode::SUCCESS)

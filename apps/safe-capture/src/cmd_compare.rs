@@ -27,9 +27,10 @@ pub struct Args {
     /// Exit 1 when a difference in the window exceeds this (in m or rad).
     #[arg(long, value_name = "X")]
     tolerance: Option<f64>,
-    /// Output directory (default: B/compare).
-    #[arg(long, value_name = "DIR")]
+    #[arg(long, value_name = "DIR", help = crate::out_help!(" (default: B/compare)"))]
     out: Option<PathBuf>,
+    #[arg(long, help = crate::out_folder::FORCE_HELP)]
+    force: bool,
 }
 
 fn records(dir: &Path) -> anyhow::Result<Vec<sc_mission::StepRecord>> {
@@ -54,12 +55,13 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         "--window {}: must be > 0",
         a.window
     );
+    let target = a.out.clone().unwrap_or_else(|| a.b.join("compare"));
+    let staged = crate::out_folder::stage(&target, "compare", a.force)?;
+    let out = staged.path().to_path_buf();
     let (ra, rb) = (records(&a.a)?, records(&a.b)?);
     let d = differences(&ra, &rb).map_err(anyhow::Error::msg)?;
     anyhow::ensure!(!d.is_empty(), "no step to compare");
     let (w, all) = (largest(&d, a.window), largest(&d, f64::INFINITY));
-    let out = a.out.clone().unwrap_or_else(|| a.b.join("compare"));
-    std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
     let mut csv =
         String::from("t_s,hill_position_m,attitude_rad,joint_angle_rad,target_attitude_rad\n");
     for x in &d {
@@ -82,6 +84,8 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         &d,
         &format!("{} against {}", a.b.display(), a.a.display()),
     )?;
+    staged.commit()?;
+    let out = target;
     println!(
         "compare: first {:.1} s ({} steps): {}",
         w.until_s,

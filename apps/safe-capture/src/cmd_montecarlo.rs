@@ -96,9 +96,10 @@ struct RunArgs {
     /// run is nine processes).
     #[arg(long, short)]
     jobs: Option<usize>,
-    /// Output directory.
-    #[arg(long, value_name = "DIR", default_value = "out/montecarlo")]
+    #[arg(long, value_name = "DIR", default_value = "out/montecarlo", help = crate::out_help!(" (with --resume: the campaign, completed in place)"))]
     out: PathBuf,
+    #[arg(long, conflicts_with = "resume", help = crate::out_folder::FORCE_HELP)]
+    force: bool,
     /// Run only shard i of N (0-based): runs k with k mod N = i [with --resume default:
     /// the campaign's].
     #[arg(long, value_name = "i/N")]
@@ -144,9 +145,10 @@ struct RerunArgs {
     /// Run index.
     #[arg(long)]
     run: usize,
-    /// Output directory for telemetry, summary and figures (default DIR/runs/K/rerun).
-    #[arg(long, value_name = "DIR")]
+    #[arg(long, value_name = "DIR", help = crate::out_help!(" for telemetry, summary and figures (default: DIR/runs/K/rerun)"))]
     out: Option<PathBuf>,
+    #[arg(long, help = crate::out_folder::FORCE_HELP)]
+    force: bool,
     /// Write no figures.
     #[arg(long)]
     no_figures: bool,
@@ -157,16 +159,19 @@ struct MergeArgs {
     /// Shard directories.
     #[arg(required = true)]
     dirs: Vec<PathBuf>,
-    /// Output directory.
-    #[arg(long, value_name = "DIR")]
+    #[arg(long, value_name = "DIR", help = crate::out_help!())]
     out: PathBuf,
+    #[arg(long, help = crate::out_folder::FORCE_HELP)]
+    force: bool,
 }
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     match a.action {
         Some(Action::Rerun(r)) => rerun(r),
         Some(Action::Merge(m)) => {
-            let s = sc_montecarlo::merge(&m.dirs, &m.out)?;
+            let staged = crate::out_folder::stage(&m.out, "montecarlo merge", m.force)?;
+            let s = sc_montecarlo::merge(&m.dirs, staged.path())?;
+            staged.commit()?;
             Ok(report(&s, &m.out))
         }
         None => campaign(a.run),
@@ -272,6 +277,13 @@ fn campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
             Box::new(executor)
         }
     };
+    // a new campaign is written apart and replaces --out once aggregated (also when
+    // interrupted: --resume then completes it there); --resume completes it in place
+    let staged = if a.resume {
+        None
+    } else {
+        Some(crate::out_folder::stage(&a.out, "montecarlo", a.force)?)
+    };
     let opts = CampaignOptions {
         scenario: p.scenario,
         config: p.config,
@@ -279,12 +291,17 @@ fn campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
         seed: p.seed,
         jobs,
         shard: p.shard,
-        out: a.out.clone(),
+        out: staged
+            .as_ref()
+            .map_or(a.out.clone(), |s| s.path().to_path_buf()),
         inject_panic: inject,
         progress: !a.quiet,
         resume: a.resume,
     };
     let s = sc_montecarlo::run_campaign_with(&opts, executor.as_ref())?;
+    if let Some(staged) = staged {
+        staged.commit()?;
+    }
     Ok(report(&s, &a.out))
 }
 
@@ -342,12 +359,15 @@ fn report(s: &CampaignSummary, out: &std::path::Path) -> ExitCode {
 }
 
 fn rerun(a: RerunArgs) -> anyhow::Result<ExitCode> {
-    let r = sc_montecarlo::rerun(&a.dir, a.run)?;
-    let out = a
+    // a campaign to rerun, and a folder to write, before the run
+    sc_montecarlo::campaign_info(&a.dir)?;
+    let target = a
         .out
         .clone()
         .unwrap_or_else(|| a.dir.join("runs").join(a.run.to_string()).join("rerun"));
-    std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
+    let staged = crate::out_folder::stage(&target, "montecarlo rerun", a.force)?;
+    let out = staged.path().to_path_buf();
+    let r = sc_montecarlo::rerun(&a.dir, a.run)?;
     let open = |name: &str| -> anyhow::Result<std::io::BufWriter<std::fs::File>> {
         let p = out.join(name);
         Ok(std::io::BufWriter::new(
@@ -381,6 +401,8 @@ fn rerun(a: RerunArgs) -> anyhow::Result<ExitCode> {
     if !a.no_figures {
         sc_plots::run_figures(&out.join("figures"), &r.scenario, &r.records, None)?;
     }
+    staged.commit()?;
+    let out = target;
     let m = r.result.metrics.as_ref();
     println!(
         "rerun of run {}: {} at t = {:.1} s, safe: {}, -> {}",

@@ -49,9 +49,10 @@ pub struct Args {
     /// Scenario file.
     #[arg(long, value_name = "FILE", default_value_os_t = crate::default_scenario())]
     scenario: PathBuf,
-    /// Output directory (created if missing).
-    #[arg(long, value_name = "DIR", default_value = "out/redteam")]
+    #[arg(long, value_name = "DIR", default_value = "out/redteam", help = crate::out_help!())]
     out: PathBuf,
+    #[arg(long, help = crate::out_folder::FORCE_HELP)]
+    force: bool,
     /// Random strategies per target (`random:1` … `random:N`).
     #[arg(long, value_name = "N", default_value_t = 5)]
     seeds: u64,
@@ -194,6 +195,8 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             .build_global()
             .context("--jobs")?;
     }
+    let staged = crate::out_folder::stage(&a.out, "redteam", a.force)?;
+    let out = staged.path().to_path_buf();
     let started = std::time::Instant::now();
     let tty = std::io::stderr().is_terminal();
     let bar = (!a.quiet && tty).then(|| {
@@ -229,7 +232,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
                 .iter()
                 .map(|c| Case::parse(&c.name()).map_err(anyhow::Error::msg))
                 .collect::<anyhow::Result<_>>()?;
-            let telemetry = a.telemetry.then_some(a.out.as_path());
+            let telemetry = a.telemetry.then_some(out.as_path());
             sc_redteam::run_campaign_recorded(&setup, &in_process, &progress, telemetry)
         }
         Some(p) => {
@@ -239,7 +242,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
                 .par_iter()
                 .enumerate()
                 .map(|(k, c)| {
-                    let out = a.out.join("cases").join(c.dir_name());
+                    let out = out.join("cases").join(c.dir_name());
                     let r = p.run_case(&setup, c, &out, &format!("rt{k}-{pid}"));
                     let n = done.fetch_add(1, Ordering::SeqCst) + 1;
                     progress(n, cases.len(), &r);
@@ -259,8 +262,8 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     } else {
         report::IN_PROCESS
     };
-    let s =
-        report::write(&a.out, &setup, how, &cases, &results, wall).map_err(anyhow::Error::msg)?;
+    let s = report::write(&out, &setup, how, &cases, &results, wall).map_err(anyhow::Error::msg)?;
+    staged.commit()?;
     for (c, r) in cases.iter().zip(&results) {
         if let Err(e) = r {
             eprintln!("redteam: {}: {e}", c.name());

@@ -24,9 +24,10 @@ pub struct Args {
     /// Scenario file.
     #[arg(long, value_name = "FILE", default_value_os_t = crate::default_scenario())]
     scenario: PathBuf,
-    /// Output directory (created if missing).
-    #[arg(long, value_name = "DIR", default_value = "out/run")]
+    #[arg(long, value_name = "DIR", default_value = "out/run", help = crate::out_help!())]
     out: PathBuf,
+    #[arg(long, help = crate::out_folder::FORCE_HELP)]
+    force: bool,
     /// Apply the nominal commands alone (saturated to the actuator bounds); the filters
     /// still evaluate every barrier so the summary shows what the nominal violates.
     #[arg(long)]
@@ -198,18 +199,13 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         no_filter: a.no_filter,
     };
     let started = std::time::Instant::now();
-    // an earlier run's comparison in this folder would be taken for this run's
-    if a.no_filter || a.no_compare || a.basilisk {
-        let stale = a.out.join("nominal");
-        if stale.join("summary.json").is_file() {
-            std::fs::remove_dir_all(&stale)
-                .with_context(|| format!("cannot remove the stale {}", stale.display()))?;
-        }
-    }
     let scenario = setup.scenario.clone();
     let compare_setup = setup.clone();
     let nominals = Nominals::from_args(&a)?;
     let source = nominals.source(&setup);
+    // a new folder replaces an earlier run's as a whole (no stale nominal/ comparison)
+    let staged = crate::out_folder::stage(&a.out, "run", a.force)?;
+    let out = staged.path().to_path_buf();
     let plant: Option<Box<dyn sc_sim::Plant + Send>> = if a.basilisk {
         let script = Path::new("scripts/basilisk_plant.py");
         let args = vec![
@@ -226,19 +222,19 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let (records, end) = run_mission(
         setup,
         options,
-        &a.out,
+        &out,
         a.dump_qp.as_deref(),
         a.quiet,
         source,
         plant,
     )?;
     let summary = summarize(&records, &end, &phase_names, !a.no_filter);
-    let path = a.out.join("summary.json");
+    let path = out.join("summary.json");
     std::fs::write(&path, serde_json::to_string_pretty(&summary)? + "\n")
         .with_context(|| format!("cannot write {}", path.display()))?;
     if !a.no_figures {
         write_figures(
-            &a.out,
+            &out,
             &scenario,
             &records,
             compare_setup,
@@ -246,6 +242,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             &nominals,
         )?;
     }
+    staged.commit()?;
     let safe = summary.violated_constraints.is_empty() && summary.fault_count == 0;
     let what = format!(
         "{}{}{}",

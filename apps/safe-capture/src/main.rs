@@ -15,6 +15,8 @@ mod cmd_redteam;
 mod cmd_run;
 mod cmd_simulate;
 mod cmd_verify_qp;
+// the output-folder policy's --out/--force, the same in every command
+mod out_folder;
 // `montecarlo --mode partition`: runs through the process partition
 mod montecarlo_partition;
 mod redteam_partition;

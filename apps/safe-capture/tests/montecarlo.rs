@@ -583,7 +583,8 @@ fn ctrl_c_stops_an_in_process_campaign_and_resume_completes_it() {
         .spawn()
         .unwrap();
     let started = std::time::Instant::now();
-    while !out.join("runs/0").is_dir() {
+    // a new campaign is written into c.incomplete, which replaces c at the end
+    while !d.join("c.incomplete/runs/0").is_dir() {
         if let Some(status) = child.try_wait().unwrap() {
             panic!("the campaign ended before a run finished: {status}");
         }

@@ -304,10 +304,15 @@ const AGGREGATE_FILES: [&str; 4] = ["summary.json", "report.md", "runs.csv", "ru
 const PARTIAL_SUFFIX: &str = ".partial";
 
 /// Creates `out` for a new campaign: refuses a non-empty directory that is not a campaign,
-/// clears the runs, figures and aggregated files of an old one.
+/// clears the runs, figures and aggregated files of an old one. (The command line writes
+/// a new campaign into a fresh folder that holds only the marker of the output-folder
+/// policy, [`sc_mission::out_dir`].)
 fn prepare_out(out: &Path) -> Result<(), McError> {
     if out.exists() {
-        let empty = std::fs::read_dir(out).map_err(io(out))?.next().is_none();
+        let empty = std::fs::read_dir(out)
+            .map_err(io(out))?
+            .flatten()
+            .all(|e| e.file_name() == sc_mission::out_dir::MARKER);
         if !empty && !out.join("campaign.json").is_file() {
             return Err(McError::Invalid(format!(
                 "{} is not empty and holds no campaign.json; choose another --out",
