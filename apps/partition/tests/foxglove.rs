@@ -138,11 +138,11 @@ fn layout_problems(layout: &Value, channels: &BTreeMap<String, Channel>) -> Vec<
                     bad.push(format!("{id}: topic {t} not in the recording"));
                 }
             }
-            for k in ["followTf"] {
-                let f = cfg[k].as_str().unwrap_or_default();
-                if !frames.contains(f) {
-                    bad.push(format!("{id}: {k} {f:?} is no frame on /tf ({frames:?})"));
-                }
+            let f = cfg["followTf"].as_str().unwrap_or_default();
+            if !frames.contains(f) {
+                bad.push(format!(
+                    "{id}: followTf {f:?} is no frame on /tf ({frames:?})"
+                ));
             }
         } else {
             bad.push(format!("{id}: a panel kind this check does not know"));

@@ -929,12 +929,19 @@ pub fn foxglove_layout() -> Value {
     use sc_icd::services as svc;
     let mut config = Map::new();
     let mut barrier_ids = Vec::new();
-    // (panel, service, index range in the filter's report, names)
+    // (panel id, title, service, index range in the filter's report, names)
+    type BarrierPlot<'a> = (
+        &'a str,
+        &'a str,
+        &'a str,
+        std::ops::Range<usize>,
+        &'a [&'a str],
+    );
     let tr = &sc_cbf::names::TRANSLATIONAL;
     let at = &sc_cbf::names::ATTITUDE;
     let rb = &sc_cbf::names::ROBOTIC;
     let nj = sc_icd::N_JOINTS;
-    let groups: [(&str, &str, &str, std::ops::Range<usize>, &[&str]); 5] = [
+    let groups: [BarrierPlot; 5] = [
         (
             "barriers_translational",
             "Barriers h: translational (corridor, zone)",
