@@ -75,8 +75,9 @@ fn lock_step_telemetry_is_identical_to_in_process_run() {
         last = last.max(m.log_time);
     }
     assert_eq!(states, b["steps"].as_u64().unwrap());
-    // reference → servicer body, reference → target body, body → end effector
-    assert_eq!(frames, 3 * states);
+    // reference → servicer body, reference → target body, body → end effector,
+    // reference → servicer centre of mass
+    assert_eq!(frames, 4 * states);
     assert_eq!(last as f64 * 1e-9, b["final_time_s"].as_f64().unwrap());
     // the run's metadata record: the build and the scenario and config it ran
     let summ = mcap::Summary::read(&bytes).unwrap().unwrap();
