@@ -436,7 +436,7 @@ impl JsonMsg for FrameTransform {
                     "type": "object",
                     "title": "time",
                     "description": "Timestamp of transform (mission time)",
-                    "properties": {"sec": int("seconds"), "nsec": int("nanoseconds")}
+                    "properties": {"sec": int("seconds [s]"), "nsec": int("nanoseconds [ns]")}
                 },
                 "parent_frame_id": string("Name of the parent frame"),
                 "child_frame_id": string("Name of the child frame"),
@@ -1431,7 +1431,15 @@ mod tests {
                 let p = format!("{path}.{k}");
                 let d = v.get("description").and_then(Value::as_str).unwrap_or("");
                 let leaf = v.get("properties").is_none();
-                if d.trim().is_empty() || (unit && leaf && !(d.contains('[') && d.contains(']'))) {
+                // a number (or an array of numbers) has a unit whatever the schema
+                let numeric = |s: &Value| {
+                    let t = &s["type"];
+                    t == "number"
+                        || t == "integer"
+                        || t.as_array().is_some_and(|a| a.contains(&json!("number")))
+                };
+                let needs_unit = leaf && (unit || numeric(v) || numeric(&v["items"]));
+                if d.trim().is_empty() || (needs_unit && !(d.contains('[') && d.contains(']'))) {
                     bad.push(p.clone());
                 }
                 undescribed(v, &p, unit, bad);
