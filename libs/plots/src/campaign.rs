@@ -1,9 +1,14 @@
 //! Figures of a Monte Carlo campaign (paper Figs. 5–6).
 
-use crate::chart::{Area, DrawResult, colour_bar, e, range, svg, with_bar};
+use crate::chart::{
+    Area, Axis, DrawResult, FONT, RefLine, TICKS, colour_bar, e, label_at, legend, log_coord,
+    range, ref_lines, standard, svg, swatch, with_bar,
+};
 use crate::colour::viridis;
+use crate::ticks::log_label;
 use crate::{Geometry, PlotError};
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, VPos};
 use std::path::{Path, PathBuf};
 
 const CORRIDOR: RGBColor = RGBColor(44, 160, 44);
@@ -13,6 +18,15 @@ const MAX: RGBColor = RGBColor(255, 127, 14);
 const CPU_GEOMEAN: RGBColor = RGBColor(158, 202, 225);
 const CPU_MAX: RGBColor = RGBColor(253, 190, 133);
 const LEVELS: usize = 32;
+/// Histogram bins of a barrier's minima.
+const BINS: usize = 20;
+/// Barrier-minima cells per row.
+const MINIMA_COLS: usize = 7;
+/// Height of one row of barrier-minima cells, and of the figure's title strip [px].
+const MINIMA_ROW_PX: u32 = 170;
+const MINIMA_TITLE_PX: u32 = 30;
+/// Width of a line of the zone geometry [px].
+const ZONE_WIDTH: u32 = 2;
 
 /// One decimated sample of a run's trajectory.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -95,22 +109,6 @@ fn coloured_runs(pts: &[(f64, f64, f64)], lo: f64, hi: f64) -> Vec<(usize, Vec<(
     out
 }
 
-/// A log axis's tick as people write it: 0.1, 1, 10, 100, 1000, 1e4 (not `10000.0`).
-pub(crate) fn log_tick(v: f64) -> String {
-    if !(v.is_finite() && v > 0.0) {
-        return String::new();
-    }
-    let e = v.log10().round();
-    if (v.log10() - e).abs() > 1e-9 {
-        // a tick between decades: plain, with as few digits as it needs
-        return format!("{}", (v * 1e6).round() / 1e6);
-    }
-    match e as i32 {
-        -2..=3 => format!("{}", 10f64.powi(e as i32)),
-        k => format!("1e{k}"),
-    }
-}
-
 fn level_colour(l: usize) -> RGBColor {
     viridis(l as f64 / (LEVELS - 1) as f64)
 }
@@ -138,17 +136,16 @@ fn trajectories(area: &Area, f: &CampaignFigures) -> DrawResult {
         f.traces.len()
     );
     let (xr, yr) = crate::chart::equal_aspect(&main, &title, xr, yr);
-    let mut chart = ChartBuilder::on(&main)
-        .caption(&title, ("sans-serif", 18))
-        .margin(8)
-        .x_label_area_size(36)
-        .y_label_area_size(64)
-        .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)
+    let (xa, ya) = (Axis::linear(xr, TICKS), Axis::linear(yr, TICKS));
+    let mut chart = standard(&main, &title)
+        .build_cartesian_2d(xa.coord(), ya.coord())
         .map_err(e)?;
     chart
         .configure_mesh()
         .x_desc("x_R [m]")
         .y_desc("y_R [m]")
+        .x_label_formatter(&|v| xa.label(*v))
+        .y_label_formatter(&|v| ya.label(*v))
         .light_line_style(WHITE.mix(0.0))
         .draw()
         .map_err(e)?;
@@ -160,12 +157,16 @@ fn trajectories(area: &Area, f: &CampaignFigures) -> DrawResult {
         for s in [1.0, -1.0] {
             let (c, sn) = (psi.cos(), s * psi.sin());
             let (dx, dy) = ((ax * c - ay * sn) / n, (ax * sn + ay * c) / n);
-            chart
+            let a = chart
                 .draw_series(LineSeries::new(
                     vec![(0.0, 0.0), (dx * reach, dy * reach)],
-                    CORRIDOR.stroke_width(2),
+                    CORRIDOR.stroke_width(ZONE_WIDTH),
                 ))
                 .map_err(e)?;
+            if s > 0.0 {
+                a.label("approach corridor")
+                    .legend(|p| swatch(p, CORRIDOR, ZONE_WIDTH, false));
+            }
         }
     }
     let circle: Vec<(f64, f64)> = (0..=120)
@@ -175,8 +176,10 @@ fn trajectories(area: &Area, f: &CampaignFigures) -> DrawResult {
         })
         .collect();
     chart
-        .draw_series(LineSeries::new(circle, CAZ.stroke_width(2)))
-        .map_err(e)?;
+        .draw_series(LineSeries::new(circle, CAZ.stroke_width(ZONE_WIDTH)))
+        .map_err(e)?
+        .label("collision-avoidance zone")
+        .legend(|p| swatch(p, CAZ, ZONE_WIDTH, false));
     for (_, t) in f.traces {
         let pts: Vec<(f64, f64, f64)> = t.iter().map(|p| (p.r_r[0], p.r_r[1], p.speed)).collect();
         for (l, line) in coloured_runs(&pts, speed.0, speed.1) {
@@ -185,6 +188,7 @@ fn trajectories(area: &Area, f: &CampaignFigures) -> DrawResult {
                 .map_err(e)?;
         }
     }
+    legend(&mut chart)?;
     colour_bar(&bar, "speed ‖v_R‖ [m/s]", speed.0, speed.1)
 }
 
@@ -198,20 +202,19 @@ fn attitude(area: &Area, f: &CampaignFigures) -> DrawResult {
         .flat_map(|p| p.los_deg)
         .filter(|x| x.is_finite())
         .fold(b * 1.3, |m, x| m.max(x.abs() * 1.05));
-    let mut chart = ChartBuilder::on(&main)
-        .caption(
-            "Line of sight in F_B against the LOS cone, coloured by sync error",
-            ("sans-serif", 18),
-        )
-        .margin(8)
-        .x_label_area_size(36)
-        .y_label_area_size(64)
-        .build_cartesian_2d(-lim..lim, -lim..lim)
-        .map_err(e)?;
+    let a = Axis::linear((-lim, lim), TICKS);
+    let mut chart = standard(
+        &main,
+        "Line of sight in F_B against the LOS cone, coloured by sync error",
+    )
+    .build_cartesian_2d(a.coord(), a.coord())
+    .map_err(e)?;
     chart
         .configure_mesh()
         .x_desc("LOS angle towards e1 (y_B for d_B = x_B) [deg]")
         .y_desc("LOS angle towards e2 (z_B for d_B = x_B) [deg]")
+        .x_label_formatter(&|v| a.label(*v))
+        .y_label_formatter(&|v| a.label(*v))
         .light_line_style(WHITE.mix(0.0))
         .draw()
         .map_err(e)?;
@@ -222,8 +225,10 @@ fn attitude(area: &Area, f: &CampaignFigures) -> DrawResult {
         })
         .collect();
     chart
-        .draw_series(LineSeries::new(circle, CORRIDOR.stroke_width(2)))
-        .map_err(e)?;
+        .draw_series(LineSeries::new(circle, CORRIDOR.stroke_width(ZONE_WIDTH)))
+        .map_err(e)?
+        .label(format!("LOS cone, β = {b}°"))
+        .legend(|p| swatch(p, CORRIDOR, ZONE_WIDTH, false));
     for (_, t) in f.traces {
         let pts: Vec<(f64, f64, f64)> = t
             .iter()
@@ -235,6 +240,7 @@ fn attitude(area: &Area, f: &CampaignFigures) -> DrawResult {
                 .map_err(e)?;
         }
     }
+    legend(&mut chart)?;
     colour_bar(&bar, "sync error [rad/s]", err.0, err.1)
 }
 
@@ -243,20 +249,20 @@ fn scatter(area: &Area, f: &CampaignFigures) -> DrawResult {
     let rate = range(f.points.iter().map(|p| p.tumble_rate), 0.0);
     let xr = range(f.points.iter().map(|p| p.peak_sync_grasp), 0.08);
     let yr = range(f.points.iter().map(|p| p.torque_norm_grasp), 0.08);
-    let mut chart = ChartBuilder::on(&main)
-        .caption(
-            "Grasping (III): joint-torque norm vs peak sync error, coloured by tumbling rate",
-            ("sans-serif", 18),
-        )
-        .margin(8)
-        .x_label_area_size(36)
-        .y_label_area_size(64)
-        .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)
-        .map_err(e)?;
+    let (xa, ya) = (Axis::linear(xr, TICKS), Axis::linear(yr, TICKS));
+    let mut chart = standard(
+        &main,
+        "Grasping (III): joint-torque norm vs peak sync error, coloured by tumbling rate",
+    )
+    .build_cartesian_2d(xa.coord(), ya.coord())
+    .map_err(e)?;
     chart
         .configure_mesh()
         .x_desc("peak sync error in grasping [rad/s]")
         .y_desc("RMS joint-torque norm ‖τ_M‖ in grasping [N m]")
+        .x_label_formatter(&|v| xa.label(*v))
+        .y_label_formatter(&|v| ya.label(*v))
+        .light_line_style(WHITE.mix(0.0))
         .draw()
         .map_err(e)?;
     let t = |v: f64| {
@@ -315,12 +321,8 @@ fn runtime(area: &Area, f: &CampaignFigures) -> DrawResult {
     };
     for (k, (area, bars, title)) in groups.iter().enumerate() {
         let n = bars.len().max(1) as f64;
-        let mut chart = ChartBuilder::on(area)
-            .caption(*title, ("sans-serif", 18))
-            .margin(8)
-            .x_label_area_size(36)
-            .y_label_area_size(64)
-            .build_cartesian_2d(0.0..n, (lo..hi).log_scale())
+        let mut chart = standard(area, title)
+            .build_cartesian_2d(0.0..n, log_coord(lo, hi))
             .map_err(e)?;
         let names: Vec<String> = bars.iter().map(|b| b.name.clone()).collect();
         chart
@@ -335,7 +337,7 @@ fn runtime(area: &Area, f: &CampaignFigures) -> DrawResult {
                     String::new()
                 }
             })
-            .y_label_formatter(&|v| log_tick(*v))
+            .y_label_formatter(&|v| log_label(*v))
             .y_desc("solve time per control step [µs]")
             .draw()
             .map_err(e)?;
@@ -374,9 +376,9 @@ fn runtime(area: &Area, f: &CampaignFigures) -> DrawResult {
                     }
                     chart
                         .draw_series(std::iter::once(Text::new(
-                            format!("{v:.1}"),
+                            duration_us(*v),
                             (x0, *v * 1.15),
-                            ("sans-serif", 12),
+                            (FONT, 12),
                         )))
                         .map_err(e)?;
                 }
@@ -386,65 +388,81 @@ fn runtime(area: &Area, f: &CampaignFigures) -> DrawResult {
             && let Some((name, g, m)) = &f.runtime_reference
         {
             for (v, c, what) in [(*g, GEOMEAN, "geomean"), (*m, MAX, "max")] {
+                let r = RefLine::new(v, c, format!("{name} {what}: {}", duration_us(v))).dashed();
+                ref_lines(&mut chart, (0.0, n), (lo, hi), &[(v, &r)], &[])?;
+                // the legend entry of the line just drawn
                 chart
-                    .draw_series(DashedLineSeries::new(
-                        vec![(0.0, v), (n, v)],
-                        6,
-                        4,
-                        c.stroke_width(1),
-                    ))
+                    .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
                     .map_err(e)?
                     .label(format!("{name} {what}"))
-                    .legend(move |(px, py)| {
-                        PathElement::new(vec![(px, py), (px + 18, py)], c.stroke_width(1))
-                    });
+                    .legend(move |p| swatch(p, c, 1, true));
             }
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK.mix(0.3))
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(e)?;
+        legend(&mut chart)?;
     }
     Ok(())
 }
 
+/// A duration given in µs as a reader wants it: `13.8 µs`, `1.59 ms`, `12 s`.
+fn duration_us(v: f64) -> String {
+    if v.abs() >= 1e6 {
+        format!("{} s", round_sig(v / 1e6))
+    } else if v.abs() >= 1000.0 {
+        format!("{} ms", round_sig(v / 1000.0))
+    } else {
+        format!("{} µs", round_sig(v))
+    }
+}
+
+/// `v` with three significant digits, no trailing zeros.
+fn round_sig(v: f64) -> String {
+    crate::ticks::linear_label(v, 10f64.powf(v.abs().log10().floor() - 2.0))
+}
+
 fn minima(area: &Area, f: &CampaignFigures) -> DrawResult {
-    let cols = 7usize;
-    let rows = f.minima.len().div_ceil(cols).max(1);
-    let cells = area.split_evenly((rows, cols));
+    let (head, body) = area.split_vertically(MINIMA_TITLE_PX);
+    head.draw(&Text::new(
+        "Every barrier's minimum over each run: runs per bin; h < 0 (left of the red h = 0 line) is a violation",
+        (10, 8),
+        (FONT, 16),
+    ))
+    .map_err(e)?;
+    let rows = f.minima.len().div_ceil(MINIMA_COLS).max(1);
+    let cells = body.split_evenly((rows, MINIMA_COLS));
     for (cell, m) in cells.iter().zip(f.minima.iter()) {
         let vals: Vec<f64> = m.values.iter().copied().filter(|v| v.is_finite()).collect();
-        let (lo, hi) = range(vals.iter().copied(), 0.05);
-        let bins = 12usize;
-        let w = (hi - lo) / bins as f64;
-        let mut counts = vec![0usize; bins];
+        // 0 always in range, so that the margin to the boundary is seen
+        let (lo, hi) = range(vals.iter().copied().chain([0.0]), 0.05);
+        let w = (hi - lo) / BINS as f64;
+        let mut counts = vec![0usize; BINS];
         for v in &vals {
-            let i = (((v - lo) / w).floor() as usize).min(bins - 1);
+            let i = (((v - lo) / w).floor().max(0.0) as usize).min(BINS - 1);
             counts[i] += 1;
         }
-        let top = counts.iter().copied().max().unwrap_or(0).max(1) as f64 * 1.1;
+        let top = counts.iter().copied().max().unwrap_or(0).max(1) as f64 * 1.15;
         let colour = if vals.iter().any(|v| *v < 0.0) {
             CAZ
         } else {
             GEOMEAN
         };
+        let (xa, ya) = (Axis::linear((lo, hi), 4), Axis::counts((0.0, top), 4));
         let mut chart = ChartBuilder::on(cell)
-            .caption(&m.name, ("sans-serif", 13))
+            .caption(&m.name, (FONT, 13))
             .margin(4)
-            .x_label_area_size(22)
-            .y_label_area_size(30)
-            .build_cartesian_2d(lo..hi, 0.0..top)
+            .x_label_area_size(34)
+            .y_label_area_size(40)
+            .build_cartesian_2d(xa.coord(), ya.coord())
             .map_err(e)?;
         chart
             .configure_mesh()
             .disable_mesh()
-            .x_labels(3)
-            .y_labels(3)
-            .x_label_style(("sans-serif", 10))
-            .y_label_style(("sans-serif", 10))
+            .x_desc("minimum of h")
+            .y_desc("runs")
+            .x_label_formatter(&|v| xa.label(*v))
+            .y_label_formatter(&|v| ya.label(*v))
+            .x_label_style((FONT, 10))
+            .y_label_style((FONT, 10))
+            .axis_desc_style((FONT, 11))
             .draw()
             .map_err(e)?;
         chart
@@ -459,14 +477,22 @@ fn minima(area: &Area, f: &CampaignFigures) -> DrawResult {
                     }),
             )
             .map_err(e)?;
-        if lo <= 0.0 && hi >= 0.0 {
-            chart
-                .draw_series(LineSeries::new(
-                    vec![(0.0, 0.0), (0.0, top)],
-                    CAZ.stroke_width(2),
-                ))
-                .map_err(e)?;
-        }
+        chart
+            .draw_series(LineSeries::new(
+                vec![(0.0, 0.0), (0.0, ya.hi)],
+                CAZ.stroke_width(ZONE_WIDTH),
+            ))
+            .map_err(e)?;
+        // label on the side of the line with more room
+        let right = hi > -lo;
+        label_at(
+            &mut chart,
+            (0.0, ya.hi),
+            (if right { 3 } else { -3 }, 2),
+            "h = 0",
+            CAZ,
+            (if right { HPos::Left } else { HPos::Right }, VPos::Top),
+        )?;
     }
     Ok(())
 }
@@ -490,24 +516,11 @@ pub fn campaign_figures(dir: &Path, f: &CampaignFigures) -> Result<Vec<PathBuf>,
     emit("trajectories_xy.svg", (1100, 600), &|a| trajectories(a, f))?;
     emit("attitude_los.svg", (800, 700), &|a| attitude(a, f))?;
     emit("torque_vs_sync.svg", (850, 600), &|a| scatter(a, f))?;
-    let rows = f.minima.len().div_ceil(7).max(1) as u32;
-    emit("barrier_minima.svg", (1400, 160 * rows), &|a| minima(a, f))?;
+    let rows = f.minima.len().div_ceil(MINIMA_COLS).max(1) as u32;
+    emit(
+        "barrier_minima.svg",
+        (1400, MINIMA_TITLE_PX + MINIMA_ROW_PX * rows),
+        &|a| minima(a, f),
+    )?;
     Ok(out)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::log_tick;
-
-    #[test]
-    fn log_ticks_read_like_numbers() {
-        let t: Vec<String> = [0.01, 0.1, 1.0, 10.0, 1000.0, 1e4, 1e5, 2.0, 0.0, f64::NAN]
-            .iter()
-            .map(|v| log_tick(*v))
-            .collect();
-        assert_eq!(
-            t,
-            ["0.01", "0.1", "1", "10", "1000", "1e4", "1e5", "2", "", ""]
-        );
-    }
 }

@@ -2,9 +2,47 @@
 
 use crate::PlotError;
 use crate::colour::viridis;
+use crate::ticks::{MIN_TICKS, linear_label, linear_ticks, log_label, log_ticks, step_of};
+use plotters::chart::SeriesAnno;
 use plotters::coord::Shift;
+use plotters::coord::combinators::LogCoord;
+use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint};
+use plotters::coord::types::RangedCoordf64;
+use plotters::element::{Drawable, PointCollection};
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use plotters_backend::DrawingErrorKind;
 use std::path::Path;
+
+/// Font family of every text (resolved by the viewer, or by [`crate::export_figures`]).
+pub const FONT: &str = "sans-serif";
+/// Caption font size [px].
+pub const TITLE_PX: u32 = 18;
+/// Margin around a chart [px].
+pub const MARGIN: u32 = 8;
+/// Height of the x label area (tick labels and axis description) [px].
+pub const X_LABEL_AREA: u32 = 40;
+/// Width of the y label area [px].
+pub const Y_LABEL_AREA: u32 = 64;
+/// Ticks a linear axis gets at most.
+pub const TICKS: usize = 6;
+/// Powers of ten a log axis labels at most (beyond, every other one or fewer).
+pub const LOG_TICKS: usize = 10;
+/// Dash and gap of a dashed series [px]; legend swatches use the same.
+pub const DASH: u32 = 6;
+pub const GAP: u32 = 4;
+/// Length of a legend swatch [px] (three dashes of a dashed series).
+const SWATCH: i32 = 26;
+/// Room for the swatch before a legend label [px].
+const LEGEND_AREA: u32 = 34;
+/// Room above the highest integer tick of a count axis (in counts).
+const COUNT_HEADROOM: f64 = 0.15;
+/// Opacity of scatter markers (overlapping dots stay visible).
+const MARKER_OPACITY: f64 = 0.6;
+/// Font size of reference-line labels [px].
+pub const REF_LABEL_PX: u32 = 12;
+/// Offset of a reference-line label from its line [px].
+const REF_LABEL_OFFSET: i32 = 3;
 
 pub type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
 pub type DrawResult = Result<(), String>;
@@ -14,8 +52,8 @@ pub fn e<T: std::fmt::Display>(x: T) -> String {
     x.to_string()
 }
 
-/// Ranges for a spatial chart of the standard layout ([`Panel`]: caption `title`, margin 8,
-/// label areas 36 and 64 px) on `area`: the shorter range is widened about its centre so
+/// Ranges for a spatial chart of the standard layout ([`Panel`]: caption `title`,
+/// [`MARGIN`], [`X_LABEL_AREA`], [`Y_LABEL_AREA`]) on `area`: the shorter range is widened about its centre so
 /// that a metre is as long on both axes and a sphere is drawn round.
 pub fn equal_aspect(
     area: &Area,
@@ -26,13 +64,7 @@ pub fn equal_aspect(
     // the plotting area this layout leaves, measured on a scratch canvas of the same size
     let mut scratch = String::new();
     let root = SVGBackend::with_string(&mut scratch, area.dim_in_pixel()).into_drawing_area();
-    let Ok(chart) = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 18))
-        .margin(8)
-        .x_label_area_size(36)
-        .y_label_area_size(64)
-        .build_cartesian_2d(0f64..1.0, 0f64..1.0)
-    else {
+    let Ok(chart) = standard(&root, title).build_cartesian_2d(0f64..1.0, 0f64..1.0) else {
         return (x, y);
     };
     let (w, h) = chart.plotting_area().dim_in_pixel();
@@ -106,6 +138,220 @@ pub fn range(values: impl IntoIterator<Item = f64>, pad: f64) -> (f64, f64) {
     (lo - pad * w, hi + pad * w)
 }
 
+/// The standard chart layout: caption, margin and label areas.
+pub fn standard<'a, 'b>(area: &'a Area<'b>, title: &str) -> ChartBuilder<'a, 'b, SVGBackend<'b>> {
+    let mut b = ChartBuilder::on(area);
+    b.caption(title, (FONT, TITLE_PX))
+        .margin(MARGIN)
+        .x_label_area_size(X_LABEL_AREA)
+        .y_label_area_size(Y_LABEL_AREA);
+    b
+}
+
+/// One axis in drawing units (log10 of the value on a log axis), with its ticks.
+#[derive(Debug, Clone)]
+pub struct Axis {
+    pub lo: f64,
+    pub hi: f64,
+    pub log: bool,
+    /// In drawing units.
+    pub ticks: Vec<f64>,
+    step: f64,
+}
+
+impl Axis {
+    /// A linear axis over `r` (a unit range if `r` is empty or not finite).
+    pub fn linear(r: (f64, f64), max_ticks: usize) -> Self {
+        let (lo, hi) = sane(r);
+        let ticks = linear_ticks(lo, hi, max_ticks);
+        Self {
+            lo,
+            hi,
+            log: false,
+            step: step_of(&ticks),
+            ticks,
+        }
+    }
+
+    /// A linear axis over `r` with integer ticks (counts), widened up to at least
+    /// [`MIN_TICKS`] integers.
+    pub fn counts(r: (f64, f64), max_ticks: usize) -> Self {
+        let (lo, hi) = sane(r);
+        let hi = hi.max(lo.ceil() + (MIN_TICKS - 1) as f64 + COUNT_HEADROOM);
+        let mut a = Self::linear((lo, hi), max_ticks);
+        if a.step < 1.0 {
+            a.ticks = (a.lo.ceil() as i64..=a.hi.floor() as i64)
+                .map(|k| k as f64)
+                .collect();
+            a.step = 1.0;
+        }
+        a
+    }
+
+    /// A log axis over `r` given in drawing units (log10 of the values).
+    pub fn log10(r: (f64, f64), max_ticks: usize) -> Self {
+        let (lo, hi) = sane(r);
+        let ticks = log_ticks(10f64.powf(lo), 10f64.powf(hi), max_ticks)
+            .into_iter()
+            .map(f64::log10)
+            .collect();
+        Self {
+            lo,
+            hi,
+            log: true,
+            ticks,
+            step: 0.0,
+        }
+    }
+
+    /// The value in drawing units (NaN for a non-positive value on a log axis).
+    pub fn map(&self, v: f64) -> f64 {
+        to_axis(v, self.log)
+    }
+
+    /// The tick label of `v` in drawing units.
+    pub fn label(&self, v: f64) -> String {
+        if self.log {
+            log_label(10f64.powf(v))
+        } else {
+            linear_label(v, self.step)
+        }
+    }
+
+    /// The plotters coordinate with exactly these ticks.
+    pub fn coord(&self) -> Ticked<RangedCoordf64> {
+        Ticked {
+            inner: (self.lo..self.hi).into(),
+            ticks: self.ticks.clone(),
+        }
+    }
+}
+
+/// A plotters coordinate whose ticks are given (no minor ticks).
+#[derive(Clone)]
+pub struct Ticked<R> {
+    pub inner: R,
+    pub ticks: Vec<f64>,
+}
+
+/// A log coordinate over `lo..hi` (data units, both > 0) with [`log_ticks`].
+pub fn log_coord(lo: f64, hi: f64) -> Ticked<LogCoord<f64>> {
+    Ticked {
+        inner: (lo..hi).log_scale().into(),
+        ticks: log_ticks(lo, hi, LOG_TICKS),
+    }
+}
+
+impl<R: Ranged<ValueType = f64>> Ranged for Ticked<R> {
+    type FormatOption = DefaultFormatting;
+    type ValueType = f64;
+
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        self.inner.map(value, limit)
+    }
+
+    fn key_points<Hint: KeyPointHint>(&self, hint: Hint) -> Vec<f64> {
+        if hint.weight().allow_light_points() {
+            Vec::new()
+        } else {
+            self.ticks.clone()
+        }
+    }
+
+    fn range(&self) -> std::ops::Range<f64> {
+        self.inner.range()
+    }
+}
+
+/// `r` if finite and non-empty, else a unit range about it.
+fn sane(r: (f64, f64)) -> (f64, f64) {
+    if r.0.is_finite() && r.1.is_finite() && r.1 > r.0 {
+        r
+    } else if r.0.is_finite() {
+        (r.0, r.0 + 1.0)
+    } else {
+        (0.0, 1.0)
+    }
+}
+
+fn to_axis(v: f64, log: bool) -> f64 {
+    if !log {
+        v
+    } else if v > 0.0 {
+        v.log10()
+    } else {
+        f64::NAN
+    }
+}
+
+/// A legend swatch: the series' line style over [`SWATCH`] pixels, dashed as the series
+/// is ([`DASH`] on, [`GAP`] off).
+pub struct Swatch {
+    /// Segment end points, in pairs.
+    ends: Vec<(i32, i32)>,
+    style: ShapeStyle,
+}
+
+impl Swatch {
+    pub fn new(p: (i32, i32), colour: RGBColor, width: u32, dashed: bool) -> Self {
+        let (dash, period) = if dashed {
+            (DASH as i32, (DASH + GAP) as i32)
+        } else {
+            (SWATCH, SWATCH)
+        };
+        let ends = (0..SWATCH)
+            .step_by(period.max(1) as usize)
+            .flat_map(|x0| [(p.0 + x0, p.1), (p.0 + (x0 + dash).min(SWATCH), p.1)])
+            .collect();
+        Self {
+            ends,
+            style: colour.stroke_width(width),
+        }
+    }
+}
+
+impl<'a> PointCollection<'a, (i32, i32)> for &'a Swatch {
+    type Point = &'a (i32, i32);
+    type IntoIter = &'a [(i32, i32)];
+    fn point_iter(self) -> Self::IntoIter {
+        &self.ends
+    }
+}
+
+impl<DB: DrawingBackend> Drawable<DB> for Swatch {
+    fn draw<I: Iterator<Item = (i32, i32)>>(
+        &self,
+        pos: I,
+        backend: &mut DB,
+        _: (u32, u32),
+    ) -> Result<(), DrawingErrorKind<DB::ErrorType>> {
+        let pts: Vec<(i32, i32)> = pos.collect();
+        for seg in pts.chunks_exact(2) {
+            backend.draw_path(seg.iter().copied(), &self.style)?;
+        }
+        Ok(())
+    }
+}
+
+/// The legend swatch of a series drawn at `p`.
+pub fn swatch(p: (i32, i32), colour: RGBColor, width: u32, dashed: bool) -> Swatch {
+    Swatch::new(p, colour, width, dashed)
+}
+
+/// Draws the legend of the labelled series of `chart` in its upper right corner.
+pub fn legend<'a, 'b: 'a, X: Ranged, Y: Ranged>(
+    chart: &mut ChartContext<'a, SVGBackend<'b>, Cartesian2d<X, Y>>,
+) -> DrawResult {
+    chart
+        .configure_series_labels()
+        .legend_area_size(LEGEND_AREA)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK.mix(0.3))
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(e)
+}
+
 /// A polyline of a panel.
 #[derive(Debug, Clone)]
 pub struct Line {
@@ -114,6 +360,8 @@ pub struct Line {
     pub dashed: bool,
     pub width: u32,
     pub label: Option<String>,
+    /// Draw a dot of radius `width` at each point instead of a line.
+    pub markers: bool,
 }
 
 impl Line {
@@ -127,12 +375,118 @@ impl Line {
             dashed,
             width: 2,
             label: None,
+            markers: false,
         }
     }
     pub fn label(mut self, s: impl Into<String>) -> Self {
         self.label = Some(s.into());
         self
     }
+}
+
+/// A labelled reference line (a bound, a threshold, a phase start).
+#[derive(Debug, Clone)]
+pub struct RefLine {
+    pub at: f64,
+    pub colour: RGBColor,
+    pub label: String,
+    pub dashed: bool,
+}
+
+impl RefLine {
+    pub fn new(at: f64, colour: RGBColor, label: impl Into<String>) -> Self {
+        Self {
+            at,
+            colour,
+            label: label.into(),
+            dashed: false,
+        }
+    }
+    pub fn dashed(mut self) -> Self {
+        self.dashed = true;
+        self
+    }
+}
+
+/// Draws `pts` (drawing units) solid or dashed and returns the series' annotation.
+fn series<'c, 'a, 'b: 'a, X: Ranged<ValueType = f64>, Y: Ranged<ValueType = f64>>(
+    chart: &'c mut ChartContext<'a, SVGBackend<'b>, Cartesian2d<X, Y>>,
+    pts: Vec<(f64, f64)>,
+    colour: RGBColor,
+    width: u32,
+    dashed: bool,
+) -> Result<&'c mut SeriesAnno<'a, SVGBackend<'b>>, String> {
+    let style = colour.stroke_width(width);
+    if dashed {
+        chart
+            .draw_series(DashedLineSeries::new(pts, DASH, GAP, style))
+            .map_err(e)
+    } else {
+        chart.draw_series(LineSeries::new(pts, style)).map_err(e)
+    }
+}
+
+/// Draws `text` at a point given in drawing units, shifted by `offset` pixels.
+pub fn label_at<'a, 'b: 'a, X: Ranged<ValueType = f64>, Y: Ranged<ValueType = f64>>(
+    chart: &mut ChartContext<'a, SVGBackend<'b>, Cartesian2d<X, Y>>,
+    at: (f64, f64),
+    offset: (i32, i32),
+    text: &str,
+    colour: RGBColor,
+    anchor: (HPos, VPos),
+) -> DrawResult {
+    let style = (FONT, REF_LABEL_PX)
+        .into_font()
+        .color(&colour)
+        .pos(Pos::new(anchor.0, anchor.1));
+    chart
+        .draw_series(std::iter::once(
+            EmptyElement::at(at) + Text::new(text.to_string(), offset, style),
+        ))
+        .map(|_| ())
+        .map_err(e)
+}
+
+/// Draws the horizontal reference lines `h` (drawing units) across `x`, each with its
+/// label above its left end, and the vertical ones `v` up `y`, each labelled at the top.
+pub fn ref_lines<'a, 'b: 'a, X: Ranged<ValueType = f64>, Y: Ranged<ValueType = f64>>(
+    chart: &mut ChartContext<'a, SVGBackend<'b>, Cartesian2d<X, Y>>,
+    x: (f64, f64),
+    y: (f64, f64),
+    h: &[(f64, &RefLine)],
+    v: &[(f64, &RefLine)],
+) -> DrawResult {
+    for (at, r) in v {
+        if at.is_finite() && *at >= x.0 && *at <= x.1 {
+            series(chart, vec![(*at, y.0), (*at, y.1)], r.colour, 1, r.dashed)?;
+            if !r.label.is_empty() {
+                label_at(
+                    chart,
+                    (*at, y.1),
+                    (REF_LABEL_OFFSET, REF_LABEL_OFFSET),
+                    &r.label,
+                    r.colour,
+                    (HPos::Left, VPos::Top),
+                )?;
+            }
+        }
+    }
+    for (at, r) in h {
+        if at.is_finite() && *at >= y.0 && *at <= y.1 {
+            series(chart, vec![(x.0, *at), (x.1, *at)], r.colour, 1, r.dashed)?;
+            if !r.label.is_empty() {
+                label_at(
+                    chart,
+                    (x.0, *at),
+                    (REF_LABEL_OFFSET, -REF_LABEL_OFFSET),
+                    &r.label,
+                    r.colour,
+                    (HPos::Left, VPos::Bottom),
+                )?;
+            }
+        }
+    }
+    Ok(())
 }
 
 /// A 2-D line panel.
@@ -142,12 +496,16 @@ pub struct Panel {
     pub xlabel: String,
     pub ylabel: String,
     pub lines: Vec<Line>,
-    /// Vertical reference lines (x, colour).
-    pub vlines: Vec<(f64, RGBColor)>,
-    /// Horizontal reference lines (y, colour).
-    pub hlines: Vec<(f64, RGBColor)>,
+    /// Vertical reference lines.
+    pub vlines: Vec<RefLine>,
+    /// Horizontal reference lines.
+    pub hlines: Vec<RefLine>,
+    /// In data units (also on a log axis).
     pub x_range: Option<(f64, f64)>,
     pub y_range: Option<(f64, f64)>,
+    /// Log axes: ticks at powers of ten; non-positive values are not drawn.
+    pub x_log: bool,
+    pub y_log: bool,
 }
 
 impl Panel {
@@ -160,96 +518,87 @@ impl Panel {
         }
     }
 
-    fn ranges(&self) -> ((f64, f64), (f64, f64)) {
-        let xs = self.lines.iter().flat_map(|l| l.pts.iter().map(|p| p.0));
-        let x = self.x_range.unwrap_or_else(|| range(xs, 0.02));
-        let ys = self
-            .lines
+    /// The lines in drawing units (log10 on a log axis), non-finite points dropped.
+    fn mapped(&self) -> Vec<Vec<(f64, f64)>> {
+        self.lines
             .iter()
-            .flat_map(|l| {
+            .map(|l| {
                 l.pts
                     .iter()
-                    .filter(|p| p.0 >= x.0 && p.0 <= x.1)
-                    .map(|p| p.1)
+                    .map(|p| (to_axis(p.0, self.x_log), to_axis(p.1, self.y_log)))
+                    .filter(|p| p.0.is_finite() && p.1.is_finite())
+                    .collect()
             })
-            .chain(self.hlines.iter().map(|h| h.0));
-        let y = self.y_range.unwrap_or_else(|| range(ys, 0.05));
-        (x, y)
+            .collect()
+    }
+
+    /// The axes in drawing units.
+    fn axes(&self, mapped: &[Vec<(f64, f64)>]) -> (Axis, Axis) {
+        let map_range = |r: (f64, f64), log: bool| (to_axis(r.0, log), to_axis(r.1, log));
+        let xs = mapped.iter().flat_map(|l| l.iter().map(|p| p.0));
+        let x = self
+            .x_range
+            .map(|r| map_range(r, self.x_log))
+            .unwrap_or_else(|| range(xs, 0.02));
+        let ys = mapped
+            .iter()
+            .flat_map(|l| l.iter().filter(|p| p.0 >= x.0 && p.0 <= x.1).map(|p| p.1))
+            .chain(self.hlines.iter().map(|h| to_axis(h.at, self.y_log)));
+        let y = self
+            .y_range
+            .map(|r| map_range(r, self.y_log))
+            .unwrap_or_else(|| range(ys, 0.05));
+        let axis = |r, log| {
+            if log {
+                Axis::log10(r, LOG_TICKS)
+            } else {
+                Axis::linear(r, TICKS)
+            }
+        };
+        (axis(x, self.x_log), axis(y, self.y_log))
     }
 
     pub fn draw(&self, area: &Area) -> DrawResult {
-        let (x, y) = self.ranges();
-        let mut chart = ChartBuilder::on(area)
-            .caption(&self.title, ("sans-serif", 18))
-            .margin(8)
-            .x_label_area_size(36)
-            .y_label_area_size(64)
-            .build_cartesian_2d(x.0..x.1, y.0..y.1)
+        let mapped = self.mapped();
+        let (xa, ya) = self.axes(&mapped);
+        let (x, y) = ((xa.lo, xa.hi), (ya.lo, ya.hi));
+        let mut chart = standard(area, &self.title)
+            .build_cartesian_2d(xa.coord(), ya.coord())
             .map_err(e)?;
         chart
             .configure_mesh()
             .x_desc(self.xlabel.as_str())
             .y_desc(self.ylabel.as_str())
-            .x_labels(6)
-            .y_labels(6)
+            .x_label_formatter(&|v| xa.label(*v))
+            .y_label_formatter(&|v| ya.label(*v))
             .light_line_style(WHITE.mix(0.0))
             .draw()
             .map_err(e)?;
-        for (v, c) in &self.vlines {
-            if v.is_finite() && *v >= x.0 && *v <= x.1 {
-                chart
-                    .draw_series(DashedLineSeries::new(
-                        vec![(*v, y.0), (*v, y.1)],
-                        4,
-                        4,
-                        c.stroke_width(1),
-                    ))
-                    .map_err(e)?;
-            }
-        }
-        for (h, c) in &self.hlines {
-            if h.is_finite() && *h >= y.0 && *h <= y.1 {
-                chart
-                    .draw_series(LineSeries::new(
-                        vec![(x.0, *h), (x.1, *h)],
-                        c.stroke_width(1),
-                    ))
-                    .map_err(e)?;
-            }
-        }
+        let hs: Vec<(f64, &RefLine)> = self.hlines.iter().map(|r| (ya.map(r.at), r)).collect();
+        let vs: Vec<(f64, &RefLine)> = self.vlines.iter().map(|r| (xa.map(r.at), r)).collect();
+        ref_lines(&mut chart, x, y, &hs, &vs)?;
         let mut labelled = false;
-        for l in &self.lines {
-            if l.pts.is_empty() {
+        for (l, pts) in self.lines.iter().zip(mapped) {
+            if pts.is_empty() {
                 continue;
             }
-            let style = l.colour.stroke_width(l.width);
-            let anno = if l.dashed {
+            let anno = if l.markers {
+                let style = l.colour.mix(MARKER_OPACITY).filled();
                 chart
-                    .draw_series(DashedLineSeries::new(l.pts.clone(), 6, 4, style))
+                    .draw_series(pts.into_iter().map(|p| Circle::new(p, l.width, style)))
                     .map_err(e)?
             } else {
-                chart
-                    .draw_series(LineSeries::new(l.pts.clone(), style))
-                    .map_err(e)?
+                series(&mut chart, pts, l.colour, l.width, l.dashed)?
             };
             if let Some(lab) = &l.label {
                 labelled = true;
-                let c = l.colour;
-                let dashed = l.dashed;
-                anno.label(lab.as_str()).legend(move |(px, py)| {
-                    let w = if dashed { 1 } else { 3 };
-                    PathElement::new(vec![(px, py), (px + 18, py)], c.stroke_width(w))
-                });
+                let (c, w, dashed) = (l.colour, l.width, l.dashed);
+                anno.label(lab.as_str())
+                    .legend(move |p| swatch(p, c, w, dashed));
             }
         }
         if labelled {
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK.mix(0.3))
-                .position(SeriesLabelPosition::UpperRight)
-                .draw()
-                .map_err(e)?;
+            legend(&mut chart)?;
         }
         Ok(())
     }
@@ -257,13 +606,14 @@ impl Panel {
 
 /// A vertical colour bar for values in `lo..hi`.
 pub fn colour_bar(area: &Area, label: &str, lo: f64, hi: f64) -> DrawResult {
-    let (lo, hi) = if hi > lo { (lo, hi) } else { (lo, lo + 1.0) };
+    let ya = Axis::linear((lo, hi), TICKS);
+    let (lo, hi) = (ya.lo, ya.hi);
     let mut chart = ChartBuilder::on(area)
         .margin_top(40)
         .margin_bottom(44)
         .margin_right(4)
         .y_label_area_size(56)
-        .build_cartesian_2d(0.0..1.0, lo..hi)
+        .build_cartesian_2d(0.0..1.0, ya.coord())
         .map_err(e)?;
     chart
         .configure_mesh()
@@ -271,9 +621,9 @@ pub fn colour_bar(area: &Area, label: &str, lo: f64, hi: f64) -> DrawResult {
         .disable_y_mesh()
         .disable_x_axis()
         .y_desc(label)
-        .y_labels(6)
-        .y_label_style(("sans-serif", 12))
-        .axis_desc_style(("sans-serif", 13))
+        .y_label_formatter(&|v| ya.label(*v))
+        .y_label_style((FONT, 12))
+        .axis_desc_style((FONT, 13))
         .draw()
         .map_err(e)?;
     let n = 64;

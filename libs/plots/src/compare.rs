@@ -12,7 +12,7 @@ const FLOOR: f64 = 1e-18;
 /// One curve: its legend, the difference it shows and its colour.
 type Series = (&'static str, fn(&StepDifference) -> f64, RGBColor);
 
-/// Writes the differences over time, `log10` of each (exact agreement at 1e-18).
+/// Writes the differences over time on a log axis (exact agreement drawn at 1e-18).
 pub fn difference_figure(path: &Path, d: &[StepDifference], title: &str) -> Result<(), PlotError> {
     let series: [Series; 4] = [
         (
@@ -37,9 +37,10 @@ pub fn difference_figure(path: &Path, d: &[StepDifference], title: &str) -> Resu
         ),
     ];
     svg(path, (900, 450), |area| {
-        let mut p = Panel::new(title, "t [s]", "log10 of the difference");
+        let mut p = Panel::new(title, "t [s]", "difference [m or rad] (log)");
+        p.y_log = true;
         for (name, f, colour) in series {
-            let pts = d.iter().map(|x| (x.t, f(x).max(FLOOR).log10())).collect();
+            let pts = d.iter().map(|x| (x.t, f(x).max(FLOOR))).collect();
             p.lines.push(Line::new(pts, colour, false).label(name));
         }
         p.draw(area)

@@ -10,24 +10,34 @@
 //!   peak synchronisation error coloured by tumbling rate, distributions of every barrier's
 //!   minimum.
 //! * [`redteam_margins`] — every red-team case against every barrier.
+//! * [`latency_percentiles`], [`latency_timeline`] — the partition's latency benchmark.
+//! * [`export_figures`] — every SVG of a folder also as PNG and/or PDF
+//!   ([`FigureFormats`], e.g. parsed from `svg,png,pdf`).
 //!
-//! SVG text is written as `<text>` elements, so no system fonts are needed. Output is a
-//! pure function of the input data (no timestamps), so identical data give identical
-//! files. Bad data (NaN, empty series) never panics: non-finite points are dropped and
+//! Every axis has at least three ticks labelled as numbers are written (`50`, `0.02`,
+//! `1e7`); legend swatches are drawn as their series (dashed, same width); reference lines
+//! carry their label. SVG text is written as `<text>` elements, so no system fonts are
+//! needed for SVG (PNG and PDF need one, see [`export_figures`]). Output is a pure
+//! function of the input data (no timestamps), so identical data give identical files. Bad data (NaN, empty series) never panics: non-finite points are dropped and
 //! empty panels get a unit range.
 
 mod campaign;
 mod chart;
 mod colour;
 mod compare;
+mod export;
+mod latency;
 mod redteam;
 mod run;
+mod ticks;
 
 pub use campaign::{
     BarrierMinima, CampaignFigures, RunPoint, RuntimeBar, TracePoint, campaign_figures,
 };
 pub use colour::viridis;
 pub use compare::difference_figure;
+pub use export::{FigureFormat, FigureFormats, PNG_SCALE, export_figure, export_figures};
+pub use latency::{LatencyPercentiles, LatencyTimeline, latency_percentiles, latency_timeline};
 pub use redteam::{RedTeamMargins, redteam_margins};
 pub use run::{los_angles_deg, run_figures};
 
@@ -41,6 +51,14 @@ pub enum PlotError {
     Io { path: String, message: String },
     #[error("cannot draw {path}: {message}")]
     Draw { path: String, message: String },
+    /// A figure format list that does not parse.
+    #[error("{message}")]
+    Format { message: String },
+    /// No font to set the figures' text in.
+    #[error("cannot export figures: {message}")]
+    Font { message: String },
+    #[error("cannot export {path}: {message}")]
+    Export { path: String, message: String },
 }
 
 /// The safety-zone geometry the figures draw, from the scenario.

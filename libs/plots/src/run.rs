@@ -1,6 +1,6 @@
 //! Figures of one mission (paper Figs. 3–4): nominal-only run dashed, filtered run solid.
 
-use crate::chart::{Area, DrawResult, Line, Panel, svg};
+use crate::chart::{Area, DrawResult, Line, Panel, RefLine, svg};
 use crate::colour::palette;
 use crate::{Geometry, PlotError};
 use nalgebra::Vector3;
@@ -104,14 +104,19 @@ fn family_series(records: &[StepRecord], select: fn(&str) -> bool) -> Vec<(f64, 
         .collect()
 }
 
-/// Starts of the phases after the first [s].
-fn phase_lines(s: &Scenario) -> Vec<(f64, RGBColor)> {
+/// Starts of the phases after the first [s], dashed, labelled with the phase's name.
+fn phase_lines(s: &Scenario) -> Vec<RefLine> {
     s.mission
         .phases
         .iter()
         .skip(1)
-        .map(|p| (p.start_s, PHASE))
+        .map(|p| RefLine::new(p.start_s, PHASE, p.name.replace('_', " ")).dashed())
         .collect()
+}
+
+/// The h = 0 line of a barrier panel: below it the barrier is violated.
+fn zero_line() -> RefLine {
+    RefLine::new(0.0, ZERO, "h = 0 (below: violated)")
 }
 
 /// The two runs, each as (records, label, colour, dashed).
@@ -209,7 +214,7 @@ fn barriers(area: &Area, runs: &Runs, s: &Scenario) -> DrawResult {
         let cols = row.split_evenly((1, fams.len()));
         for (col, (title, ylabel, select)) in cols.iter().zip(fams.iter()) {
             let mut p = Panel::new(title, "t [s]", ylabel);
-            p.hlines.push((0.0, ZERO));
+            p.hlines.push(zero_line());
             p.vlines = phase_lines(s);
             for (recs, label, c, dashed) in &runs.runs {
                 p.lines
@@ -227,8 +232,21 @@ fn range_rate(area: &Area, runs: &Runs, g: &Geometry) -> DrawResult {
         "distance ‖r‖ [m]",
         "range rate d‖r‖/dt [m/s]",
     );
-    p.vlines = vec![(g.caz_radius_m, CAZ), (g.gfc_distance_m, CORRIDOR)];
-    p.hlines.push((0.0, PHASE));
+    p.vlines = vec![
+        RefLine::new(g.caz_radius_m, CAZ, "R_CAZ").dashed(),
+        RefLine::new(g.gfc_distance_m, CORRIDOR, "Go-for-Capture").dashed(),
+    ];
+    p.hlines
+        .push(RefLine::new(0.0, PHASE, "0 (below: closing)"));
+    // from contact to the farthest point, the zone boundaries always in view
+    let far = runs
+        .runs
+        .iter()
+        .flat_map(|(r, ..)| r.iter().map(|x| x.obs.r_r.norm()))
+        .chain([g.caz_radius_m, g.gfc_distance_m])
+        .filter(|d| d.is_finite())
+        .fold(0.0, f64::max);
+    p.x_range = Some((0.0, if far > 0.0 { far * 1.02 } else { 1.0 }));
     p.lines = runs.lines(|r| {
         let d = r.obs.r_r.norm();
         (
@@ -245,7 +263,7 @@ fn range_rate(area: &Area, runs: &Runs, g: &Geometry) -> DrawResult {
 
 fn sync_error(area: &Area, runs: &Runs, s: &Scenario) -> DrawResult {
     let mut p = Panel::new(
-        "Rate-synchronisation error ‖ω_B − R_BT ω_T‖ (phase starts dashed)",
+        "Rate-synchronisation error ‖ω_B − R_BT ω_T‖",
         "t [s]",
         "sync error [rad/s]",
     );
@@ -266,9 +284,10 @@ fn joint_torques(area: &Area, runs: &Runs, s: &Scenario, g: &Geometry) -> DrawRe
         "t [s]",
         "τ_M [N m]",
     );
+    let max = g.joint_torque_max_nm;
     p.hlines = vec![
-        (g.joint_torque_max_nm, ZERO),
-        (-g.joint_torque_max_nm, ZERO),
+        RefLine::new(max, ZERO, format!("+|τ_M|max = {max} N m")),
+        RefLine::new(-max, ZERO, format!("−|τ_M|max = −{max} N m")),
     ];
     p.vlines = phase_lines(s);
     for (recs, label, _, dashed) in &runs.runs {
