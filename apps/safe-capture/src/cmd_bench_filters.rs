@@ -144,17 +144,17 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         });
         mission_wall.push(started.elapsed().as_secs_f64());
         if tty {
-            eprint!("\r  mission {}/{missions}", k + 1);
+            err!("\r  mission {}/{missions}", k + 1);
         } else {
-            eprintln!("  mission {}/{missions}", k + 1);
+            errln!("  mission {}/{missions}", k + 1);
         }
     }
     if tty {
-        eprintln!();
+        errln!();
     }
     let names = ["translational", "attitude", "robotic", "total"];
     let mut report = serde_json::Map::new();
-    println!(
+    outln!(
         "safety-layer solve time per control step [us] ({missions} missions{}, {})",
         a.redteam
             .as_deref()
@@ -166,16 +166,24 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             "skip path on"
         }
     );
-    println!(
+    outln!(
         "{:<14} {:<5} {:>7} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}",
-        "filter", "clock", "N", "geomean", "p50", "p90", "p99", "p99.9", "max"
+        "filter",
+        "clock",
+        "N",
+        "geomean",
+        "p50",
+        "p90",
+        "p99",
+        "p99.9",
+        "max"
     );
     for (i, n) in names.iter().enumerate() {
         let w = stats(&mut wall[i]);
         let c = stats(&mut cpu[i]);
         let q = stats(&mut qp[i]);
         for (clock, s) in [("wall", &w), ("cpu", &c), ("qp", &q)] {
-            println!(
+            outln!(
                 "{:<14} {:<5} {:>7} {:>9.2} {:>9.2} {:>9.2} {:>9.2} {:>9.2} {:>9.2}",
                 n,
                 clock,
@@ -200,11 +208,11 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         }
         report.insert(n.to_string(), entry);
     }
-    println!("QPs solved (steps), solver iterations and active barrier rows per solved QP:");
+    outln!("QPs solved (steps), solver iterations and active barrier rows per solved QP:");
     for (i, n) in names[..3].iter().enumerate() {
         let (im, ix) = SolverWork::mean_max(&work[i].iterations);
         let (am, ax) = SolverWork::mean_max(&work[i].active_rows);
-        println!(
+        outln!(
             "{:<14} solved {:>7}  iterations mean {:>5.2} max {:>3}  active rows mean {:>5.2} max {:>3}",
             n,
             work[i].iterations.len(),
@@ -215,7 +223,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         );
     }
     let mean_wall = mission_wall.iter().sum::<f64>() / mission_wall.len() as f64;
-    println!("whole mission (simulator + nominal + filters) wall time: mean {mean_wall:.3} s");
+    outln!("whole mission (simulator + nominal + filters) wall time: mean {mean_wall:.3} s");
     report.insert("solve_all".into(), serde_json::json!(a.solve_all));
     report.insert("mission_wall_s".into(), serde_json::json!(mission_wall));
     if let Some(p) = a.json {

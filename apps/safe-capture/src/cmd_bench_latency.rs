@@ -21,7 +21,7 @@ pub struct Args {
     #[arg(long, default_value_t = 50)]
     warmup: u64,
     /// Partition config (its rate groups set the period).
-    #[arg(long, value_name = "FILE", default_value = "config/partition.toml")]
+    #[arg(long, value_name = "FILE", default_value_os_t = crate::home::shipped("config/partition.toml"))]
     config: PathBuf,
     #[arg(long, value_name = "DIR", default_value = "out/bench-latency", help = crate::out_help!())]
     out: PathBuf,
@@ -44,7 +44,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         run_id: None,
     })?;
     staged.commit()?;
-    print!("{}", markdown(&r));
-    println!("-> {}", a.out.display());
+    out!("{}", markdown(&r));
+    outln!("-> {}", a.out.display());
     Ok(ExitCode::SUCCESS)
 }

@@ -33,9 +33,12 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let started = std::time::Instant::now();
     let m = envelope::sample(&setup.scenario, &setup.robot, a.samples, a.seed);
     let checks = envelope::checks(&setup.scenario, &m);
-    println!(
+    outln!(
         "{:<52} {:>12} {:>12} {:>8}",
-        "bound", "sampled max", "configured", "ratio"
+        "bound",
+        "sampled max",
+        "configured",
+        "ratio"
     );
     for c in &checks {
         let ratio = if c.sampled > 0.0 {
@@ -43,7 +46,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         } else {
             "-".into() // nothing moves there (link 1's spheres lie on joint 1's axis)
         };
-        println!(
+        outln!(
             "{:<52} {:>12.4} {:>12.4} {:>8}{}",
             c.key,
             c.sampled,
@@ -53,7 +56,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         );
     }
     let short = checks.iter().filter(|c| !c.holds()).count();
-    println!(
+    outln!(
         "{} of {} samples usable, {:.1} s; {} of {} bounds keep the factor {SAFETY_FACTOR}",
         m.samples,
         a.samples,

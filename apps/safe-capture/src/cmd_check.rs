@@ -58,10 +58,10 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let mut all_ok = true;
     for f in &a.files {
         match check_file(f, a.kind, &a.scenario) {
-            Ok(what) => println!("{}: ok ({what})", f.display()),
+            Ok(what) => outln!("{}: ok ({what})", f.display()),
             Err(p) => {
                 all_ok = false;
-                eprintln!("{}: {}", f.display(), p.replace('\n', " "));
+                errln!("{}: {}", f.display(), p.replace('\n', " "));
             }
         }
     }

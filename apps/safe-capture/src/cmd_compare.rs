@@ -86,13 +86,13 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     )?;
     staged.commit()?;
     let out = target;
-    println!(
+    outln!(
         "compare: first {:.1} s ({} steps): {}",
         w.until_s,
         w.steps,
         line(&w)
     );
-    println!(
+    outln!(
         "compare: whole run ({} steps of {} and {}): {} -> {}",
         all.steps,
         ra.len(),
@@ -112,7 +112,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             Some(std::cmp::Ordering::Less | std::cmp::Ordering::Equal)
         );
         if !within {
-            println!(
+            outln!(
                 "compare: {worst:.2e} > tolerance {tol:.2e} in the first {:.1} s",
                 w.until_s
             );

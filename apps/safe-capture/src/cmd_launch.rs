@@ -15,23 +15,26 @@ use std::process::ExitCode;
 /// partner scripts and the simulator's plant program are checked as `safe-capture
 /// check` does: a problem is one line naming the role or key, the cause and the fix.
 ///
-/// Exit codes, the mission's verdict: 0 captured safely, 1 the mission ended but not
-/// captured safely. The infrastructure's (no mission result): 2 bad configuration or
-/// arguments (nothing was started), 3 a process failed (did not start, crashed, was
-/// killed or hung) or the run was interrupted, 4 every process ended well but
-/// flight-side samples were lost in transport.
+/// Exit codes, the mission's verdict: 0 captured safely, 1 the mission ended (or
+/// --max-ticks stopped it) but not captured safely. The infrastructure's (no mission
+/// result; the run's output stays in OUT.incomplete): 2 bad configuration or arguments
+/// (nothing was started), 3 a process failed (did not start, crashed, was killed or
+/// hung) or the run was interrupted (SIGINT/SIGTERM: "interrupted after N ticks"), 4
+/// every process ended well but flight-side samples were lost in transport.
 #[derive(clap::Args)]
 pub struct Args {
     /// Partition config.
-    #[arg(long, value_name = "FILE", default_value = "config/partition.toml")]
+    #[arg(long, value_name = "FILE", default_value_os_t = crate::home::shipped("config/partition.toml"))]
     config: PathBuf,
-    /// Output directory.
-    #[arg(long, value_name = "DIR", default_value = "out/partition")]
+    #[arg(long, value_name = "DIR", default_value = "out/partition", help = crate::out_help!())]
     out: PathBuf,
+    #[arg(long, help = crate::out_folder::FORCE_HELP)]
+    force: bool,
     /// Pace ticks on the wall clock instead of lock-step.
     #[arg(long)]
     real_time: bool,
-    /// Stop after N ticks (0 = to the end of the mission).
+    /// Stop after N ticks (0 = to the end of the mission). A run stopped before the
+    /// mission ended says "stopped after N ticks" and exits 1 (no capture).
     #[arg(long, value_name = "N")]
     max_ticks: Option<u64>,
     /// Red team: a hostile partner process (scripts/python/hostile_nominal.py) in place
@@ -48,9 +51,78 @@ pub struct Args {
     #[arg(
         long,
         value_name = "FILE",
-        default_value = "scripts/python/hostile_nominal.py"
+        default_value_os_t = crate::home::shipped("scripts/python/hostile_nominal.py")
     )]
     partner: PathBuf,
+}
+
+fn read_json(path: &std::path::Path) -> Option<serde_json::Value> {
+    serde_json::from_str(&std::fs::read_to_string(path).ok()?).ok()
+}
+
+/// The ticks the scheduler ran (its scheduler.json).
+fn ticks_run(scheduler: Option<&serde_json::Value>) -> Option<u64> {
+    scheduler?["ticks"].as_u64()
+}
+
+/// How the mission ended, in words: its end from summary.json ("captured at t = 125.4
+/// s"), except a run that --max-ticks stopped before the mission's end (the recorder
+/// saw no end: "stopped after 50 ticks (--max-ticks) at t = 4.9 s, before the mission
+/// ended"); `duration_s` is the scenario's mission duration.
+fn outcome(
+    summary: Option<&serde_json::Value>,
+    scheduler: Option<&serde_json::Value>,
+    duration_s: f64,
+) -> String {
+    let Some(s) = summary else {
+        return "no summary".into();
+    };
+    let end = s["end"].as_str().unwrap_or("no end");
+    let t = s["final_time_s"].as_f64().unwrap_or(f64::NAN);
+    let stopped = scheduler.is_some_and(|s| s["end"] == "max_ticks");
+    if stopped && end == "timeout" && t < duration_s {
+        format!(
+            "stopped after {} ticks (--max-ticks) at t = {t:.1} s, before the mission ended",
+            ticks_run(scheduler).map_or("?".into(), |n| n.to_string())
+        )
+    } else {
+        format!("{end} at t = {t:.1} s")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::outcome;
+    use serde_json::json;
+
+    const DURATION_S: f64 = 240.0;
+
+    #[test]
+    fn a_run_stopped_by_max_ticks_is_no_timeout() {
+        let s = json!({"end": "timeout", "final_time_s": 4.9});
+        let stopped = json!({"end": "max_ticks", "ticks": 50});
+        assert_eq!(
+            outcome(Some(&s), Some(&stopped), DURATION_S),
+            "stopped after 50 ticks (--max-ticks) at t = 4.9 s, before the mission ended"
+        );
+        // the mission's own end stays its end, --max-ticks or not
+        let timeout = json!({"end": "timeout", "final_time_s": DURATION_S});
+        assert_eq!(
+            outcome(Some(&timeout), Some(&stopped), DURATION_S),
+            "timeout at t = 240.0 s"
+        );
+        let captured = json!({"end": "captured", "final_time_s": 125.4});
+        assert_eq!(
+            outcome(Some(&captured), Some(&stopped), DURATION_S),
+            "captured at t = 125.4 s"
+        );
+        let ended = json!({"end": "captured", "ticks": 1254});
+        assert_eq!(
+            outcome(Some(&s), Some(&ended), DURATION_S),
+            "timeout at t = 4.9 s"
+        );
+        assert_eq!(outcome(None, None, DURATION_S), "no summary");
+    }
 }
 
 /// The launcher's codes from this one on are the infrastructure's (a process failed,
@@ -60,7 +132,7 @@ const INFRASTRUCTURE_FAILURE: i32 = 3;
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let mut opts = LaunchOptions {
         config: a.config.clone(),
-        out: a.out.clone(),
+        out: PathBuf::new(),
         clock: a.real_time.then_some(ClockMode::RealTime),
         max_ticks: a.max_ticks,
         ..Default::default()
@@ -87,14 +159,37 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     if let Some((p, case)) = &partners {
         p.check(case)?;
     }
+    // the processes write into the staging folder; it replaces --out once they are done
+    let staged = crate::out_folder::stage(&a.out, "launch", a.force)?;
+    let out = staged.path().to_path_buf();
+    opts.out = out.clone();
+    let duration_s = sc_scenario::Scenario::load(&cfg.scenario_path())?
+        .mission
+        .duration_s;
     let rep = launch(&opts)?;
+    let scheduler = read_json(&out.join("scheduler.json"));
     if rep.code >= INFRASTRUCTURE_FAILURE {
-        // no mission result: say why, in one line
-        println!(
-            "partition: infrastructure failure (exit {}), no mission result: {}; wall {:.2} s -> {}",
-            rep.code,
-            crate::montecarlo_partition::failure_reason(&rep, &a.out),
+        // no mission result: say why, in one line; the partial output is kept apart
+        let what = if rep.interrupted {
+            format!(
+                "interrupted by SIGINT/SIGTERM{} (exit {}), no mission result",
+                ticks_run(scheduler.as_ref())
+                    .map(|n| format!(" after {n} ticks"))
+                    .unwrap_or_default(),
+                rep.code
+            )
+        } else {
+            format!(
+                "infrastructure failure (exit {}), no mission result: {}",
+                rep.code,
+                crate::montecarlo_partition::failure_reason(&rep, &out)
+            )
+        };
+        let kept = staged.abandon();
+        outln!(
+            "partition: {what}; wall {:.2} s -> {} (partial output; {} not replaced)",
             rep.wall_s,
+            kept.as_deref().unwrap_or(&out).display(),
             a.out.display()
         );
         return Ok(ExitCode::from(rep.code.clamp(0, 255) as u8));
@@ -105,19 +200,11 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         .filter(|e| !e.ended_well())
         .map(|e| e.role.clone())
         .collect();
-    let summary = std::fs::read_to_string(a.out.join("summary.json"))
-        .ok()
-        .and_then(|s| serde_json::from_str::<serde_json::Value>(&s).ok());
-    println!(
-        "partition: {} at t = {} s; {} processes, failed: [{}]; shm leftovers: {}; wall {:.2} s -> {}",
-        summary
-            .as_ref()
-            .and_then(|s| s["end"].as_str().map(String::from))
-            .unwrap_or_else(|| "no summary".into()),
-        summary
-            .as_ref()
-            .map(|s| s["final_time_s"].to_string())
-            .unwrap_or_default(),
+    let summary = read_json(&out.join("summary.json"));
+    staged.commit()?;
+    outln!(
+        "partition: {}; {} processes, failed: [{}]; shm leftovers: {}; wall {:.2} s -> {}",
+        outcome(summary.as_ref(), scheduler.as_ref(), duration_s),
         rep.exits.len(),
         failed.join(", "),
         rep.leftovers.len(),

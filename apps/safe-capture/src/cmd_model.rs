@@ -48,6 +48,6 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let state: ModelState = serde_json::from_str(&text)
         .with_context(|| format!("{}: invalid state JSON", a.state.display()))?;
     let report = evaluate_model(&robot, &state).with_context(|| a.state.display().to_string())?;
-    println!("{}", serde_json::to_string_pretty(&report)?);
+    outln!("{}", serde_json::to_string_pretty(&report)?);
     Ok(ExitCode::SUCCESS)
 }

@@ -11,7 +11,8 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-/// Partition config of --mode partition unless --partition-config is given.
+/// Partition config of --mode partition unless --partition-config is given (in the
+/// installation).
 const DEFAULT_PARTITION_CONFIG: &str = "config/partition.toml";
 
 /// Runs of a new campaign unless --runs is given.
@@ -210,7 +211,7 @@ fn params(a: &RunArgs) -> anyhow::Result<Params> {
             config: match config {
                 Some(c) => c,
                 None => {
-                    MonteCarloConfig::load(std::path::Path::new(sc_montecarlo::DEFAULT_CONFIG))?
+                    MonteCarloConfig::load(&crate::home::shipped(sc_montecarlo::DEFAULT_CONFIG))?
                 }
             },
             mode: a.mode.unwrap_or(Mode::InProcess),
@@ -269,10 +270,10 @@ fn campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
             let config = a
                 .partition_config
                 .clone()
-                .unwrap_or_else(|| PathBuf::from(DEFAULT_PARTITION_CONFIG));
+                .unwrap_or_else(|| crate::home::shipped(DEFAULT_PARTITION_CONFIG));
             let (executor, note) = PartitionExecutor::new(&config, a.keep_recordings, &p.scenario)?;
             if let Some(n) = note {
-                eprintln!("{n}");
+                errln!("{n}");
             }
             Box::new(executor)
         }
@@ -312,7 +313,7 @@ fn report(s: &CampaignSummary, out: &std::path::Path) -> ExitCode {
         .filter_map(|(n, w)| w.min_h.map(|h| (n, h, w.run)))
         .min_by(|a, b| a.1.total_cmp(&b.1));
     let t = s.solve_time_us.get("total").copied().unwrap_or_default();
-    println!(
+    outln!(
         "montecarlo: {} runs{} (seed {}): {} safe, {} captured, {} failed; worst margin {}; total solve time geomean {:.1} us, max {:.1} us; wall {:.1} s -> {}",
         s.runs,
         s.shard
@@ -334,16 +335,16 @@ fn report(s: &CampaignSummary, out: &std::path::Path) -> ExitCode {
         out.display()
     );
     for f in &s.failed {
-        println!("  run {} failed: {}", f.run, f.error);
+        outln!("  run {} failed: {}", f.run, f.error);
     }
     if !s.unsafe_runs.is_empty() {
-        println!("  unsafe runs: {:?}", s.unsafe_runs);
+        outln!("  unsafe runs: {:?}", s.unsafe_runs);
     }
     if !s.not_captured_runs.is_empty() {
-        println!("  runs without capture: {:?}", s.not_captured_runs);
+        outln!("  runs without capture: {:?}", s.not_captured_runs);
     }
     if let Some(i) = &s.interrupted {
-        println!(
+        outln!(
             "  interrupted after {} of {} runs: only those are aggregated; `safe-capture montecarlo --resume --out {}` runs the rest",
             i.completed_runs,
             i.planned_runs,
@@ -404,7 +405,7 @@ fn rerun(a: RerunArgs) -> anyhow::Result<ExitCode> {
     staged.commit()?;
     let out = target;
     let m = r.result.metrics.as_ref();
-    println!(
+    outln!(
         "rerun of run {}: {} at t = {:.1} s, safe: {}, -> {}",
         a.run,
         m.map_or("-", |m| m.end.as_str()),
@@ -413,11 +414,11 @@ fn rerun(a: RerunArgs) -> anyhow::Result<ExitCode> {
         out.display()
     );
     if r.differences.is_empty() {
-        println!("reproduced exactly: seed, dispersion, scenario and result match the saved run");
+        outln!("reproduced exactly: seed, dispersion, scenario and result match the saved run");
         Ok(ExitCode::SUCCESS)
     } else {
         for d in &r.differences {
-            println!("  differs: {d}");
+            outln!("  differs: {d}");
         }
         Ok(ExitCode::from(1))
     }

@@ -68,7 +68,7 @@ pub struct Args {
     #[arg(long)]
     partition: bool,
     /// --partition: the partition config (schedule, deadlines, the other executables).
-    #[arg(long, value_name = "FILE", default_value = "config/partition.toml")]
+    #[arg(long, value_name = "FILE", default_value_os_t = crate::home::shipped("config/partition.toml"))]
     partition_config: PathBuf,
     /// --partition: Python interpreter with the iceoryx2 package (default: $SC_PYTHON,
     /// else scripts/.venv/bin/python).
@@ -78,7 +78,7 @@ pub struct Args {
     #[arg(
         long,
         value_name = "FILE",
-        default_value = "scripts/python/hostile_nominal.py"
+        default_value_os_t = crate::home::shipped("scripts/python/hostile_nominal.py")
     )]
     partner: PathBuf,
     /// --partition: stop each run after N ticks (0: the whole mission).
@@ -155,7 +155,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let cases = selected(&a, ticks)?;
     if a.list {
         for c in &cases {
-            println!("{}", c.name());
+            outln!("{}", c.name());
         }
         return Ok(ExitCode::SUCCESS);
     }
@@ -223,7 +223,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             b.set_position(done as u64);
             b.set_message(format!("{} unsafe or failed", *u));
         } else if !a.quiet && (a.partition || done.is_multiple_of(10) || done == total) {
-            eprintln!("redteam: {done}/{total} cases, {} unsafe or failed", *u);
+            errln!("redteam: {done}/{total} cases, {} unsafe or failed", *u);
         }
     };
     let results: Vec<Result<CaseResult, String>> = match &partners {
@@ -266,10 +266,10 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     staged.commit()?;
     for (c, r) in cases.iter().zip(&results) {
         if let Err(e) = r {
-            eprintln!("redteam: {}: {e}", c.name());
+            errln!("redteam: {}: {e}", c.name());
         }
     }
-    println!(
+    outln!(
         "redteam{}: {} of {} cases safe{}{}; non-finite applied {}, out-of-bound applied {}; bystanders disturbed in {} cases{}; solve time geomean (worst case) {:.1} us, max {:.0} us; wall {:.1} s -> {}",
         match (a.partition, a.real_time) {
             (true, true) => " (partition, real time)",

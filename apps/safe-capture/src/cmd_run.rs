@@ -166,15 +166,15 @@ pub fn run_mission(
                 r.obs.grasp_distance()
             );
             if tty {
-                eprint!("\r{line}");
+                err!("\r{line}");
             } else {
-                eprintln!("{line}");
+                errln!("{line}");
             }
         }
         records.push(*r);
     });
     if !quiet && tty {
-        eprintln!();
+        errln!();
     }
     if let Some(e) = io_err {
         return Err(e).context("writing telemetry");
@@ -207,7 +207,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let staged = crate::out_folder::stage(&a.out, "run", a.force)?;
     let out = staged.path().to_path_buf();
     let plant: Option<Box<dyn sc_sim::Plant + Send>> = if a.basilisk {
-        let script = Path::new("scripts/basilisk_plant.py");
+        let script = crate::home::shipped("scripts/basilisk_plant.py");
         let args = vec![
             script.display().to_string(),
             "--scenario".to_string(),
@@ -258,7 +258,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             "filtered"
         }
     );
-    println!(
+    outln!(
         "{what}: {} at t = {:.1} s; min margin {} = {:.3e}; violated: [{}]; faults: {}; total solve time geomean {:.1} us, max {:.1} us; wall {:.2} s -> {}",
         summary.end,
         summary.final_time_s,

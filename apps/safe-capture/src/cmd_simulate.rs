@@ -70,7 +70,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             .with_context(|| format!("simulation failed at t = {} s", o.t))?;
     }
     w.flush()?;
-    eprintln!(
+    errln!(
         "simulated {duration} s ({steps} control steps) in {:.3} s -> {}",
         started.elapsed().as_secs_f64(),
         a.out.display()

@@ -132,7 +132,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         let unverified = w.checked - w.exact_n;
         let cl_ok = w.inexact_clarabel.0 <= a.clarabel_tolerance && unverified == w.inexact;
         ok &= kkt_ok && exact_ok && cl_ok;
-        println!(
+        outln!(
             "{f:<14} {:>6} QPs  violation {:.1e} (step {})  stationarity {:.1e} (step {})  distance to exact {:.1e} (step {}) on {}  to Clarabel {:.1e} (step {}){}{}  {}",
             w.checked,
             w.violation.0,
@@ -167,7 +167,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     }
     let total: usize = worst.values().map(|w| w.checked).sum();
     let exact: usize = worst.values().map(|w| w.exact_n).sum();
-    println!(
+    outln!(
         "verify-qp: {total} solved QPs checked, {exact} against an exact reference (relative to the input bound: violation <= {:e}, distance to exact <= {:e}, to Clarabel where none <= {:e}): {}",
         a.feasibility_tolerance,
         a.exact_tolerance,

@@ -1,5 +1,8 @@
 //! `safe-capture`: the command-line front door of the safety layer.
 
+// printing that survives a closed pipe (`outln!`, `errln!`), used by every module below
+#[macro_use]
+mod print;
 // One module per subcommand; add a subcommand with one `mod` line, one enum variant
 // and one match arm.
 mod cmd_bench;
@@ -15,6 +18,8 @@ mod cmd_redteam;
 mod cmd_run;
 mod cmd_simulate;
 mod cmd_verify_qp;
+// where the shipped config/ and scripts/ are (SAFE_CAPTURE_HOME, the executable's place)
+mod home;
 // the output-folder policy's --out/--force, the same in every command
 mod out_folder;
 // `montecarlo --mode partition`: runs through the process partition
@@ -28,6 +33,12 @@ use std::process::ExitCode;
 /// Safety layer for a free-flying robotic servicer capturing a tumbling target:
 /// three coupling-aware CBF safety filters (translational → attitude → robotic) over a
 /// high-fidelity simulator.
+///
+/// Runs from any folder: the shipped files the defaults name (config/, scripts/) are
+/// taken from the installation, $SAFE_CAPTURE_HOME if set, else the checkout the
+/// executable was built in (target/release/ below it); a path given on the command line
+/// is relative to the working directory, a path inside a config file to that file's
+/// folder. Outputs go to --out, relative to the working directory.
 #[derive(Parser)]
 #[command(name = "safe-capture", version = VERSION, propagate_version = true)]
 struct Cli {
@@ -70,9 +81,9 @@ enum Command {
 /// `--version`: the crate version and the git commit of the build (`build.rs`).
 const VERSION: &str = concat!(env!("CARGO_PKG_VERSION"), " (", env!("SC_GIT_COMMIT"), ")");
 
-/// Default scenario path (relative to the working directory).
+/// Default scenario: the installation's config/scenario.toml ([`home::shipped`]).
 pub fn default_scenario() -> PathBuf {
-    PathBuf::from(sc_scenario::DEFAULT_SCENARIO)
+    home::shipped(sc_scenario::DEFAULT_SCENARIO)
 }
 
 /// The command line with each subcommand's whole description in its `--help`: the
@@ -148,7 +159,7 @@ fn main() -> ExitCode {
         Err(e) => {
             // one line naming the problem
             let chain: Vec<String> = e.chain().map(|c| c.to_string()).collect();
-            eprintln!("error: {}", chain.join(": ").replace('\n', " "));
+            errln!("error: {}", chain.join(": ").replace('\n', " "));
             ExitCode::from(2)
         }
     }

@@ -41,7 +41,7 @@ pub struct Partners {
 pub fn default_python() -> PathBuf {
     std::env::var_os("SC_PYTHON")
         .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("scripts/.venv/bin/python"))
+        .unwrap_or_else(|| crate::home::shipped("scripts/.venv/bin/python"))
 }
 
 fn absolute(p: &Path) -> PathBuf {

@@ -166,12 +166,25 @@ fn a_process_that_fails_at_start_is_named_in_an_infrastructure_verdict() {
         stderr.contains("nominal_robotic") && !stderr.contains("safety_attitude"),
         "{t}"
     );
-    assert_eq!(json(&out.join("launch.json"))["code"], 3);
+    // the failed run's output is kept apart, under a name that says so
+    assert!(!out.exists(), "{t}");
+    let kept = d.join("out.incomplete");
+    assert!(
+        verdict[0].ends_with(&format!(
+            "-> {} (partial output; {} not replaced)",
+            kept.display(),
+            out.display()
+        )),
+        "{t}"
+    );
+    assert_eq!(json(&kept.join("launch.json"))["code"], 3);
     assert_eq!(shm_files_of(pid), Vec::<String>::new());
 }
 
 /// A launch that fails at start into the folder of an earlier run reports no mission
-/// result instead of the old run's, and removes only what a run writes (issue #16).
+/// result instead of the old run's and leaves that folder as it was; its own output is
+/// kept in OUT.incomplete; a folder that is not ours is refused before anything starts
+/// (issue #16).
 #[test]
 fn a_failed_launch_never_reports_an_old_run() {
     let _cpu = exclusive();
@@ -183,37 +196,124 @@ fn a_failed_launch_never_reports_an_old_run() {
     std::fs::write(d.join("partition.toml"), cfg).unwrap();
     let out = d.join("out");
     std::fs::create_dir_all(out.join("logs")).unwrap();
-    std::fs::write(
-        out.join("summary.json"),
-        r#"{"end": "captured", "final_time_s": 99.0}"#,
-    )
-    .unwrap();
+    let old_summary = r#"{"end": "captured", "final_time_s": 99.0}"#;
+    std::fs::write(out.join("summary.json"), old_summary).unwrap();
     std::fs::write(out.join("logs/simulator.log"), "an old run's log\n").unwrap();
     std::fs::write(out.join("notes.txt"), "mine\n").unwrap();
+    let launch = || {
+        cli_partition(
+            &[
+                "launch",
+                "--config",
+                d.join("partition.toml").to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            &[],
+        )
+        .0
+    };
+    // not ours (no marker): refused, nothing started or written
+    let o = launch();
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{t}");
+    assert!(
+        t.contains("was not written by safe-capture") && t.contains("--force"),
+        "{t}"
+    );
+    assert!(!d.join("out.incomplete").exists(), "{t}");
+    // an earlier run's folder: the failed launch leaves it whole and reports none of it
+    std::fs::write(out.join(".safe-capture"), "{}").unwrap();
+    let o = launch();
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(3), "{t}");
+    assert!(
+        t.contains("infrastructure failure") && !t.contains("captured"),
+        "{t}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(out.join("summary.json")).unwrap(),
+        old_summary
+    );
+    assert_eq!(
+        std::fs::read_to_string(out.join("logs/simulator.log")).unwrap(),
+        "an old run's log\n"
+    );
+    let kept = d.join("out.incomplete");
+    assert!(!kept.join("summary.json").exists(), "{t}");
+    assert_eq!(json(&kept.join("launch.json"))["code"], 3);
+    assert!(t.contains(&format!("-> {}", kept.display())), "{t}");
+}
+
+/// Ticks of the short launches below.
+const SHORT_TICKS: &str = "50";
+
+/// `--max-ticks` ends a launch in its own words, not as a mission timeout (issue #16).
+#[test]
+fn a_launch_stopped_by_max_ticks_says_so() {
+    let _cpu = exclusive();
+    let d = tmp("max-ticks");
+    let cfg = d.join("partition.toml");
+    std::fs::write(&cfg, partition_toml_absolute_scenario()).unwrap();
+    let out = d.join("out");
     let (o, _) = cli_partition(
         &[
             "launch",
             "--config",
-            d.join("partition.toml").to_str().unwrap(),
+            cfg.to_str().unwrap(),
+            "--max-ticks",
+            SHORT_TICKS,
             "--out",
             out.to_str().unwrap(),
         ],
         &[],
     );
     let t = text(&o);
-    assert!(!o.status.success(), "{t}");
+    assert_eq!(o.status.code(), Some(1), "{t}");
+    let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(
-        t.contains("infrastructure failure") && !t.contains("captured"),
+        stdout.starts_with(&format!(
+            "partition: stopped after {SHORT_TICKS} ticks (--max-ticks) at t = 4.9 s, before the mission ended; 9 processes, failed: []"
+        )),
         "{t}"
     );
-    assert!(!out.join("summary.json").exists());
-    assert_ne!(
-        std::fs::read_to_string(out.join("logs/simulator.log")).unwrap_or_default(),
-        "an old run's log\n"
-    );
-    assert_eq!(
-        std::fs::read_to_string(out.join("notes.txt")).unwrap(),
-        "mine\n"
-    );
-    let _ = std::fs::remove_dir_all(&d);
+    assert!(!t.contains("timeout"), "{t}");
+    // the recorder recorded everything: it ended well although nothing was captured
+    let launch = json(&out.join("launch.json"));
+    let recorder = launch["exits"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|e| e["role"] == "recorder")
+        .unwrap();
+    assert_eq!(recorder["code"], 0, "{launch}");
+}
+
+/// A launch whose reader has gone (`launch … | head`, stdout and stderr closed) neither
+/// panics nor stops before the teardown: its own exit code, its output committed,
+/// nothing left in /dev/shm (issue #16).
+#[test]
+fn a_launch_into_a_closed_pipe_ends_cleanly() {
+    let _cpu = exclusive();
+    let d = tmp("closed-pipe");
+    let cfg = d.join("partition.toml");
+    std::fs::write(&cfg, partition_toml_absolute_scenario()).unwrap();
+    let out = d.join("out");
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_safe-capture"))
+        .current_dir(root())
+        .args(["launch", "--config", cfg.to_str().unwrap()])
+        .args(["--max-ticks", SHORT_TICKS, "--out", out.to_str().unwrap()])
+        .env("SC_PARTITION_BIN_DIR", partition_bin_dir())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // the reader goes before anything was written
+    drop(child.stdout.take());
+    drop(child.stderr.take());
+    let pid = child.id();
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(1), "{status}");
+    assert!(out.join("summary.json").is_file());
+    assert_eq!(shm_files_of(pid), Vec::<String>::new());
 }

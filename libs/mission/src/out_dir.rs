@@ -246,8 +246,11 @@ impl Drop for Staged {
         if !self.done
             && let Some(p) = self.leave()
         {
-            eprintln!(
-                "the partial output is in {} ({} is unchanged)",
+            // not `eprintln!`: a closed stderr must not panic in a drop
+            use std::io::Write as _;
+            let _ = writeln!(
+                std::io::stderr().lock(),
+                "the partial output is in {} ({} not replaced)",
                 p.display(),
                 self.target.display()
             );

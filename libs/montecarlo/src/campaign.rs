@@ -544,7 +544,10 @@ fn runs_to_resume(
             continue;
         }
         if let Err(why) = verify_saved_run(base, out, k) {
-            eprintln!(
+            // not `eprintln!`: a closed stderr must not stop the campaign
+            use std::io::Write as _;
+            let _ = writeln!(
+                std::io::stderr().lock(),
                 "resume: run {k} in {} does not verify ({why}); running it again",
                 d.display()
             );

@@ -10,6 +10,15 @@ use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
+/// `eprintln!` that cannot panic: with stderr a closed pipe (`launch 2>&1 | head`) the
+/// launcher must still tear the run down and leave nothing in /dev/shm.
+macro_rules! note {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr().lock(), $($arg)*);
+    }};
+}
+
 /// Environment variable: directory of the partition's executables.
 pub const BIN_DIR_ENV: &str = "SC_PARTITION_BIN_DIR";
 
@@ -52,10 +61,10 @@ pub struct ProcessExit {
 }
 
 impl ProcessExit {
-    /// The process did its job: exit 0, or the recorder's 1 (it recorded everything, and
-    /// the mission did not end captured and safe — a result, not a failure).
+    /// The process did its job: exit 0 (the recorder's too when the mission did not
+    /// capture: that is the mission's result, in summary.json, not the recorder's).
     pub fn ended_well(&self) -> bool {
-        self.code == Some(0) || (self.role == "recorder" && self.code == Some(1))
+        self.code == Some(0)
     }
 }
 
@@ -371,7 +380,7 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
         None => Err(String::new()),
     };
     if let (Some(_), Err(e)) = (wakeup_request, &wakeup_held) {
-        eprintln!("launch: warning: CPU wake-up latency not set ({e})");
+        note!("launch: warning: CPU wake-up latency not set ({e})");
     }
     let stale_removed = clean_stale_runs(run.run_id());
     let _ = reap_bounded(&run);
@@ -443,7 +452,7 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
                 // the teardown stopped; one that failed by itself is named here as it
                 // happens
                 if !opts.quiet && !ex.ended_well() && !termed {
-                    eprintln!(
+                    note!(
                         "launch: {} (pid {}) exited: {}",
                         p.role,
                         ex.pid,
@@ -454,7 +463,7 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
                         }
                     );
                 }
-                let ok = ex.code == Some(0) || (p.role == "recorder" && ex.code == Some(1));
+                let ok = ex.ended_well();
                 if !ok && !termed && !out.join(ALL_READY).exists() {
                     // the handshake can never complete (a participant that cannot join,
                     // or the scheduler itself, e.g. at its handshake timeout naming who
@@ -505,13 +514,13 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
         if INTERRUPTED.load(Ordering::SeqCst) && !interrupted {
             interrupted = true;
             if !opts.quiet {
-                eprintln!("launch: interrupted, tearing down");
+                note!("launch: interrupted, tearing down");
             }
             teardown_at = Some(Instant::now());
         }
         if started.elapsed() > timeout && teardown_at.is_none() {
             if !opts.quiet {
-                eprintln!("launch: run timed out after {timeout:?}, tearing down");
+                note!("launch: run timed out after {timeout:?}, tearing down");
             }
             failed = true;
             teardown_at = Some(Instant::now());
@@ -530,7 +539,7 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
                     // a process that ignores the stop tick and SIGTERM is hung: a failure
                     failed = true;
                     if !opts.quiet {
-                        eprintln!("launch: killing {} (pid {})", p.role, p.child.id());
+                        note!("launch: killing {} (pid {})", p.role, p.child.id());
                     }
                     let _ = p.child.kill();
                 }
@@ -540,23 +549,22 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
     }
     // every process of the run is gone: remove what the run left behind
     if reap_bounded(&run).is_none() && !opts.quiet {
-        eprintln!(
+        note!(
             "launch: warning: iceoryx2's cleanup of the run's dead nodes did not finish within {REAP_TIMEOUT:?} (a process was stopped while creating a service); the run's files are removed by name"
         );
     }
     let _ = run.force_remove_files();
     let leftovers = run.leftovers();
     let exits: Vec<ProcessExit> = procs.into_iter().filter_map(|p| p.exit).collect();
-    let recorder_code = exits
-        .iter()
-        .find(|e| e.role == "recorder")
-        .and_then(|e| e.code);
     let mut code = if failed || interrupted || spawn_err.is_some() || !leftovers.is_empty() {
         3
-    } else if recorder_code == Some(0) {
-        0
     } else {
-        1
+        match mission_verdict(&out.join("summary.json")) {
+            Some(true) => 0,
+            Some(false) => 1,
+            // every process ended well and yet the recorder left no result
+            None => 3,
+        }
     };
     let mut error = spawn_err.or(early_err);
     // every process ended well, yet the flight side lost samples: the transport failed
@@ -574,7 +582,7 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
         ));
     }
     if let Some(e) = error.as_ref().filter(|_| !opts.quiet) {
-        eprintln!("launch: {e}");
+        note!("launch: {e}");
     }
     let rep = LaunchReport {
         run_id: run.run_id().to_string(),
@@ -592,6 +600,14 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
         serde_json::to_string_pretty(&rep)? + "\n",
     )?;
     Ok(rep)
+}
+
+/// The mission's verdict from a run's summary.json: captured with every barrier
+/// satisfied and no fault; `None` without a readable summary.
+pub fn mission_verdict(summary: &Path) -> Option<bool> {
+    let s: sc_mission::Summary =
+        serde_json::from_str(&std::fs::read_to_string(summary).ok()?).ok()?;
+    Some(s.captured && s.violated_constraints.is_empty() && s.fault_count == 0)
 }
 
 /// The flight-side services (everything but the partners' `safe_capture/nominal/*`) of
