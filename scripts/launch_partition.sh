@@ -4,23 +4,24 @@
 # starts every process from the config, waits for all (handshake), runs the mission
 # and tears everything down (also on Ctrl-C and on any failure).
 #
-# usage: scripts/launch_partition.sh [--config FILE] [--out DIR] [--real-time] [--max-ticks N]
-# exit:  0 captured safely, 1 not captured safely, 3 a process failed, 2 bad usage/config
+# usage: scripts/launch_partition.sh [--config FILE] [--out DIR] [--force] [--real-time] [--max-ticks N]
+# exit:  0 captured safely, 1 not captured safely, 2 bad usage/config, 3 a process failed
+#        or interrupted, 4 samples lost in transport (safe-capture launch --help)
+# Paths are relative to the caller's working directory (default config: the checkout's).
 set -euo pipefail
-cd "$(dirname "$0")/.."
-config=config/partition.toml
-out=out/partition
-extra=()
+root="$(cd "$(dirname "$0")/.." && pwd)"
+args=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
-    --config) config="$2"; shift 2 ;;
-    --out) out="$2"; shift 2 ;;
-    --real-time) extra+=(--real-time); shift ;;
-    --max-ticks) extra+=(--max-ticks "$2"); shift 2 ;;
-    -h|--help) sed -n '2,9p' "$0"; exit 0 ;;
+    --config|--out) args+=("$1" "$2"); shift 2 ;;
+    --max-ticks) args+=(--max-ticks "$2"); shift 2 ;;
+    --real-time|--force) args+=("$1"); shift ;;
+    -h|--help) sed -n '2,10p' "$0"; exit 0 ;;
     *) echo "launch_partition.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
-target="${CARGO_TARGET_DIR:-target}"
-cargo build --release --quiet -p safe-capture -p sc-partition-apps
-exec "$target/release/safe-capture" launch --config "$config" --out "$out" "${extra[@]}"
+target="${CARGO_TARGET_DIR:-$root/target}"
+cargo build --manifest-path "$root/Cargo.toml" --release --quiet -p safe-capture -p sc-partition-apps
+# no `cd`: the caller's relative --config and --out stay the caller's; the default
+# config is the checkout's (safe-capture finds it next to its executable)
+exec "$target/release/safe-capture" launch "${args[@]}"
