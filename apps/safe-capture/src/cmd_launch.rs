@@ -90,41 +90,6 @@ fn outcome(
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::outcome;
-    use serde_json::json;
-
-    const DURATION_S: f64 = 240.0;
-
-    #[test]
-    fn a_run_stopped_by_max_ticks_is_no_timeout() {
-        let s = json!({"end": "timeout", "final_time_s": 4.9});
-        let stopped = json!({"end": "max_ticks", "ticks": 50});
-        assert_eq!(
-            outcome(Some(&s), Some(&stopped), DURATION_S),
-            "stopped after 50 ticks (--max-ticks) at t = 4.9 s, before the mission ended"
-        );
-        // the mission's own end stays its end, --max-ticks or not
-        let timeout = json!({"end": "timeout", "final_time_s": DURATION_S});
-        assert_eq!(
-            outcome(Some(&timeout), Some(&stopped), DURATION_S),
-            "timeout at t = 240.0 s"
-        );
-        let captured = json!({"end": "captured", "final_time_s": 125.4});
-        assert_eq!(
-            outcome(Some(&captured), Some(&stopped), DURATION_S),
-            "captured at t = 125.4 s"
-        );
-        let ended = json!({"end": "captured", "ticks": 1254});
-        assert_eq!(
-            outcome(Some(&s), Some(&ended), DURATION_S),
-            "timeout at t = 4.9 s"
-        );
-        assert_eq!(outcome(None, None, DURATION_S), "no summary");
-    }
-}
-
 /// The launcher's codes from this one on are the infrastructure's (a process failed,
 /// samples lost): the run is no mission result.
 const INFRASTRUCTURE_FAILURE: i32 = 3;
@@ -212,4 +177,39 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         a.out.display()
     );
     Ok(ExitCode::from(rep.code.clamp(0, 255) as u8))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::outcome;
+    use serde_json::json;
+
+    const DURATION_S: f64 = 240.0;
+
+    #[test]
+    fn a_run_stopped_by_max_ticks_is_no_timeout() {
+        let s = json!({"end": "timeout", "final_time_s": 4.9});
+        let stopped = json!({"end": "max_ticks", "ticks": 50});
+        assert_eq!(
+            outcome(Some(&s), Some(&stopped), DURATION_S),
+            "stopped after 50 ticks (--max-ticks) at t = 4.9 s, before the mission ended"
+        );
+        // the mission's own end stays its end, --max-ticks or not
+        let timeout = json!({"end": "timeout", "final_time_s": DURATION_S});
+        assert_eq!(
+            outcome(Some(&timeout), Some(&stopped), DURATION_S),
+            "timeout at t = 240.0 s"
+        );
+        let captured = json!({"end": "captured", "final_time_s": 125.4});
+        assert_eq!(
+            outcome(Some(&captured), Some(&stopped), DURATION_S),
+            "captured at t = 125.4 s"
+        );
+        let ended = json!({"end": "captured", "ticks": 1254});
+        assert_eq!(
+            outcome(Some(&s), Some(&ended), DURATION_S),
+            "timeout at t = 4.9 s"
+        );
+        assert_eq!(outcome(None, None, DURATION_S), "no summary");
+    }
 }
