@@ -388,13 +388,13 @@ fn runtime(area: &Area, f: &CampaignFigures) -> DrawResult {
             && let Some((name, g, m)) = &f.runtime_reference
         {
             for (v, c, what) in [(*g, GEOMEAN, "geomean"), (*m, MAX, "max")] {
-                let r = RefLine::new(v, c, format!("{name} {what}: {}", duration_us(v))).dashed();
+                // labelled in the legend (a label on the line would cross the bars)
+                let r = RefLine::new(v, c, "").dashed();
                 ref_lines(&mut chart, (0.0, n), (lo, hi), &[(v, &r)], &[])?;
-                // the legend entry of the line just drawn
                 chart
                     .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
                     .map_err(e)?
-                    .label(format!("{name} {what}"))
+                    .label(format!("{name} {what}: {}", duration_us(v)))
                     .legend(move |p| swatch(p, c, 1, true));
             }
         }
@@ -416,7 +416,8 @@ fn duration_us(v: f64) -> String {
 
 /// `v` with three significant digits, no trailing zeros.
 fn round_sig(v: f64) -> String {
-    crate::ticks::linear_label(v, 10f64.powf(v.abs().log10().floor() - 2.0))
+    // linear_label shows one decimal more than its step
+    crate::ticks::linear_label(v, 10f64.powf(v.abs().log10().floor() - 1.0))
 }
 
 fn minima(area: &Area, f: &CampaignFigures) -> DrawResult {
@@ -434,7 +435,7 @@ fn minima(area: &Area, f: &CampaignFigures) -> DrawResult {
         // 0 always in range, so that the margin to the boundary is seen
         let (lo, hi) = range(vals.iter().copied().chain([0.0]), 0.05);
         let w = (hi - lo) / BINS as f64;
-        let mut counts = vec![0usize; BINS];
+        let mut counts = [0usize; BINS];
         for v in &vals {
             let i = (((v - lo) / w).floor().max(0.0) as usize).min(BINS - 1);
             counts[i] += 1;

@@ -35,6 +35,8 @@ pub const GAP: u32 = 4;
 const SWATCH: i32 = 26;
 /// Room for the swatch before a legend label [px].
 const LEGEND_AREA: u32 = 34;
+/// Integer steps tried for a count axis (1, 2, 5, 10, … up to 5e6).
+const COUNT_STEP_TRIES: usize = 21;
 /// Room above the highest integer tick of a count axis (in counts).
 const COUNT_HEADROOM: f64 = 0.15;
 /// Opacity of scatter markers (overlapping dots stay visible).
@@ -141,8 +143,10 @@ pub fn range(values: impl IntoIterator<Item = f64>, pad: f64) -> (f64, f64) {
 /// The standard chart layout: caption, margin and label areas.
 pub fn standard<'a, 'b>(area: &'a Area<'b>, title: &str) -> ChartBuilder<'a, 'b, SVGBackend<'b>> {
     let mut b = ChartBuilder::on(area);
-    b.caption(title, (FONT, TITLE_PX))
-        .margin(MARGIN)
+    if !title.is_empty() {
+        b.caption(title, (FONT, TITLE_PX));
+    }
+    b.margin(MARGIN)
         .x_label_area_size(X_LABEL_AREA)
         .y_label_area_size(Y_LABEL_AREA);
     b
@@ -173,17 +177,35 @@ impl Axis {
         }
     }
 
-    /// A linear axis over `r` with integer ticks (counts), widened up to at least
-    /// [`MIN_TICKS`] integers.
+    /// A linear axis over `r` with integer ticks (counts) 1, 2 or 5 × 10^k apart, widened
+    /// up to at least [`MIN_TICKS`] integers; at least [`MIN_TICKS`] ticks, a little more
+    /// than `max_ticks` if round steps allow no fewer.
     pub fn counts(r: (f64, f64), max_ticks: usize) -> Self {
         let (lo, hi) = sane(r);
         let hi = hi.max(lo.ceil() + (MIN_TICKS - 1) as f64 + COUNT_HEADROOM);
+        let max_ticks = max_ticks.max(MIN_TICKS);
         let mut a = Self::linear((lo, hi), max_ticks);
-        if a.step < 1.0 {
-            a.ticks = (a.lo.ceil() as i64..=a.hi.floor() as i64)
-                .map(|k| k as f64)
-                .collect();
-            a.step = 1.0;
+        let integers = |step: f64| -> Vec<f64> {
+            ((lo / step).ceil() as i64..=(hi / step).floor() as i64)
+                .map(|k| k as f64 * step)
+                .collect()
+        };
+        let steps = (0..).flat_map(|k| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(k)));
+        // the finest step with at most max_ticks, unless that leaves too few: then the
+        // step before it (a tick or two over max_ticks)
+        let mut prev: Option<(Vec<f64>, f64)> = None;
+        for step in steps.take(COUNT_STEP_TRIES) {
+            let t = integers(step);
+            if t.len() <= max_ticks {
+                let (t, step) = match prev {
+                    Some(p) if t.len() < MIN_TICKS => p,
+                    _ => (t, step),
+                };
+                a.ticks = t;
+                a.step = step;
+                break;
+            }
+            prev = Some((t, step));
         }
         a
     }
@@ -448,7 +470,8 @@ pub fn label_at<'a, 'b: 'a, X: Ranged<ValueType = f64>, Y: Ranged<ValueType = f6
 }
 
 /// Draws the horizontal reference lines `h` (drawing units) across `x`, each with its
-/// label above its left end, and the vertical ones `v` up `y`, each labelled at the top.
+/// label above its left end, and the vertical ones `v` up `y`, each labelled at its foot
+/// (the legend sits at the top).
 pub fn ref_lines<'a, 'b: 'a, X: Ranged<ValueType = f64>, Y: Ranged<ValueType = f64>>(
     chart: &mut ChartContext<'a, SVGBackend<'b>, Cartesian2d<X, Y>>,
     x: (f64, f64),
@@ -462,11 +485,11 @@ pub fn ref_lines<'a, 'b: 'a, X: Ranged<ValueType = f64>, Y: Ranged<ValueType = f
             if !r.label.is_empty() {
                 label_at(
                     chart,
-                    (*at, y.1),
-                    (REF_LABEL_OFFSET, REF_LABEL_OFFSET),
+                    (*at, y.0),
+                    (REF_LABEL_OFFSET, -REF_LABEL_OFFSET),
                     &r.label,
                     r.colour,
-                    (HPos::Left, VPos::Top),
+                    (HPos::Left, VPos::Bottom),
                 )?;
             }
         }
@@ -582,19 +605,25 @@ impl Panel {
             if pts.is_empty() {
                 continue;
             }
-            let anno = if l.markers {
-                let style = l.colour.mix(MARKER_OPACITY).filled();
-                chart
-                    .draw_series(pts.into_iter().map(|p| Circle::new(p, l.width, style)))
-                    .map_err(e)?
+            let (c, w, dashed) = (l.colour, l.width, l.dashed);
+            if l.markers {
+                let style = c.mix(MARKER_OPACITY).filled();
+                let anno = chart
+                    .draw_series(pts.into_iter().map(|p| Circle::new(p, w, style)))
+                    .map_err(e)?;
+                if let Some(lab) = &l.label {
+                    labelled = true;
+                    // a dot, as the series is drawn
+                    anno.label(lab.as_str())
+                        .legend(move |(x, y)| Circle::new((x + SWATCH / 2, y), w, style));
+                }
             } else {
-                series(&mut chart, pts, l.colour, l.width, l.dashed)?
-            };
-            if let Some(lab) = &l.label {
-                labelled = true;
-                let (c, w, dashed) = (l.colour, l.width, l.dashed);
-                anno.label(lab.as_str())
-                    .legend(move |p| swatch(p, c, w, dashed));
+                let anno = series(&mut chart, pts, c, w, dashed)?;
+                if let Some(lab) = &l.label {
+                    labelled = true;
+                    anno.label(lab.as_str())
+                        .legend(move |p| swatch(p, c, w, dashed));
+                }
             }
         }
         if labelled {
@@ -644,4 +673,27 @@ pub fn colour_bar(area: &Area, label: &str, lo: f64, hi: f64) -> DrawResult {
 pub fn with_bar<'a>(area: &Area<'a>, bar_px: u32) -> (Area<'a>, Area<'a>) {
     let (w, _) = area.dim_in_pixel();
     area.split_horizontally(w.saturating_sub(bar_px))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Axis;
+
+    #[test]
+    fn count_axes_have_integer_ticks() {
+        for top in [0.0, 1.15, 2.3, 8.05, 9.2, 57.5, 1.2e4] {
+            let a = Axis::counts((0.0, top), 4);
+            assert!(
+                a.ticks.len() >= 3 && a.ticks.len() <= 5,
+                "{top}: {:?}",
+                a.ticks
+            );
+            assert!(
+                a.ticks.iter().all(|t| t.fract() == 0.0),
+                "{top}: {:?}",
+                a.ticks
+            );
+            assert!(a.hi >= top);
+        }
+    }
 }
