@@ -104,8 +104,8 @@ fn help_on_every_subcommand() {
         (
             &["launch"],
             &[
-                "the mission's verdict: 0 captured safely, 1 the mission ended but not captured safely",
-                "The infrastructure's (no mission result): 2 bad configuration",
+                "the mission's verdict: 0 captured safely, 1 the mission ended (or --max-ticks stopped it) but not captured safely",
+                "The infrastructure's (no mission result; the run's output stays in OUT.incomplete): 2 bad configuration",
                 "3 a process failed",
                 "4 every process ended well",
             ],
@@ -134,6 +134,23 @@ fn help_on_every_subcommand() {
         let out = bin().args(sub).arg("--help").output().unwrap();
         let t = String::from_utf8_lossy(&out.stdout).replace('\n', " ");
         for n in needles {
+            assert!(t.contains(n), "{sub:?} --help lacks `{n}`:\n{t}");
+        }
+    }
+    // every command that writes a folder states the output-folder policy
+    for sub in [
+        &["run"][..],
+        &["launch"],
+        &["bench", "latency"],
+        &["montecarlo"],
+        &["montecarlo", "rerun"],
+        &["montecarlo", "merge"],
+        &["redteam"],
+        &["compare"],
+    ] {
+        let out = bin().args(sub).arg("--help").output().unwrap();
+        let t = String::from_utf8_lossy(&out.stdout).replace('\n', " ");
+        for n in ["Written as DIR.incomplete", "--force"] {
             assert!(t.contains(n), "{sub:?} --help lacks `{n}`:\n{t}");
         }
     }
