@@ -21,8 +21,11 @@ use std::process::ExitCode;
 /// rate; target likewise), θ, θ̇, Hill-frame relative position/velocity, grasp distance,
 /// end-effector and grasping point in the base frame. SI units; see docs/SIMULATOR.md.
 ///
+/// TRAJ.csv is written as TRAJ.csv.incomplete and renamed once complete (a simulation
+/// that fails leaves TRAJ.csv.incomplete, never a TRAJ.csv that looks whole).
+///
 /// Exit codes: 0 the trajectory was written, 2 bad arguments, an unreadable or invalid
-/// profile or scenario.
+/// profile or scenario, or a simulation that failed.
 #[derive(clap::Args)]
 pub struct Args {
     /// Command profile CSV.
@@ -52,8 +55,13 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     }
     let steps = (duration / period).round() as usize;
     let mut sim = Simulator::new(&setup.scenario, setup.robot.clone())?;
-    let file = std::fs::File::create(&a.out)
-        .with_context(|| format!("cannot create {}", a.out.display()))?;
+    // written beside it and renamed once complete: a failed simulation never leaves a
+    // trajectory that looks whole (the output-folder policy, for one file)
+    let mut partial = a.out.clone().into_os_string();
+    partial.push(sc_mission::out_dir::INCOMPLETE_SUFFIX);
+    let partial = PathBuf::from(partial);
+    let file = std::fs::File::create(&partial)
+        .with_context(|| format!("cannot create {}", partial.display()))?;
     let mut w = std::io::BufWriter::new(file);
     writeln!(w, "{}", TRAJECTORY_COLUMNS.join(","))?;
     let started = std::time::Instant::now();
@@ -70,6 +78,9 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             .with_context(|| format!("simulation failed at t = {} s", o.t))?;
     }
     w.flush()?;
+    drop(w);
+    std::fs::rename(&partial, &a.out)
+        .with_context(|| format!("cannot rename {} to {}", partial.display(), a.out.display()))?;
     errln!(
         "simulated {duration} s ({steps} control steps) in {:.3} s -> {}",
         started.elapsed().as_secs_f64(),
