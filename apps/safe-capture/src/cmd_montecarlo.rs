@@ -217,6 +217,18 @@ fn params(a: &RunArgs) -> anyhow::Result<Params> {
             mode: a.mode.unwrap_or(Mode::InProcess),
         });
     }
+    // a campaign quit at once (a second signal) was never moved from its staging folder
+    let mut staging = a.out.clone().into_os_string();
+    staging.push(sc_mission::out_dir::INCOMPLETE_SUFFIX);
+    let staging = PathBuf::from(staging);
+    if !a.out.join("campaign.json").is_file() && staging.join("campaign.json").is_file() {
+        anyhow::bail!(
+            "--resume: {} holds no campaign, but {} holds one that was quit before it was complete: resume it with --resume --out {}",
+            a.out.display(),
+            staging.display(),
+            staging.display()
+        );
+    }
     let info = sc_montecarlo::campaign_info(&a.out).context("--resume")?;
     Ok(Params {
         runs: a.runs.unwrap_or(info.runs),

@@ -240,3 +240,26 @@ fn a_run_that_fails_leaves_the_earlier_output_unchanged() {
     assert_eq!(std::fs::read(out.join("telemetry.csv")).unwrap(), before);
     assert_eq!(names(&d), ["run", "scenario.toml"], "{}", text(&o));
 }
+
+/// A campaign quit at once (second signal) stays in OUT.incomplete: `--resume --out OUT`
+/// names it and the command that resumes it.
+#[test]
+fn resume_names_a_campaign_left_in_its_staging_folder() {
+    let d = tmp("out-resume");
+    let staging = d.join("c.incomplete");
+    std::fs::create_dir_all(&staging).unwrap();
+    std::fs::write(staging.join("campaign.json"), "{}").unwrap();
+    let out = d.join("c");
+    let o = cli(
+        &["montecarlo", "--resume", "--out", out.to_str().unwrap()],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(
+        err.contains(&format!("--resume --out {}", staging.display())),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
