@@ -43,6 +43,8 @@ const COUNT_HEADROOM: f64 = 0.15;
 const MARKER_OPACITY: f64 = 0.6;
 /// Font size of reference-line labels [px].
 pub const REF_LABEL_PX: u32 = 12;
+/// Width of a character of sans-serif text, as a share of the font size (generous).
+const CHAR_WIDTH: f64 = 0.6;
 /// Offset of a reference-line label from its line [px].
 const REF_LABEL_OFFSET: i32 = 3;
 
@@ -483,13 +485,22 @@ pub fn ref_lines<'a, 'b: 'a, X: Ranged<ValueType = f64>, Y: Ranged<ValueType = f
         if at.is_finite() && *at >= x.0 && *at <= x.1 {
             series(chart, vec![(*at, y.0), (*at, y.1)], r.colour, 1, r.dashed)?;
             if !r.label.is_empty() {
+                // right of the line, or left of it where the plot ends too soon
+                let width = chart.plotting_area().dim_in_pixel().0 as f64;
+                let room = (x.1 - at) / (x.1 - x.0) * width;
+                let need = r.label.chars().count() as f64 * REF_LABEL_PX as f64 * CHAR_WIDTH;
+                let (dx, h) = if need + REF_LABEL_OFFSET as f64 <= room {
+                    (REF_LABEL_OFFSET, HPos::Left)
+                } else {
+                    (-REF_LABEL_OFFSET, HPos::Right)
+                };
                 label_at(
                     chart,
                     (*at, y.0),
-                    (REF_LABEL_OFFSET, -REF_LABEL_OFFSET),
+                    (dx, -REF_LABEL_OFFSET),
                     &r.label,
                     r.colour,
-                    (HPos::Left, VPos::Bottom),
+                    (h, VPos::Bottom),
                 )?;
             }
         }
