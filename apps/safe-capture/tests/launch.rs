@@ -317,3 +317,53 @@ fn a_launch_into_a_closed_pipe_ends_cleanly() {
     assert!(out.join("summary.json").is_file());
     assert_eq!(shm_files_of(pid), Vec::<String>::new());
 }
+
+/// How long a real-time launch may take to have every process ready.
+const READY_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(30);
+
+/// Ctrl-C (SIGINT) and SIGTERM end a launch as interrupted, not as a mission timeout:
+/// exit 3, the verdict line says "interrupted", the output stays in OUT.incomplete,
+/// nothing is left in /dev/shm (issue #16).
+#[test]
+fn an_interrupted_launch_says_so() {
+    let _cpu = exclusive();
+    let d = tmp("interrupted");
+    let cfg = d.join("partition.toml");
+    std::fs::write(&cfg, partition_toml_absolute_scenario()).unwrap();
+    for signal in ["-INT", "-TERM"] {
+        let out = d.join("out");
+        let child = std::process::Command::new(env!("CARGO_BIN_EXE_safe-capture"))
+            .current_dir(root())
+            .args(["launch", "--real-time", "--config", cfg.to_str().unwrap()])
+            .args(["--out", out.to_str().unwrap()])
+            .env("SC_PARTITION_BIN_DIR", partition_bin_dir())
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let pid = child.id();
+        let started = std::time::Instant::now();
+        while !d.join("out.incomplete/all_ready").exists() {
+            assert!(started.elapsed() < READY_TIMEOUT, "never ready");
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(500));
+        let kill = std::process::Command::new("kill")
+            .args([signal, &pid.to_string()])
+            .status()
+            .unwrap();
+        assert!(kill.success());
+        let o = child.wait_with_output().unwrap();
+        let t = text(&o);
+        assert_eq!(o.status.code(), Some(3), "{signal}: {t}");
+        let stdout = String::from_utf8_lossy(&o.stdout);
+        assert!(
+            stdout.starts_with("partition: interrupted by SIGINT/SIGTERM after ")
+                && !t.contains("timeout"),
+            "{signal}: {t}"
+        );
+        assert!(!out.exists(), "{signal}: {t}");
+        assert!(d.join("out.incomplete/launch.json").is_file(), "{t}");
+        assert_eq!(shm_files_of(pid), Vec::<String>::new());
+    }
+}
