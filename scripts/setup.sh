@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # One-time (idempotent) set-up of everything the project needs besides the Rust toolchain:
 # a Python venv with the independent reference tools (Pinocchio) and the iceoryx2 wheel
-# used by the Python partner controller. Safe to run repeatedly.
+# used by the Python partner controller, and a system font for PNG/PDF figures (Debian's
+# fonts-dejavu-core, only when the machine has none). Safe to run repeatedly.
 #
 #   scripts/setup.sh                   the lean set-up every test needs
 #   scripts/setup.sh --with-basilisk   also Basilisk (bsk, ~600 MB): `safe-capture run
@@ -17,6 +18,21 @@ for arg in "$@"; do
     *) echo "setup: unknown option $arg (see --help)" >&2; exit 2 ;;
   esac
 done
+# A font for the figures' text in PNG and PDF (--figure-format; SVG needs none): Debian's
+# DejaVu when the machine has no TrueType/OpenType font at all.
+has_font() {
+  find /usr/share/fonts /usr/local/share/fonts "$HOME/.local/share/fonts" \
+    \( -name '*.ttf' -o -name '*.otf' -o -name '*.ttc' \) -print -quit 2>/dev/null | grep -q .
+}
+if ! has_font; then
+  if command -v apt-get >/dev/null && [ "$(id -u)" = 0 ]; then
+    echo "setup: no system font for PNG/PDF figures; installing fonts-dejavu-core"
+    apt-get install -y -qq fonts-dejavu-core >/dev/null 2>&1 \
+      || { apt-get update -qq >/dev/null 2>&1 && apt-get install -y -qq fonts-dejavu-core >/dev/null; }
+  else
+    echo "setup: no system font for PNG/PDF figures (SVG needs none); install one, e.g. sudo apt-get install fonts-dejavu-core" >&2
+  fi
+fi
 VENV=scripts/.venv
 if [ ! -x "$VENV/bin/python" ]; then
   python3 -m venv "$VENV"
