@@ -31,6 +31,8 @@ pub struct Args {
     out: Option<PathBuf>,
     #[arg(long, help = crate::out_folder::FORCE_HELP)]
     force: bool,
+    #[command(flatten)]
+    figures: crate::figure_format::FigureFormatArg,
 }
 
 fn records(dir: &Path) -> anyhow::Result<Vec<sc_mission::StepRecord>> {
@@ -84,6 +86,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         &d,
         &format!("{} against {}", a.b.display(), a.a.display()),
     )?;
+    a.figures.export_file(&out.join("compare.svg"))?;
     staged.commit()?;
     let out = target;
     outln!(

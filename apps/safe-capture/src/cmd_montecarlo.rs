@@ -134,6 +134,9 @@ struct RunArgs {
     /// No progress bar.
     #[arg(long, short)]
     quiet: bool,
+    #[command(flatten)]
+    figures: crate::figure_format::FigureFormatArg,
+
     /// Test hook: make these runs panic (also SC_MONTECARLO_INJECT_PANIC=K,K,...).
     #[arg(long, value_name = "K", value_delimiter = ',', hide = true)]
     inject_panic: Vec<usize>,
@@ -153,6 +156,8 @@ struct RerunArgs {
     /// Write no figures.
     #[arg(long)]
     no_figures: bool,
+    #[command(flatten)]
+    figures: crate::figure_format::FigureFormatArg,
 }
 
 #[derive(clap::Args)]
@@ -164,6 +169,8 @@ struct MergeArgs {
     out: PathBuf,
     #[arg(long, help = crate::out_folder::FORCE_HELP)]
     force: bool,
+    #[command(flatten)]
+    figures: crate::figure_format::FigureFormatArg,
 }
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
@@ -172,6 +179,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         Some(Action::Merge(m)) => {
             let staged = crate::out_folder::stage(&m.out, "montecarlo merge", m.force)?;
             let s = sc_montecarlo::merge(&m.dirs, staged.path())?;
+            m.figures.export_dir(&staged.path().join("figures"))?;
             staged.commit()?;
             Ok(report(&s, &m.out))
         }
@@ -312,6 +320,7 @@ fn campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
         resume: a.resume,
     };
     let s = sc_montecarlo::run_campaign_with(&opts, executor.as_ref())?;
+    a.figures.export_dir(&opts.out.join("figures"))?;
     if let Some(staged) = staged {
         staged.commit()?;
     }
@@ -413,6 +422,7 @@ fn rerun(a: RerunArgs) -> anyhow::Result<ExitCode> {
     writeln!(f, "{}", serde_json::to_string_pretty(&r.result)?)?;
     if !a.no_figures {
         sc_plots::run_figures(&out.join("figures"), &r.scenario, &r.records, None)?;
+        a.figures.export_dir(&out.join("figures"))?;
     }
     staged.commit()?;
     let out = target;

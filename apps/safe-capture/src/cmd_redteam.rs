@@ -53,6 +53,8 @@ pub struct Args {
     out: PathBuf,
     #[arg(long, help = crate::out_folder::FORCE_HELP)]
     force: bool,
+    #[command(flatten)]
+    figures: crate::figure_format::FigureFormatArg,
     /// Random strategies per target (`random:1` … `random:N`).
     #[arg(long, value_name = "N", default_value_t = 5)]
     seeds: u64,
@@ -263,6 +265,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         report::IN_PROCESS
     };
     let s = report::write(&out, &setup, how, &cases, &results, wall).map_err(anyhow::Error::msg)?;
+    a.figures.export_dir(&out.join("figures"))?;
     staged.commit()?;
     for (c, r) in cases.iter().zip(&results) {
         if let Err(e) = r {

@@ -44,6 +44,8 @@ pub struct Args {
     /// Write no figures.
     #[arg(long)]
     no_figures: bool,
+    #[command(flatten)]
+    figures: crate::figure_format::FigureFormatArg,
     /// Replace nominal controllers by a red-team adversary, `<target>/<strategy>`
     /// (`safe-capture redteam --list` lists them), e.g. `all/random:3` or
     /// `robotic/toward:theta_dot_max_7`.
@@ -241,6 +243,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             a.no_filter || a.no_compare || a.basilisk,
             &nominals,
         )?;
+        a.figures.export_dir(&out.join("figures"))?;
     }
     staged.commit()?;
     let safe = summary.violated_constraints.is_empty() && summary.fault_count == 0;

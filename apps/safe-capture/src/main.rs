@@ -19,6 +19,7 @@ mod cmd_run;
 mod cmd_simulate;
 mod cmd_verify_qp;
 // where the shipped config/ and scripts/ are (SAFE_CAPTURE_HOME, the executable's place)
+mod figure_format;
 mod home;
 // the output-folder policy's --out/--force, the same in every command
 mod out_folder;

@@ -823,5 +823,56 @@ fn bench_filters_reports_the_solver_time_under_attack_over_pooled_scenarios() {
     for f in ["translational", "attitude", "robotic"] {
         assert_eq!(j[f]["solved_steps"], j[f]["n"], "{f}: every step solves");
     }
+    // the wall tails are read with the host's load beside them
+    assert!(stdout.contains("host load (1-min average) "), "{stdout}");
+    assert!(
+        j["host_load"]["start"]["cpus"].as_u64().unwrap() >= 1,
+        "{j}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `--figure-format svg,png,pdf` writes every figure three times (PNG and PDF beside the
+/// SVG, with their formats' signatures); an unknown format is refused before running.
+#[test]
+fn figures_in_every_requested_format() {
+    let d = tmp("figure-format");
+    let out = d.join("run");
+    let o = bin()
+        .args([
+            "run",
+            "-q",
+            "--no-compare",
+            "--figure-format",
+            "svg,png,pdf",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let figures = out.join("figures");
+    let mut svgs = 0;
+    for e in std::fs::read_dir(&figures).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|x| x == "svg") {
+            svgs += 1;
+            let png = std::fs::read(p.with_extension("png")).unwrap();
+            assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"), "{}", p.display());
+            let pdf = std::fs::read(p.with_extension("pdf")).unwrap();
+            assert!(pdf.starts_with(b"%PDF-"), "{}", p.display());
+        }
+    }
+    assert!(svgs >= 6, "{svgs} figures");
+    let bad = d.join("bad");
+    let o = bin()
+        .args(["run", "-q", "--figure-format", "svg,jpg", "--out"])
+        .arg(&bad)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("unknown figure format `jpg`"), "{err}");
+    assert!(!bad.exists(), "nothing written for a refused format");
     let _ = std::fs::remove_dir_all(&d);
 }

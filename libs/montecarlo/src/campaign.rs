@@ -287,7 +287,14 @@ pub const WALL_CLOCK_KEYS: [&str; 4] =
 /// Files of a campaign directory that depend on the wall clock (everything else is
 /// byte-identical between a campaign and the merge of its shards; in `summary.json` only
 /// [`WALL_CLOCK_KEYS`] differ).
-pub const WALL_CLOCK_FILES: [&str; 3] = ["runs_timing.csv", "report.md", "figures/runtime.svg"];
+/// (With `--figure-format`, the runtime figure's PNG and PDF too.)
+pub const WALL_CLOCK_FILES: [&str; 5] = [
+    "runs_timing.csv",
+    "report.md",
+    "figures/runtime.svg",
+    "figures/runtime.png",
+    "figures/runtime.pdf",
+];
 
 /// Loads the base scenario and checks the config against it.
 fn load_base(scenario: &Path, config: &MonteCarloConfig) -> Result<Setup, McError> {
