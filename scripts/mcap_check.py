@@ -8,7 +8,8 @@ package of PyPI, pinned in scripts/requirements.txt) and checks what Foxglove re
 - every channel JSON-encoded with a `jsonschema` schema, and every message of every
   channel a JSON object the schema describes completely (the fields and types it
   declares, nothing else; `null` only where the schema allows it);
-- the metadata record naming the run (build, scenario, partition config);
+- the metadata record naming the run (build, scenario, partition config), the config
+  named relative to the run's folder and holding the recorded text;
 - `/tf` (foxglove.FrameTransform) and `/scene` (foxglove.SceneUpdate) present, and
   every scene entity's frame one of the frames on `/tf`;
 - with `--recorder-json`, the recorder's own count per service equal to the MCAP's;
@@ -162,6 +163,16 @@ def check(path, recorder_json=None):
             empty = [k for k in METADATA_KEYS & ours[0].metadata.keys() if not ours[0].metadata[k]]
             if missing or empty:
                 problems.append(f"metadata: missing {sorted(missing)}, empty {sorted(empty)}")
+            # the config is named relative to the run's folder (renamed after the run)
+            config = ours[0].metadata.get("partition_config_path")
+            if config:
+                beside = pathlib.Path(path).resolve().parent / config
+                if pathlib.PurePath(config).is_absolute():
+                    problems.append(f"metadata: partition_config_path {config!r} is not relative to the run's folder")
+                elif not beside.is_file():
+                    problems.append(f"metadata: partition_config_path {config!r}: no {beside}")
+                elif beside.read_text() != ours[0].metadata.get("partition_config"):
+                    problems.append(f"metadata: {beside} differs from partition_config")
 
     by_topic = {summary.channels[cid].topic: n for cid, n in indexed.items()}
     for topic in (TF_TOPIC, SCENE_TOPIC):

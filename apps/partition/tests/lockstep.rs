@@ -89,10 +89,12 @@ fn lock_step_telemetry_is_identical_to_in_process_run() {
     let meta = mcap::read::metadata(&bytes, idx).unwrap().metadata;
     assert_eq!(meta["version"], b["version"].as_str().unwrap());
     assert_eq!(meta["git_commit"], b["git_commit"].as_str().unwrap());
-    // the config the processes ran: the launcher's resolved copy of `config`
+    // the config the processes ran: the launcher's resolved copy of `config`, named
+    // relative to the output folder (which the launcher renames after the run)
+    assert_eq!(meta["partition_config_path"], "partition.effective.toml");
     assert_eq!(
         meta["partition_config"],
-        std::fs::read_to_string(&meta["partition_config_path"]).unwrap()
+        std::fs::read_to_string(out.join(&meta["partition_config_path"])).unwrap()
     );
     assert!(meta["partition_config"].contains("clock = \"lock_step\""));
     assert_eq!(

@@ -248,7 +248,8 @@ fn a_failed_launch_never_reports_an_old_run() {
 /// Ticks of the short launches below.
 const SHORT_TICKS: &str = "50";
 
-/// `--max-ticks` ends a launch in its own words, not as a mission timeout (issue #16).
+/// `--max-ticks` ends a launch in its own words, not as a mission timeout, on the
+/// terminal and in summary.json (issue #16).
 #[test]
 fn a_launch_stopped_by_max_ticks_says_so() {
     let _cpu = exclusive();
@@ -278,6 +279,11 @@ fn a_launch_stopped_by_max_ticks_says_so() {
         "{t}"
     );
     assert!(!t.contains("timeout"), "{t}");
+    // summary.json and recorder.json say the same: the run stopped, the mission did not end
+    let summary = json(&out.join("summary.json"));
+    assert_eq!(summary["end"], "stopped", "{summary}");
+    assert_eq!(summary["captured"], false, "{summary}");
+    assert_eq!(json(&out.join("recorder.json"))["end"], "stopped");
     // the recorder recorded everything: it ended well although nothing was captured
     let launch = json(&out.join("launch.json"));
     let recorder = launch["exits"]
@@ -322,8 +328,8 @@ fn a_launch_into_a_closed_pipe_ends_cleanly() {
 const READY_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(30);
 
 /// Ctrl-C (SIGINT) and SIGTERM end a launch as interrupted, not as a mission timeout:
-/// exit 3, the verdict line says "interrupted", the output stays in OUT.incomplete,
-/// nothing is left in /dev/shm (issue #16).
+/// exit 3, the verdict line and summary.json say "interrupted", the output stays in
+/// OUT.incomplete, nothing is left in /dev/shm (issue #16).
 #[test]
 fn an_interrupted_launch_says_so() {
     let _cpu = exclusive();
@@ -364,6 +370,11 @@ fn an_interrupted_launch_says_so() {
         );
         assert!(!out.exists(), "{signal}: {t}");
         assert!(d.join("out.incomplete/launch.json").is_file(), "{t}");
+        // summary.json and recorder.json say the same, not "timeout" or "stopped"
+        for file in ["summary.json", "recorder.json"] {
+            let v = json(&d.join("out.incomplete").join(file));
+            assert_eq!(v["end"], "interrupted", "{signal}: {file}: {v}");
+        }
         assert_eq!(shm_files_of(pid), Vec::<String>::new());
     }
 }

@@ -26,15 +26,24 @@ pub enum MissionEnd {
     Timeout { t: f64 },
     /// The simulator failed (non-finite state).
     SimulatorFailed { t: f64, message: String },
+    /// The run was stopped before the mission ended: by `--max-ticks`, or by the
+    /// partition's scheduler (a process the run cannot go on without died).
+    Stopped { t: f64 },
+    /// The run was interrupted (SIGINT/SIGTERM) before the mission ended.
+    Interrupted { t: f64 },
 }
 
 impl MissionEnd {
-    /// The name in `summary.json`: "captured", "timeout" or "simulator_failed".
+    /// The name in `summary.json`: "captured", "timeout", "simulator_failed" (the
+    /// mission's own ends), "stopped" or "interrupted" (the run ended before the
+    /// mission did).
     pub fn name(&self) -> &'static str {
         match self {
             MissionEnd::Captured { .. } => "captured",
             MissionEnd::Timeout { .. } => "timeout",
             MissionEnd::SimulatorFailed { .. } => "simulator_failed",
+            MissionEnd::Stopped { .. } => "stopped",
+            MissionEnd::Interrupted { .. } => "interrupted",
         }
     }
 
@@ -43,7 +52,9 @@ impl MissionEnd {
         match self {
             MissionEnd::Captured { t }
             | MissionEnd::Timeout { t }
-            | MissionEnd::SimulatorFailed { t, .. } => *t,
+            | MissionEnd::SimulatorFailed { t, .. }
+            | MissionEnd::Stopped { t }
+            | MissionEnd::Interrupted { t } => *t,
         }
     }
 
@@ -57,6 +68,8 @@ impl MissionEnd {
                 t,
                 message: "simulator failed".into(),
             }),
+            "stopped" => Some(MissionEnd::Stopped { t }),
+            "interrupted" => Some(MissionEnd::Interrupted { t }),
             _ => None,
         }
     }
@@ -295,4 +308,30 @@ pub fn all_hold(h: &Barriers) -> bool {
 pub fn timeout_check(scenario: &sc_scenario::Scenario, t: f64) -> bool {
     let m = &scenario.mission;
     t + 0.5 * m.control_period_s >= m.duration_s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::MissionEnd;
+
+    /// Every end reads back from its name in summary.json, the run's ends as well as the
+    /// mission's; the scheduler's words for a stop are not ends.
+    #[test]
+    fn every_end_reads_back_from_its_name() {
+        const T: f64 = 4.9;
+        for end in [
+            MissionEnd::Captured { t: T },
+            MissionEnd::Timeout { t: T },
+            MissionEnd::SimulatorFailed {
+                t: T,
+                message: "simulator failed".into(),
+            },
+            MissionEnd::Stopped { t: T },
+            MissionEnd::Interrupted { t: T },
+        ] {
+            assert_eq!(MissionEnd::from_name(end.name(), T), Some(end.clone()));
+            assert_eq!(end.t(), T);
+        }
+        assert_eq!(MissionEnd::from_name("max_ticks", T), None);
+    }
 }

@@ -91,7 +91,10 @@ pub struct Summary {
     pub filtered: bool,
     pub captured: bool,
     pub capture_time_s: Option<f64>,
-    /// "captured", "timeout" or "simulator_failed".
+    /// How the run ended ([`MissionEnd::name`]): "captured", "timeout" or
+    /// "simulator_failed" when the mission ended; "stopped" (`--max-ticks`, or the
+    /// partition's scheduler stopped the run) or "interrupted" (SIGINT/SIGTERM) when
+    /// the run ended before the mission did.
     pub end: String,
     pub final_time_s: f64,
     pub steps: usize,

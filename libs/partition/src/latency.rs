@@ -5,6 +5,7 @@
 use crate::launcher::{LaunchOptions, launch};
 use anyhow::Context;
 use hdrhistogram::Histogram;
+use sc_montecarlo::report::PAPER_TOTAL_MAX_MS;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -343,46 +344,38 @@ pub fn analyse(out: &Path, warmup: u64) -> anyhow::Result<LatencyReport> {
     Ok(rep)
 }
 
+/// The reference latencies drawn on both figures [µs], with their labels: the
+/// partition's 1 ms target and the paper's maximum.
+fn references() -> Vec<(String, f64)> {
+    const NS_PER_US: f64 = 1e3;
+    const US_PER_MS: f64 = 1e3;
+    let target_us = SLOW_TICK_NS as f64 / NS_PER_US;
+    vec![
+        (
+            format!("{} ms p99 target", target_us / US_PER_MS),
+            target_us,
+        ),
+        (
+            format!("paper: {PAPER_TOTAL_MAX_MS} ms max (safety layer per step)"),
+            PAPER_TOTAL_MAX_MS * US_PER_MS,
+        ),
+    ]
+}
+
 fn plot(path: &Path, pts: &[(f64, f64)], rep: &LatencyReport) -> anyhow::Result<()> {
-    use plotters::prelude::*;
-    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
-    root.fill(&WHITE)
-        .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
-    let xmax = pts.iter().map(|p| p.0).fold(10.0, f64::max) * 1.5;
-    let ymin = pts
-        .iter()
-        .map(|p| p.1)
-        .fold(f64::INFINITY, f64::min)
-        .max(0.1)
-        / 1.5;
-    let ymax = pts.iter().map(|p| p.1).fold(1.0, f64::max) * 1.5;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            format!(
-                "whole-tick latency, {} ticks at {} s ({} cores, kernel {})",
-                rep.whole_tick.n, rep.period_s, rep.machine.cores, rep.machine.kernel
-            ),
-            ("sans-serif", 18),
-        )
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(65)
-        .build_cartesian_2d(
-            (1.0..xmax).log_scale(),
-            (ymin.min(ymax / 2.0)..ymax).log_scale(),
-        )
-        .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
-    chart
-        .configure_mesh()
-        .x_desc("percentile as 1/(1-p): 10 = p90, 100 = p99, 1000 = p99.9")
-        .y_desc("latency [us] (log)")
-        .draw()
-        .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
-    chart
-        .draw_series(LineSeries::new(pts.iter().cloned(), &BLUE))
-        .map_err(|e| anyhow::anyhow!("plot: {e}"))?;
-    root.present().map_err(|e| anyhow::anyhow!("plot: {e}"))?;
-    Ok(())
+    let title = format!(
+        "whole-tick latency, {} ticks at {} s ({} cores, kernel {})",
+        rep.whole_tick.n, rep.period_s, rep.machine.cores, rep.machine.kernel
+    );
+    sc_plots::latency_percentiles(
+        path,
+        &sc_plots::LatencyPercentiles {
+            title: &title,
+            points: pts,
+            references: &references(),
+        },
+    )
+    .with_context(|| format!("drawing {}", path.display()))
 }
 
 /// A whole tick longer than this [ns] counts as slow in the steal summary: the
@@ -500,84 +493,102 @@ fn plot_timeline(
     steal: &[crate::steal::StealSample],
     rep: &LatencyReport,
 ) -> anyhow::Result<()> {
-    use plotters::prelude::*;
-    let e = |e: &dyn std::fmt::Display| anyhow::anyhow!("timeline plot: {e}");
-    let root = SVGBackend::new(path, (1000, 640)).into_drawing_area();
-    root.fill(&WHITE).map_err(|x| e(&x))?;
-    let (top, bottom) = root.split_vertically(420);
+    const S_PER_NS: f64 = 1e-9;
+    const US_PER_NS: f64 = 1e-3;
+    const MS_PER_S: f64 = 1e3;
     let t0 = ticks.first().map_or(0, |t| t.0);
-    let secs = |ns: u64| ns.saturating_sub(t0) as f64 * 1e-9;
-    let t_end = ticks.last().map_or(1.0, |t| secs(t.0)).max(1e-3);
+    let secs = |ns: u64| ns.saturating_sub(t0) as f64 * S_PER_NS;
     let pts: Vec<(f64, f64)> = ticks
         .iter()
-        .map(|(a, d)| (secs(*a), *d as f64 / 1e3))
+        .map(|(a, d)| (secs(*a), *d as f64 * US_PER_NS))
         .collect();
-    let ymax = pts.iter().map(|p| p.1).fold(1000.0, f64::max) * 1.5;
-    let ymin = pts
-        .iter()
-        .map(|p| p.1)
-        .fold(f64::INFINITY, f64::min)
-        .min(100.0)
-        / 1.5;
-    let mut chart = ChartBuilder::on(&top)
-        .caption(
-            format!(
-                "whole-tick latency over the run ({} ticks at {} s)",
-                rep.whole_tick.n, rep.period_s
-            ),
-            ("sans-serif", 18),
-        )
-        .margin(12)
-        .x_label_area_size(30)
-        .y_label_area_size(65)
-        .build_cartesian_2d(0.0..t_end, (ymin..ymax).log_scale())
-        .map_err(|x| e(&x))?;
-    chart
-        .configure_mesh()
-        .y_desc("latency [us] (log)")
-        .draw()
-        .map_err(|x| e(&x))?;
-    chart
-        .draw_series(
-            pts.iter()
-                .map(|p| Circle::new(*p, 2, BLUE.mix(0.6).filled())),
-        )
-        .map_err(|x| e(&x))?;
-    // the 1 ms target
-    chart
-        .draw_series(LineSeries::new(
-            [(0.0, 1000.0), (t_end, 1000.0)],
-            RED.mix(0.7),
-        ))
-        .map_err(|x| e(&x))?;
     // steal rate between consecutive readings [ms of CPU per s]
     let rate: Vec<(f64, f64)> = steal
         .windows(2)
         .filter(|w| w[1].t_ns > w[0].t_ns)
         .map(|w| {
-            let dt = (w[1].t_ns - w[0].t_ns) as f64 * 1e-9;
+            let dt = (w[1].t_ns - w[0].t_ns) as f64 * S_PER_NS;
             (
                 secs(w[1].t_ns),
-                (w[1].steal_s - w[0].steal_s).max(0.0) * 1e3 / dt,
+                (w[1].steal_s - w[0].steal_s).max(0.0) * MS_PER_S / dt,
             )
         })
         .collect();
-    let rmax = rate.iter().map(|p| p.1).fold(10.0, f64::max) * 1.1;
-    let mut chart = ChartBuilder::on(&bottom)
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(65)
-        .build_cartesian_2d(0.0..t_end, 0.0..rmax)
-        .map_err(|x| e(&x))?;
-    chart
-        .configure_mesh()
-        .x_desc("time since the first measured tick [s]")
-        .y_desc("host steal [ms/s]")
-        .draw()
-        .map_err(|x| e(&x))?;
-    chart
-        .draw_series(LineSeries::new(rate, &BLACK))
-        .map_err(|x| e(&x))?;
-    root.present().map_err(|x| e(&x))?;
-    Ok(())
+    let title = format!(
+        "whole-tick latency over the run ({} ticks at {} s)",
+        rep.whole_tick.n, rep.period_s
+    );
+    sc_plots::latency_timeline(
+        path,
+        &sc_plots::LatencyTimeline {
+            title: &title,
+            ticks: &pts,
+            steal: &rate,
+            references: &references(),
+        },
+    )
+    .with_context(|| format!("drawing {}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::steal::{StealSample, write_csv};
+
+    /// Ticks of the synthetic run.
+    const TICKS: u64 = 20;
+    /// Base period of the synthetic run [ns].
+    const PERIOD_NS: u64 = 100_000_000;
+    /// Time between consecutive stamps of a tick [ns].
+    const HOP_NS: u64 = 40_000;
+
+    /// A run folder as the recorder and the scheduler leave it: every stamp of a tick
+    /// `HOP_NS` after the previous one, no fallback; a steal counter read every period.
+    fn synthetic_run(dir: &Path) {
+        std::fs::create_dir_all(dir).unwrap();
+        let columns: Vec<&str> = crate::recorder::LATENCY_CSV_HEADER.split(',').collect();
+        let mut csv = format!("{}\n", crate::recorder::LATENCY_CSV_HEADER);
+        for k in 0..TICKS {
+            let row: Vec<String> = columns
+                .iter()
+                .enumerate()
+                .map(|(i, c)| match *c {
+                    "tick" => k.to_string(),
+                    c if c.ends_with("_ns") => (k * PERIOD_NS + i as u64 * HOP_NS).to_string(),
+                    _ => "0".to_string(),
+                })
+                .collect();
+            csv += &(row.join(",") + "\n");
+        }
+        std::fs::write(dir.join("latency.csv"), csv).unwrap();
+        let sched =
+            serde_json::json!({"clock": "RealTime", "base_period_s": 0.1, "cycle_slips": 0});
+        std::fs::write(dir.join("scheduler.json"), sched.to_string()).unwrap();
+        let steal: Vec<StealSample> = (0..TICKS)
+            .map(|k| StealSample {
+                t_ns: k * PERIOD_NS,
+                steal_s: k as f64 * 1e-3,
+            })
+            .collect();
+        write_csv(&dir.join("steal.csv"), &steal).unwrap();
+    }
+
+    /// Both figures are drawn, each with the 1 ms target and the paper's maximum as
+    /// labelled reference lines.
+    #[test]
+    fn figures_carry_the_reference_latencies() {
+        let dir = std::env::temp_dir().join(format!("sc-latency-figures-{}", std::process::id()));
+        synthetic_run(&dir);
+        let r = analyse(&dir, 0).unwrap();
+        assert_eq!(r.whole_tick.n, TICKS);
+        for figure in ["latency.svg", "latency_timeline.svg"] {
+            let svg = std::fs::read_to_string(dir.join(figure)).unwrap();
+            for (label, _) in references() {
+                assert!(svg.contains(&label), "{figure}: no `{label}`");
+            }
+        }
+        assert!(references()[0].0.starts_with("1 ms"));
+        assert!(references()[1].0.contains("3.75 ms"));
+        std::fs::remove_dir_all(&dir).ok();
+    }
 }

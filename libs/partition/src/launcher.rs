@@ -554,6 +554,12 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
         );
     }
     let _ = run.force_remove_files();
+    if interrupted
+        && let Err(e) = mark_interrupted(&out)
+        && !opts.quiet
+    {
+        note!("launch: warning: {e:#}");
+    }
     let leftovers = run.leftovers();
     let exits: Vec<ProcessExit> = procs.into_iter().filter_map(|p| p.exit).collect();
     let mut code = if failed || interrupted || spawn_err.is_some() || !leftovers.is_empty() {
@@ -602,6 +608,40 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
     Ok(rep)
 }
 
+/// The files of a run that name its end ([`sc_mission::MissionEnd::name`]).
+const END_FILES: [&str; 2] = ["summary.json", "recorder.json"];
+
+/// Names the end of an interrupted run: the recorder saw the run stop before the
+/// mission ended ("stopped") but cannot tell a signal from the scheduler's stop; the
+/// launcher, that caught SIGINT/SIGTERM, rewrites it as "interrupted" in summary.json and
+/// recorder.json. A mission that had ended before the signal keeps its end; a file the
+/// recorder did not write is left absent.
+fn mark_interrupted(out: &Path) -> anyhow::Result<()> {
+    use sc_mission::MissionEnd;
+    for name in END_FILES {
+        let path = out.join(name);
+        let Ok(text) = std::fs::read_to_string(&path) else {
+            continue;
+        };
+        let mut v: serde_json::Value =
+            serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
+        let Some(fields) = v.as_object_mut() else {
+            anyhow::bail!("{}: not a JSON object", path.display());
+        };
+        let t = fields
+            .get("final_time_s")
+            .and_then(|t| t.as_f64())
+            .unwrap_or(f64::NAN);
+        let end = fields.get("end").and_then(|e| e.as_str());
+        if let Some(MissionEnd::Stopped { t }) = end.and_then(|e| MissionEnd::from_name(e, t)) {
+            fields.insert("end".into(), MissionEnd::Interrupted { t }.name().into());
+            std::fs::write(&path, serde_json::to_string_pretty(&v)? + "\n")
+                .with_context(|| format!("cannot write {}", path.display()))?;
+        }
+    }
+    Ok(())
+}
+
 /// The mission's verdict from a run's summary.json: captured with every barrier
 /// satisfied and no fault; `None` without a readable summary.
 pub fn mission_verdict(summary: &Path) -> Option<bool> {
@@ -642,5 +682,48 @@ mod infrastructure_tests {
         let healthy = serde_json::json!({"missing": {"safe_capture/nominal/robotic": 9}});
         assert!(infrastructure_losses(&healthy).is_empty());
         assert!(infrastructure_losses(&serde_json::json!({})).is_empty());
+    }
+}
+
+#[cfg(test)]
+mod end_tests {
+    use super::{END_FILES, mark_interrupted};
+    use serde_json::json;
+
+    fn end_of(dir: &std::path::Path, name: &str) -> serde_json::Value {
+        let text = std::fs::read_to_string(dir.join(name)).unwrap();
+        serde_json::from_str::<serde_json::Value>(&text).unwrap()["end"].clone()
+    }
+
+    /// An interrupted run that the recorder saw stopped is named interrupted; a mission
+    /// that had ended keeps its end; absent files stay absent.
+    #[test]
+    fn an_interrupted_run_is_named_so_unless_the_mission_had_ended() {
+        let dir = std::env::temp_dir().join(format!("sc-mark-interrupted-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for (end, want) in [
+            ("stopped", "interrupted"),
+            ("captured", "captured"),
+            ("timeout", "timeout"),
+        ] {
+            for name in END_FILES {
+                let v = json!({"end": end, "final_time_s": 4.9, "steps": 50});
+                std::fs::write(dir.join(name), v.to_string()).unwrap();
+            }
+            mark_interrupted(&dir).unwrap();
+            for name in END_FILES {
+                assert_eq!(end_of(&dir, name), want, "{name} of a run that ended {end}");
+            }
+        }
+        for name in END_FILES {
+            std::fs::remove_file(dir.join(name)).unwrap();
+        }
+        mark_interrupted(&dir).unwrap();
+        assert!(END_FILES.iter().all(|n| !dir.join(n).exists()));
+        // a file that is not a JSON object is named, not overwritten
+        std::fs::write(dir.join(END_FILES[0]), "[]").unwrap();
+        let err = mark_interrupted(&dir).unwrap_err().to_string();
+        assert!(err.contains("not a JSON object"), "{err}");
+        std::fs::remove_dir_all(&dir).ok();
     }
 }

@@ -50,7 +50,9 @@ struct Tickset {
     sr: Option<SafeRobotic>,
 }
 
-/// The recorder process.
+/// The columns of latency.csv: the stamps of every hop of a tick [ns] and its masks.
+pub const LATENCY_CSV_HEADER: &str = "tick,tick_send_ns,sim_recv_ns,state_publish_ns,nom_t_publish_ns,nom_a_publish_ns,nom_r_publish_ns,safe_t_recv_ns,safe_t_publish_ns,safe_a_recv_ns,safe_a_publish_ns,safe_r_recv_ns,safe_r_publish_ns,sim_safe_recv_ns,result_publish_ns,fallback_mask,held_mask,upstream_missing_mask";
+
 /// Name of the MCAP `Metadata` record describing the run ([`run_metadata`]).
 pub const MCAP_METADATA_NAME: &str = "safe-capture";
 
@@ -73,10 +75,17 @@ fn run_metadata(p: &Proc) -> anyhow::Result<BTreeMap<String, String>> {
         ("scenario".to_string(), read(&scenario_path)?),
         (
             "partition_config_path".to_string(),
-            p.config_path.display().to_string(),
+            path_in_out(&p.config_path, &p.out),
         ),
         ("partition_config".to_string(), read(&p.config_path)?),
     ]))
+}
+
+/// `path` as the recording names it: relative to the output folder `out` when it is in
+/// it (the launcher's effective config), since the launcher renames that folder after
+/// the run (`OUT.incomplete` → `OUT`); as given otherwise.
+fn path_in_out(path: &std::path::Path, out: &std::path::Path) -> String {
+    path.strip_prefix(out).unwrap_or(path).display().to_string()
 }
 
 pub fn recorder() -> anyhow::Result<i32> {
@@ -121,10 +130,7 @@ pub fn recorder() -> anyhow::Result<i32> {
     };
     let mut writer = TelemetryWriter::new(open("telemetry.csv")?, open("timing.csv")?)?;
     let mut latency = open("latency.csv")?;
-    writeln!(
-        latency,
-        "tick,tick_send_ns,sim_recv_ns,state_publish_ns,nom_t_publish_ns,nom_a_publish_ns,nom_r_publish_ns,safe_t_recv_ns,safe_t_publish_ns,safe_a_recv_ns,safe_a_publish_ns,safe_r_recv_ns,safe_r_publish_ns,sim_safe_recv_ns,result_publish_ns,fallback_mask,held_mask,upstream_missing_mask"
-    )?;
+    writeln!(latency, "{LATENCY_CSV_HEADER}")?;
     let mut layer = SafetyLayer::from_scenario(&p.setup.scenario, p.setup.robot.clone());
     let robot = p.setup.robot.clone();
     let phase_names: Vec<String> = p
@@ -461,7 +467,10 @@ pub fn recorder() -> anyhow::Result<i32> {
     writer.flush()?;
     latency.flush()?;
     mcap.finish()?;
-    let end = end.unwrap_or(MissionEnd::Timeout { t: last_t });
+    // no end of the mission: the run was stopped before it (the scheduler's stop tick
+    // at --max-ticks or after losing a process, or the launcher's teardown); the
+    // launcher, which knows whether it was interrupted, says so (`mark_interrupted`)
+    let end = end.unwrap_or(MissionEnd::Stopped { t: last_t });
     let summary = summarize(&records, &end, &phase_names, true);
     std::fs::write(
         p.out.join("summary.json"),
@@ -503,5 +512,31 @@ fn nominal_seen<const D: usize>(
     match msg {
         Some(v) if faults & sc_cbf::faults::NOMINAL_MISSING == 0 => v,
         _ => nalgebra::SVector::from_element(f64::NAN),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::path_in_out;
+    use std::path::Path;
+
+    /// The effective config is named relative to the output folder, which the launcher
+    /// renames after the run; a file elsewhere keeps its path.
+    #[test]
+    fn a_path_in_the_output_folder_is_relative_to_it() {
+        let out = Path::new("/runs/out.incomplete");
+        assert_eq!(
+            path_in_out(&out.join("partition.effective.toml"), out),
+            "partition.effective.toml"
+        );
+        assert_eq!(
+            path_in_out(Path::new("/etc/partition.toml"), out),
+            "/etc/partition.toml"
+        );
+        // a sibling whose name starts like the folder's is not in it
+        assert_eq!(
+            path_in_out(Path::new("/runs/out.incomplete2/p.toml"), out),
+            "/runs/out.incomplete2/p.toml"
+        );
     }
 }
