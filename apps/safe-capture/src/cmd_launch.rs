@@ -66,21 +66,17 @@ fn ticks_run(scheduler: Option<&serde_json::Value>) -> Option<u64> {
 }
 
 /// How the mission ended, in words: its end from summary.json ("captured at t = 125.4
-/// s"), except a run that --max-ticks stopped before the mission's end (the recorder
-/// saw no end: "stopped after 50 ticks (--max-ticks) at t = 4.9 s, before the mission
-/// ended"); `duration_s` is the scenario's mission duration.
-fn outcome(
-    summary: Option<&serde_json::Value>,
-    scheduler: Option<&serde_json::Value>,
-    duration_s: f64,
-) -> String {
+/// s"), except a run that --max-ticks stopped before the mission's end (summary.json
+/// says "stopped": "stopped after 50 ticks (--max-ticks) at t = 4.9 s, before the
+/// mission ended").
+fn outcome(summary: Option<&serde_json::Value>, scheduler: Option<&serde_json::Value>) -> String {
     let Some(s) = summary else {
         return "no summary".into();
     };
     let end = s["end"].as_str().unwrap_or("no end");
     let t = s["final_time_s"].as_f64().unwrap_or(f64::NAN);
-    let stopped = scheduler.is_some_and(|s| s["end"] == "max_ticks");
-    if stopped && end == "timeout" && t < duration_s {
+    let by_max_ticks = scheduler.is_some_and(|s| s["end"] == "max_ticks");
+    if by_max_ticks && end == (sc_mission::MissionEnd::Stopped { t }).name() {
         format!(
             "stopped after {} ticks (--max-ticks) at t = {t:.1} s, before the mission ended",
             ticks_run(scheduler).map_or("?".into(), |n| n.to_string())
@@ -128,9 +124,6 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let staged = crate::out_folder::stage(&a.out, "launch", a.force)?;
     let out = staged.path().to_path_buf();
     opts.out = out.clone();
-    let duration_s = sc_scenario::Scenario::load(&cfg.scenario_path())?
-        .mission
-        .duration_s;
     let rep = launch(&opts)?;
     let scheduler = read_json(&out.join("scheduler.json"));
     if rep.code >= INFRASTRUCTURE_FAILURE {
@@ -169,7 +162,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     staged.commit()?;
     outln!(
         "partition: {}; {} processes, failed: [{}]; shm leftovers: {}; wall {:.2} s -> {}",
-        outcome(summary.as_ref(), scheduler.as_ref(), duration_s),
+        outcome(summary.as_ref(), scheduler.as_ref()),
         rep.exits.len(),
         failed.join(", "),
         rep.leftovers.len(),
@@ -184,32 +177,28 @@ mod tests {
     use super::outcome;
     use serde_json::json;
 
-    const DURATION_S: f64 = 240.0;
-
     #[test]
     fn a_run_stopped_by_max_ticks_is_no_timeout() {
-        let s = json!({"end": "timeout", "final_time_s": 4.9});
+        let s = json!({"end": "stopped", "final_time_s": 4.9});
         let stopped = json!({"end": "max_ticks", "ticks": 50});
         assert_eq!(
-            outcome(Some(&s), Some(&stopped), DURATION_S),
+            outcome(Some(&s), Some(&stopped)),
             "stopped after 50 ticks (--max-ticks) at t = 4.9 s, before the mission ended"
         );
         // the mission's own end stays its end, --max-ticks or not
-        let timeout = json!({"end": "timeout", "final_time_s": DURATION_S});
+        let timeout = json!({"end": "timeout", "final_time_s": 240.0});
         assert_eq!(
-            outcome(Some(&timeout), Some(&stopped), DURATION_S),
+            outcome(Some(&timeout), Some(&stopped)),
             "timeout at t = 240.0 s"
         );
         let captured = json!({"end": "captured", "final_time_s": 125.4});
         assert_eq!(
-            outcome(Some(&captured), Some(&stopped), DURATION_S),
+            outcome(Some(&captured), Some(&stopped)),
             "captured at t = 125.4 s"
         );
-        let ended = json!({"end": "captured", "ticks": 1254});
-        assert_eq!(
-            outcome(Some(&s), Some(&ended), DURATION_S),
-            "timeout at t = 4.9 s"
-        );
-        assert_eq!(outcome(None, None, DURATION_S), "no summary");
+        // stopped by the scheduler for another reason: its own word
+        let aborted = json!({"end": "aborted", "ticks": 12});
+        assert_eq!(outcome(Some(&s), Some(&aborted)), "stopped at t = 4.9 s");
+        assert_eq!(outcome(None, None), "no summary");
     }
 }

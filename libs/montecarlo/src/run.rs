@@ -50,7 +50,8 @@ impl RunResult {
 /// What a completed run measured.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RunMetrics {
-    /// "captured", "timeout" or "simulator_failed".
+    /// "captured", "timeout" or "simulator_failed" (a partition run also "stopped" or
+    /// "interrupted", see `sc_mission::summary`).
     pub end: String,
     pub captured: bool,
     pub capture_time_s: Option<f64>,

@@ -21,7 +21,8 @@ pub struct CaseResult {
     pub case: String,
     pub target: String,
     pub strategy: String,
-    /// How the mission ended ("captured", "timeout", "simulator_failed").
+    /// How the mission ended ("captured", "timeout", "simulator_failed"; a partition run
+    /// also "stopped" before the end, e.g. by `--max-ticks`, or "interrupted" by a signal).
     pub end: String,
     pub final_time_s: f64,
     pub steps: usize,
