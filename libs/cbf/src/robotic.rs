@@ -33,8 +33,7 @@ use crate::common::{
 };
 use crate::engine::{Engine, Kind, LastProblem, Outcome};
 use crate::sampled::{
-    Decay, RateBounds, RateDecay, SampleBounds, braking_barrier, hdot_required_of,
-    phi_required_of,
+    Decay, RateBounds, RateDecay, SampleBounds, braking_barrier, hdot_required_of, phi_required_of,
 };
 use crate::{Formulation, qp::SolverParams};
 use nalgebra::{SMatrix, SVector, Vector3, Vector6};
@@ -262,7 +261,10 @@ pub fn link_base(s: &SphereTerms, x: &RoboticInput) -> RelDegTwo<NJ> {
 
 /// `rows` with their offsets replaced by `c` (the same normals).
 fn with_offsets(rows: &[Row<NJ>; N], c: &[f64; N]) -> [Row<NJ>; N] {
-    std::array::from_fn(|j| Row { a: rows[j].a, c: c[j] })
+    std::array::from_fn(|j| Row {
+        a: rows[j].a,
+        c: c[j],
+    })
 }
 
 /// `mᵀ v` without forming `mᵀ` (21 of these per step), summed in the order of
@@ -590,9 +592,8 @@ impl RoboticFilter {
         let rel2 = |r: &RelDegTwo<NJ>, b: &SampleBounds, mu: f64| {
             r.hddot_drift - phi_required_of(r.h, r.hdot, b, mu, &decay)
         };
-        let rel1 = |r: &RelDegOne<NJ>, b: &RateBounds| {
-            r.hdot_drift - hdot_required_of(r.h, b, &rate)
-        };
+        let rel1 =
+            |r: &RelDegOne<NJ>, b: &RateBounds| r.hdot_drift - hdot_required_of(r.h, b, &rate);
         std::array::from_fn(|j| {
             if j < NJ {
                 rel2(&t.theta[j], &bt[j], p.u_max_theta)
@@ -1186,10 +1187,18 @@ mod tests {
             let d = Vector3::from_fn(|_, _| next());
             let want = m.transpose() * v;
             let got = tr_mul(&m, &v);
-            assert!(want.iter().zip(got.iter()).all(|(a, b)| a.to_bits() == b.to_bits()));
+            assert!(
+                want.iter()
+                    .zip(got.iter())
+                    .all(|(a, b)| a.to_bits() == b.to_bits())
+            );
             let want = j.transpose() * d;
             let got = tr_mul(&j, &d);
-            assert!(want.iter().zip(got.iter()).all(|(a, b)| a.to_bits() == b.to_bits()));
+            assert!(
+                want.iter()
+                    .zip(got.iter())
+                    .all(|(a, b)| a.to_bits() == b.to_bits())
+            );
         }
     }
 
@@ -1215,14 +1224,22 @@ mod tests {
         let x = robotic_input_from_model(&robot, &theta, &theta_dot, &w, &fb, &tb).unwrap();
         let t = f.terms(&x).ok().unwrap();
         let local = f.barrier_rows(&x, &t, Level::Local, &[0.0; N]);
-        for qdd in [Vector7::zeros(), Vector7::repeat(3.0), Vector7::from_fn(|i, _| i as f64)] {
+        for qdd in [
+            Vector7::zeros(),
+            Vector7::repeat(3.0),
+            Vector7::from_fn(|i, _| i as f64),
+        ] {
             for level in [Level::Local, Level::Certified(qdd)] {
                 let rows = f.barrier_rows(&x, &t, level, &[0.0; N]);
                 let off = f.barrier_offsets(&x, &t, level);
                 let rebuilt = with_offsets(&local, &off);
                 for (a, b) in rows.iter().zip(&rebuilt) {
                     assert_eq!(a.c.to_bits(), b.c.to_bits());
-                    assert!(a.a.iter().zip(b.a.iter()).all(|(p, q)| p.to_bits() == q.to_bits()));
+                    assert!(
+                        a.a.iter()
+                            .zip(b.a.iter())
+                            .all(|(p, q)| p.to_bits() == q.to_bits())
+                    );
                 }
             }
         }
