@@ -17,7 +17,7 @@ mod common;
 use common::*;
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Mission time of the run [s]: short, yet long enough for several MCAP chunks, with
 /// every phase in it (the test moves the phases' starts into it, keeping their order).
@@ -151,33 +151,6 @@ fn layout_problems(layout: &Value, channels: &BTreeMap<String, Channel>) -> Vec<
     bad
 }
 
-/// The interpreter for the independent reader: `SC_PYTHON` (required: must import
-/// `mcap`), else scripts/.venv/bin/python; `None` (skip, reason printed) without it.
-fn python_with_mcap() -> Option<PathBuf> {
-    let required = std::env::var_os("SC_PYTHON");
-    let py = required
-        .clone()
-        .map(PathBuf::from)
-        .unwrap_or_else(|| repo().join("scripts/.venv/bin/python"));
-    let ok = std::process::Command::new(&py)
-        .args(["-c", "import mcap.reader"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if ok {
-        return Some(py);
-    }
-    assert!(
-        required.is_none(),
-        "SC_PYTHON={} cannot import mcap (scripts/setup.sh installs scripts/requirements.txt)",
-        py.display()
-    );
-    eprintln!(
-        "SKIPPED: independent reader: no python with the mcap package at {} (run scripts/setup.sh or set SC_PYTHON)",
-        py.display()
-    );
-    None
-}
-
 #[test]
 fn recording_opens_with_the_shipped_layout() {
     let dir = scratch("foxglove");
@@ -298,7 +271,7 @@ fn recording_opens_with_the_shipped_layout() {
     );
 
     // the independent reader
-    let Some(py) = python_with_mcap() else {
+    let Some(py) = python_with("mcap.reader") else {
         return;
     };
     let o = std::process::Command::new(&py)
@@ -322,7 +295,7 @@ fn recording_opens_with_the_shipped_layout() {
 /// same run's file cut short (no summary section) is refused.
 #[test]
 fn independent_reader_refuses_a_truncated_recording() {
-    let Some(py) = python_with_mcap() else {
+    let Some(py) = python_with("mcap.reader") else {
         return;
     };
     let dir = scratch("foxglove-cut");

@@ -207,13 +207,20 @@ pub fn assert_no_lost_wakeups(out: &Path) {
 /// fails the test), else scripts/.venv/bin/python; without either `None`, and the test
 /// is skipped with the reason printed.
 pub fn python() -> Option<PathBuf> {
+    python_with("iceoryx2")
+}
+
+/// The interpreter ([`python`]'s choice) that imports `module`: `SC_PYTHON` must (the test
+/// fails otherwise: scripts/setup.sh installs scripts/requirements.txt); the venv's may
+/// not, and then `None` and the test is skipped with the reason printed.
+pub fn python_with(module: &str) -> Option<PathBuf> {
     let required = std::env::var_os("SC_PYTHON");
     let py = required
         .clone()
         .map(PathBuf::from)
         .unwrap_or_else(|| repo().join("scripts/.venv/bin/python"));
     let ok = std::process::Command::new(&py)
-        .args(["-c", "import iceoryx2"])
+        .args(["-c", &format!("import {module}")])
         .status()
         .map(|s| s.success());
     if ok.ok() == Some(true) {
@@ -221,11 +228,11 @@ pub fn python() -> Option<PathBuf> {
     }
     assert!(
         required.is_none(),
-        "SC_PYTHON={} cannot import iceoryx2",
+        "SC_PYTHON={} cannot import {module} (scripts/setup.sh installs scripts/requirements.txt)",
         py.display()
     );
     eprintln!(
-        "SKIPPED: no python with iceoryx2 at {} (run scripts/setup.sh or set SC_PYTHON)",
+        "SKIPPED: no python with {module} at {} (run scripts/setup.sh or set SC_PYTHON)",
         py.display()
     );
     None
