@@ -35,7 +35,7 @@ verify() {
   local label="$1"; shift
   local dump="$out/qp.jsonl"
   local code=0
-  "$bin" run --quiet --no-compare --no-figures --out "$out/run" --dump-qp "$dump" "$@" > "$out/run.txt" 2>&1 || code=$?
+  "$bin" run --quiet --no-compare --no-figures --force --out "$out/run" --dump-qp "$dump" "$@" > "$out/run.txt" 2>&1 || code=$?
   # a run that ends unsafe or uncaptured still dumps its QPs (exit 1); other codes fail
   if [ "$code" != 0 ] && [ "$code" != 1 ]; then
     echo "$label: run failed ($code)" | tee -a "$log"; failed=$((failed + 1)); return
@@ -53,7 +53,14 @@ verify() {
   rm -f "$dump"
 }
 if [ "$runs" -gt 0 ]; then
-  "$bin" montecarlo --runs "$runs" --seed "$seed" --out "$out/montecarlo" > /dev/null 2>&1 || true
+  # its folders are this script's own (--force); a campaign with an unsafe run exits 1 and
+  # is still verified, anything else (bad arguments, a refused folder) stops the script
+  code=0
+  "$bin" montecarlo --runs "$runs" --seed "$seed" --force --out "$out/montecarlo" > "$out/montecarlo.txt" 2>&1 || code=$?
+  if [ "$code" -ge 2 ]; then
+    echo "verify_qp_campaigns: montecarlo failed (exit $code): $(tail -1 "$out/montecarlo.txt")" >&2
+    exit 2
+  fi
   for k in $(seq 0 $((runs - 1))); do
     sc="$out/montecarlo/runs/$k/scenario.toml"
     [ -f "$sc" ] || { echo "montecarlo run $k: no $sc" | tee -a "$log"; failed=$((failed + 1)); continue; }

@@ -37,6 +37,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let cfg = sc_partition::PartitionConfig::load(&a.config)?;
     sc_partition::preflight::preflight(&cfg, &None)
         .map_err(|e| anyhow::anyhow!("{}: {e}", a.config.display()))?;
+    a.figures.check()?;
     let staged = crate::out_folder::stage(&a.out, "bench latency", a.force)?;
     let r = bench(&BenchOptions {
         config: a.config,

@@ -58,7 +58,8 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         a.window
     );
     let target = a.out.clone().unwrap_or_else(|| a.b.join("compare"));
-    let staged = crate::out_folder::stage(&target, "compare", a.force)?;
+    a.figures.check()?;
+    let staged = crate::out_folder::stage_reading(&target, "compare", a.force, &[&a.a, &a.b])?;
     let out = staged.path().to_path_buf();
     let (ra, rb) = (records(&a.a)?, records(&a.b)?);
     let d = differences(&ra, &rb).map_err(anyhow::Error::msg)?;

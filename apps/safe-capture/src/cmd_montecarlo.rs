@@ -97,7 +97,7 @@ struct RunArgs {
     /// run is nine processes).
     #[arg(long, short)]
     jobs: Option<usize>,
-    #[arg(long, value_name = "DIR", default_value = "out/montecarlo", help = crate::out_help!(" (with --resume: the campaign, completed in place)"))]
+    #[arg(long, value_name = "DIR", default_value = "out/montecarlo", help = crate::out_help!(" (with --resume: the campaign, completed in place; a campaign stopped by Ctrl-C/SIGTERM is the exception to what follows: its completed runs, aggregated, replace DIR so that --resume completes them there)"))]
     out: PathBuf,
     #[arg(long, conflicts_with = "resume", help = crate::out_folder::FORCE_HELP)]
     force: bool,
@@ -177,7 +177,10 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     match a.action {
         Some(Action::Rerun(r)) => rerun(r),
         Some(Action::Merge(m)) => {
-            let staged = crate::out_folder::stage(&m.out, "montecarlo merge", m.force)?;
+            let inputs: Vec<&std::path::Path> = m.dirs.iter().map(|d| d.as_path()).collect();
+            m.figures.check()?;
+            let staged =
+                crate::out_folder::stage_reading(&m.out, "montecarlo merge", m.force, &inputs)?;
             let s = sc_montecarlo::merge(&m.dirs, staged.path())?;
             m.figures.export_dir(&staged.path().join("figures"))?;
             staged.commit()?;
@@ -255,6 +258,7 @@ fn params(a: &RunArgs) -> anyhow::Result<Params> {
 }
 
 fn campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
+    a.figures.check()?;
     let p = params(&a)?;
     if p.mode == Mode::InProcess {
         if a.partition_config.is_some() {
@@ -387,7 +391,8 @@ fn rerun(a: RerunArgs) -> anyhow::Result<ExitCode> {
         .out
         .clone()
         .unwrap_or_else(|| a.dir.join("runs").join(a.run.to_string()).join("rerun"));
-    let staged = crate::out_folder::stage(&target, "montecarlo rerun", a.force)?;
+    a.figures.check()?;
+    let staged = crate::out_folder::stage_reading(&target, "montecarlo rerun", a.force, &[&a.dir])?;
     let out = staged.path().to_path_buf();
     let r = sc_montecarlo::rerun(&a.dir, a.run)?;
     let open = |name: &str| -> anyhow::Result<std::io::BufWriter<std::fs::File>> {

@@ -197,6 +197,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             .build_global()
             .context("--jobs")?;
     }
+    a.figures.check()?;
     let staged = crate::out_folder::stage(&a.out, "redteam", a.force)?;
     let out = staged.path().to_path_buf();
     let started = std::time::Instant::now();

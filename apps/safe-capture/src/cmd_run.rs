@@ -206,6 +206,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let nominals = Nominals::from_args(&a)?;
     let source = nominals.source(&setup);
     // a new folder replaces an earlier run's as a whole (no stale nominal/ comparison)
+    a.figures.check()?;
     let staged = crate::out_folder::stage(&a.out, "run", a.force)?;
     let out = staged.path().to_path_buf();
     let plant: Option<Box<dyn sc_sim::Plant + Send>> = if a.basilisk {

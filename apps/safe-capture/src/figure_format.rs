@@ -14,6 +14,13 @@ pub struct FigureFormatArg {
 }
 
 impl FigureFormatArg {
+    /// Before the command runs: the requested formats can be written here (a font for
+    /// PNG/PDF), so that a missing font does not surface after a long run.
+    pub fn check(&self) -> anyhow::Result<()> {
+        sc_plots::check_formats(&self.formats)?;
+        Ok(())
+    }
+
     /// Converts every SVG in `dir` (not its sub-folders) into the other requested formats.
     pub fn export_dir(&self, dir: &Path) -> anyhow::Result<()> {
         sc_plots::export_figures(dir, &self.formats)?;

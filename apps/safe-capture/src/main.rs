@@ -18,8 +18,9 @@ mod cmd_redteam;
 mod cmd_run;
 mod cmd_simulate;
 mod cmd_verify_qp;
-// where the shipped config/ and scripts/ are (SAFE_CAPTURE_HOME, the executable's place)
+// --figure-format, the same in every command that draws figures
 mod figure_format;
+// where the shipped config/ and scripts/ are (SAFE_CAPTURE_HOME, the executable's place)
 mod home;
 // the output-folder policy's --out/--force, the same in every command
 mod out_folder;

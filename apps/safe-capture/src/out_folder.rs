@@ -25,3 +25,14 @@ pub const FORCE_HELP: &str =
 pub fn stage(out: &Path, command: &str, force: bool) -> anyhow::Result<Staged> {
     Ok(Staged::begin(out, command, force)?)
 }
+
+/// [`stage`] for a command that reads `inputs`: an `out` that is or holds one of them
+/// is refused, even with --force ([`Staged::begin_with_inputs`]).
+pub fn stage_reading(
+    out: &Path,
+    command: &str,
+    force: bool,
+    inputs: &[&Path],
+) -> anyhow::Result<Staged> {
+    Ok(Staged::begin_with_inputs(out, command, force, inputs)?)
+}

@@ -1134,6 +1134,7 @@ pub fn robotic_input_from_model(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sampled::{RelDeg1, RelDeg2};
 
     /// The bit-pattern checks equal their definitions on the awkward values.
     #[test]
@@ -1202,8 +1203,10 @@ mod tests {
         }
     }
 
-    /// The certificate's offsets with the shared normals are the rows of that level, bit
-    /// for bit, at every level (what lets the filter check a command without building them).
+    /// The rows built from offsets and normals are the sampled-data rows of their
+    /// definition (`RelDeg2::row_at`, `RelDeg1::row_at`), and the certificate's offsets with
+    /// the shared normals are the rows of that level, bit for bit, at every level (what
+    /// lets the filter check a command without building them).
     #[test]
     fn offsets_and_normals_are_the_rows_of_every_level() {
         let s = sc_scenario::Scenario::load(std::path::Path::new(concat!(
@@ -1224,13 +1227,64 @@ mod tests {
         let x = robotic_input_from_model(&robot, &theta, &theta_dot, &w, &fb, &tb).unwrap();
         let t = f.terms(&x).ok().unwrap();
         let local = f.barrier_rows(&x, &t, Level::Local, &[0.0; N]);
+        // the rows as the sampled-data formulation defines them, row by row through
+        // `RelDeg2::row_at` / `RelDeg1::row_at` (the reference the offsets must equal)
+        let reference = |level: Level| -> [Row<NJ>; N] {
+            let p = &f.params;
+            let (bt, br, blb) = match level {
+                Level::Certified(qdd) => f.certified_bounds(&x, &qdd),
+                Level::Local => (
+                    [SampleBounds {
+                        period: p.period,
+                        m2: 0.0,
+                        m3: 0.0,
+                    }; NJ],
+                    [RateBounds {
+                        period: p.period,
+                        d: 0.0,
+                        j: 0.0,
+                    }; NJ],
+                    [SampleBounds {
+                        period: p.period,
+                        m2: 0.0,
+                        m3: 0.0,
+                    }; NS],
+                ),
+            };
+            let decay = Decay::linear(p.gamma).at(p.period);
+            let rate = RateDecay::new(p.gamma_theta_dot, p.eps_theta_dot, p.period);
+            std::array::from_fn(|j| {
+                if j < NJ {
+                    RelDeg2::from(t.theta[j]).row_at(&bt[j], p.u_max_theta, &decay)
+                } else if j < 2 * NJ {
+                    RelDeg1::from(t.theta_dot_max[j - NJ]).row_at(&br[j - NJ], &rate)
+                } else if j < 3 * NJ {
+                    RelDeg1::from(t.theta_dot_min[j - 2 * NJ]).row_at(&br[j - 2 * NJ], &rate)
+                } else {
+                    RelDeg2::from(t.link_base[j - 3 * NJ]).row_at(
+                        &blb[j - 3 * NJ],
+                        p.u_max_lb,
+                        &decay,
+                    )
+                }
+            })
+        };
         for qdd in [
             Vector7::zeros(),
             Vector7::repeat(3.0),
             Vector7::from_fn(|i, _| i as f64),
         ] {
             for level in [Level::Local, Level::Certified(qdd)] {
-                let rows = f.barrier_rows(&x, &t, level, &[0.0; N]);
+                let rows = reference(level);
+                let built = f.barrier_rows(&x, &t, level, &[0.0; N]);
+                for (a, b) in rows.iter().zip(&built) {
+                    assert_eq!(a.c.to_bits(), b.c.to_bits());
+                    assert!(
+                        a.a.iter()
+                            .zip(b.a.iter())
+                            .all(|(p, q)| p.to_bits() == q.to_bits())
+                    );
+                }
                 let off = f.barrier_offsets(&x, &t, level);
                 let rebuilt = with_offsets(&local, &off);
                 for (a, b) in rows.iter().zip(&rebuilt) {

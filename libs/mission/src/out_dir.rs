@@ -35,10 +35,34 @@ pub enum OutDirError {
     #[error("{}: an output folder needs a name (not / or ..): choose another --out", .0.display())]
     NoName(PathBuf),
     #[error(
+        "{} holds {what} ({}): replacing it would delete that; choose another --out",
+        .dir.display(),
+        .inside.display()
+    )]
+    Holds {
+        dir: PathBuf,
+        what: &'static str,
+        inside: PathBuf,
+    },
+    #[error(
+        "{} holds the output of `safe-capture {other}`, not of `{command}`: choose another --out, or pass --force to replace it",
+        .dir.display()
+    )]
+    OtherCommand {
+        dir: PathBuf,
+        other: String,
+        command: String,
+    },
+    #[error(
         "{} is being written by another safe-capture (process {pid}): wait for it or choose another --out",
         .dir.display()
     )]
     Busy { dir: PathBuf, pid: u32 },
+    #[error(
+        "{} exists already (another command writing the same --out just now?): wait for it or choose another --out",
+        .0.display()
+    )]
+    Taken(PathBuf),
     // the cause is in the message, not a `source`: one line, said once
     #[error("{}: {error}", .path.display())]
     Io {
@@ -97,6 +121,56 @@ pub fn check(dir: &Path, force: bool) -> Result<(), OutDirError> {
     } else {
         Err(OutDirError::NotOurs(dir.to_path_buf()))
     }
+}
+
+/// The command's name without its sub-command (`"montecarlo merge"` → `"montecarlo"`).
+fn command_name(c: &str) -> &str {
+    c.split_whitespace().next().unwrap_or(c)
+}
+
+/// [`check`] for `command`: a folder another command wrote (e.g. a Monte Carlo campaign
+/// under `run --out`) is replaced only with `force`.
+fn check_for(dir: &Path, command: &str, force: bool) -> Result<(), OutDirError> {
+    check(dir, force)?;
+    if !force
+        && let Some(Some(m)) = marker(dir)
+        && command_name(&m.command) != command_name(command)
+    {
+        return Err(OutDirError::OtherCommand {
+            dir: dir.to_path_buf(),
+            other: m.command,
+            command: command.to_string(),
+        });
+    }
+    Ok(())
+}
+
+/// Refuses, even with `force`, an output folder that is or contains the working
+/// directory or one of the command's inputs (replacing it would delete them).
+fn check_not_holding(target: &Path, inputs: &[&Path]) -> Result<(), OutDirError> {
+    let canon = |p: &Path| std::fs::canonicalize(p).ok();
+    let Some(t) = canon(target) else {
+        return Ok(()); // a folder that does not exist holds nothing
+    };
+    let cwd = std::env::current_dir().ok().and_then(|d| canon(&d));
+    let holds = |p: &Option<PathBuf>| p.as_ref().is_some_and(|p| p.starts_with(&t));
+    if holds(&cwd) {
+        return Err(OutDirError::Holds {
+            dir: target.to_path_buf(),
+            what: "the working directory",
+            inside: cwd.unwrap_or_default(),
+        });
+    }
+    for i in inputs {
+        if holds(&canon(i)) {
+            return Err(OutDirError::Holds {
+                dir: target.to_path_buf(),
+                what: "an input of this command",
+                inside: i.to_path_buf(),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Writes the marker of `command` into `dir` (which exists).
@@ -162,12 +236,27 @@ impl Staged {
     /// with the marker of `command` (an earlier run's partial output in it is removed;
     /// one another live process is writing is refused).
     pub fn begin(target: &Path, command: &str, force: bool) -> Result<Staged, OutDirError> {
-        check(target, force)?;
-        let target = absolute(target)?;
+        Self::begin_with_inputs(target, command, force, &[])
+    }
+
+    /// [`Self::begin`] for a command that reads `inputs` (run folders, a campaign): an
+    /// output folder that is or contains one of them, or the working directory, is
+    /// refused even with `force`; so is one another command wrote, unless `force`.
+    pub fn begin_with_inputs(
+        target: &Path,
+        command: &str,
+        force: bool,
+        inputs: &[&Path],
+    ) -> Result<Staged, OutDirError> {
+        check_for(target, command, force)?;
+        let abs = absolute(target)?;
+        check_not_holding(target, inputs)?;
+        let target = abs;
         let staging = sibling(&target, INCOMPLETE_SUFFIX);
         if staging.exists() {
             if let Some(Some(m)) = marker(&staging)
                 && alive(m.pid)
+                && !force
             {
                 return Err(OutDirError::Busy {
                     dir: staging,
@@ -175,9 +264,27 @@ impl Staged {
                 });
             }
             check(&staging, force)?;
+            // not `eprintln!`: a closed stderr must not panic
+            use std::io::Write as _;
+            let _ = writeln!(
+                std::io::stderr().lock(),
+                "removing the partial output of an earlier run: {}",
+                staging.display()
+            );
             remove(&staging)?;
         }
-        std::fs::create_dir_all(&staging).map_err(io(&staging))?;
+        if let Some(parent) = staging.parent() {
+            std::fs::create_dir_all(parent).map_err(io(parent))?;
+        }
+        // `create_dir`, not `create_dir_all`: of two commands started on the same --out
+        // at once, one gets the folder and the other is refused
+        if let Err(e) = std::fs::create_dir(&staging) {
+            return Err(if e.kind() == std::io::ErrorKind::AlreadyExists {
+                OutDirError::Taken(staging)
+            } else {
+                io(&staging)(e)
+            });
+        }
         write_marker(&staging, command)?;
         Ok(Staged {
             target,
@@ -200,9 +307,13 @@ impl Staged {
     /// output folder.
     pub fn commit(mut self) -> Result<PathBuf, OutDirError> {
         self.done = true;
-        let aside = sibling(&self.target, REPLACED_SUFFIX);
+        // a name of this process's own: a folder of the user's is never taken for it
+        let aside = sibling(
+            &self.target,
+            &format!("{REPLACED_SUFFIX}.{}", std::process::id()),
+        );
         if aside.exists() {
-            remove(&aside)?;
+            return Err(OutDirError::Taken(aside));
         }
         let old = self.target.exists();
         if old {
@@ -215,8 +326,11 @@ impl Staged {
             }
             return Err(io(&self.target)(e));
         }
-        if old {
-            remove(&aside)?;
+        if old && let Err(e) = remove(&aside) {
+            // the new output is in place: the old one left behind is worth a word, not
+            // a failed run
+            use std::io::Write as _;
+            let _ = writeln!(std::io::stderr().lock(), "warning: {e}");
         }
         Ok(self.target.clone())
     }
@@ -326,6 +440,63 @@ mod tests {
         std::fs::write(s.path().join("telemetry.csv"), "t").unwrap();
         s.commit().unwrap();
         assert_eq!(names(&out), [MARKER, "telemetry.csv"]);
+    }
+
+    /// A campaign under `run --out` is not replaced without --force; a sub-command of
+    /// the same command is the same command.
+    #[test]
+    fn another_commands_folder_needs_force() {
+        let t = tmp("other");
+        let out = t.0.join("campaign");
+        let s = Staged::begin(&out, "montecarlo", false).unwrap();
+        std::fs::write(s.path().join("campaign.json"), "{}").unwrap();
+        s.commit().unwrap();
+        let e = Staged::begin(&out, "run", false).unwrap_err();
+        assert!(matches!(e, OutDirError::OtherCommand { .. }), "{e}");
+        assert!(e.to_string().contains("`safe-capture montecarlo`"), "{e}");
+        assert_eq!(names(&out), [MARKER, "campaign.json"], "untouched");
+        Staged::begin(&out, "montecarlo merge", false)
+            .unwrap()
+            .commit()
+            .unwrap();
+        Staged::begin(&out, "run", true).unwrap().commit().unwrap();
+        assert_eq!(marker(&out).unwrap().unwrap().command, "run");
+    }
+
+    /// An output folder that is or holds one of the command's inputs is refused even
+    /// with --force (compare A B --out B would delete B).
+    #[test]
+    fn a_folder_holding_an_input_is_refused_even_forced() {
+        let t = tmp("inputs");
+        let b = t.0.join("b");
+        Staged::begin(&b, "run", false).unwrap().commit().unwrap();
+        let inside = b.join("telemetry.csv");
+        std::fs::write(&inside, "t").unwrap();
+        for (out, input) in [(&b, &b), (&t.0, &inside)] {
+            assert!(Staged::begin_with_inputs(out, "run", false, &[input]).is_err());
+            let e = Staged::begin_with_inputs(out, "run", true, &[input]).unwrap_err();
+            assert!(matches!(e, OutDirError::Holds { .. }), "{e}");
+        }
+        assert!(inside.is_file());
+        // inside an input is fine (compare's default B/compare)
+        Staged::begin_with_inputs(&b.join("compare"), "compare", false, &[&b])
+            .unwrap()
+            .commit()
+            .unwrap();
+    }
+
+    /// A folder of the user's named like the old output set aside survives a commit.
+    #[test]
+    fn a_users_replaced_folder_is_not_touched() {
+        let t = tmp("aside");
+        let out = t.0.join("out");
+        Staged::begin(&out, "run", false).unwrap().commit().unwrap();
+        let users = t.0.join("out.replaced");
+        std::fs::create_dir_all(&users).unwrap();
+        std::fs::write(users.join("mine.txt"), "x").unwrap();
+        Staged::begin(&out, "run", false).unwrap().commit().unwrap();
+        assert_eq!(names(&users), ["mine.txt"]);
+        assert_eq!(names(&t.0), ["out", "out.replaced"]);
     }
 
     #[test]

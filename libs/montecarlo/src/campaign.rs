@@ -1121,7 +1121,11 @@ pub fn aggregate(dir: &Path, sessions: &Sessions) -> Result<CampaignSummary, McE
         traces: &traces,
         points: &points,
         runtime: &runtime,
-        runtime_reference: Some(("paper (CasADi + OSQP)".into(), 1590.0, 3750.0)),
+        runtime_reference: Some((
+            "paper (CasADi + OSQP)".into(),
+            crate::report::PAPER_TOTAL_GEOMEAN_MS * 1e3,
+            crate::report::PAPER_TOTAL_MAX_MS * 1e3,
+        )),
         minima: &minima,
     };
     sc_plots::campaign_figures(&dir.join("figures"), &figs)

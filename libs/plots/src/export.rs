@@ -153,6 +153,16 @@ impl std::fmt::Display for FigureFormats {
 }
 
 /// The system fonts with `sans-serif` mapped to an installed family, loaded once.
+/// Whether `formats` can be written on this machine: `Ok` when only SVG is asked for or a
+/// system font for the figures' text is installed (what a command checks before it runs,
+/// so that a missing font does not surface after a long campaign).
+pub fn check_formats(formats: &FigureFormats) -> Result<(), PlotError> {
+    if formats.needs_conversion() {
+        fonts()?;
+    }
+    Ok(())
+}
+
 fn fonts() -> Result<Arc<usvg::fontdb::Database>, PlotError> {
     static DB: OnceLock<Result<Arc<usvg::fontdb::Database>, String>> = OnceLock::new();
     DB.get_or_init(|| {

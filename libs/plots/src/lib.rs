@@ -36,7 +36,9 @@ pub use campaign::{
 };
 pub use colour::viridis;
 pub use compare::difference_figure;
-pub use export::{FigureFormat, FigureFormats, PNG_SCALE, export_figure, export_figures};
+pub use export::{
+    FigureFormat, FigureFormats, PNG_SCALE, check_formats, export_figure, export_figures,
+};
 pub use latency::{LatencyPercentiles, LatencyTimeline, latency_percentiles, latency_timeline};
 pub use redteam::{RedTeamMargins, redteam_margins};
 pub use run::{los_angles_deg, run_figures};
