@@ -178,19 +178,10 @@ fn bad_montecarlo_arguments_are_one_line_errors() {
     let missing_exec = d.join("partition.toml");
     std::fs::write(
         &missing_exec,
-        std::fs::read_to_string(root().join("config/partition.toml"))
-            .unwrap()
-            .replace(
-                "scenario = \"scenario.toml\"",
-                &format!(
-                    "scenario = \"{}\"",
-                    root().join("config/scenario.toml").display()
-                ),
-            )
-            .replace(
-                "exec = \"sc-scheduler\"",
-                "exec = \"/nonexistent/sc-scheduler\"",
-            ),
+        partition_toml_absolute_scenario().replace(
+            "exec = \"sc-scheduler\"",
+            "exec = \"/nonexistent/sc-scheduler\"",
+        ),
     )
     .unwrap();
     let missing_exec = missing_exec.to_str().unwrap();
