@@ -16,7 +16,8 @@ Both builds run, from scratch folders under --work (default: a fresh temp folder
 Every file the two builds wrote is compared byte for byte, except what holds times,
 process ids or host stamps, which no two runs share (`timing.csv`, `latency.csv`,
 `runs/K/timing.json`, `recording.mcap`, logs, ...): those are listed as skipped.
-`summary.json` and `cases.csv` are compared with their timing keys/columns removed.
+`summary.json`, `campaign.json` and `cases.csv` are compared with their timing keys/columns (and the
+build's commit) removed.
 
 --old-home/--new-home name each build's installation (SAFE_CAPTURE_HOME: the checkout
 whose config/ and scripts/ its defaults come from; default: this checkout for both).
@@ -48,8 +49,10 @@ SKIP_NAMES = {
     "partition.effective.toml",
 }
 SKIP_DIRS = {"logs"}
-# Keys of summary.json (at any depth) that are times or host readings.
+# Keys of summary.json and campaign.json (at any depth) that are times, host readings or the build's
+# own name (two builds differ in their commit by construction).
 TIMING_KEYS = {
+    "git_commit",
     "solve_time_us",
     "solve_cpu_us",
     "wall_s",
@@ -103,7 +106,7 @@ def strip_columns(text):
 
 def same(a, b):
     name = a.name
-    if name == "summary.json":
+    if name in ("summary.json", "campaign.json"):
         return strip_keys(json.loads(a.read_text())) == strip_keys(json.loads(b.read_text()))
     if name == "cases.csv":
         return strip_columns(a.read_text()) == strip_columns(b.read_text())

@@ -3,7 +3,7 @@
 
 mod common;
 use common::*;
-use sc_partition::latency::{BenchOptions, bench};
+use sc_ground::latency::{BenchOptions, bench};
 
 #[test]
 fn latency_report_is_consistent() {
@@ -63,7 +63,7 @@ fn latency_report_is_consistent() {
         st.sample_period_s > 0.05 && st.sample_period_s < 1.0,
         "{st:?}"
     );
-    let series = sc_partition::steal::read_csv(&out.join("steal.csv"))
+    let series = sc_ground::steal::read_csv(&out.join("steal.csv"))
         .unwrap()
         .unwrap();
     assert!(
@@ -90,7 +90,7 @@ fn latency_report_is_consistent() {
     // step before every tick. It changes no command: without a deadline miss (a miss
     // applies a fallback, and then the runs part), the real-time telemetry is the
     // in-process run's, row for row.
-    let lead = sc_partition::PartitionConfig::load(&config)
+    let lead = sc_ground::PartitionConfig::load(&config)
         .unwrap()
         .warmup_lead_us;
     assert!(lead > 0, "the default config has the warm-up");

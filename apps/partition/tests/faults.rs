@@ -35,7 +35,7 @@ fn kill_run(
     tag: &str,
     exec: &str,
 ) -> (
-    sc_partition::LaunchReport,
+    sc_ground::LaunchReport,
     std::path::PathBuf,
     std::path::PathBuf,
 ) {
@@ -43,7 +43,7 @@ fn kill_run(
     let out = dir.join("out");
     let config = write_config(&dir, Some(60.0), None, 5.0);
     let opts = options(&config, &out, tag);
-    let h = std::thread::spawn(move || sc_partition::launch(&opts).unwrap());
+    let h = std::thread::spawn(move || sc_ground::launch(&opts).unwrap());
     kill_when(&out, exec, 100);
     let rep = h.join().unwrap();
     assert_clean(&rep, &out);
@@ -103,7 +103,7 @@ fn degraded(exec: &str, filter: &str, mask: u32) {
         marked, expect,
         "{filter}: latency.csv upstream_missing_mask"
     );
-    let r = sc_partition::latency::analyse(&out, 0).unwrap();
+    let r = sc_ground::latency::analyse(&out, 0).unwrap();
     assert!(
         r.deadline_misses >= expect.len() as u64,
         "{}",
@@ -205,7 +205,7 @@ fn hung_robotic_filter_is_detected_by_deadlines() {
     let out = dir.join("out");
     let config = write_config(&dir, Some(60.0), None, 5.0);
     let opts = options(&config, &out, "hung");
-    let h = std::thread::spawn(move || sc_partition::launch(&opts).unwrap());
+    let h = std::thread::spawn(move || sc_ground::launch(&opts).unwrap());
     let t0 = std::time::Instant::now();
     while rows(&out) < 100 {
         assert!(t0.elapsed() < std::time::Duration::from_secs(120));
@@ -242,7 +242,7 @@ fn hung_nominal_is_caught_by_the_stage_deadline_watchdog() {
     let out = dir.join("out");
     let config = write_config(&dir, Some(60.0), None, 5.0);
     let opts = options(&config, &out, "hungnom");
-    let h = std::thread::spawn(move || sc_partition::launch(&opts).unwrap());
+    let h = std::thread::spawn(move || sc_ground::launch(&opts).unwrap());
     let t0 = std::time::Instant::now();
     while rows(&out) < 100 {
         assert!(t0.elapsed() < std::time::Duration::from_secs(120));
@@ -296,7 +296,7 @@ fn a_role_that_never_joins_is_named() {
         vec!["-c".into(), "exec sleep 60".into()],
     ));
     let t0 = std::time::Instant::now();
-    let rep = sc_partition::launch(&opts).unwrap();
+    let rep = sc_ground::launch(&opts).unwrap();
     assert_ne!(rep.code, 0, "{rep:?}");
     assert!(t0.elapsed() < std::time::Duration::from_secs(60), "{rep:?}");
     let log = std::fs::read_to_string(out.join("logs/scheduler.log")).unwrap();

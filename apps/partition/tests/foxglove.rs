@@ -80,7 +80,7 @@ fn split_path(p: &str) -> Option<(&str, &str, usize)> {
 /// The frame ids on `/tf`.
 fn tf_frames(channels: &BTreeMap<String, Channel>) -> BTreeSet<String> {
     let mut frames = BTreeSet::new();
-    if let Some(tf) = channels.get(sc_partition::mcap_out::TF_TOPIC) {
+    if let Some(tf) = channels.get(sc_ground::mcap_out::TF_TOPIC) {
         for (_, m) in &tf.messages {
             for k in ["parent_frame_id", "child_frame_id"] {
                 frames.insert(m[k].as_str().unwrap_or_default().to_string());
@@ -171,7 +171,7 @@ fn recording_opens_with_the_shipped_layout() {
     assert_eq!(sc_scenario::Scenario::load(&scenario_path).unwrap(), sc);
 
     let out = dir.join("out");
-    let rep = sc_partition::launch(&options(&config, &out, "fox")).unwrap();
+    let rep = sc_ground::launch(&options(&config, &out, "fox")).unwrap();
     assert_clean(&rep, &out);
     let rec = out.join("recording.mcap");
     let channels = read_recording(&rec);
@@ -207,7 +207,7 @@ fn recording_opens_with_the_shipped_layout() {
     }
 
     // the shipped layout refers only to what is there
-    let layout_path = repo().join(sc_partition::mcap_out::LAYOUT_FILE);
+    let layout_path = repo().join(sc_ground::mcap_out::LAYOUT_FILE);
     let layout: Value =
         serde_json::from_str(&std::fs::read_to_string(&layout_path).unwrap()).unwrap();
     let bad = layout_problems(&layout, &channels);
@@ -236,7 +236,7 @@ fn recording_opens_with_the_shipped_layout() {
 
     // the 3D panel: frames on /tf for every scene entity, the scene once per phase
     let frames = tf_frames(&channels);
-    let scene = &channels[sc_partition::mcap_out::SCENE_TOPIC];
+    let scene = &channels[sc_ground::mcap_out::SCENE_TOPIC];
     let mut phases = Vec::new();
     for (log_ns, m) in &scene.messages {
         for e in m["entities"].as_array().unwrap() {
@@ -266,7 +266,7 @@ fn recording_opens_with_the_shipped_layout() {
         .messages
         .len();
     assert_eq!(
-        channels[sc_partition::mcap_out::TF_TOPIC].messages.len(),
+        channels[sc_ground::mcap_out::TF_TOPIC].messages.len(),
         4 * states
     );
 
@@ -300,9 +300,9 @@ fn independent_reader_refuses_a_truncated_recording() {
     };
     let dir = scratch("foxglove-cut");
     let path = dir.join("cut.mcap");
-    let mut out = sc_partition::mcap_out::McapOut::create(&path).unwrap();
+    let mut out = sc_ground::mcap_out::McapOut::create(&path).unwrap();
     out.write_metadata(
-        sc_partition::recorder::MCAP_METADATA_NAME,
+        sc_ground::recorder::MCAP_METADATA_NAME,
         BTreeMap::from([("version".to_string(), "0".to_string())]),
     )
     .unwrap();

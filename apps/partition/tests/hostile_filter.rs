@@ -1,4 +1,4 @@
-//! The simulator re-validates every safe command (`sc_partition::admission`): a lying
+//! The simulator re-validates every safe command (`sc_flight::admission`): a lying
 //! process in the translational safety filter's role (`scripts/python/hostile_filter.py`)
 //! publishes, for the right tick, 1000 × the force bound, NaN or +inf in turn. Every one
 //! must be rejected and logged, the filter's backup applied instead, and the run stay
@@ -27,7 +27,7 @@ fn lying_safe_commands_are_rejected_and_the_backup_applied() {
                 .to_string(),
         ],
     ));
-    let rep = sc_partition::launch(&opts).unwrap();
+    let rep = sc_ground::launch(&opts).unwrap();
     assert_clean(&rep, &out);
     let log = |role: &str| std::fs::read_to_string(out.join(format!("logs/{role}.log"))).unwrap();
     let liar = log("safety_translational");

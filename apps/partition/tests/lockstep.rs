@@ -12,7 +12,7 @@ fn lock_step_telemetry_is_identical_to_in_process_run() {
     let dir = tmp("ident");
     let out = dir.join("out");
     let config = repo().join("config/partition.toml");
-    let rep = sc_partition::launch(&options(&config, &out, "ident")).unwrap();
+    let rep = sc_ground::launch(&options(&config, &out, "ident")).unwrap();
     assert_eq!(rep.code, 0, "{rep:?}");
     assert_clean(&rep, &out);
     assert_no_lost_wakeups(&out);
@@ -58,7 +58,7 @@ fn lock_step_telemetry_is_identical_to_in_process_run() {
     let (mut states, mut last, mut frames) = (0u64, 0u64, 0u64);
     for m in mcap::MessageStream::new(&bytes).unwrap() {
         let m = m.unwrap();
-        if m.channel.topic == sc_partition::mcap_out::TF_TOPIC {
+        if m.channel.topic == sc_ground::mcap_out::TF_TOPIC {
             let s = m.channel.schema.as_ref().unwrap();
             assert_eq!(s.name, "foxglove.FrameTransform");
             frames += 1;
@@ -84,7 +84,7 @@ fn lock_step_telemetry_is_identical_to_in_process_run() {
     let idx = summ
         .metadata_indexes
         .iter()
-        .find(|i| i.name == sc_partition::recorder::MCAP_METADATA_NAME)
+        .find(|i| i.name == sc_ground::recorder::MCAP_METADATA_NAME)
         .expect("metadata record");
     let meta = mcap::read::metadata(&bytes, idx).unwrap().metadata;
     assert_eq!(meta["version"], b["version"].as_str().unwrap());
@@ -124,7 +124,7 @@ fn multi_rate_schedule_runs_to_capture() {
     let dir = tmp("multi");
     let out = dir.join("out");
     let config = write_config(&dir, None, Some(MULTI_RATE), 20.0);
-    let rep = sc_partition::launch(&options(&config, &out, "multi")).unwrap();
+    let rep = sc_ground::launch(&options(&config, &out, "multi")).unwrap();
     assert_eq!(rep.code, 0, "{rep:?}");
     assert_clean(&rep, &out);
     assert_no_lost_wakeups(&out);
@@ -157,7 +157,7 @@ fn slower_downstream_filter_is_rejected() {
     let dir = tmp("reject");
     let groups = "[[rate_groups]]\nname = \"fast\"\nperiod_s = 0.1\nmembers = [\"translational\", \"attitude\"]\n\n[[rate_groups]]\nname = \"slow\"\nperiod_s = 0.2\nmembers = [\"robotic\"]\n\n";
     let config = write_config(&dir, None, Some(groups), 20.0);
-    let e = sc_partition::launch(&options(&config, &dir.join("out"), "reject"))
+    let e = sc_ground::launch(&options(&config, &dir.join("out"), "reject"))
         .unwrap_err()
         .to_string();
     assert!(e.contains("robotic filter (period 0.2 s) is slower than its upstream attitude filter (period 0.1 s)"), "{e}");

@@ -26,7 +26,7 @@ fn python_nominal_controller_runs_the_mission() {
                 .to_string(),
         ],
     ));
-    let rep = sc_partition::launch(&opts).unwrap();
+    let rep = sc_ground::launch(&opts).unwrap();
     assert_clean(&rep, &out);
     assert_eq!(rep.code, 0, "{rep:?}");
     // the Python process is woken and wakes the filter like the Rust one: nothing

@@ -143,7 +143,7 @@ fn installed_sdk_example_runs_the_mission_without_pinocchio() {
         example.display().to_string(),
         vec![],
     ));
-    let rep = sc_partition::launch(&opts).unwrap();
+    let rep = sc_ground::launch(&opts).unwrap();
     assert_clean(&rep, &out);
     let log = std::fs::read_to_string(out.join("logs/nominal_translational.log")).unwrap();
     assert_eq!(

@@ -5,7 +5,7 @@ use sc_cbf::FilterStatus;
 use sc_mission::summary::TimeStats;
 use sc_mission::{Mission, RunOptions, Setup};
 use sc_montecarlo::host::{HostLoad, HostSample};
-use sc_montecarlo::report::{PAPER_TOTAL_GEOMEAN_MS, PAPER_TOTAL_MAX_MS};
+use sc_plots::paper::{PAPER_TOTAL_GEOMEAN_MS, PAPER_TOTAL_MAX_MS};
 use std::path::PathBuf;
 use std::process::ExitCode;
 

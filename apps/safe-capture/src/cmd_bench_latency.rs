@@ -1,6 +1,6 @@
-//! `safe-capture bench latency`: the partition's latency in real time (logic in sc-partition).
+//! `safe-capture bench latency`: the partition's latency in real time (logic in sc-ground).
 
-use sc_partition::latency::{BenchOptions, bench, markdown};
+use sc_ground::latency::{BenchOptions, bench, markdown};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -34,8 +34,8 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     // nothing starts unless the scenario and every program are there
-    let cfg = sc_partition::PartitionConfig::load(&a.config)?;
-    sc_partition::preflight::preflight(&cfg, &None)
+    let cfg = sc_ground::PartitionConfig::load(&a.config)?;
+    sc_ground::preflight::preflight(&cfg, &None)
         .map_err(|e| anyhow::anyhow!("{}: {e}", a.config.display()))?;
     a.figures.check()?;
     let staged = crate::out_folder::stage(&a.out, "bench latency", a.force)?;

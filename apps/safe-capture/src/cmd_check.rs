@@ -1,7 +1,7 @@
 //! `safe-capture check FILE…`: configuration files validated before anything runs.
 
+use sc_ground::PartitionConfig;
 use sc_montecarlo::MonteCarloConfig;
-use sc_partition::PartitionConfig;
 use sc_scenario::{Scenario, ScenarioError};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -92,7 +92,7 @@ fn check_file(path: &Path, kind: Option<Kind>, mc_scenario: &Path) -> Result<Str
         }
         Kind::Partition => {
             let cfg = PartitionConfig::load(path).map_err(|e| in_file(e.to_string()))?;
-            let p = sc_partition::preflight::preflight(&cfg, &None).map_err(|e| e.to_string())?;
+            let p = sc_ground::preflight::preflight(&cfg, &None).map_err(|e| e.to_string())?;
             Ok(format!(
                 "partition: {} roles, scenario {}",
                 p.roles,

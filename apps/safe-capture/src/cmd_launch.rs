@@ -1,8 +1,8 @@
-//! `safe-capture launch`: the mission as a process partition (logic in sc-partition).
+//! `safe-capture launch`: the mission as a process partition (logic in sc-ground).
 
-use sc_partition::launcher::configured;
-use sc_partition::preflight::preflight;
-use sc_partition::{ClockMode, LaunchOptions, launch};
+use sc_ground::launcher::configured;
+use sc_ground::preflight::preflight;
+use sc_ground::{ClockMode, LaunchOptions, launch};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -101,7 +101,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let mut partners = None;
     if let Some(h) = &a.hostile {
         let case = crate::redteam_partition::parse_hostile(h)?;
-        let cfg = sc_partition::PartitionConfig::load(&a.config)?;
+        let cfg = sc_ground::PartitionConfig::load(&a.config)?;
         let p = crate::redteam_partition::Partners::new(
             &a.python,
             &a.partner,

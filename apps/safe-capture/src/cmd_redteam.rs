@@ -3,8 +3,8 @@
 use crate::redteam_partition::{Partners, default_python};
 use anyhow::Context;
 use rayon::prelude::*;
+use sc_ground::ClockMode;
 use sc_mission::Setup;
-use sc_partition::ClockMode;
 use sc_redteam::partners::{parse_partition_case, partition_cases};
 use sc_redteam::{Case, CaseLabel, CaseResult, Target, report};
 use std::io::IsTerminal;
@@ -179,8 +179,8 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             },
         )?;
         // every role's program, as the launcher will find it, before any case runs
-        let cfg = sc_partition::PartitionConfig::load(&a.partition_config)?;
-        sc_partition::preflight::check_programs(&cfg, &None).map_err(|e| {
+        let cfg = sc_ground::PartitionConfig::load(&a.partition_config)?;
+        sc_ground::preflight::check_programs(&cfg, &None).map_err(|e| {
             anyhow::anyhow!("--partition-config {}: {e}", a.partition_config.display())
         })?;
         for c in &cases {

@@ -216,9 +216,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             "--scenario".to_string(),
             a.scenario.display().to_string(),
         ];
-        Some(Box::new(sc_partition::plant_process::ProcessPlant::spawn(
-            &a.python, &args,
-        )?))
+        Some(Box::new(sc_sim::ProcessPlant::spawn(&a.python, &args)?))
     } else {
         None
     };

@@ -1,8 +1,8 @@
 //! `safe-capture montecarlo --mode partition`: every run's mission through the process
-//! partition (sc-partition), measured from the recorder's telemetry by the same code as
+//! partition (sc-ground), measured from the recorder's telemetry by the same code as
 //! an in-process run.
 //!
-//! Per run K: `sc_partition::launch` with the user's partition config (schedule,
+//! Per run K: `sc_ground::launch` with the user's partition config (schedule,
 //! deadlines, executables), the run's `runs/K/scenario.toml`, lock-step, to the end of
 //! the mission, a run id of its own, output in `runs/K/partition/`. The recorder's
 //! `telemetry.csv` (bit-for-bit the in-process one in lock-step with one rate group at
@@ -12,13 +12,13 @@
 //! missing, files left in /dev/shm) is a failed run; the campaign goes on.
 
 use anyhow::Context;
+use sc_core::Subsystem;
+use sc_ground::launcher::{LaunchReport, interrupted, last_log_line};
+use sc_ground::recorder::RecorderReport;
+use sc_ground::{ClockMode, LaunchOptions, PartitionConfig, launch};
 use sc_mission::{MissionEnd, Setup, StepRecord, parse_telemetry};
 use sc_montecarlo::campaign::PARTITION_DIR;
 use sc_montecarlo::{Execution, Executor};
-use sc_partition::config::ROLES;
-use sc_partition::launcher::{LaunchReport, interrupted, last_log_line};
-use sc_partition::recorder::RecorderReport;
-use sc_partition::{ClockMode, LaunchOptions, PartitionConfig, launch};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -58,19 +58,19 @@ impl PartitionExecutor {
         let schedule = cfg.schedule().context("--partition-config")?;
         // every role's program, as the launcher will find it (the scenario is the
         // campaign's, checked by the campaign)
-        sc_partition::preflight::check_programs(&cfg, &None)
+        sc_ground::preflight::check_programs(&cfg, &None)
             .map_err(|e| anyhow::anyhow!("--partition-config {}: {e}", config.display()))?;
         let period = sc_scenario::Scenario::load(scenario)
             .map(|s| s.mission.control_period_s)
             .ok();
         let note = match period {
-            Some(p) if schedule.period_s.iter().all(|x| *x == p) => None,
+            Some(p) if schedule.period_s.iter().all(|(_, x)| *x == p) => None,
             Some(p) => Some(format!(
                 "note: the schedule of {} (periods translational {} s, attitude {} s, robotic {} s) is not the scenario's control period {p} s: results will differ from --mode in-process",
                 config.display(),
-                schedule.period_s[0],
-                schedule.period_s[1],
-                schedule.period_s[2]
+                schedule.period_s[Subsystem::Translational],
+                schedule.period_s[Subsystem::Attitude],
+                schedule.period_s[Subsystem::Robotic]
             )),
             None => None, // the campaign reports the scenario's problem
         };
@@ -113,7 +113,7 @@ pub fn failure_reason(rep: &LaunchReport, out: &Path) -> String {
     if let Some(e) = &rep.error {
         return e.clone();
     }
-    let bad = |e: &&sc_partition::launcher::ProcessExit| !e.ended_well();
+    let bad = |e: &&sc_ground::launcher::ProcessExit| !e.ended_well();
     // the processes that failed by themselves, with the last line of their log
     let mut parts: Vec<String> = rep
         .exits
@@ -147,9 +147,7 @@ pub fn failure_reason(rep: &LaunchReport, out: &Path) -> String {
         ));
     }
     let started: Vec<&str> = rep.exits.iter().map(|e| e.role.as_str()).collect();
-    let missing: Vec<&str> = ROLES
-        .iter()
-        .copied()
+    let missing: Vec<&str> = sc_icd::roles::names()
         .filter(|r| !started.contains(r))
         .collect();
     if !missing.is_empty() {

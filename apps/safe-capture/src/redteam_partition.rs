@@ -2,7 +2,7 @@
 //! process partition, with hostile partner processes (`scripts/python/hostile_nominal.py`,
 //! strategies in `sc_redteam::partners`) in place of the nominal controllers.
 //!
-//! Per case: `sc_partition::launch` with the user's partition config, the campaign's
+//! Per case: `sc_ground::launch` with the user's partition config, the campaign's
 //! scenario, lock-step, a run id of its own and output in `cases/<case>/`; the hostile
 //! process replaces the nominal role(s) of the case's target. The recorder's telemetry is
 //! read back into step records (`montecarlo_partition::read_run`: every tick recorded, no
@@ -12,9 +12,9 @@
 
 use crate::montecarlo_partition::read_run;
 use anyhow::Context;
+use sc_ground::launcher::interrupted;
+use sc_ground::{ClockMode, LaunchOptions, launch};
 use sc_mission::Setup;
-use sc_partition::launcher::interrupted;
-use sc_partition::{ClockMode, LaunchOptions, launch};
 use sc_redteam::partners::roles;
 use sc_redteam::{CaseLabel, CaseResult};
 use std::path::{Path, PathBuf};

@@ -13,15 +13,16 @@
 //!
 //! ```no_run
 //! use sc_bus::{Coordinator, Participant, RunScope};
-//! use sc_icd::{role, services};
+//! use sc_icd::{Role, RoleKind, services};
 //! use std::time::Duration;
 //! let run = RunScope::unique("doc")?;
 //! // scheduler process:
 //! let node = run.node("scheduler")?;
-//! let coord = Coordinator::new(&node, services::HANDSHAKE, &[role::SIMULATOR, role::RECORDER])?;
+//! let (simulator, recorder) = (Role::of(RoleKind::Simulator).id(), Role::of(RoleKind::Recorder).id());
+//! let coord = Coordinator::new(&node, services::HANDSHAKE, &[simulator, recorder])?;
 //! coord.wait_all(Duration::from_secs(10))?;   // Err(HandshakeTimeout { missing }) otherwise
 //! // each other process (after creating its ports):
-//! let p = Participant::new(&node, services::HANDSHAKE, role::SIMULATOR)?;
+//! let p = Participant::new(&node, services::HANDSHAKE, simulator)?;
 //! p.announce_and_wait(Duration::from_secs(10))?;
 //! # Ok::<(), sc_bus::BusError>(())
 //! ```

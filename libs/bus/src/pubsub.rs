@@ -80,7 +80,7 @@ impl ServiceSettings {
     /// - `max_publishers = 2`: the owner plus one replacement (e.g. a Python
     ///   controller started while the Rust one is being stopped). A subscriber still
     ///   accepts samples only from the first publisher it heard; the partition's
-    ///   settings (`sc_partition::process::qos`) allow exactly one.
+    ///   settings (`sc_flight::process::qos`) allow exactly one.
     /// - `max_subscribers = 8`: the consumers, recorder and debug tools.
     /// - `backpressure_timeout = 50 ms`: far above a tick's work, small enough
     ///   that a SIGKILLed subscriber cannot stall the loop for long.

@@ -3,7 +3,7 @@
 //! `scripts/.venv` with the `iceoryx2` wheel exists (otherwise prints why and passes).
 
 use sc_bus::{Coordinator, Publisher, RunScope, ServiceSettings, Subscriber};
-use sc_icd::{NominalTranslational, SimState, role, services};
+use sc_icd::{NominalTranslational, Role, RoleKind, SimState, Subsystem, services};
 use std::path::PathBuf;
 use std::process::Command;
 use std::time::Duration;
@@ -43,8 +43,12 @@ fn python_controller_answers_rust_states() {
         let cmd_rx =
             Subscriber::<NominalTranslational>::new(&node, services::NOMINAL_TRANSLATIONAL, &qos)
                 .unwrap();
-        let coord =
-            Coordinator::new(&node, services::HANDSHAKE, &[role::NOMINAL_TRANSLATIONAL]).unwrap();
+        let coord = Coordinator::new(
+            &node,
+            services::HANDSHAKE,
+            &[Role::of(RoleKind::Nominal(Subsystem::Translational)).id()],
+        )
+        .unwrap();
         let mut child = Command::new(&py)
             .arg(&script)
             .env("SC_RUN_ID", run.run_id())

@@ -364,21 +364,12 @@ pub fn defines() -> Vec<Define> {
     d.push(Section(
         "Role ids (Health.role; the handshake id is SC_EVENT_HANDSHAKE_ID_OFFSET + role)",
     ));
-    ints(
-        &mut d,
-        "SC_ROLE_",
-        &[
-            ("SCHEDULER", role::SCHEDULER),
-            ("SIMULATOR", role::SIMULATOR),
-            ("NOMINAL_TRANSLATIONAL", role::NOMINAL_TRANSLATIONAL),
-            ("NOMINAL_ATTITUDE", role::NOMINAL_ATTITUDE),
-            ("NOMINAL_ROBOTIC", role::NOMINAL_ROBOTIC),
-            ("SAFETY_TRANSLATIONAL", role::SAFETY_TRANSLATIONAL),
-            ("SAFETY_ATTITUDE", role::SAFETY_ATTITUDE),
-            ("SAFETY_ROBOTIC", role::SAFETY_ROBOTIC),
-            ("RECORDER", role::RECORDER),
-        ],
-    );
+    for r in &ROLES {
+        d.push(Define::Int(
+            format!("SC_ROLE_{}", r.constant_name()),
+            r.id().into(),
+        ));
+    }
     d.push(Section("Health.state"));
     ints(
         &mut d,

@@ -25,7 +25,10 @@
 use iceoryx2::prelude::ZeroCopySend;
 
 pub mod c_header;
+pub mod roles;
 pub mod services;
+pub use roles::{ROLES, Rate, Role, RoleKind};
+pub use sc_core::Subsystem;
 pub use services::ServiceName;
 
 /// Number of manipulator joints.
@@ -111,28 +114,6 @@ pub mod health_state {
     pub const STOPPING: u32 = 4;
 }
 
-/// Role ids used in [`Health::role`] and as handshake participant ids.
-pub mod role {
-    /// Scheduler (handshake coordinator).
-    pub const SCHEDULER: u32 = 0;
-    /// Simulator.
-    pub const SIMULATOR: u32 = 1;
-    /// Nominal translational controller.
-    pub const NOMINAL_TRANSLATIONAL: u32 = 2;
-    /// Nominal attitude controller.
-    pub const NOMINAL_ATTITUDE: u32 = 3;
-    /// Nominal robotic controller.
-    pub const NOMINAL_ROBOTIC: u32 = 4;
-    /// Translational safety filter.
-    pub const SAFETY_TRANSLATIONAL: u32 = 5;
-    /// Attitude safety filter.
-    pub const SAFETY_ATTITUDE: u32 = 6;
-    /// Robotic safety filter.
-    pub const SAFETY_ROBOTIC: u32 = 7;
-    /// Telemetry recorder.
-    pub const RECORDER: u32 = 8;
-}
-
 /// Bits of the `fault_flags` fields.
 pub mod fault {
     /// Input older than one tick (stale state).
@@ -152,7 +133,7 @@ pub mod fault {
     /// A peer process was detected dead.
     pub const PEER_DEAD: u32 = 1 << 7;
     /// The simulator rejected a safe command (not finite or beyond the input bounds,
-    /// `sc_partition::admission`) and applied the filter's backup instead.
+    /// `sc_flight::admission`) and applied the filter's backup instead.
     pub const REJECTED_COMMAND: u32 = 1 << 8;
 }
 
@@ -438,7 +419,7 @@ pub struct StepResult {
 #[repr(C)]
 #[type_name("safe_capture::v1::Health")]
 pub struct Health {
-    /// Role id, one of [`role`] [-].
+    /// Role id, [`Role::id`] of the role table [-].
     pub role: u32,
     /// Operating-system process id [-].
     pub pid: u32,

@@ -125,7 +125,10 @@ impl Mission {
 
     /// Propagates with `plant` from now on (another simulator in the loop, e.g. Basilisk),
     /// started at the current state.
-    pub fn set_plant(&mut self, mut plant: Box<dyn Plant + Send>) -> Result<(), String> {
+    pub fn set_plant(
+        &mut self,
+        mut plant: Box<dyn Plant + Send>,
+    ) -> Result<(), sc_sim::PlantError> {
         plant.start(self.sim.state())?;
         self.plant = Some(plant);
         Ok(())

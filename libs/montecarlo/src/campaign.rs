@@ -1123,8 +1123,8 @@ pub fn aggregate(dir: &Path, sessions: &Sessions) -> Result<CampaignSummary, McE
         runtime: &runtime,
         runtime_reference: Some((
             "paper (CasADi + OSQP)".into(),
-            crate::report::PAPER_TOTAL_GEOMEAN_MS * 1e3,
-            crate::report::PAPER_TOTAL_MAX_MS * 1e3,
+            sc_plots::paper::PAPER_TOTAL_GEOMEAN_MS * 1e3,
+            sc_plots::paper::PAPER_TOTAL_MAX_MS * 1e3,
         )),
         minima: &minima,
     };

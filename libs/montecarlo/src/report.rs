@@ -4,12 +4,10 @@ use crate::campaign::{CampaignSummary, Spread};
 use crate::run::RunResult;
 use std::fmt::Write;
 
-/// The paper's Monte Carlo numbers (Meinert et al., Sec. "Monte Carlo Simulation").
-pub const PAPER_TOTAL_GEOMEAN_MS: f64 = 1.59;
-pub const PAPER_TOTAL_MAX_MS: f64 = 3.75;
-pub const PAPER_COMPONENT_MAX_MS: f64 = 2.3;
-pub const PAPER_SYNC_GRASP_RAD_S: (f64, f64) = (0.0432, 0.0457);
-pub const PAPER_SYNC_SYNC_RAD_S: f64 = 0.3;
+use sc_plots::paper::{
+    PAPER_COMPONENT_MAX_MS, PAPER_SYNC_GRASP_RAD_S, PAPER_SYNC_SYNC_RAD_S, PAPER_TOTAL_GEOMEAN_MS,
+    PAPER_TOTAL_MAX_MS,
+};
 
 fn spread(s: Option<&Spread>, digits: usize) -> String {
     match s {

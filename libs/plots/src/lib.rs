@@ -11,6 +11,7 @@
 //!   minimum.
 //! * [`redteam_margins`] — every red-team case against every barrier.
 //! * [`latency_percentiles`], [`latency_timeline`] — the partition's latency benchmark.
+//! * [`paper`] — the paper's published numbers the figures and reports set beside ours.
 //! * [`export_figures`] — every SVG of a folder also as PNG and/or PDF
 //!   ([`FigureFormats`], e.g. parsed from `svg,png,pdf`).
 //!
@@ -27,6 +28,7 @@ mod colour;
 mod compare;
 mod export;
 mod latency;
+pub mod paper;
 mod redteam;
 mod run;
 mod ticks;

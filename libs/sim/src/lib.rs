@@ -19,12 +19,15 @@
 
 mod observation;
 mod plant;
+pub mod plant_process;
 mod profile;
 mod report;
 mod state;
 
-pub use observation::{Observation, TRAJECTORY_COLUMNS, TrajectoryRow};
-pub use plant::{Plant, SIM_STATE_LEN};
+pub use observation::{TRAJECTORY_COLUMNS, TrajectoryRow};
+pub use plant::{Plant, PlantError, SIM_STATE_LEN};
+pub use plant_process::ProcessPlant;
 pub use profile::{CommandProfile, GRID_TOLERANCE_S, PROFILE_COLUMNS, ProfileError};
 pub use report::{ModelReport, ModelState, evaluate_model};
+pub use sc_core::Observation;
 pub use state::{BarrierState, Command, SimError, SimState, Simulator};

@@ -4,10 +4,16 @@
 
 use crate::state::{Command, SimError, SimState, Simulator};
 
+/// Why an external propagator failed (it could not start, left, or answered nonsense),
+/// in one line.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct PlantError(pub String);
+
 /// An external propagator of [`SimState`] (frames and units as documented there).
 pub trait Plant {
     /// Starts the plant at `state` (called once, before the first [`Plant::propagate`]).
-    fn start(&mut self, state: &SimState) -> Result<(), String>;
+    fn start(&mut self, state: &SimState) -> Result<(), PlantError>;
 
     /// The states after each of the `substeps` physics steps of length `physics_step` [s]
     /// under the zero-order-hold command `cmd`, starting from the plant's current state.
@@ -16,7 +22,7 @@ pub trait Plant {
         cmd: &Command,
         physics_step: f64,
         substeps: usize,
-    ) -> Result<Vec<SimState>, String>;
+    ) -> Result<Vec<SimState>, PlantError>;
 }
 
 /// The numbers of a [`SimState`] in the plant protocol's order: `t`, `r_t`, `v_t`,
@@ -83,9 +89,10 @@ impl Simulator {
         }
         let (h, n) = (self.p.physics_step, self.p.substeps);
         let t0 = self.state.t;
-        let states = plant
-            .propagate(cmd, h, n)
-            .map_err(|e| SimError::Plant { t: t0, message: e })?;
+        let states = plant.propagate(cmd, h, n).map_err(|e| SimError::Plant {
+            t: t0,
+            message: e.0,
+        })?;
         if states.len() != n {
             return Err(SimError::Plant {
                 t: t0,

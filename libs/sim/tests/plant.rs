@@ -3,7 +3,7 @@
 
 use sc_multibody::Robot;
 use sc_scenario::Scenario;
-use sc_sim::{BarrierState, Command, Plant, SimError, SimState, Simulator};
+use sc_sim::{BarrierState, Command, Plant, PlantError, SimError, SimState, Simulator};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -18,14 +18,14 @@ fn setup() -> (Scenario, Arc<Robot>) {
 struct OwnRk4(Simulator);
 
 impl Plant for OwnRk4 {
-    fn start(&mut self, state: &SimState) -> Result<(), String> {
+    fn start(&mut self, state: &SimState) -> Result<(), PlantError> {
         self.0.set_state(*state);
         Ok(())
     }
-    fn propagate(&mut self, cmd: &Command, _h: f64, n: usize) -> Result<Vec<SimState>, String> {
+    fn propagate(&mut self, cmd: &Command, _h: f64, n: usize) -> Result<Vec<SimState>, PlantError> {
         (0..n)
             .map(|_| {
-                self.0.step(cmd).map_err(|e| e.to_string())?;
+                self.0.step(cmd).map_err(|e| PlantError(e.to_string()))?;
                 Ok(*self.0.state())
             })
             .collect()
@@ -39,10 +39,10 @@ type Spoil = fn(&mut Vec<SimState>);
 struct Faulty(OwnRk4, Spoil);
 
 impl Plant for Faulty {
-    fn start(&mut self, s: &SimState) -> Result<(), String> {
+    fn start(&mut self, s: &SimState) -> Result<(), PlantError> {
         self.0.start(s)
     }
-    fn propagate(&mut self, c: &Command, h: f64, n: usize) -> Result<Vec<SimState>, String> {
+    fn propagate(&mut self, c: &Command, h: f64, n: usize) -> Result<Vec<SimState>, PlantError> {
         let mut v = self.0.propagate(c, h, n)?;
         (self.1)(&mut v);
         Ok(v)

@@ -1,6 +1,6 @@
 //! The nominal attitude controller process of the partition.
-use sc_partition::roles::{Subsystem, nominal};
+use sc_flight::roles::{Subsystem, nominal};
 
 fn main() -> std::process::ExitCode {
-    sc_partition::main_of(|| nominal(Subsystem::Attitude))
+    sc_flight::main_of(|| nominal(Subsystem::Attitude))
 }

@@ -1,6 +1,6 @@
 //! The robotic safety filter process of the partition.
-use sc_partition::roles::{Subsystem, filter};
+use sc_flight::roles::{Subsystem, filter};
 
 fn main() -> std::process::ExitCode {
-    sc_partition::main_of(|| filter(Subsystem::Robotic))
+    sc_flight::main_of(|| filter(Subsystem::Robotic))
 }

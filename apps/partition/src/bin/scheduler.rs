@@ -1,4 +1,4 @@
 //! The scheduler (rate-group driver) of the partition.
 fn main() -> std::process::ExitCode {
-    sc_partition::main_of(sc_partition::roles::scheduler)
+    sc_flight::main_of(sc_flight::roles::scheduler)
 }

@@ -1,4 +1,4 @@
 //! The simulator process of the partition.
 fn main() -> std::process::ExitCode {
-    sc_partition::main_of(sc_partition::roles::simulator)
+    sc_flight::main_of(sc_flight::roles::simulator)
 }

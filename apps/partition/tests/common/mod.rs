@@ -2,7 +2,7 @@
 //! a shortened scenario, finding and killing one process of a run.
 #![allow(dead_code)]
 
-use sc_partition::{LaunchOptions, LaunchReport};
+use sc_ground::{LaunchOptions, LaunchReport};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -10,11 +10,41 @@ pub fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
+/// The partition's executables, built with this test's profile into its target
+/// directory: the flight ones are this package's (`CARGO_BIN_EXE_*`), the ground ones
+/// (`sc-recorder`, `sc-hop-cost`) the safe-capture package's, which cargo builds here
+/// once per test binary (a no-op when they are up to date, e.g. under
+/// `cargo test --workspace`).
 pub fn bin_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_BIN_EXE_sc-scheduler"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
+    static DIR: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    DIR.get_or_init(|| {
+        let dir = PathBuf::from(env!("CARGO_BIN_EXE_sc-scheduler"))
+            .parent()
+            .unwrap()
+            .to_path_buf();
+        let profile_dir = dir.file_name().unwrap().to_str().unwrap().to_string();
+        let mut c = std::process::Command::new(env!("CARGO"));
+        c.current_dir(repo())
+            .args(["build", "--quiet", "--bins", "-p", "sc-partition-apps"])
+            .args(["-p", "safe-capture", "--target-dir"])
+            .arg(dir.parent().unwrap());
+        match profile_dir.as_str() {
+            "debug" => c.args(["--profile", "test"]),
+            "release" => c.arg("--release"),
+            p => c.args(["--profile", p]),
+        };
+        let o = c.output().unwrap();
+        assert!(
+            o.status.success(),
+            "building the partition's executables failed: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        for b in ["sc-scheduler", "sc-recorder", "sc-hop-cost"] {
+            assert!(dir.join(b).is_file(), "{b} missing in {}", dir.display());
+        }
+        dir
+    })
+    .clone()
 }
 
 /// A fresh temp directory.
@@ -184,7 +214,7 @@ pub fn summary(out: &Path) -> serde_json::Value {
 ///   deadlines are 20 times the real-time ones (0.8 s and more after the state), so
 ///   a wake-up there means a lost wake-up, not a slow machine;
 /// - no process saw the stop only when its 1 s wait ran out (it logs
-///   [`sc_partition::process::LOST_STOP_WAKEUP`] then).
+///   [`sc_flight::process::LOST_STOP_WAKEUP`] then).
 pub fn assert_no_lost_wakeups(out: &Path) {
     let s: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("scheduler.json")).unwrap())
@@ -195,7 +225,7 @@ pub fn assert_no_lost_wakeups(out: &Path) {
         let path = e.unwrap().path();
         let log = std::fs::read_to_string(&path).unwrap();
         assert!(
-            !log.contains(sc_partition::process::LOST_STOP_WAKEUP),
+            !log.contains(sc_flight::process::LOST_STOP_WAKEUP),
             "{}: {log}",
             path.display()
         );

@@ -5,26 +5,8 @@ use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// The three subsystems, in causal order.
-pub const SUBSYSTEMS: [&str; 3] = ["translational", "attitude", "robotic"];
-
-/// Every role of the partition, in start order.
-pub const ROLES: [&str; 9] = [
-    "scheduler",
-    "simulator",
-    "nominal_translational",
-    "nominal_attitude",
-    "nominal_robotic",
-    "safety_translational",
-    "safety_attitude",
-    "safety_robotic",
-    "recorder",
-];
-
-/// Role id (sc_icd::role) of a role name.
-pub fn role_id(name: &str) -> Option<u32> {
-    ROLES.iter().position(|r| *r == name).map(|i| i as u32)
-}
+use sc_core::{PerSubsystem, Subsystem, SubsystemSet};
+use sc_icd::{ROLES, Role};
 
 /// Clock mode of the scheduler.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
@@ -47,12 +29,15 @@ pub struct RateGroup {
     pub members: Vec<String>,
 }
 
-/// Executable of a role.
-#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
+/// Executable and placement of a role (`[roles.<name>]`; every key optional: a role
+/// the config does not name runs the role table's executable, `sc_icd::ROLES`).
+#[derive(Debug, Clone, Default, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct RoleExec {
     /// Program: a bare name is looked up next to the launcher's executable (or in
     /// `SC_PARTITION_BIN_DIR`); a path is relative to the config file's directory.
+    /// Absent: the role table's executable (`sc-<role>`).
+    #[serde(default)]
     pub exec: String,
     /// Extra arguments (before the standard `--config FILE --out DIR`).
     #[serde(default)]
@@ -132,6 +117,9 @@ pub struct PartitionConfig {
     pub rate_groups: Vec<RateGroup>,
     pub deadlines: Deadlines,
     pub lock_step: LockStep,
+    /// Per role (key: the role's name in `sc_icd::ROLES`); after loading every role has
+    /// an entry, with the role table's executable where the file names none.
+    #[serde(default)]
     pub roles: BTreeMap<String, RoleExec>,
     /// The simulator role's options (absent: our own simulator propagates).
     #[serde(default)]
@@ -149,7 +137,7 @@ pub struct SimulatorOptions {
     /// the simulator role with `--scenario FILE` appended; it propagates the true state
     /// instead of our RK4, while the role keeps the handshake, the admission of safe
     /// commands, the barrier monitor and everything it publishes
-    /// (`sc_partition::plant_process`, docs/SIMULATOR.md). Empty: our own simulator.
+    /// (`sc_sim::plant_process`, docs/SIMULATOR.md). Empty: our own simulator.
     #[serde(default)]
     pub plant: Vec<String>,
 }
@@ -168,22 +156,63 @@ fn err<T>(msg: impl Into<String>) -> Result<T, ConfigError> {
 pub struct Schedule {
     /// Base (fastest) period: the simulator's step [s].
     pub base_period_s: f64,
-    /// Period of each subsystem [s], order [`SUBSYSTEMS`].
-    pub period_s: [f64; 3],
-    /// Period of each subsystem in base ticks.
-    pub ratio: [u64; 3],
+    /// Period of each subsystem's rate group [s].
+    pub period_s: PerSubsystem<f64>,
+    /// Period of each subsystem's rate group in base ticks.
+    pub ratio: PerSubsystem<u64>,
 }
 
 impl Schedule {
-    /// `sc_icd::due` bits of the subsystems due at tick `k`.
+    /// The subsystems due at tick `k` (their rate group runs).
+    pub fn due(&self, k: u64) -> SubsystemSet {
+        Subsystem::ALL
+            .into_iter()
+            .filter(|s| k.is_multiple_of(self.ratio[*s]))
+            .collect()
+    }
+
+    /// [`Self::due`] as the ICD's `due_mask` bits.
     pub fn due_mask(&self, k: u64) -> u32 {
-        let mut m = 0;
-        for (i, r) in self.ratio.iter().enumerate() {
-            if k.is_multiple_of(*r) {
-                m |= 1 << i;
-            }
+        self.due(k).bits()
+    }
+}
+
+impl Deadlines {
+    /// The stage deadline of the filter of `s` [ms].
+    pub fn filter_ms(&self, s: Subsystem) -> f64 {
+        match s {
+            Subsystem::Translational => self.safety_translational_ms,
+            Subsystem::Attitude => self.safety_attitude_ms,
+            Subsystem::Robotic => self.safety_robotic_ms,
         }
-        m
+    }
+
+    /// Every stage deadline with its key, in causal order, the simulator's last.
+    fn keyed(&self) -> [(&'static str, f64); 4] {
+        [
+            (
+                "deadlines.safety_translational_ms",
+                self.safety_translational_ms,
+            ),
+            ("deadlines.safety_attitude_ms", self.safety_attitude_ms),
+            ("deadlines.safety_robotic_ms", self.safety_robotic_ms),
+            ("deadlines.simulator_ms", self.simulator_ms),
+        ]
+    }
+
+    /// Positive and in causal order.
+    fn validate(&self) -> Result<(), ConfigError> {
+        let ds = self.keyed();
+        if let Some((k, v)) = ds.iter().find(|(_, v)| !(v.is_finite() && *v > 0.0)) {
+            return err(format!("{k} = {v}: must be > 0"));
+        }
+        match ds.windows(2).find(|w| w[1].1 < w[0].1) {
+            Some(w) => err(format!(
+                "{} = {} is earlier than {} = {}: deadlines must follow the causal order",
+                w[1].0, w[1].1, w[0].0, w[0].1
+            )),
+            None => Ok(()),
+        }
     }
 }
 
@@ -210,6 +239,7 @@ impl PartitionConfig {
         })?;
         c.base_dir = base_dir.to_path_buf();
         c.validate()?;
+        c.fill_role_defaults();
         Ok(c)
     }
 
@@ -244,6 +274,15 @@ impl PartitionConfig {
 
     /// Checks the schedule and roles.
     pub fn validate(&self) -> Result<(), ConfigError> {
+        self.validate_timing()?;
+        self.validate_real_time()?;
+        self.deadlines.validate()?;
+        self.validate_roles()?;
+        self.schedule().map(|_| ())
+    }
+
+    /// The handshake timeout and the lock-step options.
+    fn validate_timing(&self) -> Result<(), ConfigError> {
         if !(self.handshake_timeout_s.is_finite() && self.handshake_timeout_s > 0.0) {
             return err(format!(
                 "handshake_timeout_s = {}: must be > 0",
@@ -262,21 +301,16 @@ impl PartitionConfig {
                 self.lock_step.recorder_window_ticks
             ));
         }
+        Ok(())
+    }
+
+    /// Priorities, PM QoS and the pre-tick warm-up of real-time mode.
+    fn validate_real_time(&self) -> Result<(), ConfigError> {
         if self.real_time_priority > 99 {
             return err(format!(
                 "real_time_priority = {}: must be 0 (off) or 1..=99",
                 self.real_time_priority
             ));
-        }
-        for (r, e) in &self.roles {
-            if let Some(p) = e.priority
-                && !(1..=99).contains(&p)
-            {
-                return err(format!("roles.{r}.priority = {p}: must be 1..=99"));
-            }
-            if let Some(c) = e.cpus.iter().find(|c| **c >= 1024) {
-                return err(format!("roles.{r}.cpus: CPU {c} is out of range (0..1024)"));
-            }
         }
         if let Some(us) = self.cpu_wakeup_latency_us
             && us > 1_000_000
@@ -299,49 +333,39 @@ impl PartitionConfig {
                 base * 1e6 / 2.0
             ));
         }
-        let d = &self.deadlines;
-        let ds = [
-            (
-                "deadlines.safety_translational_ms",
-                d.safety_translational_ms,
-            ),
-            ("deadlines.safety_attitude_ms", d.safety_attitude_ms),
-            ("deadlines.safety_robotic_ms", d.safety_robotic_ms),
-            ("deadlines.simulator_ms", d.simulator_ms),
-        ];
-        for (k, v) in ds {
-            if !(v.is_finite() && v > 0.0) {
-                return err(format!("{k} = {v}: must be > 0"));
-            }
-        }
-        for w in ds.windows(2) {
-            if w[1].1 < w[0].1 {
-                return err(format!(
-                    "{} = {} is earlier than {} = {}: deadlines must follow the causal order",
-                    w[1].0, w[1].1, w[0].0, w[0].1
-                ));
-            }
-        }
-        for r in ROLES {
-            match self.roles.get(r) {
-                None => {
-                    return err(format!(
-                        "roles.{r}: missing (every role needs an executable)"
-                    ));
-                }
-                Some(e) if e.exec.trim().is_empty() => {
-                    return err(format!("roles.{r}.exec: empty"));
-                }
-                _ => {}
-            }
-        }
-        if let Some(k) = self.roles.keys().find(|k| !ROLES.contains(&k.as_str())) {
+        Ok(())
+    }
+
+    /// Every `[roles.<name>]` names a role of the table, with a sane placement.
+    fn validate_roles(&self) -> Result<(), ConfigError> {
+        if let Some(k) = self.roles.keys().find(|k| Role::named(k).is_none()) {
+            let known: Vec<&str> = sc_icd::roles::names().collect();
             return err(format!(
                 "roles.{k}: unknown role (known: {})",
-                ROLES.join(", ")
+                known.join(", ")
             ));
         }
-        self.schedule().map(|_| ())
+        for (r, e) in &self.roles {
+            if let Some(p) = e.priority
+                && !(1..=99).contains(&p)
+            {
+                return err(format!("roles.{r}.priority = {p}: must be 1..=99"));
+            }
+            if let Some(c) = e.cpus.iter().find(|c| **c >= 1024) {
+                return err(format!("roles.{r}.cpus: CPU {c} is out of range (0..1024)"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Every role of the table gets an entry; an empty `exec` is the table's executable.
+    fn fill_role_defaults(&mut self) {
+        for r in &ROLES {
+            let e = self.roles.entry(r.name.to_string()).or_default();
+            if e.exec.trim().is_empty() {
+                e.exec = r.exec.to_string();
+            }
+        }
     }
 
     /// The schedule of the rate groups (validated).
@@ -349,71 +373,28 @@ impl PartitionConfig {
         if self.rate_groups.is_empty() {
             return err("rate_groups: empty (at least one group with all three subsystems)");
         }
-        let mut period = [f64::NAN; 3];
+        let mut period = PerSubsystem([None; 3]);
         for g in &self.rate_groups {
-            if !(g.period_s.is_finite() && g.period_s > 0.0) {
-                return err(format!(
-                    "rate group `{}`: period_s = {} must be > 0",
-                    g.name, g.period_s
-                ));
-            }
-            let mut last = None;
-            for m in &g.members {
-                let Some(i) = SUBSYSTEMS.iter().position(|s| s == m) else {
-                    return err(format!(
-                        "rate group `{}`: unknown member `{m}` (known: translational, attitude, robotic)",
-                        g.name
-                    ));
-                };
-                if !period[i].is_nan() {
-                    return err(format!(
-                        "rate group `{}`: `{m}` is already in another group",
-                        g.name
-                    ));
-                }
-                if let Some(l) = last
-                    && i < l
-                {
-                    return err(format!(
-                        "rate group `{}`: members must be in causal order translational → attitude → robotic, `{m}` comes after `{}`",
-                        g.name, SUBSYSTEMS[l]
-                    ));
-                }
-                last = Some(i);
-                period[i] = g.period_s;
-            }
+            g.assign(&mut period)?;
         }
-        for (i, p) in period.iter().enumerate() {
-            if p.is_nan() {
-                return err(format!(
-                    "rate_groups: subsystem `{}` is in no group",
-                    SUBSYSTEMS[i]
-                ));
-            }
-        }
-        for i in 1..3 {
-            if period[i] > period[i - 1] * (1.0 + 1e-9) {
-                return err(format!(
-                    "rate groups: the {} filter (period {} s) is slower than its upstream {} filter (period {} s); a downstream filter must run at least as fast as its upstream one",
-                    SUBSYSTEMS[i],
-                    period[i],
-                    SUBSYSTEMS[i - 1],
-                    period[i - 1]
-                ));
-            }
-        }
-        let base = period.iter().cloned().fold(f64::INFINITY, f64::min);
-        let mut ratio = [1u64; 3];
-        for i in 0..3 {
-            let r = period[i] / base;
+        let period = PerSubsystem::from_fn(|s| period[s]);
+        let period = match Subsystem::ALL.into_iter().find(|s| period[*s].is_none()) {
+            Some(s) => return err(format!("rate_groups: subsystem `{s}` is in no group")),
+            None => period.map(|p| p.unwrap_or(f64::NAN)),
+        };
+        downstream_not_slower(&period)?;
+        let base = period.0.iter().cloned().fold(f64::INFINITY, f64::min);
+        let mut ratio = PerSubsystem([1u64; 3]);
+        for s in Subsystem::ALL {
+            let r = period[s] / base;
             let ri = r.round();
             if (r - ri).abs() > 1e-6 || ri < 1.0 {
                 return err(format!(
-                    "rate groups: period {} s of `{}` is not an integer multiple of the base period {} s",
-                    period[i], SUBSYSTEMS[i], base
+                    "rate groups: period {} s of `{s}` is not an integer multiple of the base period {} s",
+                    period[s], base
                 ));
             }
-            ratio[i] = ri as u64;
+            ratio[s] = ri as u64;
         }
         Ok(Schedule {
             base_period_s: base,
@@ -421,6 +402,57 @@ impl PartitionConfig {
             ratio,
         })
     }
+}
+
+impl RateGroup {
+    /// Gives this group's members its period, checking each is a known subsystem, in no
+    /// other group and in causal order.
+    fn assign(&self, period: &mut PerSubsystem<Option<f64>>) -> Result<(), ConfigError> {
+        if !(self.period_s.is_finite() && self.period_s > 0.0) {
+            return err(format!(
+                "rate group `{}`: period_s = {} must be > 0",
+                self.name, self.period_s
+            ));
+        }
+        let mut last: Option<Subsystem> = None;
+        for m in &self.members {
+            let Some(s) = Subsystem::parse(m) else {
+                return err(format!(
+                    "rate group `{}`: unknown member `{m}` (known: translational, attitude, robotic)",
+                    self.name
+                ));
+            };
+            if period[s].is_some() {
+                return err(format!(
+                    "rate group `{}`: `{m}` is already in another group",
+                    self.name
+                ));
+            }
+            if let Some(l) = last.filter(|l| s < *l) {
+                return err(format!(
+                    "rate group `{}`: members must be in causal order translational → attitude → robotic, `{m}` comes after `{l}`",
+                    self.name
+                ));
+            }
+            last = Some(s);
+            period[s] = Some(self.period_s);
+        }
+        Ok(())
+    }
+}
+
+/// A downstream filter runs at least as fast as its upstream one (paper Sec. "Method").
+fn downstream_not_slower(period: &PerSubsystem<f64>) -> Result<(), ConfigError> {
+    for s in Subsystem::ALL {
+        let Some(u) = s.upstream() else { continue };
+        if period[s] > period[u] * (1.0 + 1e-9) {
+            return err(format!(
+                "rate groups: the {s} filter (period {} s) is slower than its upstream {u} filter (period {} s); a downstream filter must run at least as fast as its upstream one",
+                period[s], period[u]
+            ));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -433,7 +465,7 @@ mod tests {
         );
         s += groups;
         s += "\n[deadlines]\nsafety_translational_ms = 40\nsafety_attitude_ms = 60\nsafety_robotic_ms = 80\nsimulator_ms = 90\n[lock_step]\ndeadline_scale = 20\nrecorder_window_ticks = 8\n";
-        for r in ROLES {
+        for r in sc_icd::roles::names() {
             s += &format!("[roles.{r}]\nexec = \"sc-{r}\"\n");
         }
         s
@@ -447,7 +479,7 @@ mod tests {
         )
         .unwrap();
         let s = c.schedule().unwrap();
-        assert_eq!(s.ratio, [1, 1, 1]);
+        assert_eq!(s.ratio.0, [1, 1, 1]);
         assert_eq!(s.due_mask(7), 7);
     }
 
@@ -459,7 +491,7 @@ mod tests {
         )
         .unwrap();
         let s = c.schedule().unwrap();
-        assert_eq!(s.ratio, [10, 5, 1]);
+        assert_eq!(s.ratio.0, [10, 5, 1]);
         assert_eq!(s.due_mask(0), 7);
         assert_eq!(s.due_mask(5), 6);
         assert_eq!(s.due_mask(3), 4);

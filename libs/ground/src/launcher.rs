@@ -2,9 +2,10 @@
 //! supervises them, tears everything down on success, Ctrl-C or failure, and
 //! leaves nothing in /dev/shm.
 
-use crate::config::{ClockMode, PartitionConfig, ROLES};
 use anyhow::Context;
 use sc_bus::RunScope;
+use sc_flight::config::{ClockMode, PartitionConfig};
+use sc_icd::{ROLES, Role};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -179,7 +180,7 @@ fn reap_bounded(run: &RunScope) -> Option<sc_bus::Result<sc_bus::NodeReport>> {
 /// Written by the scheduler into the output directory once every process joined the
 /// start-up handshake. A process that fails by itself before then can never join: the
 /// launcher tears the run down at once instead of waiting for the handshake timeout.
-pub const ALL_READY: &str = "all_ready";
+pub use sc_flight::ALL_READY;
 
 /// What a partition run writes into its output directory (besides `logs/`).
 pub const RUN_OUTPUTS: [&str; 18] = [
@@ -312,8 +313,9 @@ pub fn configured(opts: &LaunchOptions) -> anyhow::Result<PartitionConfig> {
         cfg.lock_step.deadline_scale = d;
     }
     for (role, exec, args) in &opts.role_override {
-        if !ROLES.contains(&role.as_str()) {
-            anyhow::bail!("unknown role `{role}` (known: {})", ROLES.join(", "));
+        if Role::named(role).is_none() {
+            let known: Vec<&str> = sc_icd::roles::names().collect();
+            anyhow::bail!("unknown role `{role}` (known: {})", known.join(", "));
         }
         let e = cfg.roles.get_mut(role).context("role")?;
         e.exec = exec.clone();
@@ -386,7 +388,7 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
     let _ = reap_bounded(&run);
     let mut procs: Vec<Proc> = Vec::new();
     let mut spawn_err = None;
-    for role in ROLES {
+    for role in ROLES.iter().map(|r| r.name) {
         let e = &cfg.roles[role];
         // a log that cannot be opened stops the start like a process that cannot start:
         // the processes already running are torn down below, not left behind
@@ -407,8 +409,8 @@ pub fn launch(opts: &LaunchOptions) -> anyhow::Result<LaunchReport> {
             cmd.arg("--config").arg(&eff).arg("--out").arg(&out);
         }
         cmd.env(sc_bus::RUN_ID_ENV, run.run_id())
-            .env(crate::process::CONFIG_ENV, &eff)
-            .env(crate::process::OUT_ENV, &out)
+            .env(sc_flight::process::CONFIG_ENV, &eff)
+            .env(sc_flight::process::OUT_ENV, &out)
             .stdin(Stdio::null())
             .stdout(log.0)
             .stderr(log.1);

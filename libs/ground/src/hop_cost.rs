@@ -7,8 +7,8 @@
 //! pre-tick warm-up). The binary is `sc-hop-cost` (docs/PARTITION.md).
 
 use crate::pm_qos::CpuWakeupLatency;
-use crate::process::{set_cpus, set_fifo};
 use sc_bus::{Coordinator, Participant, Publisher, RunScope, ServiceSettings, Subscriber, Waiter};
+use sc_flight::process::{set_cpus, set_fifo};
 use sc_icd::{Tick, services};
 use std::time::{Duration, Instant};
 

@@ -4,5 +4,5 @@ fn main() -> std::process::ExitCode {
     sc_mission::build::register(env!("CARGO_PKG_VERSION"), env!("SC_GIT_COMMIT"));
     // it recorded everything: exit 0 also when the mission did not capture (the
     // mission's verdict is in summary.json, which the launcher reads)
-    sc_partition::main_of(|| sc_partition::recorder::recorder().map(|_| 0))
+    sc_flight::main_of(|| sc_ground::recorder::recorder().map(|_| 0))
 }

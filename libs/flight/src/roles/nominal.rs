@@ -15,7 +15,7 @@ use super::*;
 
 /// One nominal controller process.
 pub fn nominal(subsystem: Subsystem) -> anyhow::Result<i32> {
-    let which = subsystem.index();
+    let which = subsystem.position();
     let role = [
         "nominal_translational",
         "nominal_attitude",
@@ -49,7 +49,7 @@ pub fn nominal(subsystem: Subsystem) -> anyhow::Result<i32> {
     let prepare = prepare_listener(&p)?;
     let _a1 = prepare.as_ref().map(|l| waiter.attach(l)).transpose()?;
     let mut last_state: Option<SimState> = None;
-    let scenario = p.scenario_with_period(p.schedule.period_s[which]);
+    let scenario = p.scenario_with_period(p.schedule.period_s[subsystem]);
     let ctl = NominalControllers::new(&scenario, (*p.setup.robot).clone())?;
     let subsystems = [
         Subsystems::TRANSLATIONAL,

@@ -20,7 +20,7 @@ use super::*;
 
 /// One safety filter process.
 pub fn filter(subsystem: Subsystem) -> anyhow::Result<i32> {
-    let which = subsystem.index();
+    let which = subsystem.position();
     let role = ["safety_translational", "safety_attitude", "safety_robotic"][which];
     let p = Proc::start(role)?;
     let q = qos();

@@ -133,7 +133,9 @@ impl Proc {
 
     /// Announces readiness and waits for the scheduler's `go`.
     pub fn handshake(&self) -> anyhow::Result<()> {
-        let id = crate::config::role_id(self.role).context("unknown role")?;
+        let id = sc_icd::Role::named(self.role)
+            .map(|r| r.id())
+            .context("unknown role")?;
         let p = sc_bus::Participant::new(&self.node, sc_icd::services::HANDSHAKE, id)?;
         p.announce_and_wait(Duration::from_secs_f64(self.cfg.handshake_timeout_s + 5.0))?;
         Ok(())

@@ -1,12 +1,14 @@
-//! The process partition: each module of the mission (simulator, three nominal
-//! controllers, three safety filters, scheduler, recorder) in its own process,
+//! The flight side of the process partition: each module of the mission (simulator,
+//! three nominal controllers, three safety filters, scheduler) in its own process,
 //! talking only through iceoryx2 zero-copy messages (sc-bus, sc-icd).
 //!
 //! * [`config`]: `config/partition.toml` — rate groups, deadlines, clock, roles.
-//! * [`roles`] / [`recorder`]: the loop of each process (thin binaries call them).
-//! * [`launcher`]: starts every process from the config, supervises, tears down.
-//! * [`pm_qos`]: the CPU wake-up latency request of real-time runs.
-//! * [`latency`]: the latency report of `safe-capture bench latency`.
+//! * [`roles`]: the loop of each process (thin binaries call them).
+//! * [`admission`], [`fallback`], [`convert`]: what the simulator applies, the backups,
+//!   messages ↔ the libraries' types.
+//!
+//! Nothing here plots, runs campaigns, writes MCAP or draws progress bars: the ground
+//! tools (launcher, preflight, recorder, latency bench) are `sc-ground`.
 //!
 //! In lock-step mode with one rate group the partition calls exactly the stage
 //! functions of `sc_mission::stages`, so its telemetry.csv is bit-for-bit that of
@@ -16,20 +18,15 @@ pub mod admission;
 pub mod config;
 pub mod convert;
 pub mod fallback;
-pub mod hop_cost;
-pub mod latency;
-pub mod launcher;
-pub mod mcap_out;
-pub mod plant_process;
-pub mod pm_qos;
-pub mod preflight;
 pub mod process;
-pub mod recorder;
 pub mod roles;
-pub mod steal;
 
 pub use config::{ClockMode, PartitionConfig, Schedule};
-pub use launcher::{LaunchOptions, LaunchReport, launch};
+
+/// Written by the scheduler into the output directory once every process joined the
+/// start-up handshake: from then on a process that dies is a degraded mode, not a failed
+/// start (the launcher tears a run down at once when a process fails before it).
+pub const ALL_READY: &str = "all_ready";
 
 /// Runs a role's loop and turns the result into the process exit code
 /// (errors are printed as one line).

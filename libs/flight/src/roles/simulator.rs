@@ -65,8 +65,7 @@ pub fn simulator() -> anyhow::Result<i32> {
             let mut args = args.to_vec();
             args.push("--scenario".into());
             args.push(p.cfg.scenario_path().display().to_string());
-            let mut child =
-                crate::plant_process::ProcessPlant::spawn(std::path::Path::new(program), &args)?;
+            let mut child = sc_sim::ProcessPlant::spawn(std::path::Path::new(program), &args)?;
             sc_sim::Plant::start(&mut child, sim.state())
                 .map_err(|e| anyhow::anyhow!("simulator: {e}"))?;
             eprintln!(

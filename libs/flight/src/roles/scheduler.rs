@@ -56,8 +56,8 @@ pub fn scheduler() -> anyhow::Result<i32> {
         p.deadline(d.safety_attitude_ms),
         p.deadline(d.safety_robotic_ms),
     ];
-    let peers: Vec<&str> = crate::config::ROLES[1..].to_vec();
-    let ids: Vec<u32> = (1..crate::config::ROLES.len() as u32).collect();
+    let peers: Vec<&str> = sc_icd::ROLES[1..].iter().map(|r| r.name).collect();
+    let ids: Vec<u32> = sc_icd::ROLES[1..].iter().map(|r| r.id()).collect();
     let coord = sc_bus::Coordinator::new(&p.node, services::HANDSHAKE, &ids)?;
     coord
         .wait_all(Duration::from_secs_f64(p.cfg.handshake_timeout_s))
@@ -66,12 +66,7 @@ pub fn scheduler() -> anyhow::Result<i32> {
             sc_bus::BusError::HandshakeTimeout { timeout, missing } => {
                 let names: Vec<&str> = missing
                     .iter()
-                    .map(|&id| {
-                        crate::config::ROLES
-                            .get(id as usize)
-                            .copied()
-                            .unwrap_or("?")
-                    })
+                    .map(|&id| sc_icd::Role::with_id(id).map_or("?", |r| r.name))
                     .collect();
                 anyhow::anyhow!(
                     "handshake timed out after {timeout:?}: never joined: {} (see their logs)",
@@ -82,7 +77,7 @@ pub fn scheduler() -> anyhow::Result<i32> {
         })?;
     eprintln!("scheduler: all {} processes ready", ids.len());
     // from now on a process that dies is a degraded mode, not a failed start
-    let ready = p.out.join(crate::launcher::ALL_READY);
+    let ready = p.out.join(crate::ALL_READY);
     std::fs::write(&ready, "").with_context(|| format!("cannot write {}", ready.display()))?;
     let mut monitor = PeerMonitor::new(&peers);
     monitor.poll(&p.run)?;
@@ -152,7 +147,7 @@ pub fn scheduler() -> anyhow::Result<i32> {
         let since = Instant::now();
         loop {
             for h in drain(&recorder_rx)? {
-                if h.role == sc_icd::role::RECORDER {
+                if h.role == sc_icd::Role::of(sc_icd::RoleKind::Recorder).id() {
                     recorder_taken = recorder_taken.max(h.last_tick + 1);
                 }
             }

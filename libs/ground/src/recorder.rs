@@ -2,12 +2,12 @@
 //! writes the same telemetry.csv / timing.csv / summary.json as `safe-capture run`,
 //! plus latency.csv (the stamps of every hop) and recorder.json (counts).
 
-use crate::convert;
-use crate::fallback;
-use crate::process::{Proc, partner_qos, qos, wait};
 use anyhow::Context;
 use sc_bus::{Subscriber, Waiter};
 use sc_cbf::{AttitudeOutput, RoboticOutput, SafetyLayer, TranslationalOutput};
+use sc_flight::convert;
+use sc_flight::fallback;
+use sc_flight::process::{Proc, partner_qos, qos, wait};
 use sc_icd::*;
 use sc_mission::{MissionEnd, StepRecord, TelemetryWriter, summarize};
 use std::collections::BTreeMap;
@@ -263,10 +263,10 @@ pub fn recorder() -> anyhow::Result<i32> {
             )?;
             let set = pending.remove(&r.tick).unwrap_or_default();
             // this step is taken care of (written below, or skipped and reported)
-            crate::process::send(
+            sc_flight::process::send(
                 &health_tx,
                 &Health {
-                    role: role::RECORDER,
+                    role: Role::of(RoleKind::Recorder).id(),
                     pid: std::process::id(),
                     state: health_state::RUNNING,
                     last_fault_flags: 0,

@@ -22,21 +22,7 @@ use sc_bus::Subscriber;
 use sc_icd::{Tick, monotonic_ns, tick_command};
 use std::time::{Duration, Instant};
 
-/// The three subsystems, in causal order: which nominal controller or filter a
-/// process is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Subsystem {
-    Translational,
-    Attitude,
-    Robotic,
-}
-
-impl Subsystem {
-    /// 0, 1, 2 in causal order.
-    pub fn index(self) -> usize {
-        self as usize
-    }
-}
+pub use sc_core::Subsystem;
 
 pub(crate) fn now() -> u64 {
     monotonic_ns()

@@ -5,7 +5,7 @@
 use crate::launcher::{LaunchOptions, launch};
 use anyhow::Context;
 use hdrhistogram::Histogram;
-use sc_montecarlo::report::PAPER_TOTAL_MAX_MS;
+use sc_plots::paper::PAPER_TOTAL_MAX_MS;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::io::Write;

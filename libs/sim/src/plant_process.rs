@@ -4,14 +4,14 @@
 //!
 //! Protocol, one line per message over the child's stdin/stdout, numbers as shortest
 //! round-trip decimals (Rust `{:?}`, Python `repr`), so nothing is lost in transit:
-//! * `init <41 numbers>` ([`sc_sim::SimState::to_array`]) → `ready`
+//! * `init <41 numbers>` ([`SimState::to_array`]) → `ready`
 //! * `step <physics step s> <substeps> <13 numbers: f_B, τ_B, τ_M>` → `substeps` lines
 //!   `state <41 numbers>`
 //! * `stop` → the child exits.
 //!
 //! Any other reply, or `error <message>`, ends the run as a simulator failure.
 
-use sc_sim::{Command, Plant, SIM_STATE_LEN, SimState};
+use crate::{Command, Plant, PlantError, SIM_STATE_LEN, SimState};
 use std::io::{BufRead, BufReader, BufWriter, Write};
 use std::process::{Child, ChildStdin, ChildStdout, Command as Process, Stdio};
 
@@ -31,7 +31,7 @@ fn numbers(xs: &[f64]) -> String {
 
 impl ProcessPlant {
     /// Starts `program args…`; its stderr goes to ours.
-    pub fn spawn(program: &std::path::Path, args: &[String]) -> anyhow::Result<Self> {
+    pub fn spawn(program: &std::path::Path, args: &[String]) -> Result<Self, PlantError> {
         let what = format!("{} {}", program.display(), args.join(" "));
         let mut child = Process::new(program)
             .args(args)
@@ -39,7 +39,7 @@ impl ProcessPlant {
             .stdout(Stdio::piped())
             .stderr(Stdio::inherit())
             .spawn()
-            .map_err(|e| anyhow::anyhow!("cannot start the plant `{what}`: {e}"))?;
+            .map_err(|e| PlantError(format!("cannot start the plant `{what}`: {e}")))?;
         let stdin = BufWriter::new(child.stdin.take().expect("piped stdin"));
         let stdout = BufReader::new(child.stdout.take().expect("piped stdout"));
         Ok(Self {
@@ -50,34 +50,36 @@ impl ProcessPlant {
         })
     }
 
-    fn send(&mut self, line: &str) -> Result<(), String> {
+    fn send(&mut self, line: &str) -> Result<(), PlantError> {
         writeln!(self.stdin, "{line}")
             .and_then(|_| self.stdin.flush())
-            .map_err(|e| format!("plant `{}` gone: {e}", self.what))
+            .map_err(|e| PlantError(format!("plant `{}` gone: {e}", self.what)))
     }
 
-    fn receive(&mut self) -> Result<String, String> {
+    fn receive(&mut self) -> Result<String, PlantError> {
         let mut line = String::new();
         match self.stdout.read_line(&mut line) {
-            Ok(0) => Err(format!("plant `{}` exited", self.what)),
+            Ok(0) => Err(PlantError(format!("plant `{}` exited", self.what))),
             Ok(_) => {
                 let line = line.trim_end().to_string();
                 match line.strip_prefix("error ") {
-                    Some(e) => Err(format!("plant: {e}")),
+                    Some(e) => Err(PlantError(format!("plant: {e}"))),
                     None => Ok(line),
                 }
             }
-            Err(e) => Err(format!("plant `{}`: {e}", self.what)),
+            Err(e) => Err(PlantError(format!("plant `{}`: {e}", self.what))),
         }
     }
 }
 
 impl Plant for ProcessPlant {
-    fn start(&mut self, state: &SimState) -> Result<(), String> {
+    fn start(&mut self, state: &SimState) -> Result<(), PlantError> {
         self.send(&format!("init {}", numbers(&state.to_array())))?;
         match self.receive()?.as_str() {
             "ready" => Ok(()),
-            other => Err(format!("plant: expected `ready`, got `{other}`")),
+            other => Err(PlantError(format!(
+                "plant: expected `ready`, got `{other}`"
+            ))),
         }
     }
 
@@ -86,7 +88,7 @@ impl Plant for ProcessPlant {
         cmd: &Command,
         physics_step: f64,
         substeps: usize,
-    ) -> Result<Vec<SimState>, String> {
+    ) -> Result<Vec<SimState>, PlantError> {
         let u = cmd.as_vector();
         self.send(&format!(
             "step {physics_step:?} {substeps} {}",
@@ -95,18 +97,21 @@ impl Plant for ProcessPlant {
         (0..substeps)
             .map(|_| {
                 let line = self.receive()?;
-                let body = line
-                    .strip_prefix("state ")
-                    .ok_or_else(|| format!("plant: expected `state …`, got `{line}`"))?;
+                let body = line.strip_prefix("state ").ok_or_else(|| {
+                    PlantError(format!("plant: expected `state …`, got `{line}`"))
+                })?;
                 let v: Vec<f64> = body
                     .split_whitespace()
-                    .map(|x| x.parse::<f64>().map_err(|e| format!("plant: `{x}`: {e}")))
+                    .map(|x| {
+                        x.parse::<f64>()
+                            .map_err(|e| PlantError(format!("plant: `{x}`: {e}")))
+                    })
                     .collect::<Result<_, _>>()?;
                 let a: [f64; SIM_STATE_LEN] = v.try_into().map_err(|v: Vec<f64>| {
-                    format!(
+                    PlantError(format!(
                         "plant: {} numbers in a state, {SIM_STATE_LEN} expected",
                         v.len()
-                    )
+                    ))
                 })?;
                 Ok(SimState::from_array(&a))
             })

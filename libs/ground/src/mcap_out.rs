@@ -1749,7 +1749,7 @@ mod tests {
         let got = std::fs::read_to_string(&path).unwrap_or_default();
         assert!(
             got == text,
-            "{} is stale: SC_WRITE_FOXGLOVE_LAYOUT=1 cargo test -p sc-partition layout_file_is_current",
+            "{} is stale: SC_WRITE_FOXGLOVE_LAYOUT=1 cargo test -p sc-ground layout_file_is_current",
             path.display()
         );
         fn placed(node: &Value, out: &mut Vec<String>) {

@@ -7,8 +7,9 @@
 //! relative to the config's directory, a bare name next to the launcher or in
 //! `SC_PARTITION_BIN_DIR`, then `PATH`).
 
-use crate::config::{ConfigError, PartitionConfig, ROLES};
 use crate::launcher::{BIN_DIR_ENV, resolve_exec};
+use sc_flight::config::{ConfigError, PartitionConfig};
+use sc_icd::ROLES;
 use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
 
@@ -78,7 +79,7 @@ pub fn check_programs(
     bin_dir: &Option<PathBuf>,
 ) -> Result<usize, ConfigError> {
     let mut n = 0;
-    for role in ROLES {
+    for role in ROLES.iter().map(|r| r.name) {
         let Some(e) = cfg.roles.get(role) else {
             return err(format!(
                 "roles.{role}: missing (every role needs an executable)"
@@ -274,7 +275,7 @@ mod tests {
     fn roles_all(exec: &str) -> String {
         ROLES
             .iter()
-            .map(|r| format!("[roles.{r}]\nexec = \"{exec}\"\n"))
+            .map(|r| format!("[roles.{}]\nexec = \"{exec}\"\n", r.name))
             .collect()
     }
 
