@@ -36,19 +36,7 @@ pub fn monitor_state_between(b: &BarrierState) -> MonitorState {
 
 /// Input of the nominal controllers from an observation.
 pub fn nominal_input(o: &Observation) -> NominalInput {
-    NominalInput {
-        t: o.t,
-        q_hr: o.q_hr,
-        omega_h: o.omega_h,
-        r_r: o.r_r,
-        v_r: o.v_r,
-        q_rb: o.q_rb,
-        omega_b: o.omega_b,
-        q_rt: o.q_rt,
-        omega_t: o.omega_t,
-        theta: o.theta,
-        theta_dot: o.theta_dot,
-    }
+    NominalInput::from_observation(o)
 }
 
 /// Input of the translational filter (ξ_tr = 0: it runs first): the servicer's CoM.

@@ -35,6 +35,7 @@ pub mod translational;
 use attitude::{AttitudeController, AttitudeGains, AttitudeInput, AttitudeLaw, AttitudeTask};
 use attitude_mpc::{AttitudeMpc, AttitudeMpcParams};
 use robotic::{IkSolution, RoboticController, RoboticGains};
+use sc_core::{Observation, Subsystem, SubsystemSet};
 use sc_models::quat::{self, Quat};
 use sc_models::{Mat3, Vec3};
 use sc_multibody::{Robot, Vector7};
@@ -92,6 +93,25 @@ pub struct NominalInput {
     pub theta_dot: Vector7,
 }
 
+impl NominalInput {
+    /// What the nominal controllers read of the known state.
+    pub fn from_observation(o: &Observation) -> Self {
+        Self {
+            t: o.t,
+            q_hr: o.q_hr,
+            omega_h: o.omega_h,
+            r_r: o.r_r,
+            v_r: o.v_r,
+            q_rb: o.q_rb,
+            omega_b: o.omega_b,
+            q_rt: o.q_rt,
+            omega_t: o.omega_t,
+            theta: o.theta,
+            theta_dot: o.theta_dot,
+        }
+    }
+}
+
 /// Nominal commands and diagnostics of one step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NominalOutput {
@@ -117,41 +137,6 @@ pub struct NominalOutput {
     pub theta_goal: Vector7,
     /// IK outcome in grasp mode.
     pub ik: Option<IkSolution>,
-}
-
-/// Which subsystems [`NominalControllers::command_subsystems`] computes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Subsystems {
-    pub translational: bool,
-    pub attitude: bool,
-    pub robotic: bool,
-}
-
-impl Subsystems {
-    /// All three.
-    pub const ALL: Self = Self {
-        translational: true,
-        attitude: true,
-        robotic: true,
-    };
-    /// Only the translational controller.
-    pub const TRANSLATIONAL: Self = Self {
-        translational: true,
-        attitude: false,
-        robotic: false,
-    };
-    /// Only the attitude controller.
-    pub const ATTITUDE: Self = Self {
-        translational: false,
-        attitude: true,
-        robotic: false,
-    };
-    /// Only the robotic controller.
-    pub const ROBOTIC: Self = Self {
-        translational: false,
-        attitude: false,
-        robotic: true,
-    };
 }
 
 /// Modes of one mission phase.
@@ -348,14 +333,14 @@ impl NominalControllers {
     /// [`SubsystemStatus`] for the handling of bad inputs. A non-finite `t` makes
     /// every subsystem `InvalidInput`.
     pub fn command(&self, x: &NominalInput) -> NominalOutput {
-        self.command_subsystems(x, Subsystems::ALL)
+        self.command_subsystems(x, SubsystemSet::ALL)
     }
 
     /// Like [`Self::command`] but computes only the selected subsystems (the others
     /// stay `Off` with a zero command). Each selected subsystem's command is exactly
     /// what [`Self::command`] returns for it: one process per controller gives the
     /// same results as all three in one process.
-    pub fn command_subsystems(&self, x: &NominalInput, which: Subsystems) -> NominalOutput {
+    pub fn command_subsystems(&self, x: &NominalInput, which: SubsystemSet) -> NominalOutput {
         let phase = self.phase_at(x.t);
         let modes = self.phases[phase];
         let mut out = NominalOutput {
@@ -386,7 +371,9 @@ impl NominalControllers {
             }
         };
 
-        if which.translational && modes.translational == TranslationalMode::Approach {
+        if which.contains(Subsystem::Translational)
+            && modes.translational == TranslationalMode::Approach
+        {
             let valid = match quat::normalized(&x.q_hr) {
                 Some(q_hr) => {
                     let r_hr = quat::to_matrix(&q_hr);
@@ -410,7 +397,7 @@ impl NominalControllers {
             AttitudeMode::PointAndSync => Some(AttitudeTask::PointAndSync),
             AttitudeMode::Off => None,
         };
-        if let Some(task) = task.filter(|_| which.attitude) {
+        if let Some(task) = task.filter(|_| which.contains(Subsystem::Attitude)) {
             let valid = match grasp {
                 Some((p_g, v_g)) => {
                     let inertia_b = if theta_ok {
@@ -442,7 +429,7 @@ impl NominalControllers {
             out.attitude = status(valid);
         }
 
-        let robotic_mode = if which.robotic {
+        let robotic_mode = if which.contains(Subsystem::Robotic) {
             modes.robotic
         } else {
             RoboticMode::Off

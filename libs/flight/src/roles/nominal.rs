@@ -7,9 +7,10 @@ use crate::process::{
 };
 use anyhow::Context;
 use sc_bus::{Publisher, Subscriber, WaitOutcome, Waiter};
+use sc_core::SubsystemSet;
 use sc_icd::*;
 use sc_mission::stages;
-use sc_nominal::{NominalControllers, Subsystems};
+use sc_nominal::NominalControllers;
 
 use super::*;
 
@@ -51,11 +52,7 @@ pub fn nominal(subsystem: Subsystem) -> anyhow::Result<i32> {
     let mut last_state: Option<SimState> = None;
     let scenario = p.scenario_with_period(p.schedule.period_s[subsystem]);
     let ctl = NominalControllers::new(&scenario, (*p.setup.robot).clone())?;
-    let subsystems = [
-        Subsystems::TRANSLATIONAL,
-        Subsystems::ATTITUDE,
-        Subsystems::ROBOTIC,
-    ][which];
+    let subsystems = SubsystemSet::only(subsystem);
     let bit = 1u32 << which;
     p.handshake()?;
     let mut handled = 0u64;
