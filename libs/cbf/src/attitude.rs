@@ -25,10 +25,13 @@ use crate::common::{
     unit_quat,
 };
 use crate::engine::{Engine, Kind, LastProblem};
+use crate::filter::{Coupling, SafetyFilter};
 use crate::sampled::{Decay, RateBounds, RateDecay, RelDeg1, RelDeg2, SampleBounds};
 use crate::{Formulation, qp::SolverParams};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+use sc_core::{Observation, Subsystem};
 use sc_models::quat::{self, Quat};
+use sc_multibody::Robot;
 use std::time::Instant;
 
 /// Constraint names in report order.
@@ -825,5 +828,82 @@ impl AttitudeFilter {
             p.weights.to_vec(),
             self.hard_rows(x).to_vec(),
         ))
+    }
+}
+impl SafetyFilter<3, N> for AttitudeFilter {
+    const SUBSYSTEM: Subsystem = Subsystem::Attitude;
+    const NAMES: [&'static str; N] = NAMES;
+    type Input = AttitudeInput;
+
+    /// The attitude input with the upstream safe force `xi.force_b` [N, F_B] as ξ_att —
+    /// the CoM's acceleration along the line of sight, and its torque about the system
+    /// CoM in the base dynamics. A non-finite state or force gives NaN dynamics, which the
+    /// filter refuses (its braking law then applies), so the input always exists.
+    fn input(&self, model: &Robot, o: &Observation, xi: &Coupling) -> Option<AttitudeInput> {
+        Some(attitude_input(model, o, &xi.force_b))
+    }
+
+    fn filter_with(
+        &mut self,
+        x: &AttitudeInput,
+        nominal: Option<&Vector3<f64>>,
+    ) -> FilterOutput<3, N> {
+        AttitudeFilter::filter_with(self, x, nominal)
+    }
+
+    fn invalid_state(&self) -> FilterOutput<3, N> {
+        common::invalid_state_output()
+    }
+
+    fn dump_qp(&self) -> crate::QpDump {
+        AttitudeFilter::dump_qp(self)
+    }
+
+    fn set_skip_enabled(&mut self, on: bool) {
+        AttitudeFilter::set_skip_enabled(self, on)
+    }
+
+    fn input_bound(&self) -> f64 {
+        self.params.torque_max
+    }
+}
+
+/// The attitude filter's input at the known state `o` with the actuated upstream safe
+/// force `f_b_sf` [N, F_B] (ξ_att), evaluated with the servicer model `robot`.
+pub fn attitude_input(robot: &Robot, o: &Observation, f_b_sf: &Vector3<f64>) -> AttitudeInput {
+    let mass = robot.total_mass();
+    let r_rh = quat::to_matrix(&quat::conj(&o.q_hr));
+    let radial_r = r_rh * Vector3::x();
+    let r_bt = quat::to_matrix(&quat::mul(&quat::conj(&o.q_rb), &o.q_rt));
+    let nan3 = Vector3::from_element(f64::NAN);
+    let nan73 = SMatrix::<f64, 7, 3>::from_element(f64::NAN);
+    let nan7 = SVector::<f64, 7>::from_element(f64::NAN);
+    let finite = f_b_sf.iter().all(|x| x.is_finite());
+    let (p, r) = robot
+        .base_angular_dynamics(&o.theta, &o.theta_dot, &o.omega_b, f_b_sf)
+        .filter(|_| finite)
+        .map(|d| (d.p_locked, d.r_locked))
+        .unwrap_or((Matrix3::from_element(f64::NAN), nan3));
+    let wrench = nalgebra::Vector6::new(f_b_sf.x, f_b_sf.y, f_b_sf.z, 0.0, 0.0, 0.0);
+    let (k_tau, k_force) = robot
+        .reduced_arm_dynamics(&o.theta, &o.theta_dot, &o.omega_b, &wrench)
+        .filter(|_| finite)
+        .map(|d| (d.wrench_map.fixed_columns::<3>(3).into(), d.xi))
+        .unwrap_or((nan73, nan7));
+    AttitudeInput {
+        q_rb: o.q_rb,
+        omega_b: o.omega_b,
+        p,
+        r,
+        r_r: o.com_r,
+        v_r: o.com_v_r,
+        a_drift_r: tidal_acceleration(o.mean_motion, &radial_r, &o.com_r),
+        grasp_r: o.grasp_r,
+        grasp_vel_r: o.grasp_v_r,
+        grasp_acc_r: o.grasp_a_r,
+        xi_r: xi_att_from_force(f_b_sf, &o.q_rb, mass),
+        omega_target_b: r_bt * o.omega_t,
+        joint_coupling: k_tau,
+        joint_coupling_force: k_force,
     }
 }

@@ -127,6 +127,18 @@ impl<const N: usize> Default for FilterReport<N> {
     }
 }
 
+/// A filter's defined output when its input cannot even be built (a state the model
+/// cannot evaluate): zero command, status `Fallback`, flag [`faults::INVALID_STATE`].
+pub fn invalid_state_output<const M: usize, const N: usize>() -> FilterOutput<M, N> {
+    let mut report = FilterReport::default();
+    report.faults |= faults::INVALID_STATE;
+    FilterOutput {
+        u: SVector::zeros(),
+        actuated: SVector::zeros(),
+        report,
+    }
+}
+
 /// CPU time consumed by the calling thread so far [ns] (`CLOCK_THREAD_CPUTIME_ID`; 0 if the
 /// clock is unavailable). Differences of two readings measure a call's own work.
 pub fn thread_cpu_ns() -> u64 {

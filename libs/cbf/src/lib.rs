@@ -9,6 +9,9 @@
 //!   samples under the zero-order hold (docs/SAFETY.md).
 //! * [`translational`], [`attitude`], [`robotic`]: every constraint as its own function
 //!   citing its paper equation, the in-sample bounds, and the filter.
+//! * [`filter`]: what every filter is ([`SafetyFilter`]: its input from the known state and
+//!   the upstream commands, the QP step, the backup); [`chain`]: the typed causal chain
+//!   ([`SafetyLayer`]) the mission, the partition's filter processes and its backups use.
 //! * [`engine`]: the filters' QP on the exact dual active-set solver of `sc-qp`, with the
 //!   lexicographic relaxation; [`qp`]: the Clarabel engine, the independent reference.
 //! * [`monitor`]: every barrier from the true state; [`envelope`]: the model's bounds over
@@ -22,9 +25,11 @@
 
 pub mod attitude;
 pub mod barrier;
+pub mod chain;
 pub mod common;
 pub mod engine;
 pub mod envelope;
+pub mod filter;
 pub mod monitor;
 pub mod qp;
 pub mod robotic;
@@ -34,7 +39,9 @@ pub mod verify;
 
 pub use attitude::{AttitudeFilter, AttitudeInput, AttitudeParams};
 pub use barrier::{RelDegOne, RelDegTwo, Row};
+pub use chain::{Actuation, ActuatorLimits, ChainOutput, Nominals, SafetyLayer};
 pub use common::{FilterOutput, FilterReport, FilterStatus, faults, thread_cpu_ns};
+pub use filter::{Coupling, SafetyFilter};
 pub use qp::{QpDump, QpOutcome, SolverParams};
 pub use robotic::{RoboticFilter, RoboticInput, RoboticParams, robotic_input_from_model};
 pub use sampled::{RateBounds, RelDeg1, RelDeg2, SampleBounds};
@@ -47,28 +54,6 @@ pub type TranslationalOutput = FilterOutput<3, { translational::N }>;
 pub type AttitudeOutput = FilterOutput<3, { attitude::N }>;
 /// Output of the robotic filter: `τ_M` (42 constraints).
 pub type RoboticOutput = FilterOutput<7, { robotic::N }>;
-
-/// The three filters of the modular safety layer.
-pub struct SafetyLayer {
-    pub translational: TranslationalFilter,
-    pub attitude: AttitudeFilter,
-    pub robotic: RoboticFilter,
-}
-
-impl SafetyLayer {
-    /// All three filters from the scenario and the servicer model.
-    pub fn from_scenario(
-        s: &sc_scenario::Scenario,
-        robot: std::sync::Arc<sc_multibody::Robot>,
-    ) -> Self {
-        let mass = robot.total_mass();
-        Self {
-            translational: TranslationalFilter::from_scenario(s, mass),
-            attitude: AttitudeFilter::from_scenario(s, mass),
-            robotic: RoboticFilter::from_scenario(s, robot),
-        }
-    }
-}
 
 /// Stable constraint names of the three filters, in report order.
 pub mod names {

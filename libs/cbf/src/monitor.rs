@@ -23,7 +23,8 @@
 
 use crate::{attitude, robotic, translational};
 use nalgebra::Vector3;
-use sc_models::quat::{self, Quat};
+use sc_core::BarrierState;
+use sc_models::quat;
 use sc_multibody::{Robot, Vector7};
 use std::sync::Arc;
 
@@ -32,21 +33,6 @@ pub const N_ALL: usize = translational::N + attitude::N + robotic::N;
 
 /// Every barrier value, in [`crate::names`] order (translational, attitude, robotic).
 pub type Barriers = [f64; N_ALL];
-
-/// The part of the true state the barriers depend on (SI units; frames in the names).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MonitorState {
-    /// Servicer system CoM relative to the target CoM, in F_R [m].
-    pub com_r: Vector3<f64>,
-    /// `q_RB`: servicer base attitude (rotates F_B into F_R).
-    pub q_rb: Quat,
-    /// Base body rate ω_B [rad/s, F_B].
-    pub omega_b: Vector3<f64>,
-    /// Grasping point relative to the target CoM, in F_R [m].
-    pub grasp_r: Vector3<f64>,
-    pub theta: Vector7,
-    pub theta_dot: Vector7,
-}
 
 /// The geometry of every barrier, from the scenario and the servicer model.
 #[derive(Debug, Clone)]
@@ -87,7 +73,7 @@ impl Monitor {
 
     /// Every barrier at state `x`. Never panics; a non-finite state gives NaN values,
     /// which every consumer counts as a violation.
-    pub fn evaluate(&self, x: &MonitorState) -> Barriers {
+    pub fn evaluate(&self, x: &BarrierState) -> Barriers {
         let mut h = [f64::NAN; N_ALL];
         // translational (paper eqs. CBF-AC, CBF-CAZ)
         let r = &x.com_r;

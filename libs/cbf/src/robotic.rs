@@ -32,11 +32,13 @@ use crate::common::{
     self, BOX_MARGIN, FilterOutput, FilterReport, FilterStatus, clamp_box, faults,
 };
 use crate::engine::{Engine, Kind, LastProblem, Outcome};
+use crate::filter::{Coupling, SafetyFilter};
 use crate::sampled::{
     Decay, RateBounds, RateDecay, SampleBounds, braking_barrier, hdot_required_of, phi_required_of,
 };
 use crate::{Formulation, qp::SolverParams};
 use nalgebra::{SMatrix, SVector, Vector3, Vector6};
+use sc_core::{Observation, Subsystem};
 use sc_multibody::{Robot, Vector13};
 use std::sync::Arc;
 
@@ -1129,6 +1131,46 @@ pub fn robotic_input_from_model(
         force_b: *f_b_sf,
         torque_b: *tau_b_sf,
     })
+}
+
+impl SafetyFilter<NJ, N> for RoboticFilter {
+    const SUBSYSTEM: Subsystem = Subsystem::Robotic;
+    const NAMES: [&'static str; N] = NAMES;
+    type Input = RoboticInput;
+
+    /// The robotic input with the upstream safe base force and torque (ξ_rob); `None`
+    /// when the model cannot be evaluated (non-finite state or wrench, singular dynamics).
+    fn input(&self, model: &Robot, o: &Observation, xi: &Coupling) -> Option<RoboticInput> {
+        robotic_input_from_model(
+            model,
+            &o.theta,
+            &o.theta_dot,
+            &o.omega_b,
+            &xi.force_b,
+            &xi.torque_b,
+        )
+    }
+
+    fn filter_with(&mut self, x: &RoboticInput, nominal: Option<&Vector7>) -> FilterOutput<NJ, N> {
+        RoboticFilter::filter_with(self, x, nominal)
+    }
+
+    /// Zero joint torque, flagged [`faults::INVALID_STATE`].
+    fn invalid_state(&self) -> FilterOutput<NJ, N> {
+        common::invalid_state_output()
+    }
+
+    fn dump_qp(&self) -> crate::QpDump {
+        RoboticFilter::dump_qp(self)
+    }
+
+    fn set_skip_enabled(&mut self, on: bool) {
+        RoboticFilter::set_skip_enabled(self, on)
+    }
+
+    fn input_bound(&self) -> f64 {
+        self.params.torque_max
+    }
 }
 
 #[cfg(test)]

@@ -23,10 +23,13 @@ use crate::common::{
     unit_quat,
 };
 use crate::engine::{Engine, Kind, LastProblem};
+use crate::filter::{Coupling, SafetyFilter};
 use crate::sampled::{RateBounds, RelDeg1, RelDeg2, SampleBounds};
 use crate::{Formulation, qp::SolverParams};
 use nalgebra::{Matrix3, Vector3};
+use sc_core::{Observation, Subsystem};
 use sc_models::quat::{self, Quat};
+use sc_multibody::Robot;
 use std::time::Instant;
 
 /// Constraint names in report order.
@@ -572,5 +575,48 @@ impl TranslationalFilter {
     pub fn rows(&self, x: &TranslationalInput) -> Option<(Vec<Row<3>>, Vec<f64>, Vec<Row<3>>)> {
         let p = self.prepare(x)?;
         Some((p.rows.to_vec(), p.weights.to_vec(), p.bounds.to_vec()))
+    }
+}
+impl SafetyFilter<3, N> for TranslationalFilter {
+    const SUBSYSTEM: Subsystem = Subsystem::Translational;
+    const NAMES: [&'static str; N] = NAMES;
+    type Input = TranslationalInput;
+
+    /// The servicer's system centre of mass relative to the target's, in the Hill frame
+    /// (ξ_tr = 0: first in the causal order; no model needed).
+    fn input(&self, _: &Robot, o: &Observation, _: &Coupling) -> Option<TranslationalInput> {
+        Some(TranslationalInput {
+            r_h: o.com_h,
+            v_h: o.com_v_h,
+            q_hr: o.q_hr,
+            omega_h: o.omega_h,
+            omega_dot_h: o.omega_dot_h,
+            q_rb: o.q_rb,
+            omega_b: o.omega_b,
+        })
+    }
+
+    fn filter_with(
+        &mut self,
+        x: &TranslationalInput,
+        nominal: Option<&Vector3<f64>>,
+    ) -> FilterOutput<3, N> {
+        TranslationalFilter::filter_with(self, x, nominal)
+    }
+
+    fn invalid_state(&self) -> FilterOutput<3, N> {
+        common::invalid_state_output()
+    }
+
+    fn dump_qp(&self) -> crate::QpDump {
+        TranslationalFilter::dump_qp(self)
+    }
+
+    fn set_skip_enabled(&mut self, on: bool) {
+        TranslationalFilter::set_skip_enabled(self, on)
+    }
+
+    fn input_bound(&self) -> f64 {
+        self.params.force_max
     }
 }

@@ -812,7 +812,8 @@ fn robotic_sign_convention_and_sphere_order() {
 /// `sc_cbf::names` order.
 #[test]
 fn monitor_barriers_equal_the_filters_barriers() {
-    use sc_cbf::monitor::{Monitor, MonitorState, N_ALL};
+    use sc_cbf::monitor::{Monitor, N_ALL};
+    use sc_core::BarrierState;
     let s = scenario();
     let robot = robot();
     let monitor = Monitor::from_scenario(&s, robot.clone());
@@ -822,7 +823,8 @@ fn monitor_barriers_equal_the_filters_barriers() {
     let mut rng = Lcg(31);
     for case in 0..50 {
         let st = random_servicer_state(&s, &mut rng);
-        let h = monitor.evaluate(&MonitorState {
+        let h = monitor.evaluate(&BarrierState {
+            t: 0.0,
             com_r: st.com_r,
             q_rb: st.q_rb,
             omega_b: st.omega_b,

@@ -69,7 +69,40 @@ pub struct Observation {
     pub com_v_r: Vector3<f64>,
 }
 
+/// The part of the true state every safety barrier depends on (the safety monitor,
+/// `sc_cbf::monitor`, evaluates every barrier from it — at the control steps from the
+/// simulator's observation, between them from its physics steps).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BarrierState {
+    /// Time [s].
+    pub t: f64,
+    /// Servicer system CoM relative to the target CoM, in F_R [m].
+    pub com_r: Vector3<f64>,
+    /// `q_RB`: base attitude, rotates F_B vectors into F_R.
+    pub q_rb: Quat,
+    /// Base body rate [rad/s, F_B].
+    pub omega_b: Vector3<f64>,
+    /// Grasping point relative to the target CoM, in F_R [m].
+    pub grasp_r: Vector3<f64>,
+    /// Joint angles [rad] and rates [rad/s].
+    pub theta: Vector7,
+    pub theta_dot: Vector7,
+}
+
 impl Observation {
+    /// What the barriers depend on, at this observation.
+    pub fn barrier_state(&self) -> BarrierState {
+        BarrierState {
+            t: self.t,
+            com_r: self.com_r,
+            q_rb: self.q_rb,
+            omega_b: self.omega_b,
+            grasp_r: self.grasp_r,
+            theta: self.theta,
+            theta_dot: self.theta_dot,
+        }
+    }
+
     /// Distance end-effector ↔ grasping point [m].
     pub fn grasp_distance(&self) -> f64 {
         (self.ee_r - self.grasp_r).norm()

@@ -17,7 +17,6 @@
 pub mod admission;
 pub mod config;
 pub mod convert;
-pub mod fallback;
 pub mod process;
 pub mod roles;
 

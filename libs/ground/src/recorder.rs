@@ -6,7 +6,7 @@ use anyhow::Context;
 use sc_bus::{Subscriber, Waiter};
 use sc_cbf::{AttitudeOutput, RoboticOutput, SafetyLayer, TranslationalOutput};
 use sc_flight::convert;
-use sc_flight::fallback;
+
 use sc_flight::process::{Proc, partner_qos, qos, wait};
 use sc_icd::*;
 use sc_mission::{MissionEnd, StepRecord, TelemetryWriter, summarize};
@@ -132,7 +132,6 @@ pub fn recorder() -> anyhow::Result<i32> {
     let mut latency = open("latency.csv")?;
     writeln!(latency, "{LATENCY_CSV_HEADER}")?;
     let mut layer = SafetyLayer::from_scenario(&p.setup.scenario, p.setup.robot.clone());
-    let robot = p.setup.robot.clone();
     let phase_names: Vec<String> = p
         .setup
         .scenario
@@ -328,44 +327,43 @@ pub fn recorder() -> anyhow::Result<i32> {
             let tr: TranslationalOutput = match set.st {
                 // the simulator applied the backup (the command was missing at its
                 // deadline, or it rejected the one that came): that is what was applied
-                _ if r.fallback_mask & due::TRANSLATIONAL != 0 => {
-                    fallback::translational(&mut layer, &o)
-                }
+                _ if r.fallback_mask & due::TRANSLATIONAL != 0 => layer.backup_translational(&o),
                 Some(m) => {
                     h.st = Some(m);
                     convert::filter_output(&m)
                 }
                 None => {
                     h.st.map(|m| convert::filter_output(&m))
-                        .unwrap_or_else(|| fallback::translational(&mut layer, &o))
+                        .unwrap_or_else(|| layer.backup_translational(&o))
                 }
             };
             let at: AttitudeOutput = match set.sa {
                 // the simulator applied the backup (the command was missing at its
                 // deadline, or it rejected the one that came): that is what was applied
                 _ if r.fallback_mask & due::ATTITUDE != 0 => {
-                    fallback::attitude(&mut layer, &o, &robot, &applied.force_b)
+                    layer.backup_attitude(&o, &applied.force_b)
                 }
                 Some(m) => {
                     h.sa = Some(m);
                     convert::filter_output(&m)
                 }
-                None => h.sa.map(|m| convert::filter_output(&m)).unwrap_or_else(|| {
-                    fallback::attitude(&mut layer, &o, &robot, &applied.force_b)
-                }),
+                None => {
+                    h.sa.map(|m| convert::filter_output(&m))
+                        .unwrap_or_else(|| layer.backup_attitude(&o, &applied.force_b))
+                }
             };
             let rb: RoboticOutput = match set.sr {
                 // the simulator applied the backup (the command was missing at its
                 // deadline, or it rejected the one that came): that is what was applied
                 _ if r.fallback_mask & due::ROBOTIC != 0 => {
-                    fallback::robotic(&mut layer, &o, &robot, &applied.force_b, &applied.torque_b)
+                    layer.backup_robotic(&o, &applied.force_b, &applied.torque_b)
                 }
                 Some(m) => {
                     h.sr = Some(m);
                     convert::filter_output(&m)
                 }
                 None => h.sr.map(|m| convert::filter_output(&m)).unwrap_or_else(|| {
-                    fallback::robotic(&mut layer, &o, &robot, &applied.force_b, &applied.torque_b)
+                    layer.backup_robotic(&o, &applied.force_b, &applied.torque_b)
                 }),
             };
             // the mission's own schedule, as the simulator decides it

@@ -5,9 +5,9 @@ use crate::record::StepRecord;
 use crate::setup::{Setup, SetupError};
 use crate::stages;
 use sc_cbf::monitor::{Barriers, Monitor, min_into};
-use sc_cbf::{QpDump, SafetyLayer};
+use sc_cbf::{Actuation, ActuatorLimits, Nominals, QpDump, SafetyLayer};
 use sc_nominal::NominalControllers;
-use sc_sim::{Command, Plant, Simulator};
+use sc_sim::{Plant, Simulator};
 
 /// Options of a run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -143,53 +143,24 @@ impl Mission {
     /// robotic filter), without advancing the simulator.
     pub fn compute(&mut self) -> StepRecord {
         let o = self.sim.observe();
-        let barriers = self.monitor.evaluate(&stages::monitor_state(&o));
+        let barriers = self.monitor.evaluate(&o.barrier_state());
         let barriers_between = self.between.unwrap_or(barriers);
-        let robot = self.setup.robot.clone();
-        let limits = &self.setup.scenario.limits;
         let nom = self.nominal.command(&stages::nominal_input(&o));
         let cmds = match self.nominal_override.as_mut() {
             Some(src) => src.commands(&o, &nom),
             None => NominalCommands::REFERENCE,
         };
-        let f_h_nom = cmds.translational.resolve(nom.f_h);
-        let tau_b_nom = cmds.attitude.resolve(nom.tau_b);
-        let tau_m_nom = cmds.robotic.resolve(nom.tau_m);
-        let tr = self
-            .safety
-            .translational
-            .filter_with(&stages::translational_input(&o), f_h_nom.as_ref());
-        // what acts on the base: the safe force, or the saturated nominal without filters
-        let f_b = if self.options.no_filter {
-            stages::saturate(
-                &stages::hill_to_body(&o, &f_h_nom.unwrap_or_default()),
-                limits.force_max_n,
-            )
-        } else {
-            tr.actuated
+        let nominals = Nominals {
+            translational: cmds.translational.resolve(nom.f_h),
+            attitude: cmds.attitude.resolve(nom.tau_b),
+            robotic: cmds.robotic.resolve(nom.tau_m),
         };
-        let at = self.safety.attitude.filter_with(
-            &stages::attitude_input(&o, &robot, &f_b),
-            tau_b_nom.as_ref(),
-        );
-        let tau_b = if self.options.no_filter {
-            stages::saturate(&tau_b_nom.unwrap_or_default(), limits.torque_max_nm)
+        let actuation = if self.options.no_filter {
+            Actuation::NominalSaturated(ActuatorLimits::from_scenario(&self.setup.scenario))
         } else {
-            at.u
+            Actuation::Safe
         };
-        let rb = stages::robotic_step(
-            &mut self.safety.robotic,
-            &o,
-            &robot,
-            &f_b,
-            &tau_b,
-            tau_m_nom.as_ref(),
-        );
-        let tau_m = if self.options.no_filter {
-            stages::saturate(&tau_m_nom.unwrap_or_default(), limits.joint_torque_max_nm)
-        } else {
-            rb.u
-        };
+        let out = self.safety.step(&o, &nominals, actuation);
         let nan3 = nalgebra::Vector3::from_element(f64::NAN);
         StepRecord {
             step: o.step,
@@ -198,17 +169,15 @@ impl Mission {
             phase: self.setup.scenario.phase_index(o.t),
             obs: o,
             // a missing nominal is recorded as NaN
-            f_h_nom: f_h_nom.unwrap_or(nan3),
-            tau_b_nom: tau_b_nom.unwrap_or(nan3),
-            tau_m_nom: tau_m_nom.unwrap_or(sc_multibody::Vector7::from_element(f64::NAN)),
-            translational: tr,
-            attitude: at,
-            robotic: rb,
-            applied: Command {
-                force_b: f_b,
-                torque_b: tau_b,
-                tau: tau_m,
-            },
+            f_h_nom: nominals.translational.unwrap_or(nan3),
+            tau_b_nom: nominals.attitude.unwrap_or(nan3),
+            tau_m_nom: nominals
+                .robotic
+                .unwrap_or(sc_multibody::Vector7::from_element(f64::NAN)),
+            translational: out.translational,
+            attitude: out.attitude,
+            robotic: out.robotic,
+            applied: out.applied,
             barriers,
             barriers_between,
         }
@@ -255,12 +224,8 @@ impl Mission {
         }
         let monitor = &self.monitor;
         let mut between: Barriers = [f64::INFINITY; sc_cbf::monitor::N_ALL];
-        let at_physics_step = |b: &sc_sim::BarrierState| {
-            min_into(
-                &mut between,
-                &monitor.evaluate(&stages::monitor_state_between(b)),
-            )
-        };
+        let at_physics_step =
+            |b: &sc_sim::BarrierState| min_into(&mut between, &monitor.evaluate(b));
         let stepped = match self.plant.as_mut() {
             Some(p) => self
                 .sim

@@ -9,7 +9,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::{Rng, SeedableRng};
 use sc_cbf::monitor::{Barriers, Monitor};
 use sc_cbf::{attitude, robotic, translational};
-use sc_mission::{NominalCommand, NominalCommands, NominalOverride, stages};
+use sc_mission::{NominalCommand, NominalCommands, NominalOverride};
 use sc_models::quat;
 use sc_multibody::{Robot, Vector7};
 use sc_nominal::NominalOutput;
@@ -164,7 +164,7 @@ impl Adversary {
 
     /// The index, per subsystem, of the barrier closest to its boundary (distance-normalised).
     fn greedy_choice(&self, o: &Observation) -> [usize; 3] {
-        let h = self.monitor.evaluate(&stages::monitor_state(o));
+        let h = self.monitor.evaluate(&o.barrier_state());
         let argmin = |from: usize, n: usize| {
             (0..n)
                 .min_by(|&a, &b| {

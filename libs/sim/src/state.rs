@@ -8,39 +8,7 @@ use sc_multibody::{NJ, Robot, Vector7, Vector13};
 use sc_scenario::Scenario;
 use std::sync::Arc;
 
-/// One actuation command `u = [f_B; τ_B; τ_M]` held constant over a control period:
-/// base force [N] and torque [N m] in the base frame (about the base origin), joint torques [N m].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Command {
-    pub force_b: Vector3<f64>,
-    pub torque_b: Vector3<f64>,
-    pub tau: Vector7,
-}
-
-impl Command {
-    /// The zero command.
-    pub fn zero() -> Self {
-        Self {
-            force_b: Vector3::zeros(),
-            torque_b: Vector3::zeros(),
-            tau: Vector7::zeros(),
-        }
-    }
-
-    /// As the 13-vector of the free-flyer dynamics.
-    pub fn as_vector(&self) -> Vector13 {
-        let mut u = Vector13::zeros();
-        u.fixed_rows_mut::<3>(0).copy_from(&self.force_b);
-        u.fixed_rows_mut::<3>(3).copy_from(&self.torque_b);
-        u.fixed_rows_mut::<NJ>(6).copy_from(&self.tau);
-        u
-    }
-
-    /// True if every component is finite.
-    pub fn is_finite(&self) -> bool {
-        self.as_vector().iter().all(|x| x.is_finite())
-    }
-}
+pub use sc_core::Command;
 
 /// Why the simulator stopped.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -55,22 +23,7 @@ pub enum SimError {
     Plant { t: f64, message: String },
 }
 
-/// The part of the true state every safety barrier depends on (see `sc_cbf::monitor`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BarrierState {
-    /// Time [s].
-    pub t: f64,
-    /// Servicer system CoM relative to the target CoM, in F_R [m].
-    pub com_r: Vector3<f64>,
-    /// `q_RB`: base attitude, rotates F_B vectors into F_R.
-    pub q_rb: Quat,
-    /// Base body rate [rad/s, F_B].
-    pub omega_b: Vector3<f64>,
-    /// Grasping point relative to the target CoM, in F_R [m].
-    pub grasp_r: Vector3<f64>,
-    pub theta: Vector7,
-    pub theta_dot: Vector7,
-}
+pub use sc_core::BarrierState;
 
 /// The full simulator state at one instant (inertial frame I, SI units).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -4,7 +4,7 @@
 
 use crate::admission;
 use crate::convert;
-use crate::fallback;
+
 use crate::process::{
     LOST_STOP_WAKEUP, Proc, partner_qos, prepare_listener, qos, send, wait, wait_outcome,
 };
@@ -13,7 +13,6 @@ use nalgebra::Vector3;
 use sc_bus::{Publisher, SignalListener, Subscriber, WaitOutcome, Waitable, Waiter};
 use sc_cbf::SafetyLayer;
 use sc_icd::*;
-use sc_mission::stages;
 use std::time::Instant;
 
 use super::*;
@@ -111,7 +110,6 @@ pub fn filter(subsystem: Subsystem) -> anyhow::Result<i32> {
         }};
     }
     let mut layer = SafetyLayer::from_scenario(&p.setup.scenario, p.setup.robot.clone());
-    let robot = p.setup.robot.clone();
     let d = &p.cfg.deadlines;
     let deadline = p.deadline(
         [
@@ -229,17 +227,17 @@ pub fn filter(subsystem: Subsystem) -> anyhow::Result<i32> {
                     match which {
                         0 => {
                             if let Some(n) = nom_t {
-                                std::hint::black_box(layer.translational.filter_with(
-                                    &stages::translational_input(&o),
-                                    Some(&convert::vec3(&n.f_h)),
-                                ));
+                                std::hint::black_box(
+                                    layer.translational_stage(&o, Some(&convert::vec3(&n.f_h))),
+                                );
                             }
                             tx_t.as_ref().context("publisher")?.warm()?;
                         }
                         1 => {
                             if let Some(n) = nom_a {
-                                std::hint::black_box(layer.attitude.filter_with(
-                                    &stages::attitude_input(&o, &robot, &f_b),
+                                std::hint::black_box(layer.attitude_stage(
+                                    &o,
+                                    &f_b,
                                     Some(&convert::vec3(&n.tau_b)),
                                 ));
                             }
@@ -247,10 +245,8 @@ pub fn filter(subsystem: Subsystem) -> anyhow::Result<i32> {
                         }
                         _ => {
                             if let Some(n) = nom_r {
-                                std::hint::black_box(stages::robotic_step(
-                                    &mut layer.robotic,
+                                std::hint::black_box(layer.robotic_stage(
                                     &o,
-                                    &robot,
                                     &f_b,
                                     &tau_b,
                                     Some(&convert::vec7(&n.tau_m)),
@@ -338,7 +334,7 @@ pub fn filter(subsystem: Subsystem) -> anyhow::Result<i32> {
                 Some(m) => convert::vec3(&m.actuated),
                 None => {
                     upstream_missing = true;
-                    fallback::translational(&mut layer, &o).actuated
+                    layer.backup_translational(&o).actuated
                 }
             }
         } else {
@@ -352,7 +348,7 @@ pub fn filter(subsystem: Subsystem) -> anyhow::Result<i32> {
                 Some(m) => convert::vec3(&m.u),
                 None => {
                     upstream_missing = true;
-                    fallback::attitude(&mut layer, &o, &robot, &f_b).u
+                    layer.backup_attitude(&o, &f_b).u
                 }
             }
         } else {
@@ -365,11 +361,9 @@ pub fn filter(subsystem: Subsystem) -> anyhow::Result<i32> {
                 // command: the filter runs its QP on the substitute nominal
                 let nom = nom_t.filter(|m| m.tick == k && m.valid != 0);
                 let f = nom.map(|n| convert::vec3(&n.f_h));
-                let mut out = layer
-                    .translational
-                    .filter_with(&stages::translational_input(&o), f.as_ref());
+                let mut out = layer.translational_stage(&o, f.as_ref());
                 if upstream_missing {
-                    out = fallback::flag_missing(out);
+                    out = sc_cbf::chain::flag_missing(out);
                 }
                 let mut m: SafeTranslational = convert::safe_msg(&out, k, s.t, phase);
                 m.recv_ns = recv_ns;
@@ -380,11 +374,9 @@ pub fn filter(subsystem: Subsystem) -> anyhow::Result<i32> {
             1 => {
                 let nom = nom_a.filter(|m| m.tick == k && m.valid != 0);
                 let t = nom.map(|n| convert::vec3(&n.tau_b));
-                let mut out = layer
-                    .attitude
-                    .filter_with(&stages::attitude_input(&o, &robot, &f_b), t.as_ref());
+                let mut out = layer.attitude_stage(&o, &f_b, t.as_ref());
                 if upstream_missing {
-                    out = fallback::flag_missing(out);
+                    out = sc_cbf::chain::flag_missing(out);
                 }
                 let mut m: SafeAttitude = convert::safe_msg(&out, k, s.t, phase);
                 m.recv_ns = recv_ns;
@@ -395,10 +387,9 @@ pub fn filter(subsystem: Subsystem) -> anyhow::Result<i32> {
             _ => {
                 let nom = nom_r.filter(|m| m.tick == k && m.valid != 0);
                 let t = nom.map(|n| convert::vec7(&n.tau_m));
-                let mut out =
-                    stages::robotic_step(&mut layer.robotic, &o, &robot, &f_b, &tau_b, t.as_ref());
+                let mut out = layer.robotic_stage(&o, &f_b, &tau_b, t.as_ref());
                 if upstream_missing {
-                    out = fallback::flag_missing(out);
+                    out = sc_cbf::chain::flag_missing(out);
                 }
                 let mut m: SafeRobotic = convert::safe_msg(&out, k, s.t, phase);
                 m.recv_ns = recv_ns;

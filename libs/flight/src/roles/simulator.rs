@@ -4,13 +4,12 @@
 
 use crate::admission;
 use crate::convert;
-use crate::fallback;
+
 use crate::process::{Proc, partner_qos, prepare_listener, qos, send, wait};
 use nalgebra::Vector3;
 use sc_bus::{Publisher, Subscriber, Waiter};
 use sc_cbf::SafetyLayer;
 use sc_icd::*;
-use sc_mission::stages;
 use sc_sim::{Command, Simulator};
 use std::time::Instant;
 
@@ -134,7 +133,7 @@ pub fn simulator() -> anyhow::Result<i32> {
         let recv_ns = now();
         let o = sim.observe();
         let mut msg = convert::sim_state(&o);
-        let barriers = monitor.evaluate(&stages::monitor_state(&o));
+        let barriers = monitor.evaluate(&o.barrier_state());
         msg.barriers = barriers;
         msg.barriers_between = between.unwrap_or(barriers);
         // the phase is the mission's own schedule, never a partner's report
@@ -217,7 +216,7 @@ pub fn simulator() -> anyhow::Result<i32> {
                 held.force_b = convert::vec3(&m.actuated);
                 held_f_h = convert::vec3(&m.u);
             } else {
-                let f = fallback::translational(&mut layer, &o);
+                let f = layer.backup_translational(&o);
                 held.force_b = f.actuated;
                 held_f_h = f.u;
                 fallback_mask |= due::TRANSLATIONAL;
@@ -248,7 +247,7 @@ pub fn simulator() -> anyhow::Result<i32> {
             if let Some(m) = fresh_a {
                 held.torque_b = convert::vec3(&m.u);
             } else {
-                held.torque_b = fallback::attitude(&mut layer, &o, &robot, &held.force_b).u;
+                held.torque_b = layer.backup_attitude(&o, &held.force_b).u;
                 fallback_mask |= due::ATTITUDE;
                 if rejected_a {
                     rejected[1] += 1;
@@ -276,8 +275,7 @@ pub fn simulator() -> anyhow::Result<i32> {
             if let Some(m) = fresh_r {
                 held.tau = convert::vec7(&m.u);
             } else {
-                held.tau =
-                    fallback::robotic(&mut layer, &o, &robot, &held.force_b, &held.torque_b).u;
+                held.tau = layer.backup_robotic(&o, &held.force_b, &held.torque_b).u;
                 fallback_mask |= due::ROBOTIC;
                 if rejected_r {
                     rejected[2] += 1;
@@ -323,10 +321,7 @@ pub fn simulator() -> anyhow::Result<i32> {
         if res.end == end::RUNNING || keep_going {
             let mut min: sc_cbf::monitor::Barriers = [f64::INFINITY; sc_cbf::monitor::N_ALL];
             let at_physics_step = |b: &sc_sim::BarrierState| {
-                sc_cbf::monitor::min_into(
-                    &mut min,
-                    &monitor.evaluate(&stages::monitor_state_between(b)),
-                )
+                sc_cbf::monitor::min_into(&mut min, &monitor.evaluate(b))
             };
             let stepped = match plant.as_mut() {
                 Some(pl) => sim.step_with_plant(pl, &held, at_physics_step),
