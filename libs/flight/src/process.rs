@@ -1,13 +1,12 @@
 //! What every process of the partition shares: arguments, run scope, config and
-//! scenario loading, the event wait.
+//! scenario loading, real-time placement (SCHED_FIFO, CPU affinity), service settings.
 
 use crate::config::{PartitionConfig, Schedule};
-use anyhow::Context;
-use sc_bus::{BusNode, RunScope, ServiceSettings, WaitOutcome, Waiter};
-use sc_icd::services;
+use crate::error::FlightError;
+use sc_bus::{BusNode, RunScope, ServiceSettings};
 use sc_mission::Setup;
 use std::path::PathBuf;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// Environment variable with the config path (alternative to `--config`).
 pub const CONFIG_ENV: &str = "SC_PARTITION_CONFIG";
@@ -57,27 +56,17 @@ pub fn partner_qos() -> ServiceSettings {
 impl Proc {
     /// Parses `--config FILE --out DIR` (or the environment), joins the run of
     /// `SC_RUN_ID` and creates the node `role`.
-    pub fn start(role: &'static str) -> anyhow::Result<Self> {
+    pub fn start(role: &'static str) -> Result<Self, FlightError> {
         sc_bus::init_logging();
-        let mut config: Option<PathBuf> = std::env::var_os(CONFIG_ENV).map(PathBuf::from);
-        let mut out: Option<PathBuf> = std::env::var_os(OUT_ENV).map(PathBuf::from);
-        let mut args = std::env::args().skip(1);
-        while let Some(a) = args.next() {
-            match a.as_str() {
-                "--config" => config = args.next().map(PathBuf::from),
-                "--out" => out = args.next().map(PathBuf::from),
-                other => anyhow::bail!(
-                    "{role}: unknown argument `{other}` (usage: --config FILE --out DIR)"
-                ),
-            }
-        }
-        let config = config.context("missing --config FILE")?;
-        let out = out.unwrap_or_else(|| PathBuf::from("out/partition"));
+        let (config, out) = arguments(role)?;
         let cfg = PartitionConfig::load(&config)?;
         let schedule = cfg.schedule()?;
         let setup = Setup::load(&cfg.scenario_path())?;
-        let run = RunScope::from_env()
-            .context("SC_RUN_ID is not set (processes are started by the launcher)")??;
+        let run = RunScope::from_env().ok_or_else(|| {
+            FlightError::Usage(
+                "SC_RUN_ID is not set (processes are started by the launcher)".into(),
+            )
+        })??;
         let prio = cfg.priority_of(role);
         let fifo_priority = (cfg.clock == crate::ClockMode::RealTime && prio > 0)
             .then(|| set_fifo(role, prio).then_some(prio))
@@ -130,69 +119,34 @@ impl Proc {
     pub fn deadline(&self, ms: f64) -> Duration {
         Duration::from_secs_f64(self.cfg.deadline_s(ms))
     }
+}
 
-    /// Announces readiness and waits for the scheduler's `go`.
-    pub fn handshake(&self) -> anyhow::Result<()> {
-        let id = sc_icd::Role::named(self.role)
-            .map(|r| r.id())
-            .context("unknown role")?;
-        let p = sc_bus::Participant::new(&self.node, sc_icd::services::HANDSHAKE, id)?;
-        p.announce_and_wait(Duration::from_secs_f64(self.cfg.handshake_timeout_s + 5.0))?;
-        Ok(())
+/// `--config FILE --out DIR` (or `SC_PARTITION_CONFIG`, `SC_OUT_DIR`).
+fn arguments(role: &str) -> Result<(PathBuf, PathBuf), FlightError> {
+    let mut config: Option<PathBuf> = std::env::var_os(CONFIG_ENV).map(PathBuf::from);
+    let mut out: Option<PathBuf> = std::env::var_os(OUT_ENV).map(PathBuf::from);
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--config" => config = args.next().map(PathBuf::from),
+            "--out" => out = args.next().map(PathBuf::from),
+            other => {
+                return Err(FlightError::Usage(format!(
+                    "{role}: unknown argument `{other}` (usage: --config FILE --out DIR)"
+                )));
+            }
+        }
     }
+    let config = config.ok_or_else(|| FlightError::Usage("missing --config FILE".into()))?;
+    Ok((
+        config,
+        out.unwrap_or_else(|| PathBuf::from("out/partition")),
+    ))
 }
 
 /// True if this run has the pre-tick warm-up (real-time mode, `warmup_lead_us > 0`).
-pub fn warmup_enabled(p: &Proc) -> bool {
-    p.cfg.clock == crate::ClockMode::RealTime && p.cfg.warmup_lead_us > 0
-}
-
-/// The listener of the pre-tick warm-up signal ([`services::PREPARE`]) if this run
-/// has it; a process attaches it to the waiter it sleeps on between ticks.
-pub fn prepare_listener(p: &Proc) -> anyhow::Result<Option<sc_bus::SignalListener>> {
-    Ok(warmup_enabled(p)
-        .then(|| sc_bus::SignalListener::new(&p.node, services::PREPARE.as_str(), &qos()))
-        .transpose()?)
-}
-
-/// Sleeps on the waiter until an event or `until` (at most 1 s at a time).
-/// Returns false on SIGTERM/SIGINT.
-pub fn wait(waiter: &Waiter, until: Option<Instant>) -> anyhow::Result<bool> {
-    Ok(wait_outcome(waiter, until)? != WaitOutcome::TerminationRequest)
-}
-
-/// Like [`wait`], telling an event from a timeout: a process that finds new input
-/// after a timeout (with no deadline of its own passing) was not woken for it.
-pub fn wait_outcome(waiter: &Waiter, until: Option<Instant>) -> anyhow::Result<WaitOutcome> {
-    let left = match until {
-        Some(u) => u.saturating_duration_since(Instant::now()),
-        None => Duration::from_secs(1),
-    }
-    .min(Duration::from_secs(1));
-    if left.is_zero() {
-        return Ok(WaitOutcome::Timeout);
-    }
-    Ok(waiter.wait_once(left, |_| {})?)
-}
-
-/// The log line of a process that saw the stop only when a 1 s wait ran out: the
-/// wake-up that should have brought it was lost (the lock-step tests look for it).
-pub const LOST_STOP_WAKEUP: &str =
-    "the stop was seen only at a 1 s wait timeout (its wake-up was lost)";
-
-/// Sends, tolerating a dead or stuck subscriber (backpressure), which is reported.
-pub fn send<T: core::fmt::Debug + sc_bus::ZeroCopySend + Copy + 'static>(
-    p: &sc_bus::Publisher<T>,
-    msg: &T,
-) -> anyhow::Result<()> {
-    match p.send(msg) {
-        Ok(_) => Ok(()),
-        Err(e @ sc_bus::BusError::Backpressure { .. }) => {
-            eprintln!("warning: {e}");
-            Ok(())
-        }
-        Err(e) => Err(e.into()),
-    }
+pub fn warmup_enabled(cfg: &PartitionConfig) -> bool {
+    cfg.clock == crate::ClockMode::RealTime && cfg.warmup_lead_us > 0
 }
 
 /// Changes this process's SCHED_FIFO priority; false if refused.

@@ -1,6 +1,9 @@
 //! The nominal robotic controller process of the partition.
-use sc_flight::roles::{Subsystem, nominal};
+use sc_flight::roles::NominalRole;
+use sc_flight::runner;
+use sc_icd::{RoleKind, Subsystem};
 
 fn main() -> std::process::ExitCode {
-    sc_flight::main_of(|| nominal(Subsystem::Robotic))
+    let s = Subsystem::Robotic;
+    runner::main(RoleKind::Nominal(s), |p| NominalRole::from_process(s, p))
 }

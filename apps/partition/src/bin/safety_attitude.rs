@@ -1,6 +1,9 @@
 //! The attitude safety filter process of the partition.
-use sc_flight::roles::{Subsystem, filter};
+use sc_flight::roles::FilterRole;
+use sc_flight::runner;
+use sc_icd::{RoleKind, Subsystem};
 
 fn main() -> std::process::ExitCode {
-    sc_flight::main_of(|| filter(Subsystem::Attitude))
+    let s = Subsystem::Attitude;
+    runner::main(RoleKind::Filter(s), |p| FilterRole::from_process(s, p))
 }

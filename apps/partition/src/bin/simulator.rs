@@ -1,4 +1,7 @@
 //! The simulator process of the partition.
+use sc_flight::roles::SimulatorRole;
+use sc_icd::RoleKind;
+
 fn main() -> std::process::ExitCode {
-    sc_flight::main_of(sc_flight::roles::simulator)
+    sc_flight::runner::main(RoleKind::Simulator, SimulatorRole::from_process)
 }

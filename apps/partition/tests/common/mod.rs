@@ -214,7 +214,7 @@ pub fn summary(out: &Path) -> serde_json::Value {
 ///   deadlines are 20 times the real-time ones (0.8 s and more after the state), so
 ///   a wake-up there means a lost wake-up, not a slow machine;
 /// - no process saw the stop only when its 1 s wait ran out (it logs
-///   [`sc_flight::process::LOST_STOP_WAKEUP`] then).
+///   [`sc_flight::roles::LOST_STOP_WAKEUP`] then).
 pub fn assert_no_lost_wakeups(out: &Path) {
     let s: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("scheduler.json")).unwrap())
@@ -225,7 +225,7 @@ pub fn assert_no_lost_wakeups(out: &Path) {
         let path = e.unwrap().path();
         let log = std::fs::read_to_string(&path).unwrap();
         assert!(
-            !log.contains(sc_flight::process::LOST_STOP_WAKEUP),
+            !log.contains(sc_flight::roles::LOST_STOP_WAKEUP),
             "{}: {log}",
             path.display()
         );

@@ -1,419 +1,859 @@
-//! A safety filter process: waits for its state, nominal command and upstream safe
-//! commands up to its stage deadline, runs its QP (on the substitute nominal when the
-//! nominal is missing or invalid), publishes the safe command.
+//! A safety filter: waits for its state, nominal command and upstream safe commands up
+//! to its stage deadline, runs its QP (on the substitute nominal when the nominal is
+//! missing or invalid, on the upstream backup when an upstream command is missing or
+//! would be refused), publishes the safe command.
+//!
+//! Wake-ups (docs/PARTITION.md, "Who wakes whom"): normally on the nominal command and
+//! the immediately upstream safe command only — the state of the tick was published
+//! before either, so it is read without waking on it — and always on the scheduler's
+//! stage-deadline watchdog. While an input is absent (a dead or late producer), or a
+//! command of a tick whose state is not here yet shows that one is in flight, on every
+//! input including the state. The queues are read in reverse causal order (the upstream
+//! attitude command before the translational one it was computed from, the commands
+//! before the state): a message published while they are read is then never seen
+//! without the messages it depends on.
 
+use super::{LOST_STOP_WAKEUP, deadline_from, keep_for_tick};
 use crate::admission;
+use crate::component::{Component, Env, Finish, Message, Next, Outbox, WakeSet, Wakeup, Woke};
 use crate::convert;
-
-use crate::process::{
-    LOST_STOP_WAKEUP, Proc, partner_qos, prepare_listener, qos, send, wait, wait_outcome,
-};
-use anyhow::Context;
-use nalgebra::Vector3;
-use sc_bus::{Publisher, SignalListener, Subscriber, WaitOutcome, Waitable, Waiter};
+use crate::error::FlightError;
+use crate::process::Proc;
+use nalgebra::{SVector, Vector3};
 use sc_cbf::SafetyLayer;
-use sc_icd::*;
-use std::time::Instant;
+use sc_cbf::chain::flag_missing;
+use sc_core::Subsystem;
+use sc_icd::services::{self, ServiceName};
+use sc_icd::{Role, RoleKind, SafeAttitude, SafeTranslational, SimState, tick_command};
+use sc_scenario::Scenario;
+use std::collections::VecDeque;
 
-use super::*;
+/// A nominal command as the filter keeps it, whatever its subsystem.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Nominal {
+    tick: u64,
+    valid: u32,
+    /// The command's components (the first 3 or 7 are used).
+    u: [f64; 7],
+}
 
-/// One safety filter process.
-pub fn filter(subsystem: Subsystem) -> anyhow::Result<i32> {
-    let which = subsystem.position();
-    let role = ["safety_translational", "safety_attitude", "safety_robotic"][which];
-    let p = Proc::start(role)?;
-    let q = qos();
-    let partner_q = partner_qos();
-    // Subscribers without a listener until needed (see the wake-ups below).
-    let tick_rx = Subscriber::<Tick>::polled(&p.node, services::CONTROL, &q)?;
-    let state_rx = Subscriber::<SimState>::polled(&p.node, services::SIM_STATE, &q)?;
-    let nt_rx = (which == 0)
-        .then(|| {
-            Subscriber::<NominalTranslational>::new(
-                &p.node,
-                services::NOMINAL_TRANSLATIONAL,
-                &partner_q,
-            )
-        })
-        .transpose()?;
-    let na_rx = (which == 1)
-        .then(|| {
-            Subscriber::<NominalAttitude>::new(&p.node, services::NOMINAL_ATTITUDE, &partner_q)
-        })
-        .transpose()?;
-    let nr_rx = (which == 2)
-        .then(|| Subscriber::<NominalRobotic>::new(&p.node, services::NOMINAL_ROBOTIC, &partner_q))
-        .transpose()?;
-    let st_rx = (which >= 1)
-        .then(|| Subscriber::<SafeTranslational>::polled(&p.node, services::SAFE_TRANSLATIONAL, &q))
-        .transpose()?;
-    let sa_rx = (which == 2)
-        .then(|| Subscriber::<SafeAttitude>::new(&p.node, services::SAFE_ATTITUDE, &q))
-        .transpose()?;
-    let tx_t = (which == 0)
-        .then(|| Publisher::<SafeTranslational>::new(&p.node, services::SAFE_TRANSLATIONAL, &q))
-        .transpose()?;
-    let tx_a = (which == 1)
-        .then(|| Publisher::<SafeAttitude>::new(&p.node, services::SAFE_ATTITUDE, &q))
-        .transpose()?;
-    let tx_r = (which == 2)
-        .then(|| Publisher::<SafeRobotic>::new(&p.node, services::SAFE_ROBOTIC, &q))
-        .transpose()?;
-    let watchdog = SignalListener::new(&p.node, services::STAGE_DEADLINE.as_str(), &q)?;
-    // real time: the pre-tick warm-up (docs/PARTITION.md, "What a hop costs")
-    let prepare = prepare_listener(&p)?;
-    // Wake-ups (docs/PARTITION.md, "Who wakes whom"). Normally on the nominal
-    // command and the immediately upstream safe command only: the state of the tick
-    // was published before either, so it is read without waking on it. While an
-    // input is absent (dead or late producer), on every input including the state.
-    // Always on the scheduler's stage-deadline watchdog. The tick queue is read at
-    // every wake-up for the stop.
-    // the command inputs of this filter, and whether each wakes it normally (the
-    // translational command wakes only the attitude filter, its direct downstream)
-    let inputs: Vec<(&dyn Waitable, bool)> = [
-        (nt_rx.as_ref().map(|s| s as &dyn Waitable), true),
-        (na_rx.as_ref().map(|s| s as &dyn Waitable), true),
-        (nr_rx.as_ref().map(|s| s as &dyn Waitable), true),
-        (st_rx.as_ref().map(|s| s as &dyn Waitable), which == 1),
-        (sa_rx.as_ref().map(|s| s as &dyn Waitable), true),
-    ]
-    .into_iter()
-    .filter_map(|(s, wakes)| Some((s?, wakes)))
-    .collect();
-    let on_inputs = Waiter::new()?;
-    let mut att = vec![on_inputs.attach(&watchdog)?];
-    if let Some(l) = &prepare {
-        att.push(on_inputs.attach(l)?);
-    }
-    for (s, _) in inputs.iter().filter(|(_, wakes)| *wakes) {
-        att.push(on_inputs.attach(*s)?);
-    }
-    // attached on first need (creates the listeners of the state and of the
-    // translational command at the robotic filter then)
-    let on_any = Waiter::new()?;
-    let mut any_attached = Vec::new();
-    macro_rules! attach_any {
-        () => {{
-            if any_attached.is_empty() {
-                any_attached.push(on_any.attach(&watchdog)?);
-                if let Some(l) = &prepare {
-                    any_attached.push(on_any.attach(l)?);
-                }
-                any_attached.push(on_any.attach(&state_rx)?);
-                for (s, _) in &inputs {
-                    any_attached.push(on_any.attach(*s)?);
-                }
-                true
-            } else {
-                false
+impl Nominal {
+    /// The nominal command of subsystem `s` carried by `m`, if it is one.
+    fn of(s: Subsystem, m: &Message) -> Option<Self> {
+        let pad3 = |a: &[f64; 3]| [a[0], a[1], a[2], 0.0, 0.0, 0.0, 0.0];
+        match (s, m) {
+            (Subsystem::Translational, Message::NominalTranslational(n)) => {
+                Some(Self::new(n.tick, n.valid, pad3(&n.f_h)))
             }
-        }};
-    }
-    let mut layer = SafetyLayer::from_scenario(&p.setup.scenario, p.setup.robot.clone());
-    let d = &p.cfg.deadlines;
-    let deadline = p.deadline(
-        [
-            d.safety_translational_ms,
-            d.safety_attitude_ms,
-            d.safety_robotic_ms,
-        ][which],
-    );
-    let bit = 1u32 << which;
-    p.handshake()?;
-    let mut states: Vec<SimState> = Vec::new();
-    let mut nom_t: Option<NominalTranslational> = None;
-    let mut nom_a: Option<NominalAttitude> = None;
-    let mut nom_r: Option<NominalRobotic> = None;
-    let mut up_t: Option<SafeTranslational> = None;
-    let mut up_a: Option<SafeAttitude> = None;
-    // inputs found missing at a deadline are not waited for again until they reappear
-    let mut absent = [false; 3]; // nominal, upstream translational, upstream attitude
-    // the tick whose nominal command this filter waits for (the next state's)
-    let mut awaited: Option<u64>;
-    let mut misses = 0u64;
-    let mut stop = false;
-    let mut last_state: Option<SimState> = None;
-    let mut rehearse = false;
-    // The queues are read in reverse causal order (docs/PARTITION.md, "Who wakes
-    // whom"): the upstream attitude command before the translational one it was
-    // computed from, the commands before the state. A message published while the
-    // pump runs is then never seen without the messages it depends on: seeing the
-    // attitude command of tick k while the translational command of k was missed
-    // would leave this filter asleep on an input that does not wake it.
-    macro_rules! pump {
-        () => {{
-            watchdog.drain()?;
-            if let Some(l) = &prepare {
-                rehearse |= l.drain()? > 0;
+            (Subsystem::Attitude, Message::NominalAttitude(n)) => {
+                Some(Self::new(n.tick, n.valid, pad3(&n.tau_b)))
             }
-            stop |= stop_seen(&drain(&tick_rx)?);
-            if let Some(m) = newest(sa_rx.as_ref())? {
-                up_a = Some(m);
-                absent[2] = false;
+            (Subsystem::Robotic, Message::NominalRobotic(n)) => {
+                Some(Self::new(n.tick, n.valid, n.tau_m))
             }
-            if let Some(m) = newest(st_rx.as_ref())? {
-                up_t = Some(m);
-                absent[1] = false;
-            }
-            // this filter's nominal command (only one of the three subscribers exists),
-            // judged once the states it may answer are known
-            let (got_t, got_a, got_r) = (
-                drain_opt(nt_rx.as_ref())?,
-                drain_opt(na_rx.as_ref())?,
-                drain_opt(nr_rx.as_ref())?,
-            );
-            states.extend(
-                drain(&state_rx)?
-                    .into_iter()
-                    .filter(|s| s.due_mask & bit != 0),
-            );
-            let known = states.last().or(last_state.as_ref()).map(|s| s.tick);
-            if keep_for_tick(got_t, &mut nom_t, awaited, known, |m| m.tick)
-                | keep_for_tick(got_a, &mut nom_a, awaited, known, |m| m.tick)
-                | keep_for_tick(got_r, &mut nom_r, awaited, known, |m| m.tick)
-            {
-                absent[0] = false;
-            }
-        }};
-    }
-    loop {
-        awaited = states
-            .first()
-            .or(last_state.as_ref())
-            .map(|s| s.tick + u64::from(states.is_empty()));
-        if states.is_empty() {
-            if stop {
-                break;
-            }
-            // A command of a tick whose state is not queued: the state was sent
-            // before it, so its sender was preempted between this filter's queue and
-            // the others'. The state does not wake this filter: wake on every input.
-            let newest = [
-                nom_t.map(|m| m.tick),
-                nom_a.map(|m| m.tick),
-                nom_r.map(|m| m.tick),
-                up_t.map(|m| m.tick),
-                up_a.map(|m| m.tick),
-            ]
-            .into_iter()
-            .flatten()
-            .max();
-            let state_in_flight = newest > last_state.map(|s| s.tick);
-            let wake_on_any = absent.iter().any(|a| *a) || state_in_flight;
-            // just attached: no wait, read what came before the listeners existed
-            let fresh = wake_on_any && attach_any!();
-            let woke = if fresh {
-                WaitOutcome::Handled
-            } else {
-                wait_outcome(if wake_on_any { &on_any } else { &on_inputs }, None)?
-            };
-            if woke == WaitOutcome::TerminationRequest {
-                break;
-            }
-            pump!();
-            if stop && states.is_empty() && woke == WaitOutcome::Timeout {
-                eprintln!("{role}: {LOST_STOP_WAKEUP}");
-            }
-            if std::mem::take(&mut rehearse)
-                && states.is_empty()
-                && let Some(s) = &last_state
-            {
-                // the pre-tick warm-up: this filter's step on the last tick's inputs
-                // (the filters are memoryless); the output is dropped, nothing is sent
-                p.rehearse(|| -> anyhow::Result<()> {
-                    let o = convert::observation(s);
-                    let f_b = up_t.map_or_else(Vector3::zeros, |m| convert::vec3(&m.actuated));
-                    let tau_b = up_a.map_or_else(Vector3::zeros, |m| convert::vec3(&m.u));
-                    match which {
-                        0 => {
-                            if let Some(n) = nom_t {
-                                std::hint::black_box(
-                                    layer.translational_stage(&o, Some(&convert::vec3(&n.f_h))),
-                                );
-                            }
-                            tx_t.as_ref().context("publisher")?.warm()?;
-                        }
-                        1 => {
-                            if let Some(n) = nom_a {
-                                std::hint::black_box(layer.attitude_stage(
-                                    &o,
-                                    &f_b,
-                                    Some(&convert::vec3(&n.tau_b)),
-                                ));
-                            }
-                            tx_a.as_ref().context("publisher")?.warm()?;
-                        }
-                        _ => {
-                            if let Some(n) = nom_r {
-                                std::hint::black_box(layer.robotic_stage(
-                                    &o,
-                                    &f_b,
-                                    &tau_b,
-                                    Some(&convert::vec7(&n.tau_m)),
-                                ));
-                            }
-                            tx_r.as_ref().context("publisher")?.warm()?;
-                        }
-                    }
-                    Ok(())
-                })?;
-            }
-            continue;
+            _ => None,
         }
-        let s = states.remove(0);
-        last_state = Some(s);
+    }
+
+    fn new(tick: u64, valid: u32, u: [f64; 7]) -> Self {
+        Self { tick, valid, u }
+    }
+
+    fn vec<const M: usize>(&self) -> SVector<f64, M> {
+        SVector::from_column_slice(&self.u[..M])
+    }
+}
+
+/// Inputs found missing at a deadline: not waited for again until they reappear.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+struct Absent {
+    nominal: bool,
+    translational: bool,
+    attitude: bool,
+}
+
+impl Absent {
+    fn any(&self) -> bool {
+        self.nominal || self.translational || self.attitude
+    }
+}
+
+/// The tick being awaited: its state and stage deadline.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Pending {
+    state: SimState,
+    until_ns: u64,
+}
+
+/// Which inputs of a tick are here (or not awaited).
+#[derive(Debug, Clone, Copy)]
+struct Have {
+    nominal: bool,
+    translational: bool,
+    attitude: bool,
+    /// The attitude command is due in this tick.
+    need_attitude: bool,
+}
+
+impl Have {
+    fn all(&self) -> bool {
+        self.nominal && self.translational && self.attitude
+    }
+}
+
+/// The wake sets: normally, and on every input while one is absent or late.
+const NORMAL: usize = 0;
+const ANY: usize = 1;
+
+/// One safety filter.
+pub struct FilterRole {
+    subsystem: Subsystem,
+    name: &'static str,
+    layer: SafetyLayer,
+    scenario: Scenario,
+    deadline_ns: u64,
+    states: VecDeque<SimState>,
+    last_state: Option<SimState>,
+    pending: Option<Pending>,
+    nominal: Option<Nominal>,
+    up_t: Option<SafeTranslational>,
+    up_a: Option<SafeAttitude>,
+    absent: Absent,
+    stop: bool,
+    rehearse: bool,
+    misses: u64,
+}
+
+impl FilterRole {
+    /// The filter of `subsystem` on `scenario`'s safety layer with its stage deadline.
+    pub fn new(
+        subsystem: Subsystem,
+        layer: SafetyLayer,
+        scenario: Scenario,
+        deadline_ns: u64,
+    ) -> Self {
+        Self {
+            subsystem,
+            name: Role::of(RoleKind::Filter(subsystem)).name,
+            layer,
+            scenario,
+            deadline_ns,
+            states: VecDeque::new(),
+            last_state: None,
+            pending: None,
+            nominal: None,
+            up_t: None,
+            up_a: None,
+            absent: Absent::default(),
+            stop: false,
+            rehearse: false,
+            misses: 0,
+        }
+    }
+
+    /// From the process's config: the scenario's safety layer, the stage deadline of
+    /// `[deadlines]` in the run's clock mode.
+    pub fn from_process(subsystem: Subsystem, p: &Proc) -> Result<Self, FlightError> {
+        let s = &p.setup.scenario;
+        let layer = SafetyLayer::from_scenario(s, p.setup.robot.clone());
+        let deadline = p.deadline(p.cfg.deadlines.filter_ms(subsystem));
+        let ns = deadline.as_nanos().min(u128::from(u64::MAX)) as u64;
+        Ok(Self::new(subsystem, layer, s.clone(), ns))
+    }
+
+    /// The tick whose nominal command this filter waits for: the pending state's, else
+    /// the next state's.
+    fn awaited(&self) -> Option<u64> {
+        match &self.pending {
+            Some(p) => Some(p.state.tick),
+            None => self
+                .states
+                .front()
+                .or(self.last_state.as_ref())
+                .map(|s| s.tick + u64::from(self.states.is_empty())),
+        }
+    }
+
+    /// Takes the inputs of one wake-up (in the role's read order).
+    fn absorb(&mut self, w: &Wakeup, inputs: &[Message]) {
+        self.rehearse |= w.prepare > 0;
+        let awaited = self.awaited();
+        let mut got = Vec::new();
+        for m in inputs {
+            match m {
+                Message::Control(t) => self.stop |= t.command == tick_command::STOP,
+                Message::SafeAttitude(a) => {
+                    self.up_a = Some(*a);
+                    self.absent.attitude = false;
+                }
+                Message::SafeTranslational(t) => {
+                    self.up_t = Some(*t);
+                    self.absent.translational = false;
+                }
+                Message::State(s) if s.due_mask & self.subsystem.bit() != 0 => {
+                    self.states.push_back(*s)
+                }
+                m => got.extend(Nominal::of(self.subsystem, m)),
+            }
+        }
+        // judged once the states its commands may answer are known
+        let known = self
+            .states
+            .back()
+            .or(self.last_state.as_ref())
+            .map(|s| s.tick);
+        if keep_for_tick(got, &mut self.nominal, awaited, known, |m| m.tick) {
+            self.absent.nominal = false;
+        }
+    }
+
+    /// Which inputs of the pending tick `s` are here (or found absent before).
+    fn have(&self, s: &SimState) -> Have {
         let k = s.tick;
-        awaited = Some(k);
-        // the stage deadline counts from the publication of the state
-        let until = instant_of(s.publish_ns) + deadline;
-        let need_t = which >= 1 && s.due_mask & due::TRANSLATIONAL != 0;
-        let need_a = which == 2 && s.due_mask & due::ATTITUDE != 0;
-        let mut fresh = false;
+        let need_t = self.subsystem > Subsystem::Translational
+            && s.due_mask & Subsystem::Translational.bit() != 0;
+        let need_a =
+            self.subsystem == Subsystem::Robotic && s.due_mask & Subsystem::Attitude.bit() != 0;
+        Have {
+            nominal: self.absent.nominal || self.nominal.is_some_and(|m| m.tick == k),
+            translational: !need_t
+                || self.absent.translational
+                || self.up_t.is_some_and(|m| m.tick == k),
+            attitude: !need_a || self.absent.attitude || self.up_a.is_some_and(|m| m.tick == k),
+            need_attitude: need_a,
+        }
+    }
+
+    /// Computes every tick whose inputs are complete or whose deadline passed.
+    fn process(&mut self, now_ns: u64, out: &mut Outbox) {
         loop {
-            let nom_ok = absent[0]
-                || match which {
-                    0 => nom_t.is_some_and(|m| m.tick == k),
-                    1 => nom_a.is_some_and(|m| m.tick == k),
-                    _ => nom_r.is_some_and(|m| m.tick == k),
+            if self.pending.is_none() {
+                let Some(s) = self.states.pop_front() else {
+                    return;
                 };
-            let t_ok = !need_t || absent[1] || up_t.is_some_and(|m| m.tick == k);
-            let a_ok = !need_a || absent[2] || up_a.is_some_and(|m| m.tick == k);
-            if nom_ok && t_ok && a_ok {
-                break;
+                self.last_state = Some(s);
+                let until_ns = deadline_from(s.publish_ns, now_ns, self.deadline_ns);
+                self.pending = Some(Pending { state: s, until_ns });
             }
-            if Instant::now() >= until {
-                misses += 1;
-                if !nom_ok {
-                    eprintln!("{role}: FAULT tick {k}: nominal command missing at the deadline");
-                    absent[0] = true;
+            let Some(p) = self.pending else { return };
+            let have = self.have(&p.state);
+            if !have.all() {
+                if now_ns < p.until_ns {
+                    return;
                 }
-                if !t_ok {
-                    eprintln!(
-                        "{role}: FAULT tick {k}: translational safe command missing at the deadline"
-                    );
-                    absent[1] = true;
-                }
-                if !a_ok {
-                    eprintln!(
-                        "{role}: FAULT tick {k}: attitude safe command missing at the deadline"
-                    );
-                    absent[2] = true;
-                }
-                break;
+                self.deadline_passed(p.state.tick, &have, out);
             }
-            // The robotic filter does not wake on the translational command. It
-            // waits for it on every input in a tick where only the translational
-            // group is due upstream, and when the attitude command of the tick is
-            // already here without it (the translational filter was preempted between
-            // the attitude filter's queue and this one's).
-            let t_unwoken = which == 2 && !t_ok && (!need_a || up_a.is_some_and(|m| m.tick == k));
-            let wake_on_any = absent.iter().any(|a| *a) || t_unwoken;
-            if wake_on_any && attach_any!() {
-                fresh = true; // just attached: no wait, read what came before
-            }
-            if !fresh && !wait(if wake_on_any { &on_any } else { &on_inputs }, Some(until))? {
-                return Ok(0);
-            }
-            fresh = false;
-            pump!();
+            self.pending = None;
+            out.send(self.compute(&p.state, now_ns));
         }
-        let recv_ns = now();
-        let o = convert::observation(&s);
+    }
+
+    /// The stage deadline of tick `k` passed with inputs missing: each is flagged absent
+    /// (not waited for again until it reappears) and named in the log.
+    fn deadline_passed(&mut self, k: u64, have: &Have, out: &mut Outbox) {
+        self.misses += 1;
+        let name = self.name;
+        if !have.nominal {
+            out.log(format!(
+                "{name}: FAULT tick {k}: nominal command missing at the deadline"
+            ));
+            self.absent.nominal = true;
+        }
+        if !have.translational {
+            out.log(format!(
+                "{name}: FAULT tick {k}: translational safe command missing at the deadline"
+            ));
+            self.absent.translational = true;
+        }
+        if !have.attitude {
+            out.log(format!(
+                "{name}: FAULT tick {k}: attitude safe command missing at the deadline"
+            ));
+            self.absent.attitude = true;
+        }
+    }
+
+    /// The upstream safe force of tick `s` [N, F_B]: this tick's, the held one of a slower
+    /// group, or — missing, dead upstream, or one the simulator would refuse — the
+    /// upstream backup, which is what the simulator applies. `true` when it is the backup.
+    fn upstream_force(&mut self, s: &SimState, o: &sc_core::Observation) -> (Vector3<f64>, bool) {
+        let need = s.due_mask & Subsystem::Translational.bit() != 0;
+        let absent = self.absent.translational;
+        let lim = &self.scenario.limits;
+        match self
+            .up_t
+            .filter(|m| if need { m.tick == s.tick } else { !absent })
+            .filter(|m| admission::translational(m, lim))
+        {
+            Some(m) => (convert::vec3(&m.actuated), false),
+            None => (self.layer.backup_translational(o).actuated, true),
+        }
+    }
+
+    /// The upstream safe torque of tick `s` [N m, F_B] with the force `f_b` acting, as
+    /// [`Self::upstream_force`].
+    fn upstream_torque(
+        &mut self,
+        s: &SimState,
+        o: &sc_core::Observation,
+        f_b: &Vector3<f64>,
+    ) -> (Vector3<f64>, bool) {
+        let need = s.due_mask & Subsystem::Attitude.bit() != 0;
+        let absent = self.absent.attitude;
+        let lim = &self.scenario.limits;
+        match self
+            .up_a
+            .filter(|m| if need { m.tick == s.tick } else { !absent })
+            .filter(|m| admission::attitude(m, lim))
+        {
+            Some(m) => (convert::vec3(&m.u), false),
+            None => (self.layer.backup_attitude(o, f_b).u, true),
+        }
+    }
+
+    /// This filter's safe command for tick `s`, received complete (or at its deadline) at
+    /// `now_ns`.
+    fn compute(&mut self, s: &SimState, now_ns: u64) -> Message {
+        let o = convert::observation(s);
         // the mission's own schedule (a nominal's report of its phase is not trusted)
-        let phase = p.setup.scenario.phase_index(o.t);
-        // upstream safe commands: this tick's, the held one of a slower group, or
-        // (missing / dead upstream, or one the simulator would reject) the upstream
-        // fallback, which is what the simulator applies
-        let mut upstream_missing = false;
-        let lim = &p.setup.scenario.limits;
-        let f_b: Vector3<f64> = if which >= 1 {
-            match up_t
-                .filter(|m| if need_t { m.tick == k } else { !absent[1] })
-                .filter(|m| admission::translational(m, lim))
-            {
-                Some(m) => convert::vec3(&m.actuated),
-                None => {
-                    upstream_missing = true;
-                    layer.backup_translational(&o).actuated
-                }
+        let phase = self.scenario.phase_index(o.t);
+        let (mut f_b, mut tau_b) = (Vector3::zeros(), Vector3::zeros());
+        let mut missing = false;
+        if self.subsystem > Subsystem::Translational {
+            let (f, m) = self.upstream_force(s, &o);
+            (f_b, missing) = (f, m);
+        }
+        if self.subsystem == Subsystem::Robotic {
+            let (t, m) = self.upstream_torque(s, &o, &f_b);
+            (tau_b, missing) = (t, missing | m);
+        }
+        // a command for another tick, or one its sender marks invalid, is no command:
+        // the filter runs its QP on the substitute nominal
+        let nominal = self.nominal.filter(|m| m.tick == s.tick && m.valid != 0);
+        let (k, t) = (s.tick, s.t);
+        let mut msg = match self.subsystem {
+            Subsystem::Translational => {
+                let out = self
+                    .layer
+                    .translational_stage(&o, nominal.map(|n| n.vec()).as_ref());
+                Message::SafeTranslational(convert::safe_msg(&flagged(out, missing), k, t, phase))
             }
-        } else {
-            Vector3::zeros()
+            Subsystem::Attitude => {
+                let out = self
+                    .layer
+                    .attitude_stage(&o, &f_b, nominal.map(|n| n.vec()).as_ref());
+                Message::SafeAttitude(convert::safe_msg(&flagged(out, missing), k, t, phase))
+            }
+            Subsystem::Robotic => {
+                let nom = nominal.map(|n| n.vec());
+                let out = self.layer.robotic_stage(&o, &f_b, &tau_b, nom.as_ref());
+                Message::SafeRobotic(convert::safe_msg(&flagged(out, missing), k, t, phase))
+            }
         };
-        let tau_b: Vector3<f64> = if which == 2 {
-            match up_a
-                .filter(|m| if need_a { m.tick == k } else { !absent[2] })
-                .filter(|m| admission::attitude(m, lim))
-            {
-                Some(m) => convert::vec3(&m.u),
-                None => {
-                    upstream_missing = true;
-                    layer.backup_attitude(&o, &f_b).u
-                }
-            }
+        set_recv_ns(&mut msg, now_ns);
+        msg
+    }
+
+    /// The safe command's service.
+    fn output(&self) -> &'static [ServiceName] {
+        match self.subsystem {
+            Subsystem::Translational => &[services::SAFE_TRANSLATIONAL],
+            Subsystem::Attitude => &[services::SAFE_ATTITUDE],
+            Subsystem::Robotic => &[services::SAFE_ROBOTIC],
+        }
+    }
+}
+
+/// `out`, flagged [`sc_cbf::faults::UPSTREAM_MISSING`] when an upstream command was
+/// replaced by its backup.
+fn flagged<const M: usize, const N: usize>(
+    out: sc_cbf::FilterOutput<M, N>,
+    missing: bool,
+) -> sc_cbf::FilterOutput<M, N> {
+    if missing { flag_missing(out) } else { out }
+}
+
+/// The stamp at which the last input of the tick arrived.
+fn set_recv_ns(m: &mut Message, ns: u64) {
+    match m {
+        Message::SafeTranslational(x) => x.recv_ns = ns,
+        Message::SafeAttitude(x) => x.recv_ns = ns,
+        Message::SafeRobotic(x) => x.recv_ns = ns,
+        _ => {}
+    }
+}
+
+/// Per subsystem: the wake sets and the read order (reverse causal order).
+mod wiring {
+    use super::{ServiceName, WakeSet, services::*};
+
+    pub const TRANSLATIONAL_WAKE: &[WakeSet] = &[
+        WakeSet {
+            on: &[STAGE_DEADLINE, PREPARE, NOMINAL_TRANSLATIONAL],
+            lazy: false,
+        },
+        WakeSet {
+            on: &[STAGE_DEADLINE, PREPARE, SIM_STATE, NOMINAL_TRANSLATIONAL],
+            lazy: true,
+        },
+    ];
+    pub const ATTITUDE_WAKE: &[WakeSet] = &[
+        WakeSet {
+            on: &[
+                STAGE_DEADLINE,
+                PREPARE,
+                NOMINAL_ATTITUDE,
+                SAFE_TRANSLATIONAL,
+            ],
+            lazy: false,
+        },
+        WakeSet {
+            on: &[
+                STAGE_DEADLINE,
+                PREPARE,
+                SIM_STATE,
+                NOMINAL_ATTITUDE,
+                SAFE_TRANSLATIONAL,
+            ],
+            lazy: true,
+        },
+    ];
+    // the translational command wakes only its direct downstream, the attitude filter
+    pub const ROBOTIC_WAKE: &[WakeSet] = &[
+        WakeSet {
+            on: &[STAGE_DEADLINE, PREPARE, NOMINAL_ROBOTIC, SAFE_ATTITUDE],
+            lazy: false,
+        },
+        WakeSet {
+            on: &[
+                STAGE_DEADLINE,
+                PREPARE,
+                SIM_STATE,
+                NOMINAL_ROBOTIC,
+                SAFE_TRANSLATIONAL,
+                SAFE_ATTITUDE,
+            ],
+            lazy: true,
+        },
+    ];
+    pub const TRANSLATIONAL_IN: &[ServiceName] = &[
+        STAGE_DEADLINE,
+        PREPARE,
+        CONTROL,
+        NOMINAL_TRANSLATIONAL,
+        SIM_STATE,
+    ];
+    pub const ATTITUDE_IN: &[ServiceName] = &[
+        STAGE_DEADLINE,
+        PREPARE,
+        CONTROL,
+        SAFE_TRANSLATIONAL,
+        NOMINAL_ATTITUDE,
+        SIM_STATE,
+    ];
+    pub const ROBOTIC_IN: &[ServiceName] = &[
+        STAGE_DEADLINE,
+        PREPARE,
+        CONTROL,
+        SAFE_ATTITUDE,
+        SAFE_TRANSLATIONAL,
+        NOMINAL_ROBOTIC,
+        SIM_STATE,
+    ];
+}
+
+impl Component for FilterRole {
+    fn wake_sets(&self) -> &'static [WakeSet] {
+        match self.subsystem {
+            Subsystem::Translational => wiring::TRANSLATIONAL_WAKE,
+            Subsystem::Attitude => wiring::ATTITUDE_WAKE,
+            Subsystem::Robotic => wiring::ROBOTIC_WAKE,
+        }
+    }
+
+    fn inputs(&self) -> &'static [ServiceName] {
+        match self.subsystem {
+            Subsystem::Translational => wiring::TRANSLATIONAL_IN,
+            Subsystem::Attitude => wiring::ATTITUDE_IN,
+            Subsystem::Robotic => wiring::ROBOTIC_IN,
+        }
+    }
+
+    fn warm(&self) -> &'static [ServiceName] {
+        self.output()
+    }
+
+    fn next(&mut self, _: u64) -> Next {
+        if let Some(p) = &self.pending {
+            let have = self.have(&p.state);
+            // the robotic filter does not wake on the translational command: it waits
+            // for it on every input when only the translational group is due upstream,
+            // or when the attitude command of the tick is here without it (the
+            // translational filter was preempted between the two queues)
+            let unwoken = self.subsystem == Subsystem::Robotic
+                && !have.translational
+                && (!have.need_attitude || self.up_a.is_some_and(|m| m.tick == p.state.tick));
+            let set = if self.absent.any() || unwoken {
+                ANY
+            } else {
+                NORMAL
+            };
+            return Next::Wait {
+                set,
+                until_ns: Some(p.until_ns),
+            };
+        }
+        if self.stop {
+            return Next::Exit;
+        }
+        // a command of a tick whose state is not here: the state was sent before it
+        // (its sender was preempted between this filter's queue and the others'), and
+        // the state does not wake this filter
+        let newest = [
+            self.nominal.map(|m| m.tick),
+            self.up_t.map(|m| m.tick),
+            self.up_a.map(|m| m.tick),
+        ]
+        .into_iter()
+        .flatten()
+        .max();
+        let in_flight = newest > self.last_state.map(|s| s.tick);
+        let set = if self.absent.any() || in_flight {
+            ANY
         } else {
-            Vector3::zeros()
+            NORMAL
         };
-        let publish_ns;
-        match which {
-            0 => {
-                // a command for another tick, or one its sender marks invalid, is no
-                // command: the filter runs its QP on the substitute nominal
-                let nom = nom_t.filter(|m| m.tick == k && m.valid != 0);
-                let f = nom.map(|n| convert::vec3(&n.f_h));
-                let mut out = layer.translational_stage(&o, f.as_ref());
-                if upstream_missing {
-                    out = sc_cbf::chain::flag_missing(out);
-                }
-                let mut m: SafeTranslational = convert::safe_msg(&out, k, s.t, phase);
-                m.recv_ns = recv_ns;
-                publish_ns = now();
-                m.publish_ns = publish_ns;
-                send(tx_t.as_ref().context("publisher")?, &m)?;
+        Next::Wait {
+            set,
+            until_ns: None,
+        }
+    }
+
+    fn handle(&mut self, w: &Wakeup, inputs: &[Message], _: &mut dyn Env, out: &mut Outbox) {
+        let idle = self.pending.is_none();
+        self.absorb(w, inputs);
+        if idle {
+            if self.stop && self.states.is_empty() && w.why == Woke::Timeout {
+                out.log(format!("{}: {LOST_STOP_WAKEUP}", self.name));
             }
-            1 => {
-                let nom = nom_a.filter(|m| m.tick == k && m.valid != 0);
-                let t = nom.map(|n| convert::vec3(&n.tau_b));
-                let mut out = layer.attitude_stage(&o, &f_b, t.as_ref());
-                if upstream_missing {
-                    out = sc_cbf::chain::flag_missing(out);
-                }
-                let mut m: SafeAttitude = convert::safe_msg(&out, k, s.t, phase);
-                m.recv_ns = recv_ns;
-                publish_ns = now();
-                m.publish_ns = publish_ns;
-                send(tx_a.as_ref().context("publisher")?, &m)?;
+            // the pre-tick warm-up: only between ticks
+            out.rehearse = std::mem::take(&mut self.rehearse)
+                && self.states.is_empty()
+                && self.last_state.is_some();
+        }
+        self.process(w.now_ns, out);
+    }
+
+    /// This filter's step on the last tick's inputs (the filters are memoryless).
+    fn rehearse(&mut self) {
+        let (Some(s), Some(n)) = (self.last_state, self.nominal) else {
+            return;
+        };
+        let o = convert::observation(&s);
+        let f_b = self
+            .up_t
+            .map_or_else(Vector3::zeros, |m| convert::vec3(&m.actuated));
+        let tau_b = self
+            .up_a
+            .map_or_else(Vector3::zeros, |m| convert::vec3(&m.u));
+        match self.subsystem {
+            Subsystem::Translational => {
+                std::hint::black_box(self.layer.translational_stage(&o, Some(&n.vec())));
             }
-            _ => {
-                let nom = nom_r.filter(|m| m.tick == k && m.valid != 0);
-                let t = nom.map(|n| convert::vec7(&n.tau_m));
-                let mut out = layer.robotic_stage(&o, &f_b, &tau_b, t.as_ref());
-                if upstream_missing {
-                    out = sc_cbf::chain::flag_missing(out);
-                }
-                let mut m: SafeRobotic = convert::safe_msg(&out, k, s.t, phase);
-                m.recv_ns = recv_ns;
-                publish_ns = now();
-                m.publish_ns = publish_ns;
-                send(tx_r.as_ref().context("publisher")?, &m)?;
+            Subsystem::Attitude => {
+                std::hint::black_box(self.layer.attitude_stage(&o, &f_b, Some(&n.vec())));
+            }
+            Subsystem::Robotic => {
+                std::hint::black_box(self.layer.robotic_stage(&o, &f_b, &tau_b, Some(&n.vec())));
             }
         }
-        let _ = publish_ns;
     }
-    drop(att);
-    // wake the downstream filter (and the simulator) once so that they see the stop
-    match which {
-        0 => tx_t.as_ref().context("publisher")?.notify()?,
-        1 => tx_a.as_ref().context("publisher")?.notify()?,
-        _ => tx_r.as_ref().context("publisher")?.notify()?,
+
+    fn finish(&mut self, why: Finish, impostors: &[(ServiceName, u64)], out: &mut Outbox) -> i32 {
+        if why == Finish::Terminated && self.pending.is_some() {
+            return 0;
+        }
+        // wake the downstream filter (and the simulator) once so that they see the stop
+        out.notify.extend_from_slice(self.output());
+        let dropped: u64 = impostors.iter().map(|(_, n)| n).sum();
+        out.log(format!(
+            "{}: done, {} deadline misses, {dropped} samples from a second publisher dropped",
+            self.name, self.misses
+        ));
+        0
     }
-    let impostors = nt_rx.as_ref().map_or(0, |s| s.rejected())
-        + na_rx.as_ref().map_or(0, |s| s.rejected())
-        + nr_rx.as_ref().map_or(0, |s| s.rejected())
-        + st_rx.as_ref().map_or(0, |s| s.rejected())
-        + sa_rx.as_ref().map_or(0, |s| s.rejected());
-    eprintln!(
-        "{role}: done, {misses} deadline misses, {impostors} samples from a second publisher dropped"
-    );
-    Ok(0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::component::NoPeers;
+    use crate::roles::testing::{setup, state, wakeup};
+    use sc_cbf::faults;
+    use sc_core::SubsystemSet;
+    use sc_icd::{NominalAttitude, NominalRobotic, NominalTranslational, Tick};
+
+    const DEADLINE_NS: u64 = 40_000_000;
+    const PUBLISHED_NS: u64 = 1_000;
+
+    fn role(s: Subsystem) -> FilterRole {
+        let su = setup();
+        let layer = SafetyLayer::from_scenario(&su.scenario, su.robot.clone());
+        FilterRole::new(s, layer, su.scenario, DEADLINE_NS)
+    }
+
+    fn tick_state(k: u64) -> Message {
+        let mut s = state(k, SubsystemSet::ALL.bits());
+        s.publish_ns = PUBLISHED_NS;
+        Message::State(s)
+    }
+
+    fn nominal(s: Subsystem, tick: u64, valid: u32) -> Message {
+        let (t, phase, recv_ns, publish_ns) = (0.0, 0, 0, 0);
+        match s {
+            Subsystem::Translational => Message::NominalTranslational(NominalTranslational {
+                tick,
+                t,
+                valid,
+                phase,
+                recv_ns,
+                publish_ns,
+                f_h: [0.1, 0.0, 0.0],
+            }),
+            Subsystem::Attitude => Message::NominalAttitude(NominalAttitude {
+                tick,
+                t,
+                valid,
+                phase,
+                recv_ns,
+                publish_ns,
+                tau_b: [0.0, 0.01, 0.0],
+            }),
+            Subsystem::Robotic => Message::NominalRobotic(NominalRobotic {
+                tick,
+                t,
+                valid,
+                phase,
+                recv_ns,
+                publish_ns,
+                tau_m: [0.0; 7],
+            }),
+        }
+    }
+
+    /// The fault flags of the one safe command sent.
+    fn sent_faults(out: &Outbox) -> u32 {
+        match out.send.as_slice() {
+            [Message::SafeTranslational(m)] => m.fault_flags,
+            [Message::SafeAttitude(m)] => m.fault_flags,
+            [Message::SafeRobotic(m)] => m.fault_flags,
+            other => panic!("expected one safe command, got {other:?}"),
+        }
+    }
+
+    fn handle(r: &mut FilterRole, now: u64, why: Woke, inputs: &[Message]) -> Outbox {
+        let mut out = Outbox::default();
+        r.handle(&wakeup(now, why), inputs, &mut NoPeers, &mut out);
+        out
+    }
+
+    #[test]
+    fn a_complete_tick_is_filtered_at_once() {
+        let mut r = role(Subsystem::Translational);
+        let out = handle(
+            &mut r,
+            2_000,
+            Woke::Event,
+            &[nominal(Subsystem::Translational, 0, 1), tick_state(0)],
+        );
+        assert_eq!(sent_faults(&out) & faults::NOMINAL_MISSING, 0);
+        let Message::SafeTranslational(m) = out.send[0] else {
+            panic!()
+        };
+        assert_eq!((m.tick, m.recv_ns), (0, 2_000));
+        assert_eq!(
+            r.next(0),
+            Next::Wait {
+                set: NORMAL,
+                until_ns: None
+            }
+        );
+    }
+
+    #[test]
+    fn at_the_deadline_it_runs_on_the_substitute_and_stops_waiting_for_the_nominal() {
+        let mut r = role(Subsystem::Translational);
+        let out = handle(&mut r, 2_000, Woke::Event, &[tick_state(0)]);
+        assert!(
+            out.send.is_empty(),
+            "waits for its nominal until the deadline"
+        );
+        let until = PUBLISHED_NS + DEADLINE_NS;
+        assert_eq!(
+            r.next(2_000),
+            Next::Wait {
+                set: NORMAL,
+                until_ns: Some(until)
+            }
+        );
+        let out = handle(&mut r, until, Woke::Timeout, &[]);
+        assert_ne!(sent_faults(&out) & faults::NOMINAL_MISSING, 0);
+        assert!(out.log[0].contains("FAULT tick 0: nominal command missing at the deadline"));
+        // absent: the next tick is not waited for, and every input wakes the filter
+        assert_eq!(
+            r.next(until).clone(),
+            Next::Wait {
+                set: ANY,
+                until_ns: None
+            }
+        );
+        let out = handle(&mut r, until + 1, Woke::Event, &[tick_state(1)]);
+        assert_eq!(out.send.len(), 1, "tick 1 filtered without waiting");
+        assert_eq!(r.misses, 1);
+    }
+
+    #[test]
+    fn a_command_for_another_tick_or_marked_invalid_is_no_command() {
+        let mut r = role(Subsystem::Attitude);
+        let up = Message::SafeTranslational(SafeTranslational {
+            tick: 0,
+            ..Default::default()
+        });
+        // labelled for a tick whose state does not exist yet: a lie, dropped
+        let out = handle(
+            &mut r,
+            10,
+            Woke::Event,
+            &[up, nominal(Subsystem::Attitude, 5, 1), tick_state(0)],
+        );
+        assert!(out.send.is_empty());
+        assert_eq!(r.nominal, None);
+        let out = handle(
+            &mut r,
+            20,
+            Woke::Event,
+            &[nominal(Subsystem::Attitude, 0, 0)],
+        );
+        assert_ne!(
+            sent_faults(&out) & faults::NOMINAL_MISSING,
+            0,
+            "an invalid nominal is not filtered"
+        );
+    }
+
+    #[test]
+    fn a_refused_upstream_command_is_replaced_by_the_upstream_backup() {
+        let mut r = role(Subsystem::Robotic);
+        let lim = setup().scenario.limits;
+        let mut bad = SafeAttitude {
+            tick: 0,
+            ..Default::default()
+        };
+        bad.u[1] = 10.0 * lim.torque_max_nm;
+        let ok = SafeTranslational {
+            tick: 0,
+            ..Default::default()
+        };
+        let inputs = [
+            Message::SafeAttitude(bad),
+            Message::SafeTranslational(ok),
+            nominal(Subsystem::Robotic, 0, 1),
+            tick_state(0),
+        ];
+        let out = handle(&mut r, 10, Woke::Event, &inputs);
+        assert_ne!(sent_faults(&out) & faults::UPSTREAM_MISSING, 0);
+    }
+
+    #[test]
+    fn a_missing_upstream_command_is_waited_for_then_replaced_by_its_backup() {
+        let mut r = role(Subsystem::Attitude);
+        let out = handle(
+            &mut r,
+            10,
+            Woke::Event,
+            &[nominal(Subsystem::Attitude, 0, 1), tick_state(0)],
+        );
+        assert!(out.send.is_empty(), "waits for the translational command");
+        let until = PUBLISHED_NS + DEADLINE_NS;
+        let out = handle(&mut r, until, Woke::Timeout, &[]);
+        assert!(out.log[0].contains("translational safe command missing at the deadline"));
+        assert_ne!(sent_faults(&out) & faults::UPSTREAM_MISSING, 0);
+        assert!(r.absent.translational);
+        // the dead upstream comes back: no longer absent
+        let up = Message::SafeTranslational(SafeTranslational {
+            tick: 1,
+            ..Default::default()
+        });
+        handle(&mut r, until + 1, Woke::Event, &[up]);
+        assert!(!r.absent.translational);
+    }
+
+    #[test]
+    fn the_robotic_filter_waits_on_every_input_for_an_unwoken_translational_command() {
+        let mut r = role(Subsystem::Robotic);
+        let a = Message::SafeAttitude(SafeAttitude {
+            tick: 0,
+            ..Default::default()
+        });
+        handle(
+            &mut r,
+            10,
+            Woke::Event,
+            &[a, nominal(Subsystem::Robotic, 0, 1), tick_state(0)],
+        );
+        let Next::Wait { set, .. } = r.next(10) else {
+            panic!()
+        };
+        assert_eq!(set, ANY, "the translational command does not wake it");
+    }
+
+    #[test]
+    fn the_stop_ends_the_filter_and_wakes_its_downstream() {
+        let mut r = role(Subsystem::Attitude);
+        let stop = Message::Control(Tick {
+            command: tick_command::STOP,
+            ..Default::default()
+        });
+        let out = handle(&mut r, 10, Woke::Timeout, &[stop]);
+        assert!(out.log[0].contains(LOST_STOP_WAKEUP));
+        assert_eq!(r.next(10), Next::Exit);
+        let mut fin = Outbox::default();
+        assert_eq!(
+            r.finish(Finish::Done, &[(services::NOMINAL_ATTITUDE, 2)], &mut fin),
+            0
+        );
+        assert_eq!(fin.notify, vec![services::SAFE_ATTITUDE]);
+        assert!(
+            fin.log[0].contains("0 deadline misses, 2 samples from a second publisher dropped")
+        );
+    }
+
+    #[test]
+    fn a_signal_mid_tick_ends_the_filter_silently() {
+        let mut r = role(Subsystem::Translational);
+        handle(&mut r, 10, Woke::Event, &[tick_state(0)]);
+        let mut fin = Outbox::default();
+        assert_eq!(r.finish(Finish::Terminated, &[], &mut fin), 0);
+        assert_eq!(fin, Outbox::default());
+    }
+
+    #[test]
+    fn the_warm_up_rehearses_only_between_ticks() {
+        let mut r = role(Subsystem::Translational);
+        handle(
+            &mut r,
+            10,
+            Woke::Event,
+            &[nominal(Subsystem::Translational, 0, 1), tick_state(0)],
+        );
+        let mut w = wakeup(20, Woke::Event);
+        w.prepare = 1;
+        let mut out = Outbox::default();
+        r.handle(&w, &[], &mut NoPeers, &mut out);
+        assert!(out.rehearse);
+        r.rehearse();
+        let mut out = Outbox::default();
+        r.handle(&w, &[tick_state(1)], &mut NoPeers, &mut out);
+        assert!(!out.rehearse, "a tick is here: no rehearsal");
+    }
 }

@@ -1,59 +1,33 @@
-//! The loop of every process, one file per role kind. Each wakes on iceoryx2 events
-//! only (WaitSet), no busy polling; deadlines are timed waits.
+//! The roles of the partition as components (`crate::component::Component`): each
+//! file one role's decisions, driven by the one runner (`crate::runner`).
 //!
 //! * [`scheduler`] — rate groups, lock-step or real time, the end of the run, liveness;
 //! * [`simulator`] — the plant: applies the (re-validated) safe commands, publishes states;
-//! * [`nominal`] — a nominal controller ([`Subsystem`]), replaceable by a partner's process;
-//! * [`filter`] — a safety filter ([`Subsystem`]).
+//! * [`nominal`] — a nominal controller, replaceable by a partner's process;
+//! * [`filter`] — a safety filter.
 //!
-//! The recorder's loop is [`crate::recorder`].
+//! The recorder is a ground tool: `sc_ground::recorder`.
 
-mod filter;
-mod nominal;
-mod scheduler;
-mod simulator;
+pub mod filter;
+pub mod nominal;
+pub mod scheduler;
+pub mod simulator;
 
-pub use filter::filter;
-pub use nominal::nominal;
-pub use scheduler::{SchedulerReport, scheduler};
-pub use simulator::simulator;
+pub use filter::FilterRole;
+pub use nominal::NominalRole;
+pub use scheduler::{SchedulerReport, SchedulerRole};
+pub use simulator::SimulatorRole;
 
-use sc_bus::Subscriber;
-use sc_icd::{Tick, monotonic_ns, tick_command};
-use std::time::{Duration, Instant};
+/// The log line of a process that saw the stop only when a 1 s wait ran out: the
+/// wake-up that should have brought it was lost (the lock-step tests look for it).
+pub const LOST_STOP_WAKEUP: &str =
+    "the stop was seen only at a 1 s wait timeout (its wake-up was lost)";
 
-pub use sc_core::Subsystem;
-
-pub(crate) fn now() -> u64 {
-    monotonic_ns()
-}
-
-/// Drains a subscriber's events and returns its queued samples.
-pub(crate) fn drain<T: core::fmt::Debug + sc_bus::ZeroCopySend + Copy + 'static>(
-    s: &Subscriber<T>,
-) -> anyhow::Result<Vec<T>> {
-    s.drain_events()?;
-    let mut v = Vec::new();
-    s.receive_all(&mut v)?;
-    Ok(v)
-}
-
-/// Drains an optional subscriber (a role's input that this process may not have)
-/// and returns its newest sample, if any came.
-pub(crate) fn newest<T: core::fmt::Debug + sc_bus::ZeroCopySend + Copy + 'static>(
-    s: Option<&Subscriber<T>>,
-) -> anyhow::Result<Option<T>> {
-    Ok(match s {
-        Some(s) => drain(s)?.pop(),
-        None => None,
-    })
-}
-
-/// Drains an optional subscriber (a role's input that this process may not have).
-pub(crate) fn drain_opt<T: core::fmt::Debug + sc_bus::ZeroCopySend + Copy + 'static>(
-    s: Option<&Subscriber<T>>,
-) -> anyhow::Result<Vec<T>> {
-    s.map_or_else(|| Ok(Vec::new()), drain)
+/// The deadline [monotonic ns] `after_ns` from a time stamp of another process (the
+/// same clock); a missing stamp (0) counts from `now_ns`.
+pub fn deadline_from(stamp_ns: u64, now_ns: u64, after_ns: u64) -> u64 {
+    let from = if stamp_ns == 0 { now_ns } else { stamp_ns };
+    from.saturating_add(after_ns)
 }
 
 /// Keeps, of a partner's nominal commands `got` (drained before the states, so every
@@ -69,7 +43,7 @@ pub(crate) fn drain_opt<T: core::fmt::Debug + sc_bus::ZeroCopySend + Copy + 'sta
 /// Returns whether a command for the awaited tick or the one before it came: only that
 /// brings an absent partner back (a late partner answers the tick before; one that
 /// answers for older ticks would otherwise cost every tick a full deadline).
-pub(crate) fn keep_for_tick<T>(
+pub fn keep_for_tick<T>(
     got: Vec<T>,
     held: &mut Option<T>,
     want: Option<u64>,
@@ -87,20 +61,6 @@ pub(crate) fn keep_for_tick<T>(
         }
     }
     came
-}
-
-/// The `Instant` of a monotonic time stamp `ns` of another process (same clock).
-pub(crate) fn instant_of(ns: u64) -> Instant {
-    let t = Instant::now();
-    if ns == 0 {
-        return t; // no stamp: count from now
-    }
-    let ago = Duration::from_nanos(now().saturating_sub(ns));
-    t.checked_sub(ago).unwrap_or(t)
-}
-
-pub(crate) fn stop_seen(ticks: &[Tick]) -> bool {
-    ticks.iter().any(|t| t.command == tick_command::STOP)
 }
 
 #[cfg(test)]
@@ -146,5 +106,49 @@ mod tests {
         let mut held = None;
         assert!(!keep_for_tick(vec![0], &mut held, Some(0), None, id));
         assert_eq!(held, None);
+    }
+}
+
+/// Made-up inputs for the roles' unit tests.
+#[cfg(test)]
+pub(crate) mod testing {
+    use crate::component::{Wakeup, Woke};
+    use sc_icd::SimState;
+    use std::path::Path;
+    use std::sync::Arc;
+
+    fn repo() -> &'static Path {
+        Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+    }
+
+    /// The default scenario and servicer model.
+    pub fn setup() -> sc_mission::Setup {
+        sc_mission::Setup::load(&repo().join("config/scenario.toml")).unwrap()
+    }
+
+    /// The reference nominal controllers of the default scenario.
+    pub fn controllers() -> sc_nominal::NominalControllers {
+        let s = setup();
+        sc_nominal::NominalControllers::new(&s.scenario, (*s.robot).clone()).unwrap()
+    }
+
+    /// The simulator's first state of the default mission, as tick `tick` with `due`.
+    pub fn state(tick: u64, due: u32) -> SimState {
+        let s = setup();
+        let sim = sc_sim::Simulator::new(&s.scenario, Arc::clone(&s.robot)).unwrap();
+        let mut m = crate::convert::sim_state(&sim.observe());
+        m.tick = tick;
+        m.due_mask = due;
+        m
+    }
+
+    /// A wake-up at `now_ns` without signals.
+    pub fn wakeup(now_ns: u64, why: Woke) -> Wakeup {
+        Wakeup {
+            now_ns,
+            why,
+            stage_deadline: 0,
+            prepare: 0,
+        }
     }
 }

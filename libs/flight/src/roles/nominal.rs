@@ -1,148 +1,254 @@
-//! A nominal controller process (the reference controllers of `sc_nominal`); a partner
-//! replaces it with its own process (docs/PARTITION.md).
+//! A nominal controller (the reference controllers of `sc_nominal`); a partner replaces
+//! it with its own process (docs/PARTNER.md).
+//!
+//! Wakes on the states only (the nominal controllers' newest-wins copy, so a slow
+//! controller never holds the simulator up); answers every state of its rate group with
+//! its command for that tick; reads the control service at every wake-up for the stop
+//! (the simulator wakes its consumers once when it stops).
 
+use super::LOST_STOP_WAKEUP;
+use crate::component::{Component, Env, Finish, Message, Next, Outbox, WakeSet, Wakeup, Woke};
 use crate::convert;
-use crate::process::{
-    LOST_STOP_WAKEUP, Proc, partner_qos, prepare_listener, qos, send, wait_outcome,
+use crate::error::FlightError;
+use crate::process::Proc;
+use sc_core::{Subsystem, SubsystemSet};
+use sc_icd::services::{self, ServiceName};
+use sc_icd::{
+    NominalAttitude, NominalRobotic, NominalTranslational, Role, RoleKind, SimState, tick_command,
 };
-use anyhow::Context;
-use sc_bus::{Publisher, Subscriber, WaitOutcome, Waiter};
-use sc_core::SubsystemSet;
-use sc_icd::*;
 use sc_mission::stages;
-use sc_nominal::NominalControllers;
+use sc_nominal::{NominalControllers, NominalOutput, SubsystemStatus};
 
-use super::*;
+/// One nominal controller.
+pub struct NominalRole {
+    subsystem: Subsystem,
+    name: &'static str,
+    controllers: NominalControllers,
+    last_state: Option<SimState>,
+    handled: u64,
+    stop: bool,
+}
 
-/// One nominal controller process.
-pub fn nominal(subsystem: Subsystem) -> anyhow::Result<i32> {
-    let which = subsystem.position();
-    let role = [
-        "nominal_translational",
-        "nominal_attitude",
-        "nominal_robotic",
-    ][which];
-    let p = Proc::start(role)?;
-    let q = qos();
-    let partner_q = partner_qos();
-    let tick_rx = Subscriber::<Tick>::polled(&p.node, services::CONTROL, &q)?;
-    let state_rx = Subscriber::<SimState>::new(&p.node, services::PARTNER_STATE, &partner_q)?;
-    let tx_t = (which == 0)
-        .then(|| {
-            Publisher::<NominalTranslational>::new(
-                &p.node,
-                services::NOMINAL_TRANSLATIONAL,
-                &partner_q,
-            )
-        })
-        .transpose()?;
-    let tx_a = (which == 1)
-        .then(|| Publisher::<NominalAttitude>::new(&p.node, services::NOMINAL_ATTITUDE, &partner_q))
-        .transpose()?;
-    let tx_r = (which == 2)
-        .then(|| Publisher::<NominalRobotic>::new(&p.node, services::NOMINAL_ROBOTIC, &partner_q))
-        .transpose()?;
-    // Wakes on states only; the tick queue is read at every wake-up for the stop
-    // (the simulator wakes its consumers once when it stops).
-    let waiter = Waiter::new()?;
-    let _a = waiter.attach(&state_rx)?;
-    // real time: the pre-tick warm-up (docs/PARTITION.md, "What a hop costs")
-    let prepare = prepare_listener(&p)?;
-    let _a1 = prepare.as_ref().map(|l| waiter.attach(l)).transpose()?;
-    let mut last_state: Option<SimState> = None;
-    let scenario = p.scenario_with_period(p.schedule.period_s[subsystem]);
-    let ctl = NominalControllers::new(&scenario, (*p.setup.robot).clone())?;
-    let subsystems = SubsystemSet::only(subsystem);
-    let bit = 1u32 << which;
-    p.handshake()?;
-    let mut handled = 0u64;
-    'run: loop {
-        let woke = wait_outcome(&waiter, None)?;
-        if woke == WaitOutcome::TerminationRequest {
-            break;
-        }
-        if let Some(l) = &prepare
-            && l.drain()? > 0
-            && let Some(s) = &last_state
-        {
-            // rehearse the last step (the controllers are pure); nothing is sent
-            p.rehearse(|| {
-                let o = convert::observation(s);
-                std::hint::black_box(
-                    ctl.command_subsystems(&stages::nominal_input(&o), subsystems),
-                );
-                match which {
-                    0 => tx_t.as_ref().context("publisher")?.warm(),
-                    1 => tx_a.as_ref().context("publisher")?.warm(),
-                    _ => tx_r.as_ref().context("publisher")?.warm(),
-                }
-                .map_err(anyhow::Error::from)
-            })?;
-        }
-        for s in drain(&state_rx)? {
-            if s.due_mask & bit == 0 {
-                continue;
-            }
-            last_state = Some(s);
-            let recv_ns = now();
-            let o = convert::observation(&s);
-            let out = ctl.command_subsystems(&stages::nominal_input(&o), subsystems);
-            let status = [out.translational, out.attitude, out.robotic][which];
-            let valid = (status != sc_nominal::SubsystemStatus::InvalidInput) as u32;
-            let phase = out.phase as u32;
-            match which {
-                0 => send(
-                    tx_t.as_ref().context("publisher")?,
-                    &NominalTranslational {
-                        tick: s.tick,
-                        t: s.t,
-                        valid,
-                        phase,
-                        recv_ns,
-                        publish_ns: now(),
-                        f_h: convert::arr3(&out.f_h),
-                    },
-                )?,
-                1 => send(
-                    tx_a.as_ref().context("publisher")?,
-                    &NominalAttitude {
-                        tick: s.tick,
-                        t: s.t,
-                        valid,
-                        phase,
-                        recv_ns,
-                        publish_ns: now(),
-                        tau_b: convert::arr3(&out.tau_b),
-                    },
-                )?,
-                _ => send(
-                    tx_r.as_ref().context("publisher")?,
-                    &NominalRobotic {
-                        tick: s.tick,
-                        t: s.t,
-                        valid,
-                        phase,
-                        recv_ns,
-                        publish_ns: now(),
-                        tau_m: convert::arr7(&out.tau_m),
-                    },
-                )?,
-            }
-            handled += 1;
-        }
-        if stop_seen(&drain(&tick_rx)?) {
-            if woke == WaitOutcome::Timeout {
-                eprintln!("{role}: {LOST_STOP_WAKEUP}");
-            }
-            // wake the filter once so that it sees the stop too
-            match which {
-                0 => tx_t.as_ref().context("publisher")?.notify()?,
-                1 => tx_a.as_ref().context("publisher")?.notify()?,
-                _ => tx_r.as_ref().context("publisher")?.notify()?,
-            }
-            break 'run;
+const WAKE: &[WakeSet] = &[WakeSet {
+    on: &[services::PARTNER_STATE, services::PREPARE],
+    lazy: false,
+}];
+
+impl NominalRole {
+    /// The controller of `subsystem` with the reference controllers of `controllers`.
+    pub fn new(subsystem: Subsystem, controllers: NominalControllers) -> Self {
+        Self {
+            subsystem,
+            name: Role::of(RoleKind::Nominal(subsystem)).name,
+            controllers,
+            last_state: None,
+            handled: 0,
+            stop: false,
         }
     }
-    eprintln!("{role}: handled {handled} states");
-    Ok(0)
+
+    /// From the process's config: the controllers step at the subsystem's rate group's
+    /// period (their MPC's step).
+    pub fn from_process(subsystem: Subsystem, p: &Proc) -> Result<Self, FlightError> {
+        let scenario = p.scenario_with_period(p.schedule.period_s[subsystem]);
+        let controllers = NominalControllers::new(&scenario, (*p.setup.robot).clone())?;
+        Ok(Self::new(subsystem, controllers))
+    }
+
+    /// This controller's command for state `s`.
+    fn command(&self, s: &SimState) -> NominalOutput {
+        let o = convert::observation(s);
+        self.controllers.command_subsystems(
+            &stages::nominal_input(&o),
+            SubsystemSet::only(self.subsystem),
+        )
+    }
+
+    /// The command message for state `s` received at `recv_ns`.
+    fn message(&self, s: &SimState, recv_ns: u64) -> Message {
+        let out = self.command(s);
+        let status = match self.subsystem {
+            Subsystem::Translational => out.translational,
+            Subsystem::Attitude => out.attitude,
+            Subsystem::Robotic => out.robotic,
+        };
+        let (tick, t, phase) = (s.tick, s.t, out.phase as u32);
+        let valid = u32::from(status != SubsystemStatus::InvalidInput);
+        match self.subsystem {
+            Subsystem::Translational => Message::NominalTranslational(NominalTranslational {
+                tick,
+                t,
+                valid,
+                phase,
+                recv_ns,
+                publish_ns: 0,
+                f_h: convert::arr3(&out.f_h),
+            }),
+            Subsystem::Attitude => Message::NominalAttitude(NominalAttitude {
+                tick,
+                t,
+                valid,
+                phase,
+                recv_ns,
+                publish_ns: 0,
+                tau_b: convert::arr3(&out.tau_b),
+            }),
+            Subsystem::Robotic => Message::NominalRobotic(NominalRobotic {
+                tick,
+                t,
+                valid,
+                phase,
+                recv_ns,
+                publish_ns: 0,
+                tau_m: convert::arr7(&out.tau_m),
+            }),
+        }
+    }
+
+    /// The service it publishes on.
+    fn output(&self) -> &'static [ServiceName] {
+        match self.subsystem {
+            Subsystem::Translational => &[services::NOMINAL_TRANSLATIONAL],
+            Subsystem::Attitude => &[services::NOMINAL_ATTITUDE],
+            Subsystem::Robotic => &[services::NOMINAL_ROBOTIC],
+        }
+    }
+}
+
+impl Component for NominalRole {
+    fn wake_sets(&self) -> &'static [WakeSet] {
+        WAKE
+    }
+
+    fn inputs(&self) -> &'static [ServiceName] {
+        &[
+            services::PREPARE,
+            services::PARTNER_STATE,
+            services::CONTROL,
+        ]
+    }
+
+    fn warm(&self) -> &'static [ServiceName] {
+        self.output()
+    }
+
+    fn next(&mut self, _: u64) -> Next {
+        if self.stop {
+            return Next::Exit;
+        }
+        Next::Wait {
+            set: 0,
+            until_ns: None,
+        }
+    }
+
+    fn handle(&mut self, w: &Wakeup, inputs: &[Message], _: &mut dyn Env, out: &mut Outbox) {
+        out.rehearse = w.prepare > 0 && self.last_state.is_some();
+        for m in inputs {
+            match m {
+                Message::PartnerState(s) if s.due_mask & self.subsystem.bit() != 0 => {
+                    self.last_state = Some(*s);
+                    out.send(self.message(s, w.now_ns));
+                    self.handled += 1;
+                }
+                Message::Control(t) if t.command == tick_command::STOP => self.stop = true,
+                _ => {}
+            }
+        }
+        if self.stop {
+            if w.why == Woke::Timeout {
+                out.log(format!("{}: {LOST_STOP_WAKEUP}", self.name));
+            }
+            // wake the filter once so that it sees the stop too
+            out.notify.extend_from_slice(self.output());
+        }
+    }
+
+    fn rehearse(&mut self) {
+        if let Some(s) = self.last_state {
+            std::hint::black_box(self.command(&s));
+        }
+    }
+
+    fn finish(&mut self, _: Finish, _: &[(ServiceName, u64)], out: &mut Outbox) -> i32 {
+        out.log(format!("{}: handled {} states", self.name, self.handled));
+        0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::component::NoPeers;
+    use crate::roles::testing::{controllers, state, wakeup};
+
+    fn role(s: Subsystem) -> NominalRole {
+        NominalRole::new(s, controllers())
+    }
+
+    #[test]
+    fn answers_each_state_of_its_rate_group_for_its_tick() {
+        let mut r = role(Subsystem::Attitude);
+        let mut out = Outbox::default();
+        let due = state(7, Subsystem::Attitude.bit());
+        let not_due = state(8, Subsystem::Robotic.bit());
+        r.handle(
+            &wakeup(100, Woke::Event),
+            &[Message::PartnerState(due), Message::PartnerState(not_due)],
+            &mut NoPeers,
+            &mut out,
+        );
+        assert_eq!(out.send.len(), 1, "only the state of its rate group");
+        let Message::NominalAttitude(m) = out.send[0] else {
+            panic!("{:?}", out.send[0])
+        };
+        assert_eq!((m.tick, m.recv_ns, m.valid), (7, 100, 1));
+        assert_eq!(
+            r.next(0),
+            Next::Wait {
+                set: 0,
+                until_ns: None
+            }
+        );
+    }
+
+    #[test]
+    fn a_state_it_cannot_use_gives_an_invalid_command() {
+        let mut r = role(Subsystem::Translational);
+        let mut bad = state(3, SubsystemSet::ALL.bits());
+        bad.q_hr = [f64::NAN; 4];
+        let mut out = Outbox::default();
+        r.handle(
+            &wakeup(1, Woke::Event),
+            &[Message::PartnerState(bad)],
+            &mut NoPeers,
+            &mut out,
+        );
+        let Message::NominalTranslational(m) = out.send[0] else {
+            panic!()
+        };
+        assert_eq!(m.valid, 0, "flagged invalid, never a silent command");
+    }
+
+    #[test]
+    fn the_stop_wakes_its_filter_and_ends_the_role() {
+        let mut r = role(Subsystem::Robotic);
+        let stop = sc_icd::Tick {
+            command: tick_command::STOP,
+            ..Default::default()
+        };
+        let mut out = Outbox::default();
+        r.handle(
+            &wakeup(1, Woke::Timeout),
+            &[Message::Control(stop)],
+            &mut NoPeers,
+            &mut out,
+        );
+        assert_eq!(out.notify, vec![services::NOMINAL_ROBOTIC]);
+        assert!(out.log[0].contains(LOST_STOP_WAKEUP), "{:?}", out.log);
+        assert_eq!(r.next(0), Next::Exit);
+        let mut fin = Outbox::default();
+        assert_eq!(r.finish(Finish::Done, &[], &mut fin), 0);
+        assert_eq!(fin.log, vec!["nominal_robotic: handled 0 states"]);
+    }
 }

@@ -1,346 +1,656 @@
-//! The simulator process: the plant in the loop. It applies the safe commands of each
-//! tick after re-validating them (`crate::admission`), the filter's backup when one is
-//! missing or rejected, and publishes the state with the monitored barriers.
+//! The simulator: the plant in the loop. At each tick it publishes the state with the
+//! monitored barriers, waits up to its deadline for the safe commands of the subsystems
+//! due, applies them after re-validating them (`crate::admission`) — the filter's backup
+//! when one is missing or refused, the held command of a slower rate group — advances
+//! the physics and publishes the step result.
+//!
+//! Wake-ups (docs/PARTITION.md, "Who wakes whom"): between ticks on the tick only;
+//! within a tick on the robotic safe command, the last of the causal chain (the earlier
+//! ones were sent before it). While a filter is absent (dead or late: its command may
+//! never come), when the robotic group is not due, or when the robotic command of the
+//! tick is here without an earlier one, on every safe command — their listeners are
+//! created then, so that in a healthy run the translational and attitude filters wake
+//! only their downstream filter.
 
 use crate::admission;
+use crate::component::{Component, Env, Finish, Message, Next, Outbox, WakeSet, Wakeup};
 use crate::convert;
-
-use crate::process::{Proc, partner_qos, prepare_listener, qos, send, wait};
-use nalgebra::Vector3;
-use sc_bus::{Publisher, Subscriber, Waiter};
+use crate::error::FlightError;
+use crate::process::Proc;
 use sc_cbf::SafetyLayer;
-use sc_icd::*;
-use sc_sim::{Command, Simulator};
-use std::time::Instant;
+use sc_cbf::monitor::{Barriers, Monitor, N_ALL, min_into};
+use sc_core::{Command, Observation, PerSubsystem, Subsystem, SubsystemSet};
+use sc_icd::services::{self, ServiceName};
+use sc_icd::{StepResult, Tick, end, fault, tick_command};
+use sc_scenario::Scenario;
+use sc_sim::{Plant, Simulator};
+use std::collections::VecDeque;
 
-use super::*;
+/// A safe command as the simulator judges it, whatever its subsystem.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Received {
+    tick: u64,
+    /// It passed the re-validation (finite, within the input bounds).
+    admitted: bool,
+    /// What it applies: `f_B`, `τ_B` or `τ_M` (the first 3 or 7 components).
+    command: [f64; 7],
+}
 
-/// The simulator: publishes the state of each tick, applies the safe commands
-/// (held for slower rate groups, the filter's fallback when missing), ends the
-/// mission on capture/timeout.
-/// A tick-matched safe command if the simulator may apply it (`ok`); `true` with `None`
-/// when one came and was rejected.
-fn admit<T>(fresh: Option<T>, ok: impl Fn(&T) -> bool) -> (Option<T>, bool) {
-    match fresh {
-        Some(m) if ok(&m) => (Some(m), false),
-        Some(_) => (None, true),
-        None => (None, false),
+impl Received {
+    /// The safe command carried by `m` with its subsystem, judged against `limits`.
+    fn of(m: &Message, limits: &sc_scenario::Limits) -> Option<(Subsystem, Self)> {
+        let pad3 = |a: &[f64; 3]| [a[0], a[1], a[2], 0.0, 0.0, 0.0, 0.0];
+        let (s, tick, admitted, command) = match m {
+            Message::SafeTranslational(x) => (
+                Subsystem::Translational,
+                x.tick,
+                admission::translational(x, limits),
+                pad3(&x.actuated),
+            ),
+            Message::SafeAttitude(x) => (
+                Subsystem::Attitude,
+                x.tick,
+                admission::attitude(x, limits),
+                pad3(&x.u),
+            ),
+            Message::SafeRobotic(x) => (
+                Subsystem::Robotic,
+                x.tick,
+                admission::robotic(x, limits),
+                x.u,
+            ),
+            _ => return None,
+        };
+        Some((
+            s,
+            Self {
+                tick,
+                admitted,
+                command,
+            },
+        ))
     }
 }
 
-pub fn simulator() -> anyhow::Result<i32> {
-    let p = Proc::start("simulator")?;
-    let q = qos();
-    let tick_rx = Subscriber::<Tick>::new(&p.node, services::TICK, &q)?;
-    let st_rx = Subscriber::<SafeTranslational>::polled(&p.node, services::SAFE_TRANSLATIONAL, &q)?;
-    let sa_rx = Subscriber::<SafeAttitude>::polled(&p.node, services::SAFE_ATTITUDE, &q)?;
-    let sr_rx = Subscriber::<SafeRobotic>::new(&p.node, services::SAFE_ROBOTIC, &q)?;
-    let state_tx = Publisher::<SimState>::new(&p.node, services::SIM_STATE, &q)?;
-    // the nominal controllers' copy: newest wins, a partner cannot hold the tick up
-    let partner_state_tx =
-        Publisher::<SimState>::new(&p.node, services::PARTNER_STATE, &partner_qos())?;
-    let result_tx = Publisher::<StepResult>::new(&p.node, services::STEP_RESULT, &q)?;
-    // Wake-ups (docs/PARTITION.md, "Who wakes whom"): between ticks on the tick only;
-    // within a tick on the robotic safe command, the last of the causal chain (the
-    // earlier ones were sent before it). While a filter is absent (dead or late: its
-    // command may never come) or the robotic group is not due, on every safe
-    // command: their listeners are created then, so that in a healthy run the
-    // translational and attitude filters wake only their downstream filter.
-    let on_tick = Waiter::new()?;
-    let _a0 = on_tick.attach(&tick_rx)?;
-    // real time: the pre-tick warm-up (docs/PARTITION.md, "What a hop costs")
-    let prepare = prepare_listener(&p)?;
-    let _a2 = prepare.as_ref().map(|l| on_tick.attach(l)).transpose()?;
-    let on_robotic = Waiter::new()?;
-    let _a1 = [on_robotic.attach(&tick_rx)?, on_robotic.attach(&sr_rx)?];
-    let on_any = Waiter::new()?;
-    let mut any_attached = Vec::new();
-    let scenario = p.scenario_with_period(p.schedule.base_period_s);
-    let mut sim =
-        Simulator::new(&scenario, p.setup.robot.clone()).map_err(|e| anyhow::anyhow!("{e}"))?;
-    // another propagator behind this role (e.g. Basilisk), started before the handshake
-    let mut plant = match p.cfg.simulator.plant.split_first() {
-        Some((program, args)) => {
-            let mut args = args.to_vec();
-            args.push("--scenario".into());
-            args.push(p.cfg.scenario_path().display().to_string());
-            let mut child = sc_sim::ProcessPlant::spawn(std::path::Path::new(program), &args)?;
-            sc_sim::Plant::start(&mut child, sim.state())
-                .map_err(|e| anyhow::anyhow!("simulator: {e}"))?;
-            eprintln!(
-                "simulator: the plant `{}` propagates",
-                p.cfg.simulator.plant.join(" ")
-            );
-            Some(child)
+/// The tick in progress: its state and deadline.
+struct InTick {
+    tick: Tick,
+    o: Observation,
+    barriers: Barriers,
+    barriers_between: Barriers,
+    until_ns: u64,
+    /// When the robotic safe command (the tick's last) was delivered [monotonic ns].
+    safe_recv_ns: u64,
+}
+
+/// The wake sets: between ticks, within a tick, within a tick on every safe command.
+const IDLE: usize = 0;
+const ROBOTIC: usize = 1;
+const ANY: usize = 2;
+const WAKE: &[WakeSet] = &[
+    WakeSet {
+        on: &[services::TICK, services::PREPARE],
+        lazy: false,
+    },
+    WakeSet {
+        on: &[services::TICK, services::SAFE_ROBOTIC],
+        lazy: false,
+    },
+    WakeSet {
+        on: &[
+            services::TICK,
+            services::SAFE_TRANSLATIONAL,
+            services::SAFE_ATTITUDE,
+            services::SAFE_ROBOTIC,
+        ],
+        lazy: true,
+    },
+];
+
+/// The simulator role.
+pub struct SimulatorRole {
+    sim: Simulator,
+    plant: Option<Box<dyn Plant + Send>>,
+    layer: SafetyLayer,
+    monitor: Monitor,
+    scenario: Scenario,
+    deadline_ns: u64,
+    /// With `max_ticks` (benchmarks, soak runs) the physics goes on after the mission's
+    /// end and the scheduler stops after exactly `max_ticks`.
+    keep_going: bool,
+    ticks: VecDeque<Tick>,
+    got: PerSubsystem<Option<Received>>,
+    absent: PerSubsystem<bool>,
+    rejected: PerSubsystem<u64>,
+    held: Command,
+    between: Option<Barriers>,
+    pending: Option<InTick>,
+    ended: bool,
+    stop: bool,
+    rehearse: bool,
+    misses: u64,
+}
+
+impl SimulatorRole {
+    /// The role with its simulator (and, optionally, another propagator behind it) on
+    /// `scenario` (whose control period is the base period).
+    pub fn new(
+        sim: Simulator,
+        plant: Option<Box<dyn Plant + Send>>,
+        scenario: Scenario,
+        robot: std::sync::Arc<sc_multibody::Robot>,
+        deadline_ns: u64,
+        keep_going: bool,
+    ) -> Self {
+        Self {
+            sim,
+            plant,
+            layer: SafetyLayer::from_scenario(&scenario, robot.clone()),
+            monitor: Monitor::from_scenario(&scenario, robot),
+            scenario,
+            deadline_ns,
+            keep_going,
+            ticks: VecDeque::new(),
+            got: PerSubsystem::default(),
+            absent: PerSubsystem::default(),
+            rejected: PerSubsystem::default(),
+            held: Command::zero(),
+            between: None,
+            pending: None,
+            ended: false,
+            stop: false,
+            rehearse: false,
+            misses: 0,
         }
-        None => None,
-    };
-    let mut layer = SafetyLayer::from_scenario(&scenario, p.setup.robot.clone());
-    let robot = p.setup.robot.clone();
-    let monitor = sc_cbf::monitor::Monitor::from_scenario(&scenario, robot.clone());
-    let mut between: Option<sc_cbf::monitor::Barriers> = None;
-    let deadline = p.deadline(p.cfg.deadlines.simulator_ms);
-    let keep_going = p.cfg.max_ticks > 0;
-    p.handshake()?;
-    let mut ticks: Vec<Tick> = Vec::new();
-    let (mut got_t, mut got_a, mut got_r): (
-        Option<SafeTranslational>,
-        Option<SafeAttitude>,
-        Option<SafeRobotic>,
-    ) = (None, None, None);
-    let mut absent = [false; 3];
-    // safe commands the simulator refused to apply, per filter (admission.rs)
-    let mut rejected = [0u64; 3];
-    let lim = &scenario.limits;
-    let mut held = Command::zero();
-    let mut held_f_h = Vector3::zeros();
-    let mut ended = false;
-    let mut misses = 0u64;
-    loop {
-        if ticks.is_empty() {
-            if !wait(&on_tick, None)? {
-                break;
-            }
-            if let Some(l) = &prepare
-                && l.drain()? > 0
-            {
-                // rehearse the start of a tick on the current state; nothing is sent
-                p.rehearse(|| {
-                    std::hint::black_box(convert::sim_state(&sim.observe()));
-                    partner_state_tx.warm()?;
-                    state_tx.warm()
-                })?;
-            }
-            ticks.extend(drain(&tick_rx)?);
-            // keep only the newest safe commands; tick-matched below (read in
-            // reverse causal order, as in the loop below)
-            got_r = newest(Some(&sr_rx))?.or(got_r);
-            got_a = newest(Some(&sa_rx))?.or(got_a);
-            got_t = newest(Some(&st_rx))?.or(got_t);
-            continue;
-        }
-        let tick = ticks.remove(0);
-        if tick.command == tick_command::STOP {
-            // wake the consumers once so that they see the stop too
-            partner_state_tx.notify()?;
-            state_tx.notify()?;
-            result_tx.notify()?;
-            break;
-        }
-        if ended {
-            continue;
-        }
-        let recv_ns = now();
-        let o = sim.observe();
-        let mut msg = convert::sim_state(&o);
-        let barriers = monitor.evaluate(&o.barrier_state());
-        msg.barriers = barriers;
-        msg.barriers_between = between.unwrap_or(barriers);
-        // the phase is the mission's own schedule, never a partner's report
-        let phase = scenario.phase_index(o.t);
-        msg.tick = tick.tick;
-        msg.due_mask = tick.due_mask;
-        msg.tick_send_ns = tick.send_ns;
-        msg.recv_ns = recv_ns;
-        msg.publish_ns = now();
-        // flight side first: a nominal command can then never reach a filter before
-        // the state it answers (the filters drop commands for states they have not
-        // seen as lies about the tick)
-        send(&state_tx, &msg)?;
-        send(&partner_state_tx, &msg)?;
-        let k = tick.tick;
-        let due = tick.due_mask;
-        let until = Instant::now() + deadline;
-        let mut safe_recv_ns = 0;
-        loop {
-            let have = |bit: u32, ok: bool, i: usize| due & bit == 0 || ok || absent[i];
-            let ok_t = got_t.is_some_and(|m| m.tick == k);
-            let ok_a = got_a.is_some_and(|m| m.tick == k);
-            let ok_r = got_r.is_some_and(|m| m.tick == k);
-            if have(due::TRANSLATIONAL, ok_t, 0)
-                && have(due::ATTITUDE, ok_a, 1)
-                && have(due::ROBOTIC, ok_r, 2)
-            {
-                break;
-            }
-            if Instant::now() >= until {
-                misses += 1;
-                break;
-            }
-            // On every safe command while one is absent, in a tick where the robotic
-            // group is not due, and when the robotic command of the tick is here
-            // without an earlier one of the chain (its filter was preempted between
-            // the downstream filter's queue and the simulator's).
-            let wake_on_any = absent.iter().any(|a| *a) || due & due::ROBOTIC == 0 || ok_r;
-            if wake_on_any && any_attached.is_empty() {
-                any_attached = vec![
-                    on_any.attach(&tick_rx)?,
-                    on_any.attach(&st_rx)?,
-                    on_any.attach(&sa_rx)?,
-                    on_any.attach(&sr_rx)?,
-                ];
-                // no wait this time: what came before the listeners existed is read now
-            } else if !wait(if wake_on_any { &on_any } else { &on_robotic }, Some(until))? {
-                return Ok(0);
-            }
-            // Reverse causal order (docs/PARTITION.md, "Who wakes whom"): a command
-            // published while the queues are read is never seen without the earlier
-            // commands of its tick, which do not wake the simulator.
-            ticks.extend(drain(&tick_rx)?);
-            for m in drain(&sr_rx)? {
-                if m.tick == k {
+    }
+
+    /// From the process's config: the simulator at the base period, the plant process of
+    /// `[simulator] plant` (started now, before the handshake), the simulator's deadline.
+    pub fn from_process(p: &Proc) -> Result<Self, FlightError> {
+        let scenario = p.scenario_with_period(p.schedule.base_period_s);
+        let robot = p.setup.robot.clone();
+        let sim = Simulator::new(&scenario, robot.clone())
+            .map_err(|e| FlightError::Simulator(e.to_string()))?;
+        let plant = start_plant(p, &sim)?;
+        let deadline = p.deadline(p.cfg.deadlines.simulator_ms);
+        let ns = deadline.as_nanos().min(u128::from(u64::MAX)) as u64;
+        let keep_going = p.cfg.max_ticks > 0;
+        Ok(Self::new(sim, plant, scenario, robot, ns, keep_going))
+    }
+
+    /// Takes the inputs of one wake-up (in the role's read order).
+    fn absorb(&mut self, w: &Wakeup, inputs: &[Message]) {
+        self.rehearse |= w.prepare > 0;
+        let in_tick = self.pending.as_ref().map(|p| p.tick.tick);
+        for m in inputs {
+            if let Message::Tick(t) = m {
+                self.ticks.push_back(*t);
+            } else if let Some((s, r)) = Received::of(m, &self.scenario.limits) {
+                if in_tick.is_some() {
+                    // within a tick a command brings an absent filter back
+                    self.absent[s] = false;
+                }
+                if s == Subsystem::Robotic && Some(r.tick) == in_tick {
                     // delivered: the simulator holds the tick's last safe command
-                    safe_recv_ns = now();
-                }
-                got_r = Some(m);
-                absent[2] = false;
-            }
-            if let Some(m) = newest(Some(&sa_rx))? {
-                got_a = Some(m);
-                absent[1] = false;
-            }
-            if let Some(m) = newest(Some(&st_rx))? {
-                got_t = Some(m);
-                absent[0] = false;
-            }
-        }
-        let mut fallback_mask = 0;
-        let mut held_mask = 0;
-        let mut flags = 0;
-        // translational
-        let (fresh_t, rejected_t) = admit(got_t.filter(|m| m.tick == k), |m| {
-            admission::translational(m, lim)
-        });
-        if due & due::TRANSLATIONAL != 0 || absent[0] {
-            if let Some(m) = fresh_t {
-                held.force_b = convert::vec3(&m.actuated);
-                held_f_h = convert::vec3(&m.u);
-            } else {
-                let f = layer.backup_translational(&o);
-                held.force_b = f.actuated;
-                held_f_h = f.u;
-                fallback_mask |= due::TRANSLATIONAL;
-                if rejected_t {
-                    rejected[0] += 1;
-                    eprintln!(
-                        "simulator: FAULT tick {k}: translational safe command rejected (not finite or beyond the input bounds), backup applied"
-                    );
-                    flags |= fault::REJECTED_COMMAND;
-                } else {
-                    if !absent[0] {
-                        eprintln!(
-                            "simulator: FAULT tick {k}: translational safe command missing, fallback applied"
-                        );
+                    if let Some(p) = self.pending.as_mut() {
+                        p.safe_recv_ns = w.now_ns;
                     }
-                    absent[0] = true;
-                    flags |= fault::DEADLINE_MISS;
                 }
+                self.got[s] = Some(r);
             }
-        } else {
-            held_mask |= due::TRANSLATIONAL;
         }
-        let _ = held_f_h;
-        let (fresh_a, rejected_a) = admit(got_a.filter(|m| m.tick == k), |m| {
-            admission::attitude(m, lim)
+    }
+
+    /// The subsystems of tick `t` whose safe command is here, not due, or absent.
+    fn complete(&self, t: &Tick) -> bool {
+        let due = SubsystemSet::from_bits(t.due_mask);
+        Subsystem::ALL.into_iter().all(|s| {
+            !due.contains(s) || self.absent[s] || self.got[s].is_some_and(|m| m.tick == t.tick)
+        })
+    }
+
+    /// Starts tick `t` received at `now_ns`: observes, publishes the state (flight side
+    /// first: a nominal command can then never reach a filter before the state it
+    /// answers), awaits the safe commands.
+    fn start_tick(&mut self, t: Tick, now_ns: u64, out: &mut Outbox) {
+        let o = self.sim.observe();
+        let mut msg = convert::sim_state(&o);
+        let barriers = self.monitor.evaluate(&o.barrier_state());
+        msg.barriers = barriers;
+        msg.barriers_between = self.between.unwrap_or(barriers);
+        msg.tick = t.tick;
+        msg.due_mask = t.due_mask;
+        msg.tick_send_ns = t.send_ns;
+        msg.recv_ns = now_ns;
+        out.send(Message::State(msg));
+        out.send(Message::PartnerState(msg));
+        self.pending = Some(InTick {
+            tick: t,
+            o,
+            barriers,
+            barriers_between: msg.barriers_between,
+            until_ns: now_ns.saturating_add(self.deadline_ns),
+            safe_recv_ns: 0,
         });
-        if due & due::ATTITUDE != 0 || absent[1] {
-            if let Some(m) = fresh_a {
-                held.torque_b = convert::vec3(&m.u);
-            } else {
-                held.torque_b = layer.backup_attitude(&o, &held.force_b).u;
-                fallback_mask |= due::ATTITUDE;
-                if rejected_a {
-                    rejected[1] += 1;
-                    eprintln!(
-                        "simulator: FAULT tick {k}: attitude safe command rejected (not finite or beyond the input bounds), backup applied"
-                    );
-                    flags |= fault::REJECTED_COMMAND;
-                } else {
-                    if !absent[1] {
-                        eprintln!(
-                            "simulator: FAULT tick {k}: attitude safe command missing, fallback applied"
-                        );
-                    }
-                    absent[1] = true;
-                    flags |= fault::DEADLINE_MISS;
-                }
-            }
-        } else {
-            held_mask |= due::ATTITUDE;
+    }
+
+    /// What acts for subsystem `s` over tick `k`: the fresh safe command if it passed
+    /// the re-validation, the held one of a slower group, or the filter's backup (a
+    /// missing or refused command), which is flagged, counted and logged.
+    fn apply(
+        &mut self,
+        s: Subsystem,
+        o: &Observation,
+        k: u64,
+        due: SubsystemSet,
+        res: &mut StepResult,
+        out: &mut Outbox,
+    ) {
+        if !(due.contains(s) || self.absent[s]) {
+            res.held_mask |= s.bit();
+            return;
         }
-        let (fresh_r, rejected_r) = admit(got_r.filter(|m| m.tick == k), |m| {
-            admission::robotic(m, lim)
-        });
-        if due & due::ROBOTIC != 0 || absent[2] {
-            if let Some(m) = fresh_r {
-                held.tau = convert::vec7(&m.u);
-            } else {
-                held.tau = layer.backup_robotic(&o, &held.force_b, &held.torque_b).u;
-                fallback_mask |= due::ROBOTIC;
-                if rejected_r {
-                    rejected[2] += 1;
-                    eprintln!(
-                        "simulator: FAULT tick {k}: robotic safe command rejected (not finite or beyond the input bounds), backup applied"
-                    );
-                    flags |= fault::REJECTED_COMMAND;
-                } else {
-                    if !absent[2] {
-                        eprintln!(
-                            "simulator: FAULT tick {k}: robotic safe command missing, fallback applied"
-                        );
-                    }
-                    absent[2] = true;
-                    flags |= fault::DEADLINE_MISS;
-                }
-            }
-        } else {
-            held_mask |= due::ROBOTIC;
+        let fresh = self.got[s].filter(|m| m.tick == k);
+        if let Some(m) = fresh.filter(|m| m.admitted) {
+            self.hold(s, &m.command);
+            return;
         }
+        let backup = self.backup(s, o);
+        self.hold(s, &backup);
+        res.fallback_mask |= s.bit();
+        if fresh.is_some() {
+            self.rejected[s] += 1;
+            out.log(format!("simulator: FAULT tick {k}: {s} safe command rejected (not finite or beyond the input bounds), backup applied"));
+            res.fault_flags |= fault::REJECTED_COMMAND;
+        } else {
+            if !self.absent[s] {
+                out.log(format!(
+                    "simulator: FAULT tick {k}: {s} safe command missing, fallback applied"
+                ));
+            }
+            self.absent[s] = true;
+            res.fault_flags |= fault::DEADLINE_MISS;
+        }
+    }
+
+    /// The backup of subsystem `s` with what acts upstream (the causal chain's backups).
+    fn backup(&mut self, s: Subsystem, o: &Observation) -> [f64; 7] {
+        let pad3 = |v: nalgebra::Vector3<f64>| [v.x, v.y, v.z, 0.0, 0.0, 0.0, 0.0];
+        match s {
+            Subsystem::Translational => pad3(self.layer.backup_translational(o).actuated),
+            Subsystem::Attitude => pad3(self.layer.backup_attitude(o, &self.held.force_b).u),
+            Subsystem::Robotic => convert::arr7(
+                &self
+                    .layer
+                    .backup_robotic(o, &self.held.force_b, &self.held.torque_b)
+                    .u,
+            ),
+        }
+    }
+
+    /// Holds `command` for subsystem `s` until it is due again.
+    fn hold(&mut self, s: Subsystem, command: &[f64; 7]) {
+        let v3 = nalgebra::Vector3::new(command[0], command[1], command[2]);
+        match s {
+            Subsystem::Translational => self.held.force_b = v3,
+            Subsystem::Attitude => self.held.torque_b = v3,
+            Subsystem::Robotic => self.held.tau = convert::vec7(command),
+        }
+    }
+
+    /// Ends the tick in progress: applies the commands, decides the mission's end,
+    /// advances the physics (the barriers monitored at every physics step) and
+    /// publishes the step result.
+    fn finish_tick(&mut self, p: InTick, out: &mut Outbox) {
+        let (k, o) = (p.tick.tick, p.o);
+        let due = SubsystemSet::from_bits(p.tick.due_mask);
         let mut res = StepResult {
             tick: k,
             t: o.t,
-            fallback_mask,
-            held_mask,
-            fault_flags: flags,
-            safe_recv_ns,
+            safe_recv_ns: p.safe_recv_ns,
             ..Default::default()
         };
-        convert::set_applied(&mut res, &held);
-        let captured = sc_mission::capture_check(&scenario, phase, &o)
-            && sc_mission::all_hold(&msg.barriers)
-            && sc_mission::all_hold(&msg.barriers_between);
+        for s in Subsystem::ALL {
+            self.apply(s, &o, k, due, &mut res, out);
+        }
+        convert::set_applied(&mut res, &self.held);
+        // the phase is the mission's own schedule, never a partner's report
+        let phase = self.scenario.phase_index(o.t);
+        let captured = sc_mission::capture_check(&self.scenario, phase, &o)
+            && sc_mission::all_hold(&p.barriers)
+            && sc_mission::all_hold(&p.barriers_between);
         res.end = if captured {
             end::CAPTURED
-        } else if sc_mission::timeout_check(&scenario, o.t) {
+        } else if sc_mission::timeout_check(&self.scenario, o.t) {
             end::TIMEOUT
         } else {
             end::RUNNING
         };
-        // with max_ticks (benchmarks, soak runs) the physics goes on after the end
-        // and the scheduler stops after exactly max_ticks
-        if res.end == end::RUNNING || keep_going {
-            let mut min: sc_cbf::monitor::Barriers = [f64::INFINITY; sc_cbf::monitor::N_ALL];
-            let at_physics_step = |b: &sc_sim::BarrierState| {
-                sc_cbf::monitor::min_into(&mut min, &monitor.evaluate(b))
+        if res.end == end::RUNNING || self.keep_going {
+            self.advance(&mut res, out);
+        }
+        self.ended =
+            res.end == end::SIMULATOR_FAILED || (res.end != end::RUNNING && !self.keep_going);
+        out.send(Message::StepResult(res));
+    }
+
+    /// One control period of physics under the held command, with the barrier minima
+    /// over its physics steps.
+    fn advance(&mut self, res: &mut StepResult, out: &mut Outbox) {
+        let mut min: Barriers = [f64::INFINITY; N_ALL];
+        let monitor = &self.monitor;
+        let at_physics_step = |b: &sc_sim::BarrierState| min_into(&mut min, &monitor.evaluate(b));
+        let stepped = match self.plant.as_mut() {
+            Some(pl) => self
+                .sim
+                .step_with_plant(pl.as_mut(), &self.held, at_physics_step),
+            None => self.sim.step_with(&self.held, at_physics_step),
+        };
+        self.between = Some(min);
+        if let Err(e) = stepped {
+            out.log(format!("simulator: {e}"));
+            res.end = end::SIMULATOR_FAILED;
+        }
+    }
+
+    /// Works through the queued ticks until one awaits its commands.
+    fn process(&mut self, now_ns: u64, out: &mut Outbox) {
+        loop {
+            if let Some(p) = self.pending.take() {
+                let complete = self.complete(&p.tick);
+                if !complete && now_ns < p.until_ns {
+                    self.pending = Some(p);
+                    return;
+                }
+                if !complete {
+                    self.misses += 1;
+                }
+                self.finish_tick(p, out);
+                continue;
+            }
+            let Some(t) = self.ticks.pop_front() else {
+                return;
             };
-            let stepped = match plant.as_mut() {
-                Some(pl) => sim.step_with_plant(pl, &held, at_physics_step),
-                None => sim.step_with(&held, at_physics_step),
-            };
-            between = Some(min);
-            if let Err(e) = stepped {
-                eprintln!("simulator: {e}");
-                res.end = end::SIMULATOR_FAILED;
+            if t.command == tick_command::STOP {
+                // wake the consumers once so that they see the stop too
+                out.notify.extend_from_slice(&[
+                    services::PARTNER_STATE,
+                    services::SIM_STATE,
+                    services::STEP_RESULT,
+                ]);
+                self.stop = true;
+                return;
+            }
+            if !self.ended {
+                self.start_tick(t, now_ns, out);
             }
         }
-        ended = res.end == end::SIMULATOR_FAILED || (res.end != end::RUNNING && !keep_going);
-        res.publish_ns = now();
-        send(&result_tx, &res)?;
     }
-    let impostors = [st_rx.rejected(), sa_rx.rejected(), sr_rx.rejected()];
+}
+
+/// Starts the plant process of `[simulator] plant`, if any, at the simulator's state.
+fn start_plant(p: &Proc, sim: &Simulator) -> Result<Option<Box<dyn Plant + Send>>, FlightError> {
+    let Some((program, args)) = p.cfg.simulator.plant.split_first() else {
+        return Ok(None);
+    };
+    let mut args = args.to_vec();
+    args.push("--scenario".into());
+    args.push(p.cfg.scenario_path().display().to_string());
+    let fail = |e: sc_sim::PlantError| FlightError::Simulator(e.0);
+    let mut child =
+        sc_sim::ProcessPlant::spawn(std::path::Path::new(program), &args).map_err(fail)?;
+    child.start(sim.state()).map_err(fail)?;
     eprintln!(
-        "simulator: done at step {}, {misses} deadline misses, safe commands rejected (translational, attitude, robotic) {rejected:?}, samples from a second publisher dropped {impostors:?}",
-        sim.step_count()
+        "simulator: the plant `{}` propagates",
+        p.cfg.simulator.plant.join(" ")
     );
-    Ok(0)
+    Ok(Some(Box::new(child)))
+}
+
+impl Component for SimulatorRole {
+    fn wake_sets(&self) -> &'static [WakeSet] {
+        WAKE
+    }
+
+    fn inputs(&self) -> &'static [ServiceName] {
+        // reverse causal order: a command published while the queues are read is never
+        // seen without the earlier commands of its tick, which do not wake the simulator
+        &[
+            services::PREPARE,
+            services::TICK,
+            services::SAFE_ROBOTIC,
+            services::SAFE_ATTITUDE,
+            services::SAFE_TRANSLATIONAL,
+        ]
+    }
+
+    fn warm(&self) -> &'static [ServiceName] {
+        &[services::PARTNER_STATE, services::SIM_STATE]
+    }
+
+    fn next(&mut self, _: u64) -> Next {
+        if self.stop {
+            return Next::Exit;
+        }
+        let Some(p) = &self.pending else {
+            return Next::Wait {
+                set: IDLE,
+                until_ns: None,
+            };
+        };
+        let due = SubsystemSet::from_bits(p.tick.due_mask);
+        let robotic_here = self.got[Subsystem::Robotic].is_some_and(|m| m.tick == p.tick.tick);
+        let any =
+            self.absent.0.iter().any(|a| *a) || !due.contains(Subsystem::Robotic) || robotic_here;
+        Next::Wait {
+            set: if any { ANY } else { ROBOTIC },
+            until_ns: Some(p.until_ns),
+        }
+    }
+
+    fn handle(&mut self, w: &Wakeup, inputs: &[Message], _: &mut dyn Env, out: &mut Outbox) {
+        let idle = self.pending.is_none();
+        self.absorb(w, inputs);
+        if idle {
+            // the pre-tick warm-up: only between ticks
+            out.rehearse = std::mem::take(&mut self.rehearse);
+        }
+        self.process(w.now_ns, out);
+    }
+
+    /// The start of a tick on the current state; nothing is sent.
+    fn rehearse(&mut self) {
+        std::hint::black_box(convert::sim_state(&self.sim.observe()));
+    }
+
+    fn finish(&mut self, why: Finish, impostors: &[(ServiceName, u64)], out: &mut Outbox) -> i32 {
+        if why == Finish::Terminated && self.pending.is_some() {
+            return 0;
+        }
+        let dropped = |svc| {
+            impostors
+                .iter()
+                .find(|(s, _)| *s == svc)
+                .map_or(0, |(_, n)| *n)
+        };
+        let impostors = [
+            dropped(services::SAFE_TRANSLATIONAL),
+            dropped(services::SAFE_ATTITUDE),
+            dropped(services::SAFE_ROBOTIC),
+        ];
+        out.log(format!(
+            "simulator: done at step {}, {} deadline misses, safe commands rejected (translational, attitude, robotic) {:?}, samples from a second publisher dropped {impostors:?}",
+            self.sim.step_count(),
+            self.misses,
+            self.rejected.0
+        ));
+        0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::component::{NoPeers, Woke};
+    use crate::roles::testing::{setup, wakeup};
+    use sc_icd::{SafeAttitude, SafeRobotic, SafeTranslational};
+
+    const DEADLINE_NS: u64 = 90_000_000;
+
+    fn role() -> SimulatorRole {
+        let su = setup();
+        let sim = Simulator::new(&su.scenario, su.robot.clone()).unwrap();
+        SimulatorRole::new(sim, None, su.scenario, su.robot, DEADLINE_NS, false)
+    }
+
+    fn tick(k: u64, due: SubsystemSet) -> Message {
+        Message::Tick(Tick {
+            tick: k,
+            due_mask: due.bits(),
+            ..Default::default()
+        })
+    }
+
+    fn safe(k: u64) -> [Message; 3] {
+        [
+            Message::SafeRobotic(SafeRobotic {
+                tick: k,
+                ..Default::default()
+            }),
+            Message::SafeAttitude(SafeAttitude {
+                tick: k,
+                ..Default::default()
+            }),
+            Message::SafeTranslational(SafeTranslational {
+                tick: k,
+                ..Default::default()
+            }),
+        ]
+    }
+
+    fn handle(r: &mut SimulatorRole, now: u64, why: Woke, inputs: &[Message]) -> Outbox {
+        let mut out = Outbox::default();
+        r.handle(&wakeup(now, why), inputs, &mut NoPeers, &mut out);
+        out
+    }
+
+    fn result(out: &Outbox) -> StepResult {
+        match out.send.iter().find_map(|m| match m {
+            Message::StepResult(r) => Some(*r),
+            _ => None,
+        }) {
+            Some(r) => r,
+            None => panic!("no step result in {:?}", out.send),
+        }
+    }
+
+    #[test]
+    fn a_tick_publishes_the_state_then_applies_the_safe_commands() {
+        let mut r = role();
+        let out = handle(&mut r, 100, Woke::Event, &[tick(0, SubsystemSet::ALL)]);
+        assert!(
+            matches!(out.send[..], [Message::State(_), Message::PartnerState(_)]),
+            "flight side first"
+        );
+        assert_eq!(
+            r.next(100),
+            Next::Wait {
+                set: ROBOTIC,
+                until_ns: Some(100 + DEADLINE_NS)
+            }
+        );
+        let out = handle(&mut r, 200, Woke::Event, &safe(0));
+        let res = result(&out);
+        assert_eq!(
+            (res.tick, res.fallback_mask, res.fault_flags, res.end),
+            (0, 0, 0, end::RUNNING)
+        );
+        assert_eq!(res.safe_recv_ns, 200);
+        assert_eq!(r.sim.step_count(), 1, "the physics advanced");
+    }
+
+    #[test]
+    fn at_the_deadline_the_missing_commands_are_the_filters_backups() {
+        let mut r = role();
+        handle(&mut r, 0, Woke::Event, &[tick(0, SubsystemSet::ALL)]);
+        // a command for another tick is not this tick's
+        let late = Message::SafeTranslational(SafeTranslational {
+            tick: 7,
+            ..Default::default()
+        });
+        assert!(handle(&mut r, 10, Woke::Event, &[late]).send.is_empty());
+        let out = handle(&mut r, DEADLINE_NS, Woke::Timeout, &[]);
+        let res = result(&out);
+        assert_eq!(res.fallback_mask, SubsystemSet::ALL.bits());
+        assert_eq!(res.fault_flags, fault::DEADLINE_MISS);
+        assert!(out.log.iter().any(|l| {
+            l.contains("FAULT tick 0: translational safe command missing, fallback applied")
+        }));
+        assert_eq!(r.misses, 1);
+        assert!(r.absent.0.iter().all(|a| *a), "not waited for again");
+        assert_eq!(
+            r.next(0),
+            Next::Wait {
+                set: IDLE,
+                until_ns: None
+            }
+        );
+    }
+
+    #[test]
+    fn a_command_beyond_its_bounds_is_refused_and_counted() {
+        let mut r = role();
+        handle(&mut r, 0, Woke::Event, &[tick(0, SubsystemSet::ALL)]);
+        let mut cmds = safe(0);
+        if let Message::SafeRobotic(m) = &mut cmds[0] {
+            m.u[6] = f64::NAN;
+        }
+        let res = result(&handle(&mut r, 10, Woke::Event, &cmds));
+        assert_eq!(res.fallback_mask, Subsystem::Robotic.bit());
+        assert_eq!(res.fault_flags, fault::REJECTED_COMMAND);
+        assert!(res.tau.iter().all(|x| x.is_finite()));
+        let mut fin = Outbox::default();
+        r.finish(Finish::Done, &[], &mut fin);
+        assert!(
+            fin.log[0]
+                .contains("safe commands rejected (translational, attitude, robotic) [0, 0, 1]")
+        );
+    }
+
+    #[test]
+    fn a_slower_group_holds_its_command() {
+        let mut r = role();
+        let only_robotic = SubsystemSet::only(Subsystem::Robotic);
+        handle(&mut r, 0, Woke::Event, &[tick(0, only_robotic)]);
+        let Next::Wait { set, .. } = r.next(0) else {
+            panic!()
+        };
+        assert_eq!(set, ROBOTIC);
+        let cmd = [Message::SafeRobotic(SafeRobotic {
+            tick: 0,
+            ..Default::default()
+        })];
+        let res = result(&handle(&mut r, 10, Woke::Event, &cmd));
+        let others = Subsystem::Translational.bit() | Subsystem::Attitude.bit();
+        assert_eq!((res.held_mask, res.fallback_mask), (others, 0));
+    }
+
+    #[test]
+    fn the_stop_wakes_every_consumer_and_ends_the_role() {
+        let mut r = role();
+        let stop = Message::Tick(Tick {
+            command: tick_command::STOP,
+            ..Default::default()
+        });
+        let out = handle(&mut r, 0, Woke::Event, &[stop]);
+        assert_eq!(
+            out.notify,
+            vec![
+                services::PARTNER_STATE,
+                services::SIM_STATE,
+                services::STEP_RESULT
+            ]
+        );
+        assert_eq!(r.next(0), Next::Exit);
+    }
 }
