@@ -13,21 +13,9 @@ use sc_icd::ROLES;
 use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
 
-/// The command that builds the partition's own executables.
-pub const BUILD_COMMAND: &str = "cargo build --release -p sc-partition-apps";
-
-/// The executables of package sc-partition-apps that serve the roles (`apps/partition`).
-pub const PARTITION_EXECUTABLES: [&str; 9] = [
-    "sc-scheduler",
-    "sc-simulator",
-    "sc-nominal-translational",
-    "sc-nominal-attitude",
-    "sc-nominal-robotic",
-    "sc-safety-translational",
-    "sc-safety-attitude",
-    "sc-safety-robotic",
-    "sc-recorder",
-];
+/// The command that builds the partition's own executables (the flight ones are package
+/// sc-partition-apps, the recorder is safe-capture's): the README's quick start.
+pub const BUILD_COMMAND: &str = "cargo build --release -p safe-capture -p sc-partition-apps";
 
 /// Mode bits that make a file executable by someone.
 const ANY_EXECUTE: u32 = 0o111;
@@ -122,7 +110,7 @@ fn fix_for(program: &Path, key: &str) -> String {
         .file_name()
         .map(|n| n.to_string_lossy().to_string())
         .unwrap_or_default();
-    if PARTITION_EXECUTABLES.contains(&name.as_str()) {
+    if ROLES.iter().any(|r| r.exec == name) {
         format!("build it with `{BUILD_COMMAND}` or correct `{key}`")
     } else if program.ends_with(".venv/bin/python") {
         format!("create the Python environment with `scripts/setup.sh` or correct `{key}`")

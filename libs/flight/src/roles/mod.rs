@@ -66,6 +66,106 @@ pub fn keep_for_tick<T>(
 #[cfg(test)]
 mod tests {
     use super::keep_for_tick;
+    use super::testing::{controllers, setup};
+    use super::*;
+    use crate::component::Component;
+    use sc_icd::services::{HANDSHAKE, ServiceName};
+    use sc_icd::{ROLES, Role, RoleKind, Subsystem};
+
+    /// The component of every flight role (the recorder's test is sc-ground's).
+    fn components() -> Vec<(RoleKind, Box<dyn Component>)> {
+        let su = setup();
+        let layer = || sc_cbf::SafetyLayer::from_scenario(&su.scenario, su.robot.clone());
+        let sim = sc_sim::Simulator::new(&su.scenario, su.robot.clone()).unwrap();
+        let schedule = crate::config::Schedule {
+            base_period_s: 0.1,
+            period_s: sc_core::PerSubsystem([0.1; 3]),
+            ratio: sc_core::PerSubsystem([1; 3]),
+        };
+        let timing = scheduler::Timing {
+            schedule,
+            real_time: false,
+            period_ns: 1,
+            warmup_lead_ns: None,
+            stage_deadline_ns: [1; 3],
+            step_timeout_ns: 1,
+            recorder_window: 1,
+            max_ticks: 0,
+        };
+        let mut v: Vec<(RoleKind, Box<dyn Component>)> = vec![
+            (
+                RoleKind::Scheduler,
+                Box::new(SchedulerRole::new(timing, "LockStep")),
+            ),
+            (
+                RoleKind::Simulator,
+                Box::new(SimulatorRole::new(
+                    sim,
+                    None,
+                    su.scenario.clone(),
+                    su.robot.clone(),
+                    1,
+                    false,
+                )),
+            ),
+        ];
+        for s in Subsystem::ALL {
+            v.push((
+                RoleKind::Nominal(s),
+                Box::new(NominalRole::new(s, controllers())),
+            ));
+            v.push((
+                RoleKind::Filter(s),
+                Box::new(FilterRole::new(s, layer(), su.scenario.clone(), 1)),
+            ));
+        }
+        v
+    }
+
+    fn sorted(v: impl IntoIterator<Item = ServiceName>) -> Vec<&'static str> {
+        let mut v: Vec<&str> = v.into_iter().map(|s| s.as_str()).collect();
+        v.sort();
+        v
+    }
+
+    /// What a component reads and wakes on is what the role table says it subscribes
+    /// to: the table is the one list, and a component cannot drift from it.
+    #[test]
+    fn every_flight_role_reads_exactly_its_table_row() {
+        let comps = components();
+        let flight: Vec<&Role> = ROLES.iter().filter(|r| r.flight).collect();
+        assert_eq!(
+            comps.len(),
+            flight.len(),
+            "a flight role without a component"
+        );
+        for (kind, c) in &comps {
+            let role = Role::of(*kind);
+            let table = role.subscribes.iter().copied().filter(|s| *s != HANDSHAKE);
+            assert_eq!(
+                sorted(c.inputs().iter().copied()),
+                sorted(table),
+                "{}",
+                role.name
+            );
+            for set in c.wake_sets() {
+                for s in set.on {
+                    assert!(
+                        c.inputs().contains(s),
+                        "{}: wakes on {s} it does not read",
+                        role.name
+                    );
+                }
+            }
+            for s in c.warm() {
+                assert!(
+                    role.publishes.contains(s),
+                    "{}: warms {s} it does not publish",
+                    role.name
+                );
+            }
+        }
+    }
 
     #[test]
     fn the_awaited_command_is_kept_and_lies_about_ticks_are_dropped() {

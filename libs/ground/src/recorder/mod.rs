@@ -518,6 +518,22 @@ mod tests {
         out
     }
 
+    /// The recorder reads what the role table says it subscribes to.
+    #[test]
+    fn the_recorder_reads_exactly_its_table_row() {
+        let role = Role::of(RoleKind::Recorder);
+        let mut want: Vec<&str> = role.subscribes.iter().map(|s| s.as_str()).collect();
+        let mut got: Vec<&str> = role_inputs().iter().map(|s| s.as_str()).collect();
+        want.sort();
+        got.sort();
+        assert_eq!(got, want);
+        assert!(!role.flight, "a ground tool");
+    }
+
+    fn role_inputs() -> &'static [ServiceName] {
+        role().inputs()
+    }
+
     #[test]
     fn a_complete_tick_is_written_and_reported_to_the_scheduler() {
         let mut r = role();
