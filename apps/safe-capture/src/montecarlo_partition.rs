@@ -270,10 +270,8 @@ impl Executor for PartitionExecutor {
             opts.role_override
                 .push(("simulator".into(), INJECTED_MISSING_EXEC.into(), Vec::new()));
         }
-        let rep = launch(&opts).map_err(|e| {
-            let chain: Vec<String> = e.chain().map(|c| c.to_string()).collect();
-            format!("partition: {}", chain.join(": ").replace('\n', " "))
-        })?;
+        let rep = launch(&opts)
+            .map_err(|e| format!("partition: {}", e.to_string().replace('\n', " ")))?;
         if rep.interrupted || interrupted() {
             return Err(self.stop());
         }

@@ -157,10 +157,8 @@ impl Partners {
         if interrupted() {
             return Err("interrupted".into());
         }
-        let rep = launch(&self.options(case, out, tag)).map_err(|e| {
-            let chain: Vec<String> = e.chain().map(|c| c.to_string()).collect();
-            format!("partition: {}", chain.join(": ").replace('\n', " "))
-        })?;
+        let rep = launch(&self.options(case, out, tag))
+            .map_err(|e| format!("partition: {}", e.to_string().replace('\n', " ")))?;
         if let Some(e) = &rep.error {
             return Err(format!("partition: {e} (exit code {})", rep.code));
         }

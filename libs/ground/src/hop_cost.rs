@@ -6,6 +6,7 @@
 //! optionally, a warm-up round trip before each measured one (the partition's
 //! pre-tick warm-up). The binary is `sc-hop-cost` (docs/PARTITION.md).
 
+use crate::error::BenchError;
 use crate::pm_qos::CpuWakeupLatency;
 use sc_bus::{Coordinator, Participant, Publisher, RunScope, ServiceSettings, Subscriber, Waiter};
 use sc_flight::process::{set_cpus, set_fifo};
@@ -15,6 +16,9 @@ use std::time::{Duration, Instant};
 /// Command-line usage of `sc-hop-cost`.
 pub const USAGE: &str = "usage: sc-hop-cost [--n N] [--period-us P] [--cpus A,B] [--fifo PRIO] \
 [--cpu-wakeup-latency-us L] [--touch-kib K] [--prewarm-us W]";
+
+/// The longest a round trip may take before the measurement fails.
+const ECHO_TIMEOUT: Duration = Duration::from_secs(2);
 
 /// Ticks of the measured and of the warm-up round trips, and the stop.
 const WARM_TICK: u64 = u64::MAX - 1;
@@ -58,7 +62,11 @@ impl Default for HopCostOptions {
 
 impl HopCostOptions {
     /// Parses the arguments (without the program name).
-    pub fn parse(args: &[String]) -> Result<Self, String> {
+    pub fn parse(args: &[String]) -> Result<Self, BenchError> {
+        Self::parse_words(args).map_err(BenchError::Data)
+    }
+
+    fn parse_words(args: &[String]) -> Result<Self, String> {
         let mut o = Self::default();
         let mut it = args.iter();
         while let Some(a) = it.next() {
@@ -117,8 +125,15 @@ fn place(o: &HopCostOptions, cpu: Option<usize>) {
     }
 }
 
+/// The echo process of the run named in the environment (`SC_RUN_ID`, set by the
+/// sender that started it).
+pub fn echo_from_env(o: &HopCostOptions) -> Result<(), BenchError> {
+    let run_id = std::env::var(sc_bus::RUN_ID_ENV).unwrap_or_default();
+    echo(&run_id, o)
+}
+
 /// The echo process: answers every ping until the stop.
-pub fn echo(run_id: &str, o: &HopCostOptions) -> anyhow::Result<()> {
+pub fn echo(run_id: &str, o: &HopCostOptions) -> Result<(), BenchError> {
     place(o, o.cpus.map(|c| c.1));
     let scope = RunScope::new(run_id)?;
     let node = scope.node("echo")?;
@@ -154,7 +169,7 @@ fn round_trip(
     pong: &Subscriber<Tick>,
     waiter: &Waiter,
     tick: u64,
-) -> anyhow::Result<Duration> {
+) -> Result<Duration, BenchError> {
     let t0 = Instant::now();
     ping.send(&Tick {
         tick,
@@ -166,10 +181,9 @@ fn round_trip(
         if pong.try_receive()?.is_some_and(|t| t.tick == tick) {
             return Ok(t0.elapsed());
         }
-        anyhow::ensure!(
-            t0.elapsed() < Duration::from_secs(2),
-            "no echo of tick {tick}"
-        );
+        if t0.elapsed() >= ECHO_TIMEOUT {
+            return Err(BenchError::Data(format!("no echo of tick {tick}")));
+        }
     }
 }
 
@@ -179,13 +193,13 @@ pub fn measure(
     o: &HopCostOptions,
     exe: &std::path::Path,
     args: &[String],
-) -> anyhow::Result<RoundTrips> {
+) -> Result<RoundTrips, BenchError> {
     place(o, o.cpus.map(|c| c.0));
     let _pm_qos = o
         .cpu_wakeup_latency_us
         .map(CpuWakeupLatency::request)
         .transpose()
-        .map_err(|e| anyhow::anyhow!("PM QoS ({}): {e}", crate::pm_qos::DEVICE))?;
+        .map_err(|e| BenchError::Data(format!("PM QoS ({}): {e}", crate::pm_qos::DEVICE)))?;
     let scope = RunScope::unique("hopcost")?;
     let mut rt = Vec::with_capacity(o.n);
     {
@@ -198,7 +212,8 @@ pub fn measure(
             .args(args)
             .arg("--echo")
             .env(sc_bus::RUN_ID_ENV, scope.run_id())
-            .spawn()?;
+            .spawn()
+            .map_err(|e| BenchError::Data(format!("cannot start {}: {e}", exe.display())))?;
         coord.wait_all(Duration::from_secs(20))?;
         let waiter = Waiter::new()?;
         let _a = waiter.attach(&pong)?;
@@ -219,7 +234,9 @@ pub fn measure(
             tick: STOP_TICK,
             ..Default::default()
         })?;
-        child.wait()?;
+        child
+            .wait()
+            .map_err(|e| BenchError::Data(format!("the echo process: {e}")))?;
     }
     scope.teardown()?;
     rt.sort_by(f64::total_cmp);
@@ -232,36 +249,6 @@ pub fn measure(
         p99_us: p(0.99),
         max_us: rt[rt.len() - 1],
     })
-}
-
-/// `sc-hop-cost`: measures and prints the round trips, or (with `--echo`, on the
-/// child it starts) answers them. Exit code 2 on bad arguments, 1 on failure.
-pub fn main() -> std::process::ExitCode {
-    use std::process::ExitCode;
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let o = match HopCostOptions::parse(&args) {
-        Ok(o) => o,
-        Err(e) => {
-            eprintln!("sc-hop-cost: {e}");
-            return ExitCode::from(2);
-        }
-    };
-    let r = if o.echo {
-        let run_id = std::env::var(sc_bus::RUN_ID_ENV).unwrap_or_default();
-        echo(&run_id, &o)
-    } else {
-        std::env::current_exe()
-            .map_err(anyhow::Error::from)
-            .and_then(|exe| measure(&o, &exe, &args))
-            .map(|rt| println!("{rt}, period {:?}", o.period))
-    };
-    match r {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("sc-hop-cost: {e:#}");
-            ExitCode::FAILURE
-        }
-    }
 }
 
 #[cfg(test)]

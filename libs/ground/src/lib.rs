@@ -8,6 +8,7 @@
 //! * [`latency`], [`hop_cost`], [`steal`], [`pm_qos`]: the latency bench of
 //!   `safe-capture bench latency` and what it needs.
 
+pub mod error;
 pub mod hop_cost;
 pub mod latency;
 pub mod launcher;

@@ -13,9 +13,10 @@ use sc_icd::ROLES;
 use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
 
-/// The command that builds the partition's own executables (the flight ones are package
-/// sc-partition-apps, the recorder is safe-capture's): the README's quick start.
-pub const BUILD_COMMAND: &str = "cargo build --release -p safe-capture -p sc-partition-apps";
+/// The command that builds the partition's flight executables (package sc-partition-apps).
+pub const BUILD_COMMAND: &str = "cargo build --release -p sc-partition-apps";
+/// The command that builds its ground executables (the recorder: package safe-capture).
+pub const BUILD_GROUND_COMMAND: &str = "cargo build --release -p safe-capture";
 
 /// Mode bits that make a file executable by someone.
 const ANY_EXECUTE: u32 = 0o111;
@@ -110,8 +111,13 @@ fn fix_for(program: &Path, key: &str) -> String {
         .file_name()
         .map(|n| n.to_string_lossy().to_string())
         .unwrap_or_default();
-    if ROLES.iter().any(|r| r.exec == name) {
-        format!("build it with `{BUILD_COMMAND}` or correct `{key}`")
+    if let Some(role) = ROLES.iter().find(|r| r.exec == name) {
+        let build = if role.flight {
+            BUILD_COMMAND
+        } else {
+            BUILD_GROUND_COMMAND
+        };
+        format!("build it with `{build}` or correct `{key}`")
     } else if program.ends_with(".venv/bin/python") {
         format!("create the Python environment with `scripts/setup.sh` or correct `{key}`")
     } else {

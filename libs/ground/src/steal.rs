@@ -90,13 +90,19 @@ pub fn write_csv(path: &Path, series: &[StealSample]) -> std::io::Result<()> {
 }
 
 /// Reads a series written by [`write_csv`]; None if the file is absent.
-pub fn read_csv(path: &Path) -> anyhow::Result<Option<Vec<StealSample>>> {
+pub fn read_csv(path: &Path) -> Result<Option<Vec<StealSample>>, crate::error::BenchError> {
     let Ok(text) = std::fs::read_to_string(path) else {
         return Ok(None);
     };
     let mut v = Vec::new();
     for (i, l) in text.lines().enumerate().skip(1) {
-        let bad = || anyhow::anyhow!("{}: line {}: expected t_ns,steal_s", path.display(), i + 1);
+        let bad = || {
+            crate::error::BenchError::Data(format!(
+                "{}: line {}: expected t_ns,steal_s",
+                path.display(),
+                i + 1
+            ))
+        };
         let (t, s) = l.split_once(',').ok_or_else(bad)?;
         v.push(StealSample {
             t_ns: t.parse().map_err(|_| bad())?,

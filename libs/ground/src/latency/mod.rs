@@ -2,14 +2,18 @@
 //! tick (scheduler tick sent → robotic safe command delivered to the simulator), from
 //! the stamps every message carries (latency.csv written by the recorder).
 
+mod analyse;
+
+pub use analyse::analyse;
+
+use crate::error::BenchError;
 use crate::launcher::{LaunchOptions, launch};
-use anyhow::Context;
 use hdrhistogram::Histogram;
 use sc_plots::paper::PAPER_TOTAL_MAX_MS;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::io::Write;
-use std::path::{Path, PathBuf};
+
+use std::path::PathBuf;
 use std::time::Duration;
 
 /// Percentiles of one hop [µs].
@@ -127,13 +131,13 @@ pub const HOPS: [(&str, &str, &str); 9] = [
     ),
 ];
 
-fn hist() -> Histogram<u64> {
+pub(crate) fn hist() -> Histogram<u64> {
     // 1 ns .. 100 s, 3 significant digits
     Histogram::new_with_bounds(1, 100_000_000_000, 3)
         .unwrap_or_else(|_| Histogram::new(3).expect("histogram"))
 }
 
-fn stats(h: &Histogram<u64>) -> HopStats {
+pub(crate) fn stats(h: &Histogram<u64>) -> HopStats {
     let us = |v: u64| v as f64 / 1e3;
     if h.is_empty() {
         return HopStats {
@@ -180,173 +184,9 @@ pub fn machine() -> Machine {
     }
 }
 
-/// Computes the report from a run's output directory, excluding the first `warmup` ticks;
-/// writes `latency_whole_tick.hgrm` (HDR percentile distribution) and
-/// `latency.svg` (log-scale percentile plot) next to it.
-pub fn analyse(out: &Path, warmup: u64) -> anyhow::Result<LatencyReport> {
-    let text = std::fs::read_to_string(out.join("latency.csv"))
-        .with_context(|| format!("reading {}", out.join("latency.csv").display()))?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines
-        .next()
-        .context("latency.csv is empty")?
-        .split(',')
-        .collect();
-    let col = |n: &str| {
-        header
-            .iter()
-            .position(|c| *c == n)
-            .with_context(|| format!("latency.csv: no column {n}"))
-    };
-    let mut whole = hist();
-    let mut hops: Vec<Histogram<u64>> = HOPS.iter().map(|_| hist()).collect();
-    let (c_tick, c_send, c_recv, c_fb) = (
-        col("tick")?,
-        col("tick_send_ns")?,
-        col("sim_safe_recv_ns")?,
-        col("fallback_mask")?,
-    );
-    // filters that applied their fallback at a stage deadline (absent in older files)
-    let c_um = col("upstream_missing_mask").ok();
-    let hop_cols: Vec<(usize, usize)> = HOPS
-        .iter()
-        .map(|(_, a, b)| Ok((col(a)?, col(b)?)))
-        .collect::<anyhow::Result<_>>()?;
-    let mut total = 0;
-    let mut misses = 0;
-    // (tick send, whole-tick latency) [ns] of the measured ticks
-    let mut ticks: Vec<(u64, u64)> = Vec::new();
-    for l in lines {
-        let v: Vec<&str> = l.split(',').collect();
-        total += 1;
-        let tick: u64 = v[c_tick].parse().context("latency.csv: bad tick")?;
-        if tick < warmup {
-            continue;
-        }
-        let flagged = |c: Option<usize>| c.and_then(|c| v.get(c)).is_some_and(|x| *x != "0");
-        if flagged(Some(c_fb)) || flagged(c_um) {
-            misses += 1;
-        }
-        let num = |i: usize| v.get(i).and_then(|x| x.parse::<u64>().ok());
-        if let (Some(a), Some(b)) = (num(c_send), num(c_recv)) {
-            whole.saturating_record(b.saturating_sub(a).max(1));
-            ticks.push((a, b.saturating_sub(a).max(1)));
-        }
-        for (h, (a, b)) in hops.iter_mut().zip(&hop_cols) {
-            if let (Some(a), Some(b)) = (num(*a), num(*b)) {
-                h.saturating_record(b.saturating_sub(a).max(1));
-            }
-        }
-    }
-    let sched: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(out.join("scheduler.json")).context("reading scheduler.json")?,
-    )?;
-    let series = crate::steal::read_csv(&out.join("steal.csv"))?;
-    let steal_of: Vec<Option<f64>> = ticks
-        .iter()
-        .map(|(a, d)| {
-            series
-                .as_ref()
-                .and_then(|v| crate::steal::steal_around(v, *a, a + d))
-        })
-        .collect();
-    let steal = series.as_ref().filter(|v| v.len() >= 2).map(|v| {
-        let mut calm = hist();
-        let (mut with, mut over, mut over_with) = (0, 0, 0);
-        for ((_, d), st) in ticks.iter().zip(&steal_of) {
-            let stolen = st.is_some_and(|x| x > 0.0);
-            with += u64::from(stolen);
-            if *d > SLOW_TICK_NS {
-                over += 1;
-                over_with += u64::from(stolen);
-            }
-            if !stolen {
-                calm.saturating_record(*d);
-            }
-        }
-        let span = v[v.len() - 1].t_ns.saturating_sub(v[0].t_ns) as f64 * 1e-9;
-        StealSummary {
-            sample_period_s: span / (v.len() - 1) as f64,
-            ticks_with_steal: with,
-            whole_tick_without_steal: stats(&calm),
-            over_1ms: over,
-            over_1ms_with_steal: over_with,
-        }
-    });
-    let rep = LatencyReport {
-        clock: sched["clock"].as_str().unwrap_or("").to_string(),
-        period_s: sched["base_period_s"].as_f64().unwrap_or(0.0),
-        ticks_total: total,
-        warmup_ticks: warmup,
-        whole_tick: stats(&whole),
-        hops: HOPS
-            .iter()
-            .zip(&hops)
-            .map(|((n, _, _), h)| (n.to_string(), stats(h)))
-            .collect(),
-        cycle_slips: sched["cycle_slips"].as_u64().unwrap_or(0),
-        deadline_misses: misses,
-        // what every process of the run read
-        warmup_lead_us: crate::PartitionConfig::load(&out.join("partition.effective.toml"))
-            .map_or(0, |c| c.warmup_lead_us),
-        steal,
-        machine: machine(),
-    };
-    // HDR percentile distribution of the whole tick
-    let mut f =
-        std::io::BufWriter::new(std::fs::File::create(out.join("latency_whole_tick.hgrm"))?);
-    writeln!(
-        f,
-        "{:>12} {:>14} {:>10} {:>14}",
-        "Value(us)", "Percentile", "TotalCount", "1/(1-Percentile)"
-    )?;
-    let mut points = Vec::new();
-    for v in whole.iter_quantiles(4) {
-        let q = v.quantile_iterated_to();
-        let val = v.value_iterated_to() as f64 / 1e3;
-        let inv = if q < 1.0 {
-            1.0 / (1.0 - q)
-        } else {
-            f64::INFINITY
-        };
-        writeln!(
-            f,
-            "{:>12.3} {:>14.12} {:>10} {:>14.2}",
-            val,
-            q,
-            v.count_since_last_iteration(),
-            inv
-        )?;
-        if q < 1.0 {
-            points.push((inv, val));
-        }
-    }
-    writeln!(
-        f,
-        "#[Mean = {:.3}, StdDeviation = {:.3}]",
-        whole.mean() / 1e3,
-        whole.stdev() / 1e3
-    )?;
-    writeln!(
-        f,
-        "#[Max = {:.3}, Total count = {}]",
-        whole.max() as f64 / 1e3,
-        whole.len()
-    )?;
-    f.flush()?;
-    plot(&out.join("latency.svg"), &points, &rep)?;
-    plot_timeline(
-        &out.join("latency_timeline.svg"),
-        &ticks,
-        series.as_deref().unwrap_or(&[]),
-        &rep,
-    )?;
-    Ok(rep)
-}
-
 /// The reference latencies drawn on both figures [µs], with their labels: the
 /// partition's 1 ms target and the paper's maximum.
-fn references() -> Vec<(String, f64)> {
+pub(crate) fn references() -> Vec<(String, f64)> {
     const NS_PER_US: f64 = 1e3;
     const US_PER_MS: f64 = 1e3;
     let target_us = SLOW_TICK_NS as f64 / NS_PER_US;
@@ -360,22 +200,6 @@ fn references() -> Vec<(String, f64)> {
             PAPER_TOTAL_MAX_MS * US_PER_MS,
         ),
     ]
-}
-
-fn plot(path: &Path, pts: &[(f64, f64)], rep: &LatencyReport) -> anyhow::Result<()> {
-    let title = format!(
-        "whole-tick latency, {} ticks at {} s ({} cores, kernel {})",
-        rep.whole_tick.n, rep.period_s, rep.machine.cores, rep.machine.kernel
-    );
-    sc_plots::latency_percentiles(
-        path,
-        &sc_plots::LatencyPercentiles {
-            title: &title,
-            points: pts,
-            references: &references(),
-        },
-    )
-    .with_context(|| format!("drawing {}", path.display()))
 }
 
 /// A whole tick longer than this [ns] counts as slow in the steal summary: the
@@ -397,7 +221,7 @@ pub struct BenchOptions {
 }
 
 /// Runs the partition in real-time mode for `warmup + ticks` ticks and analyses it.
-pub fn bench(o: &BenchOptions) -> anyhow::Result<LatencyReport> {
+pub fn bench(o: &BenchOptions) -> Result<LatencyReport, BenchError> {
     let sampler = crate::steal::StealSampler::start(STEAL_SAMPLE_PERIOD);
     let rep = launch(&LaunchOptions {
         config: o.config.clone(),
@@ -409,9 +233,13 @@ pub fn bench(o: &BenchOptions) -> anyhow::Result<LatencyReport> {
         ..Default::default()
     })?;
     let series = sampler.finish();
-    crate::steal::write_csv(&o.out.join("steal.csv"), &series)?;
+    let steal_csv = o.out.join("steal.csv");
+    crate::steal::write_csv(&steal_csv, &series).map_err(BenchError::write(&steal_csv))?;
     if rep.code == 3 {
-        anyhow::bail!("the partition run failed (see {}/logs)", o.out.display());
+        return Err(BenchError::Data(format!(
+            "the partition run failed (see {}/logs)",
+            o.out.display()
+        )));
     }
     let mut r = analyse(&o.out, o.warmup)?;
     r.machine.cpu_wakeup_latency = rep.cpu_wakeup_latency.clone();
@@ -419,11 +247,11 @@ pub fn bench(o: &BenchOptions) -> anyhow::Result<LatencyReport> {
         .first()
         .zip(series.last())
         .map(|(a, b)| (b.steal_s - a.steal_s).max(0.0));
-    std::fs::write(
-        o.out.join("latency_report.json"),
-        serde_json::to_string_pretty(&r)? + "\n",
-    )?;
-    std::fs::write(o.out.join("latency_report.md"), markdown(&r))?;
+    let json = o.out.join("latency_report.json");
+    let text = serde_json::to_string_pretty(&r).unwrap_or_default() + "\n";
+    std::fs::write(&json, text).map_err(BenchError::write(&json))?;
+    let md = o.out.join("latency_report.md");
+    std::fs::write(&md, markdown(&r)).map_err(BenchError::write(&md))?;
     Ok(r)
 }
 
@@ -485,55 +313,11 @@ pub fn markdown(r: &LatencyReport) -> String {
     s
 }
 
-/// Whole-tick latency of every measured tick over the run (log scale) above the
-/// host's steal rate, so that a reader sees whether the tail follows the host.
-fn plot_timeline(
-    path: &Path,
-    ticks: &[(u64, u64)],
-    steal: &[crate::steal::StealSample],
-    rep: &LatencyReport,
-) -> anyhow::Result<()> {
-    const S_PER_NS: f64 = 1e-9;
-    const US_PER_NS: f64 = 1e-3;
-    const MS_PER_S: f64 = 1e3;
-    let t0 = ticks.first().map_or(0, |t| t.0);
-    let secs = |ns: u64| ns.saturating_sub(t0) as f64 * S_PER_NS;
-    let pts: Vec<(f64, f64)> = ticks
-        .iter()
-        .map(|(a, d)| (secs(*a), *d as f64 * US_PER_NS))
-        .collect();
-    // steal rate between consecutive readings [ms of CPU per s]
-    let rate: Vec<(f64, f64)> = steal
-        .windows(2)
-        .filter(|w| w[1].t_ns > w[0].t_ns)
-        .map(|w| {
-            let dt = (w[1].t_ns - w[0].t_ns) as f64 * S_PER_NS;
-            (
-                secs(w[1].t_ns),
-                (w[1].steal_s - w[0].steal_s).max(0.0) * MS_PER_S / dt,
-            )
-        })
-        .collect();
-    let title = format!(
-        "whole-tick latency over the run ({} ticks at {} s)",
-        rep.whole_tick.n, rep.period_s
-    );
-    sc_plots::latency_timeline(
-        path,
-        &sc_plots::LatencyTimeline {
-            title: &title,
-            ticks: &pts,
-            steal: &rate,
-            references: &references(),
-        },
-    )
-    .with_context(|| format!("drawing {}", path.display()))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::steal::{StealSample, write_csv};
+    use std::path::Path;
 
     /// Ticks of the synthetic run.
     const TICKS: u64 = 20;

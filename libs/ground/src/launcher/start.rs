@@ -1,0 +1,174 @@
+//! The start of a run: the effective config every process reads (absolute paths, the
+//! options' overrides) and one process per role of the role table, each with its log.
+
+use super::{BIN_DIR_ENV, LaunchError, LaunchOptions, abs};
+use sc_bus::RunScope;
+use sc_flight::config::PartitionConfig;
+use sc_icd::{ROLES, Role};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+
+/// The config `opts` names, with the options' overrides applied (scenario, clock,
+/// ticks, deadline scale, role executables); paths still relative to its directory.
+pub fn configured(opts: &LaunchOptions) -> Result<PartitionConfig, LaunchError> {
+    let mut cfg = PartitionConfig::load(&opts.config)?;
+    if let Some(sc) = &opts.scenario {
+        cfg.scenario = abs(sc);
+    }
+    if let Some(c) = opts.clock {
+        cfg.clock = c;
+    }
+    if let Some(n) = opts.max_ticks {
+        cfg.max_ticks = n;
+    }
+    if let Some(d) = opts.deadline_scale {
+        cfg.lock_step.deadline_scale = d;
+    }
+    for (role, exec, args) in &opts.role_override {
+        let unknown = || LaunchError::UnknownRole {
+            role: role.clone(),
+            known: sc_icd::roles::names().collect::<Vec<_>>().join(", "),
+        };
+        Role::named(role).ok_or_else(unknown)?;
+        let e = cfg.roles.get_mut(role).ok_or_else(unknown)?;
+        e.exec = exec.clone();
+        e.args = args.clone();
+    }
+    Ok(cfg)
+}
+
+/// A file argument relative to the config directory `base` made absolute (options and
+/// names that are not files there are left alone).
+fn absolute_arg(a: &mut String, base: &Path, is_file_name: bool) {
+    if !a.starts_with('-') && is_file_name && !Path::new(a).is_absolute() && base.join(&*a).exists()
+    {
+        *a = base.join(&*a).display().to_string();
+    }
+}
+
+/// Clears `out` of an earlier run's outputs and writes the effective config into it
+/// (absolute paths: what every process reads); returns it and its path.
+pub(super) fn prepare(
+    opts: &LaunchOptions,
+    out: &Path,
+) -> Result<(PartitionConfig, PathBuf), LaunchError> {
+    let mut cfg = configured(opts)?;
+    super::clean::clear_previous_run(out);
+    std::fs::create_dir_all(out.join("logs")).map_err(|e| LaunchError::io(out, e))?;
+    let base = abs(&cfg.base_dir);
+    cfg.scenario = base.join(&cfg.scenario);
+    for e in cfg.roles.values_mut() {
+        e.exec = resolve_exec(&e.exec, &base, &opts.bin_dir)
+            .display()
+            .to_string();
+        // arguments that name files relative to the config directory
+        for a in e.args.iter_mut() {
+            let file = a.contains('/');
+            absolute_arg(a, &base, file);
+        }
+    }
+    // the plant's program and files, relative to the config directory like a role's
+    for (i, a) in cfg.simulator.plant.iter_mut().enumerate() {
+        let file = i == 0 || a.contains('/');
+        absolute_arg(a, &base, file);
+    }
+    cfg.validate()?;
+    let eff = out.join("partition.effective.toml");
+    let text = toml::to_string(&cfg)
+        .map_err(|e| LaunchError::Output(format!("serialising the effective config: {e}")))?;
+    std::fs::write(&eff, text).map_err(|e| LaunchError::io(&eff, e))?;
+    Ok((cfg, eff))
+}
+
+/// A started process of the run.
+pub(super) struct Started {
+    pub role: &'static str,
+    pub child: Child,
+}
+
+/// Starts the process of every role in the table's order, each with its log; stops at
+/// the first that cannot start (or whose log cannot be opened) and says why.
+pub(super) fn spawn_roles(
+    cfg: &PartitionConfig,
+    eff: &Path,
+    out: &Path,
+    run: &RunScope,
+) -> (Vec<Started>, Option<String>) {
+    let mut procs = Vec::new();
+    for role in ROLES.iter().map(|r| r.name) {
+        match spawn_role(cfg, role, eff, out, run) {
+            Ok(child) => procs.push(Started { role, child }),
+            // the processes already running are torn down, not left behind
+            Err(why) => return (procs, Some(why)),
+        }
+    }
+    (procs, None)
+}
+
+/// Starts one role's process with its log and the run's environment.
+fn spawn_role(
+    cfg: &PartitionConfig,
+    role: &str,
+    eff: &Path,
+    out: &Path,
+    run: &RunScope,
+) -> Result<Child, String> {
+    let e = &cfg.roles[role];
+    let path = out.join("logs").join(format!("{role}.log"));
+    let log = std::fs::File::create(&path)
+        .and_then(|l| Ok((l.try_clone()?, l)))
+        .map_err(|err| {
+            format!(
+                "cannot open the log of role `{role}` ({}): {err}",
+                path.display()
+            )
+        })?;
+    let mut cmd = Command::new(&e.exec);
+    cmd.args(&e.args);
+    if !e.no_standard_args {
+        cmd.arg("--config").arg(eff).arg("--out").arg(out);
+    }
+    cmd.env(sc_bus::RUN_ID_ENV, run.run_id())
+        .env(sc_flight::process::CONFIG_ENV, eff)
+        .env(sc_flight::process::OUT_ENV, out)
+        .stdin(Stdio::null())
+        .stdout(log.0)
+        .stderr(log.1);
+    cmd.spawn()
+        .map_err(|err| format!("cannot start role `{role}` ({}): {err}", e.exec))
+}
+
+/// The executable a role's `exec` names: a path relative to the config directory
+/// `base_dir`, or a bare name looked up in `bin_dir`, `SC_PARTITION_BIN_DIR` and the
+/// launcher's own directory; a bare name found in none of them is returned as is
+/// (then `PATH` decides).
+pub fn resolve_exec(exec: &str, base_dir: &Path, bin_dir: &Option<PathBuf>) -> PathBuf {
+    if exec.contains('/') {
+        let p = PathBuf::from(exec);
+        return if p.is_absolute() { p } else { base_dir.join(p) };
+    }
+    let mut dirs: Vec<PathBuf> = Vec::new();
+    if let Some(d) = bin_dir {
+        dirs.push(d.clone());
+    }
+    if let Some(d) = std::env::var_os(BIN_DIR_ENV) {
+        dirs.push(PathBuf::from(d));
+    }
+    if let Ok(me) = std::env::current_exe()
+        && let Some(d) = me.parent()
+    {
+        dirs.push(d.to_path_buf());
+        if d.file_name().is_some_and(|n| n == "deps")
+            && let Some(pd) = d.parent()
+        {
+            dirs.push(pd.to_path_buf());
+        }
+    }
+    for d in dirs {
+        let c = d.join(exec);
+        if c.is_file() {
+            return c;
+        }
+    }
+    PathBuf::from(exec)
+}

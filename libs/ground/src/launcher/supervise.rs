@@ -1,0 +1,239 @@
+//! The watch over a run's processes until every one has ended: a process that fails
+//! before every process is ready stops the start at once (naming it and the last line
+//! of its log); the scheduler's end starts the teardown; the death of an essential role
+//! (scheduler, simulator, recorder) too; a signal or the run's timeout too. The teardown
+//! is the stop tick (already sent by the scheduler), then SIGTERM, then SIGKILL for a
+//! process that ignores both (a hung process: a failure).
+
+use super::start::Started;
+use super::{ALL_READY, ProcessExit, QUOTED_LOG_CHARS, last_log_line, note};
+use sc_icd::{Role, RoleKind};
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+/// After the scheduler ended normally, the others have this long to finish their
+/// outputs (they got the stop tick) before SIGTERM.
+const AFTER_SCHEDULER: Duration = Duration::from_secs(8);
+/// After the simulator or the recorder died, the scheduler notices and stops the run;
+/// the launcher waits this long for that.
+const AFTER_ESSENTIAL_DEATH: Duration = Duration::from_secs(20);
+/// SIGTERM to SIGKILL.
+const TERM_TO_KILL: Duration = Duration::from_secs(3);
+/// How often the launcher looks at its processes.
+const POLL: Duration = Duration::from_millis(20);
+
+/// What the watch found.
+pub(super) struct Supervised {
+    pub exits: Vec<ProcessExit>,
+    pub interrupted: bool,
+    pub failed: bool,
+    /// A process that failed by itself before every process was ready.
+    pub early_err: Option<String>,
+}
+
+struct Watched {
+    role: &'static str,
+    child: std::process::Child,
+    exit: Option<ProcessExit>,
+}
+
+/// The watch over one run.
+pub(super) struct Supervisor<'a> {
+    procs: Vec<Watched>,
+    quiet: bool,
+    out: &'a Path,
+    teardown_at: Option<Instant>,
+    interrupted: bool,
+    failed: bool,
+    termed: bool,
+    killed: bool,
+    early_err: Option<String>,
+}
+
+/// How a process ended, in words.
+fn how(code: Option<i32>, signal: Option<i32>, exit_word: &str) -> String {
+    match (code, signal) {
+        (Some(c), _) => format!("{exit_word} {c}"),
+        (_, Some(s)) => format!("signal {s}"),
+        _ => "unknown end".into(),
+    }
+}
+
+impl<'a> Supervisor<'a> {
+    /// The watch over `procs`; `start_failed`: a role could not be started (tear down).
+    pub fn new(procs: Vec<Started>, start_failed: bool, quiet: bool, out: &'a Path) -> Self {
+        Self {
+            procs: procs
+                .into_iter()
+                .map(|p| Watched {
+                    role: p.role,
+                    child: p.child,
+                    exit: None,
+                })
+                .collect(),
+            quiet,
+            out,
+            teardown_at: start_failed.then(Instant::now),
+            interrupted: false,
+            failed: start_failed,
+            termed: false,
+            killed: false,
+            early_err: None,
+        }
+    }
+
+    /// Watches until every process ended.
+    pub fn run(mut self, started: Instant, timeout: Duration, signal: &AtomicBool) -> Supervised {
+        loop {
+            self.reap();
+            if self.procs.iter().all(|p| p.exit.is_some()) {
+                break;
+            }
+            self.watch_signal_and_timeout(started, timeout, signal);
+            self.tear_down();
+            std::thread::sleep(POLL);
+        }
+        Supervised {
+            exits: self.procs.into_iter().filter_map(|p| p.exit).collect(),
+            interrupted: self.interrupted,
+            failed: self.failed,
+            early_err: self.early_err,
+        }
+    }
+
+    /// Notes every process that ended since the last look.
+    fn reap(&mut self) {
+        for i in 0..self.procs.len() {
+            let p = &mut self.procs[i];
+            if p.exit.is_some() {
+                continue;
+            }
+            let Ok(Some(st)) = p.child.try_wait() else {
+                continue;
+            };
+            use std::os::unix::process::ExitStatusExt;
+            let ex = ProcessExit {
+                role: p.role.to_string(),
+                pid: p.child.id(),
+                code: st.code(),
+                signal: st.signal(),
+                killed_by_launcher: self.termed,
+            };
+            self.on_exit(self.procs[i].role, &ex);
+            self.procs[i].exit = Some(ex);
+        }
+    }
+
+    /// What the end of `role`'s process means for the run.
+    fn on_exit(&mut self, role: &'static str, ex: &ProcessExit) {
+        let ok = ex.ended_well();
+        let kind = Role::named(role).map(|r| r.kind);
+        // a process that ended well is counted in the verdict line, and so is one the
+        // teardown stopped; one that failed by itself is named here as it happens
+        if !self.quiet && !ok && !self.termed {
+            note!(
+                "launch: {role} (pid {}) exited: {}",
+                ex.pid,
+                how(ex.code, ex.signal, "code")
+            );
+        }
+        if !ok && !self.termed && !self.out.join(ALL_READY).exists() {
+            self.early_failure(role, ex);
+        }
+        if !ok && !self.termed {
+            self.failed = true;
+            // the scheduler, simulator and recorder are essential: without them the run
+            // cannot go on; nominal/filter deaths are degraded modes the partition
+            // handles (fallbacks)
+            match kind {
+                Some(RoleKind::Scheduler) => self.tear_down_in(Duration::ZERO),
+                Some(RoleKind::Simulator | RoleKind::Recorder) => {
+                    self.tear_down_in(AFTER_ESSENTIAL_DEATH)
+                }
+                _ => {}
+            }
+        }
+        if kind == Some(RoleKind::Scheduler) {
+            // normal end: the others got the stop tick and finish their outputs
+            self.tear_down_in(AFTER_SCHEDULER);
+        }
+    }
+
+    /// The handshake can never complete (a participant that cannot join, or the
+    /// scheduler itself, e.g. at its handshake timeout naming who never joined): stop
+    /// now, naming it, instead of waiting for the scheduler's handshake timeout.
+    fn early_failure(&mut self, role: &str, ex: &ProcessExit) {
+        let log = self.out.join("logs").join(format!("{role}.log"));
+        self.early_err.get_or_insert_with(|| {
+            format!(
+                "role `{role}` ended ({}) before every process was ready{}; see {}",
+                how(ex.code, ex.signal, "exit code"),
+                last_log_line(&log, QUOTED_LOG_CHARS)
+                    .map(|l| format!(": {l}"))
+                    .unwrap_or_default(),
+                log.display()
+            )
+        });
+        self.teardown_at = Some(Instant::now());
+    }
+
+    /// Sets the teardown `after` from now, unless one is set already.
+    fn tear_down_in(&mut self, after: Duration) {
+        if self.teardown_at.is_none() {
+            self.teardown_at = Some(Instant::now() + after);
+        }
+    }
+
+    fn watch_signal_and_timeout(
+        &mut self,
+        started: Instant,
+        timeout: Duration,
+        signal: &AtomicBool,
+    ) {
+        if signal.load(Ordering::SeqCst) && !self.interrupted {
+            self.interrupted = true;
+            if !self.quiet {
+                note!("launch: interrupted, tearing down");
+            }
+            self.teardown_at = Some(Instant::now());
+        }
+        if started.elapsed() > timeout && self.teardown_at.is_none() {
+            if !self.quiet {
+                note!("launch: run timed out after {timeout:?}, tearing down");
+            }
+            self.failed = true;
+            self.teardown_at = Some(Instant::now());
+        }
+    }
+
+    /// SIGTERM at the teardown time, SIGKILL [`TERM_TO_KILL`] later.
+    fn tear_down(&mut self) {
+        let Some(t) = self.teardown_at else { return };
+        let now = Instant::now();
+        if now >= t && !self.termed {
+            self.termed = true;
+            for p in self.procs.iter().filter(|p| p.exit.is_none()) {
+                signal_pid(p.child.id(), libc::SIGTERM);
+            }
+        }
+        if now >= t + TERM_TO_KILL && !self.killed {
+            self.killed = true;
+            for p in self.procs.iter_mut().filter(|p| p.exit.is_none()) {
+                // a process that ignores the stop tick and SIGTERM is hung: a failure
+                self.failed = true;
+                if !self.quiet {
+                    note!("launch: killing {} (pid {})", p.role, p.child.id());
+                }
+                let _ = p.child.kill();
+            }
+        }
+    }
+}
+
+fn signal_pid(pid: u32, sig: libc::c_int) {
+    // SAFETY: kill(2) on a child pid we started and have not reaped yet.
+    unsafe {
+        libc::kill(pid as libc::pid_t, sig);
+    }
+}
