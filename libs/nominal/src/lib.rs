@@ -190,7 +190,7 @@ fn translational_mpc(scenario: &Scenario, robot: &Robot) -> Result<Translational
         return Err(NominalError::Param(format!("corridor_axis = {d_r:?}")));
     }
     let nt = &scenario.nominal.translational;
-    Ok(TranslationalMpc::new(TranslationalMpcParams {
+    TranslationalMpc::new(TranslationalMpcParams {
         mean_motion: n,
         mass: robot.total_mass(),
         dt: scenario.mission.control_period_s,
@@ -200,7 +200,7 @@ fn translational_mpc(scenario: &Scenario, robot: &Robot) -> Result<Translational
         weight_velocity: nt.weight_velocity,
         weight_force: nt.weight_force,
         weight_terminal: nt.weight_terminal,
-    })?)
+    })
 }
 
 /// The attitude controller with the scenario's law (the MPC on the servicer's inertia
