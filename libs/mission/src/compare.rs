@@ -40,17 +40,29 @@ pub fn rotation_angle(p: &Quat, r: &Quat) -> f64 {
         .atan2(d[0].abs())
 }
 
+/// Two runs that cannot be compared step by step.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum CompareError {
+    /// The runs' control steps are at different times.
+    #[error("step {step}: times differ ({a} s and {b} s)")]
+    TimesDiffer { step: u64, a: f64, b: f64 },
+}
+
 /// The differences at every control step both runs have (paired by step index); an
 /// error when the runs' times differ at a step.
-pub fn differences(a: &[StepRecord], b: &[StepRecord]) -> Result<Vec<StepDifference>, String> {
+pub fn differences(
+    a: &[StepRecord],
+    b: &[StepRecord],
+) -> Result<Vec<StepDifference>, CompareError> {
     a.iter()
         .zip(b)
         .map(|(x, y)| {
             if x.t != y.t {
-                return Err(format!(
-                    "step {}: times differ ({} s and {} s)",
-                    x.step, x.t, y.t
-                ));
+                return Err(CompareError::TimesDiffer {
+                    step: x.step,
+                    a: x.t,
+                    b: y.t,
+                });
             }
             let (o, p) = (&x.obs, &y.obs);
             Ok(StepDifference {

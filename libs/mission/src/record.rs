@@ -254,6 +254,71 @@ impl<W: Write> TelemetryWriter<W> {
     }
 }
 
+/// Why `telemetry.csv` and `timing.csv` could not be read back ([`parse_telemetry`]):
+/// each names the file and the line.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TelemetryError {
+    #[error("{file}: the header is not this version's columns")]
+    Header { file: &'static str },
+    #[error("{file} line {line}: {found} fields, the header has {expected}")]
+    FieldCount {
+        file: &'static str,
+        line: usize,
+        found: usize,
+        expected: usize,
+    },
+    #[error("{file} line {line}: `{column}` = `{value}` is not {what}")]
+    Field {
+        file: &'static str,
+        line: usize,
+        column: String,
+        value: String,
+        what: &'static str,
+    },
+    #[error("{file} line {line}: solve time {us} us is not a finite number >= 0")]
+    SolveTime {
+        file: &'static str,
+        line: usize,
+        us: f64,
+    },
+    #[error(
+        "{file} line {line}: {column} does not match the state it derives from (a corrupt file or another version)"
+    )]
+    Derived {
+        file: &'static str,
+        line: usize,
+        column: &'static str,
+    },
+    #[error("{file} line {line}: filter status {value} is not one of 0..=3")]
+    Status {
+        file: &'static str,
+        line: usize,
+        value: u8,
+    },
+    #[error("timing.csv: ends before step {step} (telemetry.csv line {line})")]
+    TimingEnds { step: u64, line: usize },
+    #[error(
+        "timing.csv line {line}: step {timing_step} at t = {timing_t} s, telemetry.csv has step {step} at t = {t} s"
+    )]
+    StepMismatch {
+        line: usize,
+        timing_step: u64,
+        timing_t: f64,
+        step: u64,
+        t: f64,
+    },
+    #[error(
+        "telemetry.csv line {line}: read {read} of {columns} columns (the reader is out of step with telemetry_columns)"
+    )]
+    OutOfStep {
+        line: usize,
+        read: usize,
+        columns: usize,
+    },
+    #[error("timing.csv: more rows than the {rows} of telemetry.csv")]
+    TimingLonger { rows: usize },
+}
+
 /// Bit-for-bit equality of two floats (NaN equals NaN).
 fn same_bits(a: f64, b: f64) -> bool {
     a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
@@ -274,14 +339,15 @@ impl<'a> Fields<'a> {
         line: usize,
         text: &'a str,
         names: &'a [String],
-    ) -> Result<Self, String> {
+    ) -> Result<Self, TelemetryError> {
         let fields: Vec<&str> = text.split(',').collect();
         if fields.len() != names.len() {
-            return Err(format!(
-                "{file} line {line}: {} fields, the header has {}",
-                fields.len(),
-                names.len()
-            ));
+            return Err(TelemetryError::FieldCount {
+                file,
+                line,
+                found: fields.len(),
+                expected: names.len(),
+            });
         }
         Ok(Self {
             file,
@@ -298,21 +364,22 @@ impl<'a> Fields<'a> {
         (self.fields[i], self.names[i].as_str())
     }
 
-    fn parse<T: std::str::FromStr>(&mut self, what: &str) -> Result<T, String> {
+    fn parse<T: std::str::FromStr>(&mut self, what: &'static str) -> Result<T, TelemetryError> {
         let (v, name) = self.raw();
-        v.parse().map_err(|_| {
-            format!(
-                "{} line {}: `{name}` = `{v}` is not {what}",
-                self.file, self.line
-            )
+        v.parse().map_err(|_| TelemetryError::Field {
+            file: self.file,
+            line: self.line,
+            column: name.to_string(),
+            value: v.to_string(),
+            what,
         })
     }
 
-    fn f(&mut self) -> Result<f64, String> {
+    fn f(&mut self) -> Result<f64, TelemetryError> {
         self.parse("a number")
     }
 
-    fn array<const N: usize>(&mut self) -> Result<[f64; N], String> {
+    fn array<const N: usize>(&mut self) -> Result<[f64; N], TelemetryError> {
         let mut a = [0.0; N];
         for x in a.iter_mut() {
             *x = self.f()?;
@@ -320,44 +387,65 @@ impl<'a> Fields<'a> {
         Ok(a)
     }
 
-    fn v3(&mut self) -> Result<Vector3<f64>, String> {
+    fn v3(&mut self) -> Result<Vector3<f64>, TelemetryError> {
         Ok(Vector3::from(self.array::<3>()?))
     }
 
-    fn v7(&mut self) -> Result<Vector7, String> {
+    fn v7(&mut self) -> Result<Vector7, TelemetryError> {
         Ok(Vector7::from(self.array::<7>()?))
     }
 
     /// A solve time written in µs (of whole ns, see [`timing_line`]) back in ns.
-    fn ns(&mut self) -> Result<u64, String> {
+    fn ns(&mut self) -> Result<u64, TelemetryError> {
         let us = self.f()?;
         if !(us.is_finite() && us >= 0.0) {
-            return Err(format!(
-                "{} line {}: solve time {us} us is not a finite number >= 0",
-                self.file, self.line
-            ));
+            return Err(TelemetryError::SolveTime {
+                file: self.file,
+                line: self.line,
+                us,
+            });
         }
         Ok((us * 1e3).round() as u64)
     }
 
-    fn check(&self, what: &str, ok: bool) -> Result<(), String> {
+    /// A derived column (`column`) checked against the state it comes from.
+    fn check(&self, column: &'static str, ok: bool) -> Result<(), TelemetryError> {
         if ok {
             Ok(())
         } else {
-            Err(format!(
-                "{} line {}: {what} does not match the state it derives from (a corrupt file or another version)",
-                self.file, self.line
-            ))
+            Err(TelemetryError::Derived {
+                file: self.file,
+                line: self.line,
+                column,
+            })
         }
+    }
+
+    /// One filter's report: status, iterations, active set, faults, violation (the
+    /// solve times come from `timing.csv`).
+    fn report<const N: usize>(
+        &mut self,
+        r: &mut sc_cbf::FilterReport<N>,
+    ) -> Result<(), TelemetryError> {
+        r.status = status_of(self.parse("a filter status")?, self.file, self.line)?;
+        r.iterations = self.parse("an iteration count")?;
+        r.active = self.parse("an active-set bitset")?;
+        r.faults = self.parse("a fault bitset")?;
+        r.violation = self.f()?;
+        Ok(())
     }
 }
 
-fn status_of(v: u8, file: &'static str, line: usize) -> Result<sc_cbf::FilterStatus, String> {
+fn status_of(
+    value: u8,
+    file: &'static str,
+    line: usize,
+) -> Result<sc_cbf::FilterStatus, TelemetryError> {
     use sc_cbf::FilterStatus as S;
     [S::Skipped, S::Solved, S::Relaxed, S::Fallback]
         .into_iter()
-        .find(|s| *s as u8 == v)
-        .ok_or_else(|| format!("{file} line {line}: filter status {v} is not one of 0..=3"))
+        .find(|s| *s as u8 == value)
+        .ok_or(TelemetryError::Status { file, line, value })
 }
 
 /// Rebuilds the records of a run from its `telemetry.csv` and `timing.csv` (as written
@@ -380,174 +468,190 @@ pub fn parse_telemetry(
     telemetry: &str,
     timing: &str,
     filtered: bool,
-) -> Result<Vec<StepRecord>, String> {
+) -> Result<Vec<StepRecord>, TelemetryError> {
     let tel_names = telemetry_columns();
     let tim_names = timing_columns();
     let mut tel = telemetry.lines();
     let mut tim = timing.lines();
     if tel.next() != Some(tel_names.join(",").as_str()) {
-        return Err("telemetry.csv: the header is not this version's columns".into());
+        return Err(TelemetryError::Header {
+            file: "telemetry.csv",
+        });
     }
     if tim.next() != Some(tim_names.join(",").as_str()) {
-        return Err("timing.csv: the header is not this version's columns".into());
+        return Err(TelemetryError::Header { file: "timing.csv" });
     }
-    let nan3 = Vector3::from_element(f64::NAN);
     let mut out = Vec::new();
     for (i, line) in tel.enumerate() {
         let n = i + 2;
         let mut c = Fields::new("telemetry.csv", n, line, &tel_names)?;
-        let step: u64 = c.parse("a step number")?;
-        let t = c.f()?;
-        let phase: usize = c.parse("a phase index")?;
-        let r_h = c.v3()?;
-        let v_h = c.v3()?;
-        let r_r = c.v3()?;
-        let v_r = c.v3()?;
-        let com_r = c.v3()?;
-        let com_v_r = c.v3()?;
-        let com_h = c.v3()?;
-        let com_v_h = c.v3()?;
-        let q_rb = c.array::<4>()?;
-        let omega_b = c.v3()?;
-        let theta = c.v7()?;
-        let theta_dot = c.v7()?;
-        let q_rt = c.array::<4>()?;
-        let omega_t = c.v3()?;
-        let sync_error = c.v3()?;
-        let grasp_distance = c.f()?;
-        let ee_r = c.v3()?;
-        let grasp_r = c.v3()?;
-        let obs = Observation {
-            step,
-            t,
-            r_h,
-            v_h,
-            r_r,
-            v_r,
-            q_hr: [f64::NAN; 4],
-            omega_h: nan3,
-            omega_dot_h: nan3,
-            mean_motion: f64::NAN,
-            q_rb,
-            omega_b,
-            theta,
-            theta_dot,
-            q_rt,
-            omega_t,
-            omega_dot_t: nan3,
-            grasp_r,
-            grasp_v_r: nan3,
-            grasp_a_r: nan3,
-            grasp_b: Observation::grasp_in_base(&q_rb, &r_r, &grasp_r),
-            ee_b: nan3,
-            ee_r,
-            ee_v_r: nan3,
-            com_h,
-            com_v_h,
-            com_r,
-            com_v_r,
-        };
-        let s = obs.sync_error();
-        c.check(
-            "sync_error_b",
-            (0..3).all(|k| same_bits(s[k], sync_error[k])),
-        )?;
-        c.check(
-            "grasp_distance_m",
-            same_bits(obs.grasp_distance(), grasp_distance),
-        )?;
-        let f_h_nom = c.v3()?;
-        let tau_b_nom = c.v3()?;
-        let tau_m_nom = c.v7()?;
-        let f_h_safe = c.v3()?;
-        let applied = Command {
-            force_b: c.v3()?,
-            torque_b: c.v3()?,
-            tau: c.v7()?,
-        };
-        let mut translational = sc_cbf::TranslationalOutput {
-            u: f_h_safe,
-            actuated: if filtered { applied.force_b } else { nan3 },
-            report: Default::default(),
-        };
-        let mut attitude = sc_cbf::AttitudeOutput {
-            u: if filtered { applied.torque_b } else { nan3 },
-            actuated: if filtered { applied.torque_b } else { nan3 },
-            report: Default::default(),
-        };
-        let nan7 = Vector7::from_element(f64::NAN);
-        let mut robotic = sc_cbf::RoboticOutput {
-            u: if filtered { applied.tau } else { nan7 },
-            actuated: if filtered { applied.tau } else { nan7 },
-            report: Default::default(),
-        };
-        let mut barriers = [0.0; sc_cbf::monitor::N_ALL];
-        for h in barriers.iter_mut() {
-            *h = c.f()?;
-        }
-        let mut barriers_between = [0.0; sc_cbf::monitor::N_ALL];
-        for h in barriers_between.iter_mut() {
-            *h = c.f()?;
-        }
-        macro_rules! report {
-            ($r:expr) => {{
-                $r.status = status_of(c.parse("a filter status")?, "telemetry.csv", n)?;
-                $r.iterations = c.parse("an iteration count")?;
-                $r.active = c.parse("an active-set bitset")?;
-                $r.faults = c.parse("a fault bitset")?;
-                $r.violation = c.f()?;
-            }};
-        }
-        report!(translational.report);
-        report!(attitude.report);
-        report!(robotic.report);
+        let mut record = read_record(&mut c, filtered)?;
         // solve times from the same step of timing.csv
-        let tl = tim.next().ok_or_else(|| {
-            format!("timing.csv: ends before step {step} (telemetry.csv line {n})")
+        let tl = tim.next().ok_or(TelemetryError::TimingEnds {
+            step: record.step,
+            line: n,
         })?;
         let mut tc = Fields::new("timing.csv", n, tl, &tim_names)?;
-        let tstep: u64 = tc.parse("a step number")?;
-        let tt = tc.f()?;
-        if tstep != step || !same_bits(tt, t) {
-            return Err(format!(
-                "timing.csv line {n}: step {tstep} at t = {tt} s, telemetry.csv has step {step} at t = {t} s"
-            ));
-        }
-        translational.report.solve_time_ns = tc.ns()?;
-        attitude.report.solve_time_ns = tc.ns()?;
-        robotic.report.solve_time_ns = tc.ns()?;
-        tc.ns()?; // total_us
-        translational.report.solve_cpu_ns = tc.ns()?;
-        attitude.report.solve_cpu_ns = tc.ns()?;
-        robotic.report.solve_cpu_ns = tc.ns()?;
+        read_solve_times(&mut tc, &mut record)?;
         if c.next != tel_names.len() {
-            return Err(format!(
-                "telemetry.csv line {n}: read {} of {} columns (the reader is out of step with telemetry_columns)",
-                c.next,
-                tel_names.len()
-            ));
+            return Err(TelemetryError::OutOfStep {
+                line: n,
+                read: c.next,
+                columns: tel_names.len(),
+            });
         }
-        out.push(StepRecord {
-            step,
-            t,
-            phase,
-            obs,
-            f_h_nom,
-            tau_b_nom,
-            tau_m_nom,
-            translational,
-            attitude,
-            robotic,
-            applied,
-            barriers,
-            barriers_between,
-        });
+        out.push(record);
     }
     if tim.next().is_some_and(|l| !l.is_empty()) {
-        return Err(format!(
-            "timing.csv: more rows than the {} of telemetry.csv",
-            out.len()
-        ));
+        return Err(TelemetryError::TimingLonger { rows: out.len() });
     }
     Ok(out)
+}
+
+/// One line of `telemetry.csv` (see [`parse_telemetry`]) as a record without its solve
+/// times.
+fn read_record(c: &mut Fields, filtered: bool) -> Result<StepRecord, TelemetryError> {
+    let nan3 = Vector3::from_element(f64::NAN);
+    let nan7 = Vector7::from_element(f64::NAN);
+    let step: u64 = c.parse("a step number")?;
+    let t = c.f()?;
+    let phase: usize = c.parse("a phase index")?;
+    let obs = read_observation(c, step, t)?;
+    let f_h_nom = c.v3()?;
+    let tau_b_nom = c.v3()?;
+    let tau_m_nom = c.v7()?;
+    let f_h_safe = c.v3()?;
+    let applied = Command {
+        force_b: c.v3()?,
+        torque_b: c.v3()?,
+        tau: c.v7()?,
+    };
+    let mut translational = sc_cbf::TranslationalOutput {
+        u: f_h_safe,
+        actuated: if filtered { applied.force_b } else { nan3 },
+        report: Default::default(),
+    };
+    let mut attitude = sc_cbf::AttitudeOutput {
+        u: if filtered { applied.torque_b } else { nan3 },
+        actuated: if filtered { applied.torque_b } else { nan3 },
+        report: Default::default(),
+    };
+    let mut robotic = sc_cbf::RoboticOutput {
+        u: if filtered { applied.tau } else { nan7 },
+        actuated: if filtered { applied.tau } else { nan7 },
+        report: Default::default(),
+    };
+    let mut barriers = [0.0; sc_cbf::monitor::N_ALL];
+    for h in barriers.iter_mut() {
+        *h = c.f()?;
+    }
+    let mut barriers_between = [0.0; sc_cbf::monitor::N_ALL];
+    for h in barriers_between.iter_mut() {
+        *h = c.f()?;
+    }
+    c.report(&mut translational.report)?;
+    c.report(&mut attitude.report)?;
+    c.report(&mut robotic.report)?;
+    Ok(StepRecord {
+        step,
+        t,
+        phase,
+        obs,
+        f_h_nom,
+        tau_b_nom,
+        tau_m_nom,
+        translational,
+        attitude,
+        robotic,
+        applied,
+        barriers,
+        barriers_between,
+    })
+}
+
+/// The state columns of a `telemetry.csv` line (after step, time and phase) as the
+/// observation of step `step` at `t`, the derived columns checked against it.
+fn read_observation(c: &mut Fields, step: u64, t: f64) -> Result<Observation, TelemetryError> {
+    let nan3 = Vector3::from_element(f64::NAN);
+    let r_h = c.v3()?;
+    let v_h = c.v3()?;
+    let r_r = c.v3()?;
+    let v_r = c.v3()?;
+    let com_r = c.v3()?;
+    let com_v_r = c.v3()?;
+    let com_h = c.v3()?;
+    let com_v_h = c.v3()?;
+    let q_rb = c.array::<4>()?;
+    let omega_b = c.v3()?;
+    let theta = c.v7()?;
+    let theta_dot = c.v7()?;
+    let q_rt = c.array::<4>()?;
+    let omega_t = c.v3()?;
+    let sync_error = c.v3()?;
+    let grasp_distance = c.f()?;
+    let ee_r = c.v3()?;
+    let grasp_r = c.v3()?;
+    let obs = Observation {
+        step,
+        t,
+        r_h,
+        v_h,
+        r_r,
+        v_r,
+        q_hr: [f64::NAN; 4],
+        omega_h: nan3,
+        omega_dot_h: nan3,
+        mean_motion: f64::NAN,
+        q_rb,
+        omega_b,
+        theta,
+        theta_dot,
+        q_rt,
+        omega_t,
+        omega_dot_t: nan3,
+        grasp_r,
+        grasp_v_r: nan3,
+        grasp_a_r: nan3,
+        grasp_b: Observation::grasp_in_base(&q_rb, &r_r, &grasp_r),
+        ee_b: nan3,
+        ee_r,
+        ee_v_r: nan3,
+        com_h,
+        com_v_h,
+        com_r,
+        com_v_r,
+    };
+    let s = obs.sync_error();
+    c.check(
+        "sync_error_b",
+        (0..3).all(|k| same_bits(s[k], sync_error[k])),
+    )?;
+    c.check(
+        "grasp_distance_m",
+        same_bits(obs.grasp_distance(), grasp_distance),
+    )?;
+    Ok(obs)
+}
+
+/// The solve times of `r` from its line of `timing.csv` (the same step at the same time).
+fn read_solve_times(tc: &mut Fields, r: &mut StepRecord) -> Result<(), TelemetryError> {
+    let tstep: u64 = tc.parse("a step number")?;
+    let tt = tc.f()?;
+    if tstep != r.step || !same_bits(tt, r.t) {
+        return Err(TelemetryError::StepMismatch {
+            line: tc.line,
+            timing_step: tstep,
+            timing_t: tt,
+            step: r.step,
+            t: r.t,
+        });
+    }
+    r.translational.report.solve_time_ns = tc.ns()?;
+    r.attitude.report.solve_time_ns = tc.ns()?;
+    r.robotic.report.solve_time_ns = tc.ns()?;
+    tc.ns()?; // total_us
+    r.translational.report.solve_cpu_ns = tc.ns()?;
+    r.attitude.report.solve_cpu_ns = tc.ns()?;
+    r.robotic.report.solve_cpu_ns = tc.ns()?;
+    Ok(())
 }

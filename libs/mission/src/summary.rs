@@ -126,6 +126,12 @@ fn flag_names(bits: u32) -> Vec<String> {
         .collect()
 }
 
+/// The filters' names in the order of the records' arrays.
+const FILTERS: [&str; 3] = ["translational", "attitude", "robotic"];
+
+/// Most fault events kept in the summary (every one is counted in `fault_count`).
+const MAX_FAULT_EVENTS: usize = 1000;
+
 /// Builds the summary of a run from its records.
 pub fn summarize(
     records: &[StepRecord],
@@ -133,43 +139,72 @@ pub fn summarize(
     phase_names: &[String],
     filtered: bool,
 ) -> Summary {
-    let names = crate::constraint_names();
     let phase_name = |p: usize| {
         phase_names
             .get(p)
             .cloned()
             .unwrap_or_else(|| format!("phase_{p}"))
     };
-    let mut constraints: BTreeMap<String, ConstraintSummary> = BTreeMap::new();
-    for n in &names {
-        constraints.insert(
-            n.to_string(),
-            ConstraintSummary {
-                min_h: f64::INFINITY,
-                min_h_at_control_steps: f64::INFINITY,
-                violated: false,
-                t_of_min_s: 0.0,
-                nan_samples: 0,
-                min_h_per_phase: BTreeMap::new(),
-            },
-        );
-    }
-    let mut solve: [Vec<f64>; 4] = Default::default();
-    let mut solve_cpu: [Vec<f64>; 4] = Default::default();
-    let mut inter: [Interventions; 3] = Default::default();
-    let row_names: [&[&str]; 3] = [
-        &sc_cbf::names::TRANSLATIONAL,
-        &sc_cbf::names::ATTITUDE,
-        &sc_cbf::names::ROBOTIC,
-    ];
-    let mut sync_peak: BTreeMap<String, f64> = BTreeMap::new();
-    let mut torque_peak: BTreeMap<String, f64> = BTreeMap::new();
-    let mut fault_events = Vec::new();
-    let mut fault_count = 0;
+    let mut tally = Tally::new();
     for r in records {
         let pn = phase_name(r.phase);
-        for (i, n) in names.iter().enumerate() {
-            let c = constraints.get_mut(*n).expect("constraint present");
+        tally.barriers(r, &pn);
+        tally.solve_times(r);
+        tally.interventions(r);
+        tally.peaks(r, &pn);
+        tally.faults(r);
+    }
+    tally.finish(records.len(), end, filtered)
+}
+
+/// What [`summarize`] gathers over the records, one record at a time.
+struct Tally {
+    names: Vec<&'static str>,
+    constraints: BTreeMap<String, ConstraintSummary>,
+    /// Per filter and the total (the records' order).
+    solve: [Vec<f64>; 4],
+    solve_cpu: [Vec<f64>; 4],
+    inter: [Interventions; 3],
+    sync_peak: BTreeMap<String, f64>,
+    torque_peak: BTreeMap<String, f64>,
+    fault_events: Vec<FaultEvent>,
+    fault_count: usize,
+}
+
+impl Tally {
+    fn new() -> Self {
+        let names = crate::constraint_names();
+        let mut constraints: BTreeMap<String, ConstraintSummary> = BTreeMap::new();
+        for n in &names {
+            constraints.insert(
+                n.to_string(),
+                ConstraintSummary {
+                    min_h: f64::INFINITY,
+                    min_h_at_control_steps: f64::INFINITY,
+                    violated: false,
+                    t_of_min_s: 0.0,
+                    nan_samples: 0,
+                    min_h_per_phase: BTreeMap::new(),
+                },
+            );
+        }
+        Self {
+            names,
+            constraints,
+            solve: Default::default(),
+            solve_cpu: Default::default(),
+            inter: Default::default(),
+            sync_peak: BTreeMap::new(),
+            torque_peak: BTreeMap::new(),
+            fault_events: Vec::new(),
+            fault_count: 0,
+        }
+    }
+
+    /// The barriers' minima, at the control step and between it and the next one.
+    fn barriers(&mut self, r: &StepRecord, pn: &str) {
+        for (i, n) in self.names.iter().enumerate() {
+            let c = self.constraints.get_mut(*n).expect("constraint present");
             let at_step = r.barriers[i];
             if !at_step.is_nan() {
                 c.min_h_at_control_steps = c.min_h_at_control_steps.min(at_step);
@@ -187,16 +222,31 @@ pub fn summarize(
                 if h < 0.0 {
                     c.violated = true;
                 }
-                let e = c.min_h_per_phase.entry(pn.clone()).or_insert(f64::INFINITY);
+                let e = c
+                    .min_h_per_phase
+                    .entry(pn.to_string())
+                    .or_insert(f64::INFINITY);
                 *e = e.min(h);
             }
         }
+    }
+
+    fn solve_times(&mut self, r: &StepRecord) {
         let t = r.solve_time_us();
         let c = r.solve_cpu_us();
         for i in 0..4 {
-            solve[i].push(t[i]);
-            solve_cpu[i].push(c[i]);
+            self.solve[i].push(t[i]);
+            self.solve_cpu[i].push(c[i]);
         }
+    }
+
+    /// The steps where a filter changed the nominal command, and the rows it had active.
+    fn interventions(&mut self, r: &StepRecord) {
+        let row_names: [&[&str]; 3] = [
+            &sc_cbf::names::TRANSLATIONAL,
+            &sc_cbf::names::ATTITUDE,
+            &sc_cbf::names::ROBOTIC,
+        ];
         let changed = [
             (r.translational.u - r.f_h_nom).amax() > 1e-9,
             (r.attitude.u - r.tau_b_nom).amax() > 1e-9,
@@ -211,29 +261,38 @@ pub fn summarize(
             if !changed[i] {
                 continue;
             }
-            inter[i].steps += 1;
+            let inter = &mut self.inter[i];
+            inter.steps += 1;
             if active[i] == 0 {
-                inter[i].without_active_row += 1;
+                inter.without_active_row += 1;
             }
             for (bit, name) in row_names[i].iter().enumerate() {
                 if bit < 64 && active[i] & (1u64 << bit) != 0 {
-                    *inter[i].active_rows.entry(name.to_string()).or_insert(0) += 1;
+                    *inter.active_rows.entry(name.to_string()).or_insert(0) += 1;
                 }
             }
         }
-        let s = sync_peak.entry(pn.clone()).or_insert(0.0);
+    }
+
+    /// The per-phase peaks of the synchronisation error and the joint torque.
+    fn peaks(&mut self, r: &StepRecord, pn: &str) {
+        let s = self.sync_peak.entry(pn.to_string()).or_insert(0.0);
         *s = s.max(r.obs.sync_error().norm());
-        let tq = torque_peak.entry(pn.clone()).or_insert(0.0);
+        let tq = self.torque_peak.entry(pn.to_string()).or_insert(0.0);
         *tq = tq.max(r.applied.tau.norm());
-        for (name, f) in [
-            ("translational", r.translational.report.faults),
-            ("attitude", r.attitude.report.faults),
-            ("robotic", r.robotic.report.faults),
-        ] {
+    }
+
+    fn faults(&mut self, r: &StepRecord) {
+        let reported = [
+            r.translational.report.faults,
+            r.attitude.report.faults,
+            r.robotic.report.faults,
+        ];
+        for (name, f) in FILTERS.into_iter().zip(reported) {
             if f != 0 {
-                fault_count += 1;
-                if fault_events.len() < 1000 {
-                    fault_events.push(FaultEvent {
+                self.fault_count += 1;
+                if self.fault_events.len() < MAX_FAULT_EVENTS {
+                    self.fault_events.push(FaultEvent {
                         step: r.step,
                         t_s: r.t,
                         filter: name.into(),
@@ -243,69 +302,71 @@ pub fn summarize(
             }
         }
     }
-    let mut min_margin = (String::new(), f64::INFINITY);
-    for (n, c) in &constraints {
-        if c.min_h < min_margin.1 {
-            min_margin = (n.clone(), c.min_h);
+
+    /// The summary of `steps` records gathered here.
+    fn finish(self, steps: usize, end: &MissionEnd, filtered: bool) -> Summary {
+        let mut min_margin = (String::new(), f64::INFINITY);
+        for (n, c) in &self.constraints {
+            if c.min_h < min_margin.1 {
+                min_margin = (n.clone(), c.min_h);
+            }
+        }
+        let violated_constraints = self
+            .constraints
+            .iter()
+            .filter(|(_, c)| c.violated)
+            .map(|(n, _)| n.clone())
+            .collect();
+        let fraction = |k: usize| {
+            if steps == 0 {
+                0.0
+            } else {
+                k as f64 / steps as f64
+            }
+        };
+        let interventions = FILTERS
+            .iter()
+            .zip(self.inter)
+            .map(|(n, mut k)| {
+                k.fraction = fraction(k.steps);
+                (n.to_string(), k)
+            })
+            .collect();
+        let (captured, capture_time_s) = match end {
+            MissionEnd::Captured { t } => (true, Some(*t)),
+            _ => (false, None),
+        };
+        let build = crate::build::current();
+        Summary {
+            version: build.version,
+            git_commit: build.git_commit,
+            filtered,
+            captured,
+            capture_time_s,
+            end: end.name().into(),
+            final_time_s: end.t(),
+            steps,
+            min_margin,
+            violated_constraints,
+            constraints: self.constraints,
+            interventions,
+            solve_time_us: time_stats(&self.solve),
+            solve_cpu_us: time_stats(&self.solve_cpu),
+            sync_error_peak_rad_s: self.sync_peak,
+            joint_torque_norm_peak_nm: self.torque_peak,
+            fault_count: self.fault_count,
+            faults: self.fault_events,
         }
     }
-    let violated_constraints = constraints
+}
+
+/// The statistics of each filter's times and the total's, by name.
+fn time_stats(v: &[Vec<f64>; 4]) -> BTreeMap<String, TimeStats> {
+    ["translational", "attitude", "robotic", "total"]
         .iter()
-        .filter(|(_, c)| c.violated)
-        .map(|(n, _)| n.clone())
-        .collect();
-    let steps = records.len();
-    let fraction = |k: usize| {
-        if steps == 0 {
-            0.0
-        } else {
-            k as f64 / steps as f64
-        }
-    };
-    let interventions = ["translational", "attitude", "robotic"]
-        .iter()
-        .zip(inter)
-        .map(|(n, mut k)| {
-            k.fraction = fraction(k.steps);
-            (n.to_string(), k)
-        })
-        .collect();
-    let solve_time_us = ["translational", "attitude", "robotic", "total"]
-        .iter()
-        .zip(solve.iter())
+        .zip(v.iter())
         .map(|(n, v)| (n.to_string(), TimeStats::of(v)))
-        .collect();
-    let solve_cpu_us = ["translational", "attitude", "robotic", "total"]
-        .iter()
-        .zip(solve_cpu.iter())
-        .map(|(n, v)| (n.to_string(), TimeStats::of(v)))
-        .collect();
-    let (captured, capture_time_s) = match end {
-        MissionEnd::Captured { t } => (true, Some(*t)),
-        _ => (false, None),
-    };
-    let (end_name, final_time_s) = (end.name(), end.t());
-    let build = crate::build::current();
-    Summary {
-        version: build.version,
-        git_commit: build.git_commit,
-        filtered,
-        captured,
-        capture_time_s,
-        end: end_name.into(),
-        final_time_s,
-        steps,
-        min_margin,
-        violated_constraints,
-        constraints,
-        interventions,
-        solve_time_us,
-        solve_cpu_us,
-        sync_error_peak_rad_s: sync_peak,
-        joint_torque_norm_peak_nm: torque_peak,
-        fault_count,
-        faults: fault_events,
-    }
+        .collect()
 }
 
 #[cfg(test)]

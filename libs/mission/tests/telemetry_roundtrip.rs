@@ -251,7 +251,7 @@ fn bad_files_are_one_line_errors() {
         ),
     ];
     for (t, m, want) in cases {
-        let e = parse_telemetry(&t, &m, true).unwrap_err();
+        let e = parse_telemetry(&t, &m, true).unwrap_err().to_string();
         assert!(e.contains(want), "{e}\nwanted: {want}");
         assert!(!e.contains('\n'), "{e}");
     }

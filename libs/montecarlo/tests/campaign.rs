@@ -368,7 +368,8 @@ impl Executor for ViaTelemetry {
             std::str::from_utf8(&tel).unwrap(),
             std::str::from_utf8(&tim).unwrap(),
             true,
-        )?;
+        )
+        .map_err(|e| e.to_string())?;
         let end = MissionEnd::from_name(end.name(), parsed.last().unwrap().t).unwrap();
         Ok((parsed, end))
     }

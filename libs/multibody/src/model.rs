@@ -160,30 +160,19 @@ fn link_inertia(link: &urdf_rs::Link) -> Result<Inertia, ModelError> {
     Ok(Inertia::from_com(m, c, ic_link))
 }
 
-impl Robot {
-    /// Load and validate a URDF file (see [`Robot::from_urdf_str`] for the rules).
-    pub fn from_urdf_file(path: &Path) -> Result<Robot, ModelError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ModelError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        Self::from_urdf_str(&text)
-    }
+/// The URDF's links and joints as a tree: unique names, every joint between known links,
+/// one parent per link, one root, [`NJ`] revolute joints and otherwise only fixed ones.
+struct Tree<'a> {
+    /// Index of each link by name.
+    link_idx: HashMap<&'a str, usize>,
+    /// The joints leaving each link.
+    children: Vec<Vec<usize>>,
+    /// The root link (the base).
+    root: usize,
+}
 
-    /// Parse and validate a URDF document.
-    ///
-    /// Rules: one root link (the base); exactly [`NJ`] `revolute` joints forming one serial
-    /// chain from the root, any number of `fixed` joints (their links are merged into the moving
-    /// body they hang on), no other joint types; masses finite and ≥ 0, inertias positive
-    /// definite and satisfying the triangle inequality (or all zero for massless links); the base
-    /// body and every arm body with mass > 0 after merging; joint axes non-zero (normalized
-    /// here), `lower ≤ upper`, velocity and effort limits > 0; collision geometry only spheres
-    /// with radius > 0. The end-effector frame is the link named `end_effector`, or the last
-    /// arm body if there is none.
-    pub fn from_urdf_str(urdf: &str) -> Result<Robot, ModelError> {
-        let doc = urdf_rs::read_from_string(urdf).map_err(|e| ModelError::Parse(e.to_string()))?;
-
-        // --- names, indices, tree structure
+impl<'a> Tree<'a> {
+    fn of(doc: &'a urdf_rs::Robot) -> Result<Self, ModelError> {
         let mut link_idx: HashMap<&str, usize> = HashMap::new();
         for (i, l) in doc.links.iter().enumerate() {
             if link_idx.insert(l.name.as_str(), i).is_some() {
@@ -222,49 +211,76 @@ impl Robot {
             }
             parent_of[c] = Some(ji);
             children[p].push(ji);
-            match j.joint_type {
-                urdf_rs::JointType::Revolute => n_rev += 1,
-                urdf_rs::JointType::Fixed => {}
-                ref other => {
-                    return Err(ModelError::UnsupportedJoint {
-                        joint: j.name.clone(),
-                        kind: format!("{other:?}").to_lowercase(),
-                    });
-                }
+            if is_revolute(j)? {
+                n_rev += 1;
             }
         }
-        let roots: Vec<usize> = (0..doc.links.len())
-            .filter(|&i| parent_of[i].is_none())
-            .collect();
-        if roots.len() != 1 {
-            return Err(ModelError::RootCount {
-                count: roots.len(),
-                names: roots.iter().map(|&i| doc.links[i].name.clone()).collect(),
-            });
-        }
+        let root = single_root(doc, &parent_of)?;
         if n_rev != NJ {
             return Err(ModelError::JointCount {
                 found: n_rev,
                 expected: NJ,
             });
         }
-        let root = roots[0];
+        Ok(Tree {
+            link_idx,
+            children,
+            root,
+        })
+    }
+}
 
-        // --- walk the tree: body index and placement of every link
+/// `true` for a revolute joint, `false` for a fixed one; other types are refused.
+fn is_revolute(j: &urdf_rs::Joint) -> Result<bool, ModelError> {
+    match j.joint_type {
+        urdf_rs::JointType::Revolute => Ok(true),
+        urdf_rs::JointType::Fixed => Ok(false),
+        ref other => Err(ModelError::UnsupportedJoint {
+            joint: j.name.clone(),
+            kind: format!("{other:?}").to_lowercase(),
+        }),
+    }
+}
+
+/// The one link without a parent joint.
+fn single_root(doc: &urdf_rs::Robot, parent_of: &[Option<usize>]) -> Result<usize, ModelError> {
+    let roots: Vec<usize> = (0..doc.links.len())
+        .filter(|&i| parent_of[i].is_none())
+        .collect();
+    if roots.len() != 1 {
+        return Err(ModelError::RootCount {
+            count: roots.len(),
+            names: roots.iter().map(|&i| doc.links[i].name.clone()).collect(),
+        });
+    }
+    Ok(roots[0])
+}
+
+/// The serial chain found by walking the tree from the root: the moving body of every link
+/// and its placement in that body, the bodies' names and the [`NJ`] revolute joints in
+/// chain order.
+struct Chain {
+    link_body: Vec<Option<(usize, Transform)>>,
+    body_names: [String; NJ + 1],
+    joints: Vec<RevJoint>,
+}
+
+impl Chain {
+    fn walk(doc: &urdf_rs::Robot, tree: &Tree) -> Result<Self, ModelError> {
         let mut link_body: Vec<Option<(usize, Transform)>> = vec![None; doc.links.len()];
-        link_body[root] = Some((0, Transform::IDENTITY));
+        link_body[tree.root] = Some((0, Transform::IDENTITY));
         let mut body_joint: [Option<usize>; NJ + 1] = [None; NJ + 1];
         let mut joints: Vec<Option<RevJoint>> = vec![None; NJ];
         let mut body_names: [String; NJ + 1] = Default::default();
-        body_names[0] = doc.links[root].name.clone();
-        let mut stack = vec![root];
+        body_names[0] = doc.links[tree.root].name.clone();
+        let mut stack = vec![tree.root];
         while let Some(li) = stack.pop() {
             let Some((body, place)) = link_body[li] else {
                 continue;
             };
-            for &ji in &children[li] {
+            for &ji in &tree.children[li] {
                 let j = &doc.joints[ji];
-                let ci = link_idx[j.child.link.as_str()];
+                let ci = tree.link_idx[j.child.link.as_str()];
                 let origin = pose_to_transform(&format!("joint '{}'", j.name), &j.origin)?;
                 if j.joint_type == urdf_rs::JointType::Fixed {
                     link_body[ci] = Some((body, place.compose(&origin)));
@@ -275,47 +291,7 @@ impl Robot {
                         });
                     }
                     body_joint[body] = Some(ji);
-                    let el = format!("joint '{}'", j.name);
-                    finite3(&el, "axis", &j.axis.xyz.0)?;
-                    let a = Vector3::from(j.axis.xyz.0);
-                    let n = a.norm();
-                    if n <= 1e-9 {
-                        return Err(ModelError::ZeroAxis {
-                            joint: j.name.clone(),
-                            axis: j.axis.xyz.0,
-                        });
-                    }
-                    let lim = &j.limit;
-                    if !lim.lower.is_finite() || !lim.upper.is_finite() || lim.lower > lim.upper {
-                        return Err(ModelError::LimitOrder {
-                            joint: j.name.clone(),
-                            lower: lim.lower,
-                            upper: lim.upper,
-                        });
-                    }
-                    if !lim.velocity.is_finite() || lim.velocity <= 0.0 {
-                        return Err(ModelError::InvalidVelocityLimit {
-                            joint: j.name.clone(),
-                            value: lim.velocity,
-                        });
-                    }
-                    if !lim.effort.is_finite() || lim.effort <= 0.0 {
-                        return Err(ModelError::InvalidEffortLimit {
-                            joint: j.name.clone(),
-                            value: lim.effort,
-                        });
-                    }
-                    joints[body] = Some(RevJoint {
-                        name: j.name.clone(),
-                        origin: place.compose(&origin),
-                        axis: a / n,
-                        limits: JointLimits {
-                            lower: lim.lower,
-                            upper: lim.upper,
-                            velocity: lim.velocity,
-                            effort: lim.effort,
-                        },
-                    });
+                    joints[body] = Some(rev_joint(j, place.compose(&origin))?);
                     link_body[ci] = Some((body + 1, Transform::IDENTITY));
                     body_names[body + 1] = j.child.link.clone();
                 }
@@ -344,8 +320,73 @@ impl Robot {
                 }
             }
         }
+        Ok(Chain {
+            link_body,
+            body_names,
+            joints: rev,
+        })
+    }
+}
 
-        // --- inertias, collision spheres, frames
+/// A revolute joint placed at `origin` in its parent body: axis non-zero (normalized here),
+/// `lower ≤ upper`, velocity and effort limits > 0.
+fn rev_joint(j: &urdf_rs::Joint, origin: Transform) -> Result<RevJoint, ModelError> {
+    let el = format!("joint '{}'", j.name);
+    finite3(&el, "axis", &j.axis.xyz.0)?;
+    let a = Vector3::from(j.axis.xyz.0);
+    let n = a.norm();
+    if n <= 1e-9 {
+        return Err(ModelError::ZeroAxis {
+            joint: j.name.clone(),
+            axis: j.axis.xyz.0,
+        });
+    }
+    let lim = &j.limit;
+    if !lim.lower.is_finite() || !lim.upper.is_finite() || lim.lower > lim.upper {
+        return Err(ModelError::LimitOrder {
+            joint: j.name.clone(),
+            lower: lim.lower,
+            upper: lim.upper,
+        });
+    }
+    if !lim.velocity.is_finite() || lim.velocity <= 0.0 {
+        return Err(ModelError::InvalidVelocityLimit {
+            joint: j.name.clone(),
+            value: lim.velocity,
+        });
+    }
+    if !lim.effort.is_finite() || lim.effort <= 0.0 {
+        return Err(ModelError::InvalidEffortLimit {
+            joint: j.name.clone(),
+            value: lim.effort,
+        });
+    }
+    Ok(RevJoint {
+        name: j.name.clone(),
+        origin,
+        axis: a / n,
+        limits: JointLimits {
+            lower: lim.lower,
+            upper: lim.upper,
+            velocity: lim.velocity,
+            effort: lim.effort,
+        },
+    })
+}
+
+/// What the links contribute to their moving bodies: the merged inertias, the collision
+/// spheres (sorted by body, URDF order within a body) and one frame per link.
+struct Bodies {
+    inertias: [Inertia; NJ + 1],
+    spheres: Vec<CollisionSphere>,
+    frames: Vec<Frame>,
+}
+
+impl Bodies {
+    fn gather(
+        doc: &urdf_rs::Robot,
+        link_body: &[Option<(usize, Transform)>],
+    ) -> Result<Self, ModelError> {
         let mut inertias = [Inertia::ZERO; NJ + 1];
         let mut spheres = Vec::new();
         let mut frames = Vec::with_capacity(doc.links.len());
@@ -356,31 +397,7 @@ impl Robot {
             let inertia = link_inertia(link)?;
             inertias[body] = inertias[body].add(&inertia.transformed(&place));
             for (k, col) in link.collision.iter().enumerate() {
-                let urdf_rs::Geometry::Sphere { radius } = col.geometry else {
-                    return Err(ModelError::InvalidCollision {
-                        link: link.name.clone(),
-                        index: k,
-                        detail: format!("geometry {:?} is not a sphere", col.geometry),
-                    });
-                };
-                if !radius.is_finite() || radius <= 0.0 {
-                    return Err(ModelError::InvalidCollision {
-                        link: link.name.clone(),
-                        index: k,
-                        detail: format!("radius {radius} m"),
-                    });
-                }
-                let o = pose_to_transform(
-                    &format!("link '{}' collision #{k}", link.name),
-                    &col.origin,
-                )?;
-                spheres.push(CollisionSphere {
-                    link: body,
-                    center: place.act_point(&o.trans),
-                    radius,
-                    urdf_link: link.name.clone(),
-                    urdf_index: k,
-                });
+                spheres.push(collision_sphere(link, k, col, body, &place)?);
             }
             frames.push(Frame {
                 name: link.name.clone(),
@@ -389,26 +406,97 @@ impl Robot {
             });
         }
         spheres.sort_by_key(|s| s.link); // stable: URDF order kept within a body
+        Ok(Bodies {
+            inertias,
+            spheres,
+            frames,
+        })
+    }
+}
+
+/// Collision element `k` of `link` (on moving body `body` at `place`): a sphere with
+/// radius > 0.
+fn collision_sphere(
+    link: &urdf_rs::Link,
+    k: usize,
+    col: &urdf_rs::Collision,
+    body: usize,
+    place: &Transform,
+) -> Result<CollisionSphere, ModelError> {
+    let urdf_rs::Geometry::Sphere { radius } = col.geometry else {
+        return Err(ModelError::InvalidCollision {
+            link: link.name.clone(),
+            index: k,
+            detail: format!("geometry {:?} is not a sphere", col.geometry),
+        });
+    };
+    if !radius.is_finite() || radius <= 0.0 {
+        return Err(ModelError::InvalidCollision {
+            link: link.name.clone(),
+            index: k,
+            detail: format!("radius {radius} m"),
+        });
+    }
+    let o = pose_to_transform(&format!("link '{}' collision #{k}", link.name), &col.origin)?;
+    Ok(CollisionSphere {
+        link: body,
+        center: place.act_point(&o.trans),
+        radius,
+        urdf_link: link.name.clone(),
+        urdf_index: k,
+    })
+}
+
+impl Robot {
+    /// Load and validate a URDF file (see [`Robot::from_urdf_str`] for the rules).
+    pub fn from_urdf_file(path: &Path) -> Result<Robot, ModelError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ModelError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_urdf_str(&text)
+    }
+
+    /// Parse and validate a URDF document.
+    ///
+    /// Rules: one root link (the base); exactly [`NJ`] `revolute` joints forming one serial
+    /// chain from the root, any number of `fixed` joints (their links are merged into the moving
+    /// body they hang on), no other joint types; masses finite and ≥ 0, inertias positive
+    /// definite and satisfying the triangle inequality (or all zero for massless links); the base
+    /// body and every arm body with mass > 0 after merging; joint axes non-zero (normalized
+    /// here), `lower ≤ upper`, velocity and effort limits > 0; collision geometry only spheres
+    /// with radius > 0. The end-effector frame is the link named `end_effector`, or the last
+    /// arm body if there is none.
+    pub fn from_urdf_str(urdf: &str) -> Result<Robot, ModelError> {
+        let doc = urdf_rs::read_from_string(urdf).map_err(|e| ModelError::Parse(e.to_string()))?;
+        let tree = Tree::of(&doc)?;
+        let chain = Chain::walk(&doc, &tree)?;
+        let Bodies {
+            inertias,
+            spheres,
+            frames,
+        } = Bodies::gather(&doc, &chain.link_body)?;
         for (b, inertia) in inertias.iter().enumerate() {
             if inertia.mass <= 0.0 {
                 return Err(ModelError::MasslessBody {
-                    link: body_names[b].clone(),
+                    link: chain.body_names[b].clone(),
                     mass: inertia.mass,
                 });
             }
         }
+        let body_names = chain.body_names;
         let ee_frame = frames
             .iter()
             .position(|f| f.name == "end_effector")
             .or_else(|| frames.iter().position(|f| f.name == body_names[NJ]))
             .unwrap_or(0);
         let total_mass = inertias.iter().map(|i| i.mass).sum();
-        let joint_names = rev.iter().map(|j| j.name.clone()).collect();
+        let joint_names = chain.joints.iter().map(|j| j.name.clone()).collect();
         Ok(Robot {
             name: doc.name.clone(),
             body_names,
             inertias,
-            joints: rev,
+            joints: chain.joints,
             joint_names,
             spheres,
             frames,

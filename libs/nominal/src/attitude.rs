@@ -214,21 +214,7 @@ impl AttitudeController {
         let s_r = los / rho;
         let s_b = r_br * s_r;
         let d = self.boresight;
-
-        // pointing error: rotation turning d_B onto s_B
-        let c = d.cross(&s_b);
-        let sin_phi = c.norm();
-        let cos_phi = d.dot(&s_b);
-        let phi = sin_phi.atan2(cos_phi);
-        let axis = if sin_phi > 1e-12 {
-            c / sin_phi
-        } else if cos_phi > 0.0 {
-            Vec3::zeros()
-        } else {
-            any_perpendicular(&d)
-        };
-        let mut rot_err = axis * phi;
-
+        let (phi, mut rot_err) = pointing_error(&d, &s_b);
         let w = x.omega_b;
         let (w_ref, w_ref_dot) = match task {
             AttitudeTask::Point => {
@@ -236,15 +222,7 @@ impl AttitudeController {
                 let w_ref = r_br * w_los_r;
                 (w_ref, -w.cross(&w_ref))
             }
-            AttitudeTask::PointAndSync => {
-                let r_bt: Matrix3<f64> = r_br * quat::to_matrix(&q_rt);
-                let w_ref = r_bt * x.omega_t;
-                let w_t_dot = match &self.target_inertia {
-                    Some((it, it_inv)) => it_inv * (-x.omega_t.cross(&(it * x.omega_t))),
-                    None => Vec3::zeros(),
-                };
-                (w_ref, -w.cross(&w_ref) + r_bt * w_t_dot)
-            }
+            AttitudeTask::PointAndSync => self.sync_reference(x, &r_br, &q_rt),
         };
         if let (AttitudeTask::PointAndSync, Some((g, a_t))) = (task, &self.alignment) {
             let a = r_br * quat::to_matrix(&q_rt) * a_t;
@@ -269,6 +247,38 @@ impl AttitudeController {
             valid: true,
         }
     }
+
+    /// The reference rate of sync mode, the target's rate in F_B, and its derivative
+    /// as seen in F_B (the target's torque-free Euler equation when its inertia is
+    /// known, else a constant rate in F_T).
+    fn sync_reference(&self, x: &AttitudeInput, r_br: &Matrix3<f64>, q_rt: &Quat) -> (Vec3, Vec3) {
+        let w = x.omega_b;
+        let r_bt: Matrix3<f64> = r_br * quat::to_matrix(q_rt);
+        let w_ref = r_bt * x.omega_t;
+        let w_t_dot = match &self.target_inertia {
+            Some((it, it_inv)) => it_inv * (-x.omega_t.cross(&(it * x.omega_t))),
+            None => Vec3::zeros(),
+        };
+        (w_ref, -w.cross(&w_ref) + r_bt * w_t_dot)
+    }
+}
+
+/// The pointing error: the angle `φ` between the boresight `d` and the line of sight
+/// `s_b` (both unit, F_B) and the rotation vector `φ·axis` that turns `d` onto `s_b`
+/// (about any perpendicular axis when they are opposite).
+fn pointing_error(d: &Vec3, s_b: &Vec3) -> (f64, Vec3) {
+    let c = d.cross(s_b);
+    let sin_phi = c.norm();
+    let cos_phi = d.dot(s_b);
+    let phi = sin_phi.atan2(cos_phi);
+    let axis = if sin_phi > 1e-12 {
+        c / sin_phi
+    } else if cos_phi > 0.0 {
+        Vec3::zeros()
+    } else {
+        any_perpendicular(d)
+    };
+    (phi, axis * phi)
 }
 
 /// The signed angle `ψ ∈ (−π/2, π/2]` about the unit vector `d` that turns the line of

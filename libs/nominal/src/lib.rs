@@ -149,6 +149,131 @@ pub struct PhaseModes {
     pub robotic: RoboticMode,
 }
 
+/// `Active` for a valid command, `InvalidInput` otherwise.
+fn status(valid: bool) -> SubsystemStatus {
+    if valid {
+        SubsystemStatus::Active
+    } else {
+        SubsystemStatus::InvalidInput
+    }
+}
+
+impl NominalOutput {
+    /// Every subsystem `Off` with zero commands and diagnostics, in phase `phase`.
+    fn off(phase: usize) -> Self {
+        Self {
+            phase,
+            f_h: Vec3::zeros(),
+            tau_b: Vec3::zeros(),
+            tau_m: Vector7::zeros(),
+            translational: SubsystemStatus::Off,
+            attitude: SubsystemStatus::Off,
+            robotic: SubsystemStatus::Off,
+            gfc_point_h: Vec3::zeros(),
+            pointing_error_rad: 0.0,
+            rate_error_b: Vec3::zeros(),
+            theta_goal: Vector7::zeros(),
+            ik: None,
+        }
+    }
+}
+
+/// The translational MPC: mean motion `n = √(μ / (R_E + h)³)`, mass = total servicer
+/// mass, Go-for-Capture point `p_gfc,R = gfc_distance_m · d_R`.
+fn translational_mpc(scenario: &Scenario, robot: &Robot) -> Result<TranslationalMpc, NominalError> {
+    let orbit = &scenario.orbit;
+    let a = orbit.earth_radius_m + orbit.altitude_m;
+    let n = (orbit.earth_mu_m3_s2 / (a * a * a)).sqrt();
+    let d_r = Vec3::from(scenario.safety.translational.corridor_axis);
+    let d_norm = d_r.norm();
+    if !d_norm.is_finite() || d_norm < 1e-9 {
+        return Err(NominalError::Param(format!("corridor_axis = {d_r:?}")));
+    }
+    let nt = &scenario.nominal.translational;
+    TranslationalMpc::new(TranslationalMpcParams {
+        mean_motion: n,
+        mass: robot.total_mass(),
+        dt: scenario.mission.control_period_s,
+        horizon: nt.horizon_steps as usize,
+        gfc_point_r: d_r / d_norm * nt.gfc_distance_m,
+        weight_position: nt.weight_position,
+        weight_velocity: nt.weight_velocity,
+        weight_force: nt.weight_force,
+        weight_terminal: nt.weight_terminal,
+    })
+}
+
+/// The attitude controller with the scenario's law (the MPC on the servicer's inertia
+/// at the hold angles, or the PD), boresight and, when both axes are given, the
+/// gripper's alignment with the fixture.
+fn attitude_controller(
+    scenario: &Scenario,
+    inertia_hold: Mat3,
+) -> Result<AttitudeController, NominalError> {
+    let na = &scenario.nominal.attitude;
+    let target_inertia = Mat3::from_fn(|i, j| scenario.target.inertia_kg_m2[i][j]);
+    let law = match (na.law, &na.mpc) {
+        (AttitudeLawKind::Mpc, Some(m)) => {
+            AttitudeLaw::Mpc(Box::new(AttitudeMpc::new(AttitudeMpcParams {
+                dt: scenario.mission.control_period_s,
+                horizon: m.horizon_steps as usize,
+                inertia: inertia_hold,
+                weight_pointing: m.weight_pointing_per_rad2,
+                weight_rate: m.weight_rate_s2_per_rad2,
+                weight_torque: m.weight_torque_per_nm2,
+                weight_terminal: m.weight_terminal,
+            })?))
+        }
+        (AttitudeLawKind::Mpc, None) => {
+            return Err(NominalError::Param(
+                "nominal.attitude.law = mpc without [nominal.attitude.mpc]".into(),
+            ));
+        }
+        (AttitudeLawKind::Pd, _) => AttitudeLaw::Pd(AttitudeGains {
+            kp: na.kp_nm_per_rad,
+            kd: na.kd_nm_s_per_rad,
+            k_sync: na.sync_gain_nm_s_per_rad,
+        }),
+    };
+    let attitude = AttitudeController::with_law(
+        law,
+        Vec3::from(scenario.servicer.boresight_body),
+        Some(target_inertia),
+    )
+    .ok_or_else(|| NominalError::Param("attitude gains or boresight".into()))?;
+    match (
+        scenario.servicer.gripper_axis_body,
+        scenario.target.grasp_fixture_axis,
+    ) {
+        (Some(g), Some(a)) => attitude
+            .with_alignment(Vec3::from(g), Vec3::from(a))
+            .ok_or_else(|| NominalError::Param("gripper_axis_body or grasp_fixture_axis".into())),
+        _ => Ok(attitude),
+    }
+}
+
+/// The phases' modes sorted by start time.
+fn phase_schedule(scenario: &Scenario) -> Result<Vec<PhaseModes>, NominalError> {
+    let mut phases: Vec<PhaseModes> = scenario
+        .mission
+        .phases
+        .iter()
+        .map(|p| PhaseModes {
+            start_s: p.start_s,
+            translational: p.translational,
+            attitude: p.attitude,
+            robotic: p.robotic,
+        })
+        .collect();
+    if phases.is_empty() || phases.iter().any(|p| !p.start_s.is_finite()) {
+        return Err(NominalError::Param(
+            "mission.phases empty or non-finite start".into(),
+        ));
+    }
+    phases.sort_by(|a, b| a.start_s.total_cmp(&b.start_s));
+    Ok(phases)
+}
+
 /// The three nominal controllers and the phase schedule that switches them.
 #[derive(Debug, Clone)]
 pub struct NominalControllers {
@@ -174,28 +299,7 @@ impl NominalControllers {
     /// * boresight `servicer.boresight_body`, grasping point `target.grasp_point_m`;
     /// * hold goal `servicer.initial_theta_rad`.
     pub fn new(scenario: &Scenario, robot: Robot) -> Result<Self, NominalError> {
-        let orbit = &scenario.orbit;
-        let a = orbit.earth_radius_m + orbit.altitude_m;
-        let n = (orbit.earth_mu_m3_s2 / (a * a * a)).sqrt();
-        let d_r = Vec3::from(scenario.safety.translational.corridor_axis);
-        let d_norm = d_r.norm();
-        if !d_norm.is_finite() || d_norm < 1e-9 {
-            return Err(NominalError::Param(format!("corridor_axis = {d_r:?}")));
-        }
-        let nt = &scenario.nominal.translational;
-        let translational = TranslationalMpc::new(TranslationalMpcParams {
-            mean_motion: n,
-            mass: robot.total_mass(),
-            dt: scenario.mission.control_period_s,
-            horizon: nt.horizon_steps as usize,
-            gfc_point_r: d_r / d_norm * nt.gfc_distance_m,
-            weight_position: nt.weight_position,
-            weight_velocity: nt.weight_velocity,
-            weight_force: nt.weight_force,
-            weight_terminal: nt.weight_terminal,
-        })?;
-        let na = &scenario.nominal.attitude;
-        let target_inertia = Mat3::from_fn(|i, j| scenario.target.inertia_kg_m2[i][j]);
+        let translational = translational_mpc(scenario, &robot)?;
         let theta_hold = Vector7::from(scenario.servicer.initial_theta_rad);
         let grasp_point_t = Vec3::from(scenario.target.grasp_point_m);
         if !theta_hold
@@ -208,46 +312,7 @@ impl NominalControllers {
             ));
         }
         let inertia_hold = robot.system_inertia_com(&theta_hold);
-        let law = match (na.law, &na.mpc) {
-            (AttitudeLawKind::Mpc, Some(m)) => {
-                AttitudeLaw::Mpc(Box::new(AttitudeMpc::new(AttitudeMpcParams {
-                    dt: scenario.mission.control_period_s,
-                    horizon: m.horizon_steps as usize,
-                    inertia: inertia_hold,
-                    weight_pointing: m.weight_pointing_per_rad2,
-                    weight_rate: m.weight_rate_s2_per_rad2,
-                    weight_torque: m.weight_torque_per_nm2,
-                    weight_terminal: m.weight_terminal,
-                })?))
-            }
-            (AttitudeLawKind::Mpc, None) => {
-                return Err(NominalError::Param(
-                    "nominal.attitude.law = mpc without [nominal.attitude.mpc]".into(),
-                ));
-            }
-            (AttitudeLawKind::Pd, _) => AttitudeLaw::Pd(AttitudeGains {
-                kp: na.kp_nm_per_rad,
-                kd: na.kd_nm_s_per_rad,
-                k_sync: na.sync_gain_nm_s_per_rad,
-            }),
-        };
-        let attitude = AttitudeController::with_law(
-            law,
-            Vec3::from(scenario.servicer.boresight_body),
-            Some(target_inertia),
-        )
-        .ok_or_else(|| NominalError::Param("attitude gains or boresight".into()))?;
-        let attitude = match (
-            scenario.servicer.gripper_axis_body,
-            scenario.target.grasp_fixture_axis,
-        ) {
-            (Some(g), Some(a)) => attitude
-                .with_alignment(Vec3::from(g), Vec3::from(a))
-                .ok_or_else(|| {
-                    NominalError::Param("gripper_axis_body or grasp_fixture_axis".into())
-                })?,
-            _ => attitude,
-        };
+        let attitude = attitude_controller(scenario, inertia_hold)?;
         let nr = &scenario.nominal.robotic;
         let robotic = RoboticController::new(
             RoboticGains {
@@ -260,25 +325,8 @@ impl NominalControllers {
             &robot,
         )
         .ok_or_else(|| NominalError::Param("robotic gains or IK settings".into()))?;
-        let mut phases: Vec<PhaseModes> = scenario
-            .mission
-            .phases
-            .iter()
-            .map(|p| PhaseModes {
-                start_s: p.start_s,
-                translational: p.translational,
-                attitude: p.attitude,
-                robotic: p.robotic,
-            })
-            .collect();
-        if phases.is_empty() || phases.iter().any(|p| !p.start_s.is_finite()) {
-            return Err(NominalError::Param(
-                "mission.phases empty or non-finite start".into(),
-            ));
-        }
-        phases.sort_by(|a, b| a.start_s.total_cmp(&b.start_s));
         Ok(Self {
-            phases,
+            phases: phase_schedule(scenario)?,
             translational,
             attitude,
             robotic,
@@ -343,92 +391,28 @@ impl NominalControllers {
     pub fn command_subsystems(&self, x: &NominalInput, which: SubsystemSet) -> NominalOutput {
         let phase = self.phase_at(x.t);
         let modes = self.phases[phase];
-        let mut out = NominalOutput {
-            phase,
-            f_h: Vec3::zeros(),
-            tau_b: Vec3::zeros(),
-            tau_m: Vector7::zeros(),
-            translational: SubsystemStatus::Off,
-            attitude: SubsystemStatus::Off,
-            robotic: SubsystemStatus::Off,
-            gfc_point_h: Vec3::zeros(),
-            pointing_error_rad: 0.0,
-            rate_error_b: Vec3::zeros(),
-            theta_goal: Vector7::zeros(),
-            ik: None,
-        };
+        let mut out = NominalOutput::off(phase);
         if !x.t.is_finite() {
             out.translational = SubsystemStatus::InvalidInput;
             out.attitude = SubsystemStatus::InvalidInput;
             out.robotic = SubsystemStatus::InvalidInput;
             return out;
         }
-        let status = |valid: bool| {
-            if valid {
-                SubsystemStatus::Active
-            } else {
-                SubsystemStatus::InvalidInput
-            }
-        };
-
         if which.contains(Subsystem::Translational)
             && modes.translational == TranslationalMode::Approach
         {
-            let valid = match quat::normalized(&x.q_hr) {
-                Some(q_hr) => {
-                    let r_hr = quat::to_matrix(&q_hr);
-                    let r_h = r_hr * x.r_r;
-                    let v_h = r_hr * x.v_r - x.omega_h.cross(&r_h);
-                    let c = self.translational.command(&r_h, &v_h, &q_hr, &x.omega_h);
-                    out.f_h = c.f_h;
-                    out.gfc_point_h = c.gfc_point_h;
-                    c.valid
-                }
-                None => false,
-            };
-            out.translational = status(valid);
+            self.command_translational(x, &mut out);
         }
-
         let grasp = self.grasp_point_r(&x.q_rt, &x.omega_t);
         let theta_ok = x.theta.iter().all(|v| v.is_finite());
-
         let task = match modes.attitude {
             AttitudeMode::Point => Some(AttitudeTask::Point),
             AttitudeMode::PointAndSync => Some(AttitudeTask::PointAndSync),
             AttitudeMode::Off => None,
         };
         if let Some(task) = task.filter(|_| which.contains(Subsystem::Attitude)) {
-            let valid = match grasp {
-                Some((p_g, v_g)) => {
-                    let inertia_b = if theta_ok {
-                        self.robot.system_inertia_com(&x.theta)
-                    } else {
-                        self.inertia_hold
-                    };
-                    let c = self.attitude.command(
-                        task,
-                        &AttitudeInput {
-                            q_rb: x.q_rb,
-                            omega_b: x.omega_b,
-                            inertia_b,
-                            r_r: x.r_r,
-                            v_r: x.v_r,
-                            grasp_r: p_g,
-                            grasp_vel_r: v_g,
-                            q_rt: x.q_rt,
-                            omega_t: x.omega_t,
-                        },
-                    );
-                    out.tau_b = c.tau_b;
-                    out.pointing_error_rad = c.pointing_error_rad;
-                    out.rate_error_b = c.rate_error;
-                    c.valid
-                }
-                None => false,
-            };
-            out.attitude = status(valid);
+            self.command_attitude(x, task, grasp, theta_ok, &mut out);
         }
-
         let robotic_mode = if which.contains(Subsystem::Robotic) {
             modes.robotic
         } else {
@@ -449,35 +433,7 @@ impl NominalControllers {
                 out.robotic = status(c.valid);
             }
             RoboticMode::Grasp => {
-                let valid = match (grasp, quat::normalized(&x.q_rb)) {
-                    (Some((p_g, v_g)), Some(q_rb)) if theta_ok => {
-                        let r_br = quat::to_matrix(&q_rb).transpose();
-                        // grasping point relative to the base origin, in F_B, and its
-                        // rate of change as seen in the rotating F_B
-                        let p_gb = r_br * (p_g - x.r_r);
-                        let v_gb = r_br * (v_g - x.v_r) - x.omega_b.cross(&p_gb);
-                        let ik = self
-                            .robotic
-                            .inverse_kinematics(&self.robot, &p_gb, &x.theta);
-                        let rate_ff = if v_gb.iter().all(|v| v.is_finite()) {
-                            self.robotic.dls_rate(&self.robot, &ik.theta, &v_gb)
-                        } else {
-                            Vector7::zeros()
-                        };
-                        let c = self.robotic.computed_torque(
-                            &self.robot,
-                            &x.theta,
-                            &x.theta_dot,
-                            &ik.theta,
-                            &rate_ff,
-                        );
-                        out.tau_m = c.tau_m;
-                        out.theta_goal = c.theta_goal;
-                        out.ik = Some(ik);
-                        c.valid && ik.error_m.is_finite()
-                    }
-                    _ => false,
-                };
+                let valid = theta_ok && self.command_grasp(x, grasp, &mut out);
                 if !valid {
                     out.tau_m = Vector7::zeros();
                 }
@@ -491,5 +447,99 @@ impl NominalControllers {
             out.tau_b = Vec3::zeros();
         }
         out
+    }
+
+    /// The translational MPC's force in F_H towards the Go-for-Capture point, from the
+    /// state taken into the Hill frame.
+    fn command_translational(&self, x: &NominalInput, out: &mut NominalOutput) {
+        let valid = match quat::normalized(&x.q_hr) {
+            Some(q_hr) => {
+                let r_hr = quat::to_matrix(&q_hr);
+                let r_h = r_hr * x.r_r;
+                let v_h = r_hr * x.v_r - x.omega_h.cross(&r_h);
+                let c = self.translational.command(&r_h, &v_h, &q_hr, &x.omega_h);
+                out.f_h = c.f_h;
+                out.gfc_point_h = c.gfc_point_h;
+                c.valid
+            }
+            None => false,
+        };
+        out.translational = status(valid);
+    }
+
+    /// The attitude controller's torque for `task`, pointing at the grasping point
+    /// `grasp` (position and velocity in F_R); the servicer's inertia at the current
+    /// joint angles (at the hold angles when those are not finite).
+    fn command_attitude(
+        &self,
+        x: &NominalInput,
+        task: AttitudeTask,
+        grasp: Option<(Vec3, Vec3)>,
+        theta_ok: bool,
+        out: &mut NominalOutput,
+    ) {
+        let valid = match grasp {
+            Some((p_g, v_g)) => {
+                let inertia_b = if theta_ok {
+                    self.robot.system_inertia_com(&x.theta)
+                } else {
+                    self.inertia_hold
+                };
+                let c = self.attitude.command(
+                    task,
+                    &AttitudeInput {
+                        q_rb: x.q_rb,
+                        omega_b: x.omega_b,
+                        inertia_b,
+                        r_r: x.r_r,
+                        v_r: x.v_r,
+                        grasp_r: p_g,
+                        grasp_vel_r: v_g,
+                        q_rt: x.q_rt,
+                        omega_t: x.omega_t,
+                    },
+                );
+                out.tau_b = c.tau_b;
+                out.pointing_error_rad = c.pointing_error_rad;
+                out.rate_error_b = c.rate_error;
+                c.valid
+            }
+            None => false,
+        };
+        out.attitude = status(valid);
+    }
+
+    /// Grasp mode (with finite joint angles): computed torque to the IK solution of the
+    /// grasping point in F_B, with the DLS rate of its motion as feed-forward. `false`
+    /// when an input is degenerate or the result is not valid.
+    fn command_grasp(
+        &self,
+        x: &NominalInput,
+        grasp: Option<(Vec3, Vec3)>,
+        out: &mut NominalOutput,
+    ) -> bool {
+        let (Some((p_g, v_g)), Some(q_rb)) = (grasp, quat::normalized(&x.q_rb)) else {
+            return false;
+        };
+        let r_br = quat::to_matrix(&q_rb).transpose();
+        // grasping point relative to the base origin, in F_B, and its rate of change as
+        // seen in the rotating F_B
+        let p_gb = r_br * (p_g - x.r_r);
+        let v_gb = r_br * (v_g - x.v_r) - x.omega_b.cross(&p_gb);
+        let ik = self
+            .robotic
+            .inverse_kinematics(&self.robot, &p_gb, &x.theta);
+        let rate_ff = if v_gb.iter().all(|v| v.is_finite()) {
+            self.robotic.dls_rate(&self.robot, &ik.theta, &v_gb)
+        } else {
+            Vector7::zeros()
+        };
+        let c =
+            self.robotic
+                .computed_torque(&self.robot, &x.theta, &x.theta_dot, &ik.theta, &rate_ff);
+        out.tau_m = c.tau_m;
+        out.theta_goal = c.theta_goal;
+        out.ik = Some(ik);
+        c.valid && ik.error_m.is_finite()
     }
 }

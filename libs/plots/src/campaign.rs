@@ -289,6 +289,8 @@ fn scatter(area: &Area, f: &CampaignFigures) -> DrawResult {
     colour_bar(&bar, "tumbling rate [rad/s]", rate.0, rate.1)
 }
 
+/// The solve-time bars: the safety layer's total on the left, each filter's QP on the
+/// right, on one log axis; the paper's figures as reference lines on the total's panel.
 fn runtime(area: &Area, f: &CampaignFigures) -> DrawResult {
     let panels = area.split_horizontally(area.dim_in_pixel().0 / 3);
     let groups: [(&Area, &[RuntimeBar], &str); 2] = [
@@ -303,22 +305,7 @@ fn runtime(area: &Area, f: &CampaignFigures) -> DrawResult {
             "Per filter QP",
         ),
     ];
-    let mut vals: Vec<f64> = f
-        .runtime
-        .iter()
-        .flat_map(|b| [b.geomean_us, b.max_us, b.cpu_geomean_us, b.cpu_max_us])
-        .filter(|v| v.is_finite() && *v > 0.0)
-        .collect();
-    if let Some((_, g, m)) = &f.runtime_reference {
-        vals.extend([*g, *m]);
-    }
-    let lo = vals.iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = vals.iter().copied().fold(0.0, f64::max);
-    let (lo, hi) = if lo.is_finite() && hi > 0.0 {
-        (lo / 3.0, hi * 40.0)
-    } else {
-        (0.1, 10.0)
-    };
+    let (lo, hi) = runtime_range(f);
     for (k, (area, bars, title)) in groups.iter().enumerate() {
         let n = bars.len().max(1) as f64;
         let mut chart = standard(area, title)
@@ -342,47 +329,7 @@ fn runtime(area: &Area, f: &CampaignFigures) -> DrawResult {
             .draw()
             .map_err(e)?;
         for (i, b) in bars.iter().enumerate() {
-            let x = i as f64;
-            for (j, (v, c)) in [
-                (b.geomean_us, GEOMEAN),
-                (b.max_us, MAX),
-                (b.cpu_geomean_us, CPU_GEOMEAN),
-                (b.cpu_max_us, CPU_MAX),
-            ]
-            .iter()
-            .enumerate()
-            {
-                if v.is_finite() && *v > lo {
-                    let x0 = x + 0.08 + 0.21 * j as f64;
-                    let a = chart
-                        .draw_series(std::iter::once(Rectangle::new(
-                            [(x0, lo), (x0 + 0.19, *v)],
-                            c.filled(),
-                        )))
-                        .map_err(e)?;
-                    if i == 0 {
-                        let c = *c;
-                        a.label(
-                            [
-                                "geometric mean (wall)",
-                                "maximum (wall)",
-                                "geometric mean (thread CPU)",
-                                "maximum (thread CPU)",
-                            ][j],
-                        )
-                        .legend(move |(px, py)| {
-                            Rectangle::new([(px, py - 5), (px + 12, py + 5)], c.filled())
-                        });
-                    }
-                    chart
-                        .draw_series(std::iter::once(Text::new(
-                            duration_us(*v),
-                            (x0, *v * 1.15),
-                            (FONT, 12),
-                        )))
-                        .map_err(e)?;
-                }
-            }
+            runtime_bar(&mut chart, i, b, lo)?;
         }
         if k == 0
             && let Some((name, g, m)) = &f.runtime_reference
@@ -399,6 +346,77 @@ fn runtime(area: &Area, f: &CampaignFigures) -> DrawResult {
             }
         }
         legend(&mut chart)?;
+    }
+    Ok(())
+}
+
+/// The log axis of the solve times: from a third of the smallest positive value to 40
+/// times the largest (room for the labels above the bars), the reference included.
+fn runtime_range(f: &CampaignFigures) -> (f64, f64) {
+    let mut vals: Vec<f64> = f
+        .runtime
+        .iter()
+        .flat_map(|b| [b.geomean_us, b.max_us, b.cpu_geomean_us, b.cpu_max_us])
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .collect();
+    if let Some((_, g, m)) = &f.runtime_reference {
+        vals.extend([*g, *m]);
+    }
+    let lo = vals.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = vals.iter().copied().fold(0.0, f64::max);
+    if lo.is_finite() && hi > 0.0 {
+        (lo / 3.0, hi * 40.0)
+    } else {
+        (0.1, 10.0)
+    }
+}
+
+/// The four bars of `b` (wall and CPU, geometric mean and maximum) at slot `i`, each
+/// with its value above it; the first slot's bars make the legend.
+fn runtime_bar<'a, 'b: 'a, X: Ranged<ValueType = f64>, Y: Ranged<ValueType = f64>>(
+    chart: &mut ChartContext<'a, SVGBackend<'b>, Cartesian2d<X, Y>>,
+    i: usize,
+    b: &RuntimeBar,
+    lo: f64,
+) -> DrawResult {
+    const LEGEND: [&str; 4] = [
+        "geometric mean (wall)",
+        "maximum (wall)",
+        "geometric mean (thread CPU)",
+        "maximum (thread CPU)",
+    ];
+    let x = i as f64;
+    for (j, (v, c)) in [
+        (b.geomean_us, GEOMEAN),
+        (b.max_us, MAX),
+        (b.cpu_geomean_us, CPU_GEOMEAN),
+        (b.cpu_max_us, CPU_MAX),
+    ]
+    .iter()
+    .enumerate()
+    {
+        if v.is_finite() && *v > lo {
+            let x0 = x + 0.08 + 0.21 * j as f64;
+            let a = chart
+                .draw_series(std::iter::once(Rectangle::new(
+                    [(x0, lo), (x0 + 0.19, *v)],
+                    c.filled(),
+                )))
+                .map_err(e)?;
+            if i == 0 {
+                let c = *c;
+                a.label(LEGEND[j]).legend(move |(px, py)| {
+                    Rectangle::new([(px, py - 5), (px + 12, py + 5)], c.filled())
+                });
+            }
+            chart
+                .draw_series(std::iter::once(Text::new(
+                    duration_us(*v),
+                    (x0, *v * 1.15),
+                    (FONT, 12),
+                )))
+                .map_err(e)?;
+        }
     }
     Ok(())
 }

@@ -49,11 +49,23 @@ const CHAR_WIDTH: f64 = 0.6;
 const REF_LABEL_OFFSET: i32 = 3;
 
 pub type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
-pub type DrawResult = Result<(), String>;
+pub type DrawResult = Result<(), DrawError>;
 
-/// Maps any plotters error to its message.
-pub fn e<T: std::fmt::Display>(x: T) -> String {
-    x.to_string()
+/// Why a figure could not be drawn (inside [`crate::PlotError::Draw`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DrawError {
+    /// The plotting library refused: its message (plotters' errors are generic over the
+    /// backend, so their text is kept).
+    #[error("{0}")]
+    Backend(String),
+    /// The plotting library panicked (it has a few panics on degenerate input).
+    #[error("plotting library panicked")]
+    Panicked,
+}
+
+/// Maps any plotters error to a [`DrawError`].
+pub fn e<T: std::fmt::Display>(x: T) -> DrawError {
+    DrawError::Backend(x.to_string())
 }
 
 /// Ranges for a spatial chart of the standard layout ([`Panel`]: caption `title`,
@@ -101,16 +113,16 @@ pub fn svg(
     }));
     match outcome {
         Ok(Ok(())) => {}
-        Ok(Err(message)) => {
+        Ok(Err(source)) => {
             return Err(PlotError::Draw {
                 path: shown,
-                message,
+                source,
             });
         }
         Err(_) => {
             return Err(PlotError::Draw {
                 path: shown,
-                message: "plotting library panicked".into(),
+                source: DrawError::Panicked,
             });
         }
     }
@@ -439,7 +451,7 @@ fn series<'c, 'a, 'b: 'a, X: Ranged<ValueType = f64>, Y: Ranged<ValueType = f64>
     colour: RGBColor,
     width: u32,
     dashed: bool,
-) -> Result<&'c mut SeriesAnno<'a, SVGBackend<'b>>, String> {
+) -> Result<&'c mut SeriesAnno<'a, SVGBackend<'b>>, DrawError> {
     let style = colour.stroke_width(width);
     if dashed {
         chart

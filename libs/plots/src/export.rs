@@ -31,6 +31,35 @@ const NO_FONT_HINT: &str = "no font found for figure text in the system font fol
     (/usr/share/fonts, /usr/local/share/fonts, ~/.local/share/fonts); install one, e.g. \
     `apt-get install fonts-dejavu-core`";
 
+/// Why an SVG could not be converted (inside [`PlotError::Export`]).
+#[derive(Debug, thiserror::Error)]
+pub enum ConvertError {
+    /// The SVG is not well-formed XML.
+    #[error(transparent)]
+    Xml(#[from] usvg::roxmltree::Error),
+    /// The renderer could not read the SVG.
+    #[error(transparent)]
+    Svg(#[from] usvg::Error),
+    /// Texts the renderer could not set in the font (they would be dropped silently).
+    #[error("{missing} of {want} texts could not be set in the font `{family}`")]
+    TextNotSet {
+        missing: usize,
+        want: usize,
+        family: String,
+    },
+    /// The PNG's size overflows.
+    #[error("figure too large")]
+    TooLarge,
+    #[error("cannot allocate {width}x{height} pixels")]
+    Pixels { width: u32, height: u32 },
+    /// The PNG encoder's message.
+    #[error("{0}")]
+    Png(String),
+    /// The PDF converter's message.
+    #[error("{0}")]
+    Pdf(String),
+}
+
 /// One figure file format.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum FigureFormat {
@@ -164,20 +193,23 @@ pub fn check_formats(formats: &FigureFormats) -> Result<(), PlotError> {
 }
 
 fn fonts() -> Result<Arc<usvg::fontdb::Database>, PlotError> {
-    static DB: OnceLock<Result<Arc<usvg::fontdb::Database>, String>> = OnceLock::new();
+    // `None`: no font installed
+    static DB: OnceLock<Option<Arc<usvg::fontdb::Database>>> = OnceLock::new();
     DB.get_or_init(|| {
         let mut db = usvg::fontdb::Database::new();
         db.load_system_fonts();
-        let family = pick_family(&db).ok_or_else(|| NO_FONT_HINT.to_string())?;
+        let family = pick_family(&db)?;
         db.set_sans_serif_family(family.clone());
         db.set_serif_family(family.clone());
         db.set_monospace_family(family.clone());
         db.set_cursive_family(family.clone());
         db.set_fantasy_family(family);
-        Ok(Arc::new(db))
+        Some(Arc::new(db))
     })
     .clone()
-    .map_err(|message| PlotError::Font { message })
+    .ok_or_else(|| PlotError::Font {
+        message: NO_FONT_HINT.to_string(),
+    })
 }
 
 /// The preferred installed sans-serif family, else the alphabetically first family.
@@ -196,8 +228,8 @@ fn pick_family(db: &usvg::fontdb::Database) -> Option<String> {
 }
 
 /// Number of `<text>` elements of `svg` with something to show.
-fn texts_in_source(svg: &str) -> Result<usize, String> {
-    let doc = usvg::roxmltree::Document::parse(svg).map_err(|e| e.to_string())?;
+fn texts_in_source(svg: &str) -> Result<usize, ConvertError> {
+    let doc = usvg::roxmltree::Document::parse(svg)?;
     Ok(doc
         .descendants()
         .filter(|n| n.has_tag_name("text"))
@@ -222,7 +254,7 @@ fn texts_in_tree(g: &usvg::Group) -> usize {
 }
 
 /// Parses `svg` with the fonts; an error if any text could not be set.
-fn parse(svg: &str, fonts: Arc<usvg::fontdb::Database>) -> Result<usvg::Tree, String> {
+fn parse(svg: &str, fonts: Arc<usvg::fontdb::Database>) -> Result<usvg::Tree, ConvertError> {
     let family = fonts
         .family_name(&usvg::fontdb::Family::SansSerif)
         .to_string();
@@ -231,43 +263,49 @@ fn parse(svg: &str, fonts: Arc<usvg::fontdb::Database>) -> Result<usvg::Tree, St
         fontdb: fonts,
         ..Default::default()
     };
-    let tree = usvg::Tree::from_str(svg, &options).map_err(|e| e.to_string())?;
+    let tree = usvg::Tree::from_str(svg, &options)?;
     let (want, got) = (texts_in_source(svg)?, texts_in_tree(tree.root()));
     if got < want {
-        return Err(format!(
-            "{} of {want} texts could not be set in the font `{family}`",
-            want - got
-        ));
+        return Err(ConvertError::TextNotSet {
+            missing: want - got,
+            want,
+            family,
+        });
     }
     Ok(tree)
 }
 
 /// The PNG of `tree`: [`PNG_SCALE`] pixels per SVG pixel, white where the SVG is clear.
-fn png(tree: &usvg::Tree) -> Result<Vec<u8>, String> {
+fn png(tree: &usvg::Tree) -> Result<Vec<u8>, ConvertError> {
     let size = tree
         .size()
         .to_int_size()
         .scale_by(PNG_SCALE)
-        .ok_or("figure too large")?;
-    let mut pixmap = tiny_skia::Pixmap::new(size.width(), size.height())
-        .ok_or_else(|| format!("cannot allocate {}x{} pixels", size.width(), size.height()))?;
+        .ok_or(ConvertError::TooLarge)?;
+    let mut pixmap =
+        tiny_skia::Pixmap::new(size.width(), size.height()).ok_or(ConvertError::Pixels {
+            width: size.width(),
+            height: size.height(),
+        })?;
     pixmap.fill(tiny_skia::Color::WHITE);
     resvg::render(
         tree,
         tiny_skia::Transform::from_scale(PNG_SCALE, PNG_SCALE),
         &mut pixmap.as_mut(),
     );
-    pixmap.encode_png().map_err(|e| e.to_string())
+    pixmap
+        .encode_png()
+        .map_err(|e| ConvertError::Png(e.to_string()))
 }
 
 /// The PDF of `tree`, one page of the figure's size (1 SVG pixel = 1 pt).
-fn pdf(tree: &usvg::Tree) -> Result<Vec<u8>, String> {
+fn pdf(tree: &usvg::Tree) -> Result<Vec<u8>, ConvertError> {
     svg2pdf::to_pdf(
         tree,
         svg2pdf::ConversionOptions::default(),
         svg2pdf::PageOptions::default(),
     )
-    .map_err(|e| e.to_string())
+    .map_err(|e| ConvertError::Pdf(e.to_string()))
 }
 
 /// Converts `svg_path` into the formats of `formats` other than SVG, beside it (same
@@ -282,9 +320,9 @@ pub fn export_figure(svg_path: &Path, formats: &FigureFormats) -> Result<Vec<Pat
         message: err.to_string(),
     };
     let text = std::fs::read_to_string(svg_path).map_err(|err| io(svg_path, err))?;
-    let tree = parse(&text, fonts()?).map_err(|message| PlotError::Export {
+    let tree = parse(&text, fonts()?).map_err(|source| PlotError::Export {
         path: shown.clone(),
-        message,
+        source,
     })?;
     let mut out = Vec::new();
     for f in formats.iter() {
@@ -293,9 +331,9 @@ pub fn export_figure(svg_path: &Path, formats: &FigureFormats) -> Result<Vec<Pat
             FigureFormat::Png => png(&tree),
             FigureFormat::Pdf => pdf(&tree),
         }
-        .map_err(|message| PlotError::Export {
+        .map_err(|source| PlotError::Export {
             path: format!("{shown} as {f}"),
-            message,
+            source,
         })?;
         let target = svg_path.with_extension(f.extension());
         std::fs::write(&target, bytes).map_err(|err| io(&target, err))?;
@@ -346,7 +384,7 @@ mod tests {
     fn text_without_a_font_is_an_error_not_a_blank() {
         let empty = Arc::new(usvg::fontdb::Database::new());
         assert_eq!(pick_family(&empty), None);
-        let m = parse(TEXT, empty).unwrap_err();
+        let m = parse(TEXT, empty).unwrap_err().to_string();
         assert!(m.contains("1 of 1 texts could not be set"), "{m}");
         assert_eq!(texts_in_source(TEXT).unwrap(), 1);
     }

@@ -36,10 +36,12 @@ mod ticks;
 pub use campaign::{
     BarrierMinima, CampaignFigures, RunPoint, RuntimeBar, TracePoint, campaign_figures,
 };
+pub use chart::DrawError;
 pub use colour::viridis;
 pub use compare::difference_figure;
 pub use export::{
-    FigureFormat, FigureFormats, PNG_SCALE, check_formats, export_figure, export_figures,
+    ConvertError, FigureFormat, FigureFormats, PNG_SCALE, check_formats, export_figure,
+    export_figures,
 };
 pub use latency::{LatencyPercentiles, LatencyTimeline, latency_percentiles, latency_timeline};
 pub use redteam::{RedTeamMargins, redteam_margins};
@@ -53,16 +55,22 @@ use sc_scenario::Scenario;
 pub enum PlotError {
     #[error("cannot create {path}: {message}")]
     Io { path: String, message: String },
-    #[error("cannot draw {path}: {message}")]
-    Draw { path: String, message: String },
+    #[error("cannot draw {path}: {source}")]
+    Draw {
+        path: String,
+        source: chart::DrawError,
+    },
     /// A figure format list that does not parse.
     #[error("{message}")]
     Format { message: String },
     /// No font to set the figures' text in.
     #[error("cannot export figures: {message}")]
     Font { message: String },
-    #[error("cannot export {path}: {message}")]
-    Export { path: String, message: String },
+    #[error("cannot export {path}: {source}")]
+    Export {
+        path: String,
+        source: export::ConvertError,
+    },
 }
 
 /// The safety-zone geometry the figures draw, from the scenario.

@@ -22,51 +22,81 @@ pub struct RedTeamMargins<'a> {
     pub values: &'a [Vec<f64>],
 }
 
+/// Colour of a violated cell.
+const VIOLATED: RGBColor = RGBColor(214, 39, 40);
+/// Room left of the cells for the case names [px].
+const LEFT_PX: i32 = 260;
+/// Room above the cells for the title and the barrier names [px].
+const TOP_PX: i32 = 150;
+/// Room below the cells for the colour legend [px].
+const LEGEND_PX: i32 = 60;
+
+type Svg<'a> = DrawingArea<SVGBackend<'a>, plotters::coord::Shift>;
+
 /// Colour of a normalised margin: red for a violation (or NaN), else viridis over
 /// `log10` of the margin between 1e-6 and 1.
 fn cell_colour(v: f64) -> RGBColor {
     if v.is_nan() || v < 0.0 {
-        return RGBColor(214, 39, 40);
+        return VIOLATED;
     }
     let t = ((v.max(1e-6).log10() + 6.0) / 6.0).clamp(0.0, 1.0);
     viridis(t)
 }
 
-fn draw(
-    area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
-    f: &RedTeamMargins,
-) -> DrawResult {
+/// Where the cells go: left and top edge of the grid, cell width and height [px].
+#[derive(Clone, Copy)]
+struct Grid {
+    left: i32,
+    top: i32,
+    cw: i32,
+    ch: i32,
+}
+
+fn draw(area: &Svg, f: &RedTeamMargins) -> DrawResult {
     let (w, h) = area.dim_in_pixel();
-    let left = 260i32;
-    let top = 150i32;
-    let legend = 60i32;
     let rows = f.cases.len().max(1) as i32;
     let cols = f.barriers.len().max(1) as i32;
-    let cw = ((w as i32 - left - 20) / cols).max(1);
-    let ch = ((h as i32 - top - legend) / rows).max(1);
-    let font = ("sans-serif", 11).into_font();
-    let small = ("sans-serif", 9).into_font();
+    let g = Grid {
+        left: LEFT_PX,
+        top: TOP_PX,
+        cw: ((w as i32 - LEFT_PX - 20) / cols).max(1),
+        ch: ((h as i32 - TOP_PX - LEGEND_PX) / rows).max(1),
+    };
     area.draw(&Text::new(
         "Red team: smallest value of every barrier over each case (true state, every physics step)",
         (10, 14),
         ("sans-serif", 15).into_font(),
     ))
     .map_err(e)?;
+    barrier_names(area, f, g)?;
+    cells(area, f, g)?;
+    colour_legend(area, g.left, g.top + rows * g.ch + 18)
+}
+
+/// The barrier names above the columns, written upwards.
+fn barrier_names(area: &Svg, f: &RedTeamMargins, g: Grid) -> DrawResult {
+    let small = ("sans-serif", 9).into_font();
     for (j, name) in f.barriers.iter().enumerate() {
-        let x = left + j as i32 * cw + cw / 2;
+        let x = g.left + j as i32 * g.cw + g.cw / 2;
         let style = small
             .clone()
             .transform(FontTransform::Rotate270)
             .color(&BLACK)
             .pos(Pos::new(HPos::Left, VPos::Center));
-        area.draw(&Text::new(name.clone(), (x, top - 6), style))
+        area.draw(&Text::new(name.clone(), (x, g.top - 6), style))
             .map_err(e)?;
     }
+    Ok(())
+}
+
+/// One row per case: its name, then a cell per barrier.
+fn cells(area: &Svg, f: &RedTeamMargins, g: Grid) -> DrawResult {
+    let font = ("sans-serif", 11).into_font();
     for (i, case) in f.cases.iter().enumerate() {
-        let y = top + i as i32 * ch;
+        let y = g.top + i as i32 * g.ch;
         area.draw(&Text::new(
             case.clone(),
-            (left - 6, y + ch / 2),
+            (g.left - 6, y + g.ch / 2),
             font.clone()
                 .color(&BLACK)
                 .pos(Pos::new(HPos::Right, VPos::Center)),
@@ -79,19 +109,23 @@ fn draw(
                 .and_then(|r| r.get(j))
                 .copied()
                 .unwrap_or(f64::NAN);
-            let x = left + j as i32 * cw;
+            let x = g.left + j as i32 * g.cw;
             area.draw(&Rectangle::new(
-                [(x, y), (x + cw - 1, y + ch - 1)],
+                [(x, y), (x + g.cw - 1, y + g.ch - 1)],
                 cell_colour(v).filled(),
             ))
             .map_err(e)?;
         }
     }
-    // legend
-    let y = top + rows * ch + 18;
+    Ok(())
+}
+
+/// The colour legend at `(left, y)`: violated, then the margins 1e-6 … 1e0.
+fn colour_legend(area: &Svg, left: i32, y: i32) -> DrawResult {
+    let font = ("sans-serif", 11).into_font();
     area.draw(&Rectangle::new(
         [(left, y), (left + 14, y + 14)],
-        RGBColor(214, 39, 40).filled(),
+        VIOLATED.filled(),
     ))
     .map_err(e)?;
     area.draw(&Text::new(

@@ -11,6 +11,20 @@ pub(crate) enum Core {
     IterationLimit,
 }
 
+/// One step's directions for a violated row `p` (Goldfarb–Idnani step 2).
+struct Direction<const M: usize> {
+    /// `Jᵀ â_p`.
+    d: [f64; M],
+    /// The primal direction `J₂J₂ᵀ â_p` (in the null space of the active rows).
+    z: [f64; M],
+    /// `‖z‖²`.
+    zz: f64,
+    /// The dual direction `R⁻¹ J₁ᵀ â_p` (entries `0..q`).
+    r: [f64; M],
+    /// Entries of `r` at or below this are zero.
+    rtol: f64,
+}
+
 /// Dual active-set solver for `min ½‖x − x0‖²  s.t.  a_i·x ≥ b_i` with `x ∈ ℝᴹ` and at most
 /// `N ≤ 64` rows. All workspace is inside the struct: build it once, call
 /// [`solve`](Self::solve) every control step; no call allocates.
@@ -148,75 +162,95 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
             if !b[i].is_finite() || !wi.is_finite() || wi < 0.0 {
                 return false;
             }
-            let row = &a[i];
-            if self.inv[i] > 0.0 && same_bits(row, &self.raw[i]) {
-                // the same row as last time: its unit row and norm are in place; the
-                // right-hand side and weight scale exactly as in the branch below
-                let inv = self.inv[i];
-                self.bn[i] = b[i] * inv;
-                self.wn[i] = wi * inv;
-                if !self.bn[i].is_finite() || !self.wn[i].is_finite() {
-                    return false;
-                }
-                continue;
-            }
-            self.inv[i] = 0.0;
-            if !row.iter().all(|v| v.is_finite()) {
-                return false;
-            }
-            let m = inf_norm(row);
-            if m == 0.0 {
-                self.zero |= 1 << i;
-                self.an[i] = [0.0; M];
-                for k in 0..M {
-                    self.at[k][i] = 0.0;
-                }
-                self.nu[i] = 0.0;
-                self.bn[i] = b[i];
-                self.wn[i] = wi;
-                continue;
-            }
-            if (1e-100..=1e100).contains(&m) {
-                // the squares can neither overflow nor underflow to a wrong norm
-                let mut s = 0.0;
-                for &v in row {
-                    s += v * v;
-                }
-                let nu = s.sqrt();
-                let inv = 1.0 / nu;
-                for k in 0..M {
-                    self.an[i][k] = row[k] * inv;
-                    self.at[k][i] = self.an[i][k];
-                }
-                self.nu[i] = nu;
-                self.bn[i] = b[i] * inv;
-                self.wn[i] = wi * inv;
-                if inv.is_finite() && nu.is_finite() {
-                    self.raw[i] = *row;
-                    self.inv[i] = inv;
-                }
-            } else {
-                // ‖a‖ = m·h with h = ‖a/m‖ ∈ [1, √M]: no overflow or underflow.
-                let mut s = 0.0;
-                for &v in row {
-                    let v = v / m;
-                    s += v * v;
-                }
-                let h = s.sqrt();
-                for k in 0..M {
-                    self.an[i][k] = (row[k] / m) / h;
-                    self.at[k][i] = self.an[i][k];
-                }
-                self.nu[i] = m * h;
-                self.bn[i] = (b[i] / m) / h;
-                self.wn[i] = (wi / m) / h;
-            }
-            if !self.nu[i].is_finite() || !self.bn[i].is_finite() || !self.wn[i].is_finite() {
-                self.inv[i] = 0.0;
+            if !self.prepare_row(i, &a[i], b[i], wi) {
                 return false;
             }
         }
         true
+    }
+
+    /// Scales row `i` (`a_i·x ≥ b_i`, weight `w_i`) into the workspace, reusing its
+    /// scaling when the row is the one of the last call. `false` for non-finite data or
+    /// data that overflows when scaled.
+    #[inline(always)]
+    fn prepare_row(&mut self, i: usize, row: &[f64; M], bi: f64, wi: f64) -> bool {
+        if self.inv[i] > 0.0 && same_bits(row, &self.raw[i]) {
+            // the same row as last time: its unit row and norm are in place; the
+            // right-hand side and weight scale exactly as in `scale_row`
+            let inv = self.inv[i];
+            self.bn[i] = bi * inv;
+            self.wn[i] = wi * inv;
+            return self.bn[i].is_finite() && self.wn[i].is_finite();
+        }
+        self.inv[i] = 0.0;
+        if !row.iter().all(|v| v.is_finite()) {
+            return false;
+        }
+        let m = inf_norm(row);
+        if m == 0.0 {
+            self.zero |= 1 << i;
+            self.an[i] = [0.0; M];
+            for k in 0..M {
+                self.at[k][i] = 0.0;
+            }
+            self.nu[i] = 0.0;
+            self.bn[i] = bi;
+            self.wn[i] = wi;
+            return true;
+        }
+        if (1e-100..=1e100).contains(&m) {
+            self.scale_row(i, row, bi, wi);
+        } else {
+            self.scale_row_extreme(i, row, m, bi, wi);
+        }
+        if !self.nu[i].is_finite() || !self.bn[i].is_finite() || !self.wn[i].is_finite() {
+            self.inv[i] = 0.0;
+            return false;
+        }
+        true
+    }
+
+    /// Row `i` to unit norm when its largest entry `m` lies in `[1e-100, 1e100]`: the
+    /// squares can neither overflow nor underflow to a wrong norm. The scaling is kept
+    /// for reuse when finite.
+    #[inline(always)]
+    fn scale_row(&mut self, i: usize, row: &[f64; M], bi: f64, wi: f64) {
+        let mut s = 0.0;
+        for &v in row {
+            s += v * v;
+        }
+        let nu = s.sqrt();
+        let inv = 1.0 / nu;
+        for k in 0..M {
+            self.an[i][k] = row[k] * inv;
+            self.at[k][i] = self.an[i][k];
+        }
+        self.nu[i] = nu;
+        self.bn[i] = bi * inv;
+        self.wn[i] = wi * inv;
+        if inv.is_finite() && nu.is_finite() {
+            self.raw[i] = *row;
+            self.inv[i] = inv;
+        }
+    }
+
+    /// Row `i` to unit norm when its largest entry `m` is huge or tiny: `‖a‖ = m·h` with
+    /// `h = ‖a/m‖ ∈ [1, √M]`, no overflow or underflow.
+    #[inline(always)]
+    fn scale_row_extreme(&mut self, i: usize, row: &[f64; M], m: f64, bi: f64, wi: f64) {
+        let mut s = 0.0;
+        for &v in row {
+            let v = v / m;
+            s += v * v;
+        }
+        let h = s.sqrt();
+        for k in 0..M {
+            self.an[i][k] = (row[k] / m) / h;
+            self.at[k][i] = self.an[i][k];
+        }
+        self.nu[i] = m * h;
+        self.bn[i] = (bi / m) / h;
+        self.wn[i] = (wi / m) / h;
     }
 
     /// The dual active-set iteration from `x0` on `an`, `rhs` (rows `0..n`, zero rows
@@ -225,25 +259,15 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
     /// With `warm`, the iteration starts from the active set left by the previous call
     /// (on the same rows, with another right-hand side): see [`warm_start`](Self::warm_start).
     pub(crate) fn core(&mut self, x0: &[f64; M], max_iter: u32, warm: bool) -> Core {
-        let n = self.n;
         self.iterations = 0;
         if warm {
             self.warm_start(x0);
         } else {
-            self.q = 0;
-            self.mask = 0;
-            self.x = *x0;
-            for k in 0..M {
-                self.jc[k] = [0.0; M];
-                self.jc[k][k] = 1.0;
-                self.rc[k] = [0.0; M];
-            }
+            self.cold_start(x0);
         }
         // The iterate carries the rounding of the steps that brought it from x0: a few ulps
         // of ‖x0‖ (however far x0 is), on top of the relative tolerance of the rows.
         let x0_noise = 64.0 * f64::EPSILON * inf_norm(x0);
-        let ptol = self.settings.primal_tol;
-        let dtol = self.settings.dependence_tol;
         // Rows found to be violated only by rounding (dependent on the active rows, and the
         // data say they hold): not picked again until the active set grows.
         let mut noise: u64 = 0;
@@ -264,96 +288,148 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
             }
             fresh = false;
             // Step 2: move towards satisfying row p, dropping blocking rows on the way.
-            let mut up = 0.0;
-            loop {
-                if self.iterations >= max_iter {
-                    return Core::IterationLimit;
-                }
-                self.iterations += 1;
-                let q = self.q;
-                let mut d = [0.0; M];
-                for (k, dk) in d.iter_mut().enumerate() {
-                    *dk = dot(&self.jc[k], &self.an[p]);
-                }
-                // z = J₂J₂ᵀ â_p, ‖z‖² = Σ_{k≥q} d_k²
-                let mut z = [0.0; M];
-                let mut zz = 0.0;
-                for k in q..M {
-                    zz += d[k] * d[k];
-                    for i in 0..M {
-                        z[i] += d[k] * self.jc[k][i];
-                    }
-                }
-                // r = R⁻¹ J₁ᵀ â_p
-                let mut r = d;
-                self.r_solve(&mut r);
-                let rtol = self.settings.dual_tol * (1.0 + inf_norm(&r[..q]));
-                let mut t1 = f64::INFINITY;
-                let mut kdrop = usize::MAX;
-                for j in 0..q {
-                    if r[j] > rtol {
-                        let ratio = self.u[j] / r[j];
-                        if ratio < t1 {
-                            t1 = ratio;
-                            kdrop = j;
-                        }
-                    }
-                }
-                let t2 = if zz.sqrt() > dtol {
-                    let sp = dot(&self.an[p], &self.x) - self.rhs[p];
-                    -sp / zz
-                } else {
-                    f64::INFINITY
-                };
-                if kdrop == usize::MAX && t2 == f64::INFINITY {
-                    // â_p = Σ r_j â_j with r ≤ 0: y = e_p − Σ r_j e_j ≥ 0 has Σ y_i â_i ≈ 0,
-                    // and, the active rows being tight, s_p = −Σ y_i b̂_i. Decide from the
-                    // data (free of the iterate's rounding) whether row p really fails.
-                    // Entries of r within the dual tolerance are zero (as for the steps):
-                    // rounding noise must not put weight on a row (for the least-violation
-                    // iteration, noise on a soft row would fake Σ y_i w_i > 0).
-                    let yj = |rj: f64| if -rj > rtol { -rj } else { 0.0 };
-                    let mut yb = self.rhs[p];
-                    let mut mag = self.rhs[p].abs();
-                    for j in 0..q {
-                        yb += yj(r[j]) * self.rhs[self.act[j]];
-                        mag += yj(r[j]) * self.rhs[self.act[j]].abs();
-                    }
-                    if yb > ptol * mag {
-                        self.y[..n].fill(0.0);
-                        self.y[p] = 1.0;
-                        for j in 0..q {
-                            self.y[self.act[j]] = yj(r[j]);
-                        }
-                        return Core::Infeasible;
-                    }
-                    // Row p holds up to rounding: fold the multiplier it gathered into the
-                    // active rows it depends on (â_p = Σ r_j â_j) and set it aside.
-                    for j in 0..q {
-                        self.u[j] = (self.u[j] + up * r[j]).max(0.0);
-                    }
-                    noise |= 1 << p;
-                    break;
-                }
-                let t = t1.min(t2);
-                if t2 != f64::INFINITY {
-                    for i in 0..M {
-                        self.x[i] += t * z[i];
-                    }
-                }
-                for j in 0..q {
-                    self.u[j] = (self.u[j] - t * r[j]).max(0.0);
-                }
-                up += t;
-                if t2 <= t1 {
-                    self.add(p, d, up);
-                    noise = 0;
-                    break;
-                }
-                self.u[kdrop] = 0.0;
-                self.drop(kdrop);
+            if let Some(end) = self.satisfy(p, max_iter, &mut noise) {
+                return end;
             }
         }
+    }
+
+    /// The start without an active set: `x = x0`, `J = I`, `R` empty.
+    #[inline(always)]
+    fn cold_start(&mut self, x0: &[f64; M]) {
+        self.q = 0;
+        self.mask = 0;
+        self.x = *x0;
+        for k in 0..M {
+            self.jc[k] = [0.0; M];
+            self.jc[k][k] = 1.0;
+            self.rc[k] = [0.0; M];
+        }
+    }
+
+    /// Step 2 of the iteration for the violated row `p`: full or partial steps until `p`
+    /// joins the active set (`None`, `noise` cleared), or `p` is found to hold up to
+    /// rounding (`None`, `p` added to `noise`), or the iteration ends (`Some`: the rows are
+    /// infeasible, or the iteration limit is reached).
+    #[inline(always)]
+    fn satisfy(&mut self, p: usize, max_iter: u32, noise: &mut u64) -> Option<Core> {
+        // the multiplier row p has gathered so far
+        let mut up = 0.0;
+        loop {
+            if self.iterations >= max_iter {
+                return Some(Core::IterationLimit);
+            }
+            self.iterations += 1;
+            let q = self.q;
+            let dir = self.step_direction(p);
+            let (t1, kdrop) = self.dual_step(&dir.r, dir.rtol);
+            let t2 = if dir.zz.sqrt() > self.settings.dependence_tol {
+                let sp = dot(&self.an[p], &self.x) - self.rhs[p];
+                -sp / dir.zz
+            } else {
+                f64::INFINITY
+            };
+            if kdrop == usize::MAX && t2 == f64::INFINITY {
+                if self.dependent_row_fails(p, &dir.r, dir.rtol) {
+                    return Some(Core::Infeasible);
+                }
+                // Row p holds up to rounding: fold the multiplier it gathered into the
+                // active rows it depends on (â_p = Σ r_j â_j) and set it aside.
+                for j in 0..q {
+                    self.u[j] = (self.u[j] + up * dir.r[j]).max(0.0);
+                }
+                *noise |= 1 << p;
+                return None;
+            }
+            let t = t1.min(t2);
+            if t2 != f64::INFINITY {
+                for i in 0..M {
+                    self.x[i] += t * dir.z[i];
+                }
+            }
+            for j in 0..q {
+                self.u[j] = (self.u[j] - t * dir.r[j]).max(0.0);
+            }
+            up += t;
+            if t2 <= t1 {
+                self.add(p, dir.d, up);
+                *noise = 0;
+                return None;
+            }
+            self.u[kdrop] = 0.0;
+            self.drop(kdrop);
+        }
+    }
+
+    /// The step direction for row `p`: `d = Jᵀ â_p`, the primal direction
+    /// `z = J₂J₂ᵀ â_p` with `‖z‖² = Σ_{k≥q} d_k²`, and the dual direction `r = R⁻¹ J₁ᵀ â_p`
+    /// with its tolerance.
+    #[inline(always)]
+    fn step_direction(&self, p: usize) -> Direction<M> {
+        let q = self.q;
+        let mut d = [0.0; M];
+        for (k, dk) in d.iter_mut().enumerate() {
+            *dk = dot(&self.jc[k], &self.an[p]);
+        }
+        let mut z = [0.0; M];
+        let mut zz = 0.0;
+        for k in q..M {
+            zz += d[k] * d[k];
+            for i in 0..M {
+                z[i] += d[k] * self.jc[k][i];
+            }
+        }
+        let mut r = d;
+        self.r_solve(&mut r);
+        let rtol = self.settings.dual_tol * (1.0 + inf_norm(&r[..q]));
+        Direction { d, z, zz, r, rtol }
+    }
+
+    /// The longest dual step `t1 = min u_j / r_j` over `r_j > rtol` and the active
+    /// position that blocks it (`usize::MAX` and `∞` if none).
+    #[inline(always)]
+    fn dual_step(&self, r: &[f64; M], rtol: f64) -> (f64, usize) {
+        let mut t1 = f64::INFINITY;
+        let mut kdrop = usize::MAX;
+        for j in 0..self.q {
+            if r[j] > rtol {
+                let ratio = self.u[j] / r[j];
+                if ratio < t1 {
+                    t1 = ratio;
+                    kdrop = j;
+                }
+            }
+        }
+        (t1, kdrop)
+    }
+
+    /// Row `p` depends on the active rows with no blocking row: `â_p = Σ r_j â_j` with
+    /// `r ≤ 0`, so `y = e_p − Σ r_j e_j ≥ 0` has `Σ y_i â_i ≈ 0` and, the active rows being
+    /// tight, `s_p = −Σ y_i b̂_i`. Decides from the data (free of the iterate's rounding)
+    /// whether row p really fails; if so `y` holds the certificate.
+    ///
+    /// Entries of r within the dual tolerance are zero (as for the steps): rounding noise
+    /// must not put weight on a row (for the least-violation iteration, noise on a soft
+    /// row would fake `Σ y_i w_i > 0`).
+    #[inline(always)]
+    fn dependent_row_fails(&mut self, p: usize, r: &[f64; M], rtol: f64) -> bool {
+        let q = self.q;
+        let yj = |rj: f64| if -rj > rtol { -rj } else { 0.0 };
+        let mut yb = self.rhs[p];
+        let mut mag = self.rhs[p].abs();
+        for j in 0..q {
+            yb += yj(r[j]) * self.rhs[self.act[j]];
+            mag += yj(r[j]) * self.rhs[self.act[j]].abs();
+        }
+        if yb > self.settings.primal_tol * mag {
+            self.y[..self.n].fill(0.0);
+            self.y[p] = 1.0;
+            for j in 0..q {
+                self.y[self.act[j]] = yj(r[j]);
+            }
+            return true;
+        }
+        false
     }
 
     /// A dual-feasible start from the current active set for the current right-hand side:

@@ -126,13 +126,7 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
                 return Core::IterationLimit;
             }
             lv.outer_iterations += 1;
-            for i in 0..n {
-                self.rhs[i] = if self.zero >> i & 1 == 1 {
-                    0.0
-                } else {
-                    self.bn[i] - self.wn[i] * t
-                };
-            }
+            self.relax_rhs(t);
             let c = self.core(x0, max_iter, warm);
             warm = true;
             lv.iterations += self.iterations;
@@ -149,42 +143,66 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
                 }
                 Core::Infeasible => {}
             }
-            // Σ y_i (â_i·x + ŵ_i t') ≥ Σ y_i b̂_i with Σ y_i â_i = 0  ⇒  t' ≥ yᵀb̂ / yᵀŵ.
-            let (mut yw, mut yb, mut yr) = (0.0, 0.0, 0.0);
-            for i in 0..n {
-                yw += self.y[i] * self.wn[i];
-                yb += self.y[i] * self.bn[i];
-                yr += self.y[i] * self.rhs[i];
-            }
-            if yw <= 0.0 {
-                // Only hard rows in the certificate: the hard rows alone are infeasible.
-                lv.status = Status::Infeasible;
-                lv.t = t;
-                lv.dual = [0.0; N];
-                self.certificate(&mut lv.certificate);
-                return c;
-            }
-            let mut tn = yb / yw;
-            if tn.partial_cmp(&t) != Some(core::cmp::Ordering::Greater) {
-                // Rounding in yᵀb̂: the same bound from the current residual instead.
-                tn = t + yr / yw;
-                if tn.partial_cmp(&t) != Some(core::cmp::Ordering::Greater) {
-                    tn = t.next_up();
-                }
-            }
-            if !tn.is_finite() {
-                lv.status = Status::IterationLimit;
-                lv.t = t;
-                return Core::IterationLimit;
-            }
-            t = tn;
-            for i in 0..n {
-                lv.dual[i] = if self.y[i] > 0.0 {
-                    self.y[i] / yw / self.nu[i]
-                } else {
-                    0.0
-                };
+            match self.raise_t(t, lv) {
+                Ok(tn) => t = tn,
+                Err(end) => return end,
             }
         }
+    }
+
+    /// The right-hand side of `P(t)`: `b̂_i − ŵ_i t` (0 for zero rows).
+    #[inline(always)]
+    fn relax_rhs(&mut self, t: f64) {
+        for i in 0..self.n {
+            self.rhs[i] = if self.zero >> i & 1 == 1 {
+                0.0
+            } else {
+                self.bn[i] - self.wn[i] * t
+            };
+        }
+    }
+
+    /// After `P(t)` was found empty: the lower bound on `t` from the Farkas certificate `y`
+    /// (with the LP-dual point in `lv.dual`), or the end of the iteration (`Err`, with
+    /// `lv`'s status set): the hard rows alone are infeasible, or the bound is not finite.
+    #[inline(always)]
+    fn raise_t(&mut self, t: f64, lv: &mut LeastViolation<N>) -> Result<f64, Core> {
+        let n = self.n;
+        // Σ y_i (â_i·x + ŵ_i t') ≥ Σ y_i b̂_i with Σ y_i â_i = 0  ⇒  t' ≥ yᵀb̂ / yᵀŵ.
+        let (mut yw, mut yb, mut yr) = (0.0, 0.0, 0.0);
+        for i in 0..n {
+            yw += self.y[i] * self.wn[i];
+            yb += self.y[i] * self.bn[i];
+            yr += self.y[i] * self.rhs[i];
+        }
+        if yw <= 0.0 {
+            // Only hard rows in the certificate: the hard rows alone are infeasible.
+            lv.status = Status::Infeasible;
+            lv.t = t;
+            lv.dual = [0.0; N];
+            self.certificate(&mut lv.certificate);
+            return Err(Core::Infeasible);
+        }
+        let mut tn = yb / yw;
+        if tn.partial_cmp(&t) != Some(core::cmp::Ordering::Greater) {
+            // Rounding in yᵀb̂: the same bound from the current residual instead.
+            tn = t + yr / yw;
+            if tn.partial_cmp(&t) != Some(core::cmp::Ordering::Greater) {
+                tn = t.next_up();
+            }
+        }
+        if !tn.is_finite() {
+            lv.status = Status::IterationLimit;
+            lv.t = t;
+            return Err(Core::IterationLimit);
+        }
+        for i in 0..n {
+            lv.dual[i] = if self.y[i] > 0.0 {
+                self.y[i] / yw / self.nu[i]
+            } else {
+                0.0
+            };
+        }
+        Ok(tn)
     }
 }

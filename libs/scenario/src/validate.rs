@@ -159,8 +159,24 @@ fn inertia(key: &str, m: &[V3; 3]) -> Result<(), ScenarioError> {
 }
 
 impl Scenario {
-    /// Checks every rule; returns the first broken one.
+    /// Checks every rule; returns the first broken one. The sections are checked
+    /// in the order of the file (docs/SCENARIO.md), so the first error is the
+    /// first broken key.
     pub fn validate(&self) -> Result<(), ScenarioError> {
+        self.validate_orbit()?;
+        unit(
+            "reference_frame.attitude_in_hill",
+            &self.reference_frame.attitude_in_hill,
+        )?;
+        self.validate_servicer()?;
+        self.validate_target()?;
+        self.validate_mission()?;
+        self.validate_limits()?;
+        self.validate_safety()?;
+        self.validate_nominal()
+    }
+
+    fn validate_orbit(&self) -> Result<(), ScenarioError> {
         let o = &self.orbit;
         // 0 is zero gravity (docs/SCENARIO.md): the target rests, the Hill frame is fixed
         non_negative("orbit.earth_mu_m3_s2", o.earth_mu_m3_s2)?;
@@ -168,13 +184,10 @@ impl Scenario {
         positive("orbit.altitude_m", o.altitude_m)?;
         finite("orbit.inclination_deg", o.inclination_deg)?;
         finite("orbit.raan_deg", o.raan_deg)?;
-        finite("orbit.argument_of_latitude_deg", o.argument_of_latitude_deg)?;
+        finite("orbit.argument_of_latitude_deg", o.argument_of_latitude_deg)
+    }
 
-        unit(
-            "reference_frame.attitude_in_hill",
-            &self.reference_frame.attitude_in_hill,
-        )?;
-
+    fn validate_servicer(&self) -> Result<(), ScenarioError> {
         let s = &self.servicer;
         let urdf = self.urdf_path();
         if !urdf.is_file() {
@@ -185,6 +198,21 @@ impl Scenario {
             ));
         }
         unit("servicer.boresight_body", &s.boresight_body)?;
+        self.validate_grasp_axes()?;
+        finite_all("servicer.initial_position_m", &s.initial_position_m)?;
+        finite_all("servicer.initial_velocity_m_s", &s.initial_velocity_m_s)?;
+        finite_all("servicer.initial_omega_rad_s", &s.initial_omega_rad_s)?;
+        finite_all("servicer.initial_theta_rad", &s.initial_theta_rad)?;
+        finite_all(
+            "servicer.initial_theta_dot_rad_s",
+            &s.initial_theta_dot_rad_s,
+        )
+    }
+
+    /// The gripper's axis and the fixture's axis come together (or neither), and
+    /// the gripper's axis is (nearly) normal to the boresight.
+    fn validate_grasp_axes(&self) -> Result<(), ScenarioError> {
+        let s = &self.servicer;
         match (&s.gripper_axis_body, &self.target.grasp_fixture_axis) {
             (Some(g), Some(a)) => {
                 unit("servicer.gripper_axis_body", g)?;
@@ -197,39 +225,32 @@ impl Scenario {
                         "must be (nearly) normal to the boresight: the alignment turns it about the boresight",
                     ));
                 }
+                Ok(())
             }
-            (None, None) => {}
-            (Some(_), None) => {
-                return Err(invalid(
-                    "target.grasp_fixture_axis",
-                    "missing",
-                    "servicer.gripper_axis_body is set: give the fixture's axis too (or neither)",
-                ));
-            }
-            (None, Some(_)) => {
-                return Err(invalid(
-                    "servicer.gripper_axis_body",
-                    "missing",
-                    "target.grasp_fixture_axis is set: give the gripper's axis too (or neither)",
-                ));
-            }
+            (None, None) => Ok(()),
+            (Some(_), None) => Err(invalid(
+                "target.grasp_fixture_axis",
+                "missing",
+                "servicer.gripper_axis_body is set: give the fixture's axis too (or neither)",
+            )),
+            (None, Some(_)) => Err(invalid(
+                "servicer.gripper_axis_body",
+                "missing",
+                "target.grasp_fixture_axis is set: give the gripper's axis too (or neither)",
+            )),
         }
-        finite_all("servicer.initial_position_m", &s.initial_position_m)?;
-        finite_all("servicer.initial_velocity_m_s", &s.initial_velocity_m_s)?;
-        finite_all("servicer.initial_omega_rad_s", &s.initial_omega_rad_s)?;
-        finite_all("servicer.initial_theta_rad", &s.initial_theta_rad)?;
-        finite_all(
-            "servicer.initial_theta_dot_rad_s",
-            &s.initial_theta_dot_rad_s,
-        )?;
+    }
 
+    fn validate_target(&self) -> Result<(), ScenarioError> {
         let t = &self.target;
         positive("target.mass_kg", t.mass_kg)?;
         inertia("target.inertia_kg_m2", &t.inertia_kg_m2)?;
         unit("target.initial_attitude", &t.initial_attitude)?;
         finite_all("target.initial_omega_rad_s", &t.initial_omega_rad_s)?;
-        finite_all("target.grasp_point_m", &t.grasp_point_m)?;
+        finite_all("target.grasp_point_m", &t.grasp_point_m)
+    }
 
+    fn validate_mission(&self) -> Result<(), ScenarioError> {
         let m = &self.mission;
         positive("mission.control_period_s", m.control_period_s)?;
         positive("mission.physics_step_s", m.physics_step_s)?;
@@ -250,20 +271,26 @@ impl Scenario {
                 ),
             ));
         }
-        if m.phases.is_empty() {
+        self.validate_phases()
+    }
+
+    /// At least one phase; the first starts at 0, the others in strictly increasing order.
+    fn validate_phases(&self) -> Result<(), ScenarioError> {
+        let phases = &self.mission.phases;
+        if phases.is_empty() {
             return Err(invalid(
                 "mission.phases",
                 "[]",
                 "at least one phase is required",
             ));
         }
-        for (i, p) in m.phases.iter().enumerate() {
+        for (i, p) in phases.iter().enumerate() {
             let key = format!("mission.phases[{i}].start_s");
             non_negative(&key, p.start_s)?;
             if i == 0 && p.start_s != 0.0 {
                 return Err(invalid(&key, p.start_s, "the first phase must start at 0"));
             }
-            if i > 0 && p.start_s <= m.phases[i - 1].start_s {
+            if i > 0 && p.start_s <= phases[i - 1].start_s {
                 return Err(invalid(
                     &key,
                     p.start_s,
@@ -271,15 +298,27 @@ impl Scenario {
                 ));
             }
         }
+        Ok(())
+    }
 
+    fn validate_limits(&self) -> Result<(), ScenarioError> {
         let l = &self.limits;
         positive("limits.force_max_n", l.force_max_n)?;
         positive("limits.torque_max_nm", l.torque_max_nm)?;
-        positive("limits.joint_torque_max_nm", l.joint_torque_max_nm)?;
+        positive("limits.joint_torque_max_nm", l.joint_torque_max_nm)
+    }
 
-        let sf = &self.safety;
-        positive("safety.gamma_per_s", sf.gamma_per_s)?;
-        let tr = &sf.translational;
+    fn validate_safety(&self) -> Result<(), ScenarioError> {
+        positive("safety.gamma_per_s", self.safety.gamma_per_s)?;
+        self.validate_safety_translational()?;
+        self.validate_safety_attitude()?;
+        self.validate_safety_robotic()?;
+        self.validate_safety_solver()?;
+        self.validate_safety_fallback()
+    }
+
+    fn validate_safety_translational(&self) -> Result<(), ScenarioError> {
+        let tr = &self.safety.translational;
         unit("safety.translational.corridor_axis", &tr.corridor_axis)?;
         angle_deg(
             "safety.translational.corridor_half_angle_deg",
@@ -289,9 +328,11 @@ impl Scenario {
         non_negative("safety.translational.eps_ac", tr.eps_ac)?;
         non_negative("safety.translational.eps_caz", tr.eps_caz)?;
         positive("safety.translational.u_max_ac_m_s2", tr.u_max_ac_m_s2)?;
-        positive("safety.translational.u_max_caz_m2_s2", tr.u_max_caz_m2_s2)?;
+        positive("safety.translational.u_max_caz_m2_s2", tr.u_max_caz_m2_s2)
+    }
 
-        let at = &sf.attitude;
+    fn validate_safety_attitude(&self) -> Result<(), ScenarioError> {
+        let at = &self.safety.attitude;
         angle_deg("safety.attitude.los_half_angle_deg", at.los_half_angle_deg)?;
         finite_all("safety.attitude.omega_max_rad_s", &at.omega_max_rad_s)?;
         finite_all("safety.attitude.omega_min_rad_s", &at.omega_min_rad_s)?;
@@ -308,6 +349,23 @@ impl Scenario {
         non_negative("safety.attitude.eps_omega", at.eps_omega)?;
         positive("safety.attitude.gamma_omega_per_s", at.gamma_omega_per_s)?;
         positive("safety.attitude.u_max_att_per_s2", at.u_max_att_per_s2)?;
+        self.validate_safety_attitude_los()?;
+        positive(
+            "safety.attitude.boresight_rate_max_rad_s",
+            at.boresight_rate_max_rad_s,
+        )?;
+        positive(
+            "safety.attitude.gamma_boresight_rate_per_s",
+            at.gamma_boresight_rate_per_s,
+        )?;
+        self.validate_safety_attitude_bounds()
+    }
+
+    /// The line-of-sight barrier's decay: its knee inside the cone, its inner
+    /// rate at least the outer one.
+    fn validate_safety_attitude_los(&self) -> Result<(), ScenarioError> {
+        let sf = &self.safety;
+        let at = &sf.attitude;
         if !(at.los_decay_knee_deg >= 0.0 && at.los_decay_knee_deg < at.los_half_angle_deg) {
             return Err(invalid(
                 "safety.attitude.los_decay_knee_deg",
@@ -328,15 +386,12 @@ impl Scenario {
                 ),
             ));
         }
-        positive(
-            "safety.attitude.boresight_rate_max_rad_s",
-            at.boresight_rate_max_rad_s,
-        )?;
-        positive(
-            "safety.attitude.gamma_boresight_rate_per_s",
-            at.gamma_boresight_rate_per_s,
-        )?;
+        Ok(())
+    }
 
+    /// The attitude filter's disturbance budgets and derivative bounds.
+    fn validate_safety_attitude_bounds(&self) -> Result<(), ScenarioError> {
+        let at = &self.safety.attitude;
         for i in 0..3 {
             non_negative(
                 &format!("safety.attitude.arm_reaction_budget_rad_s2[{i}]"),
@@ -356,34 +411,15 @@ impl Scenario {
         non_negative(
             "safety.attitude.angular_jerk_bound_rad_s3",
             at.angular_jerk_bound_rad_s3,
-        )?;
+        )
+    }
 
-        let rb = &sf.robotic;
+    fn validate_safety_robotic(&self) -> Result<(), ScenarioError> {
+        let rb = &self.safety.robotic;
         finite_all("safety.robotic.theta_min_rad", &rb.theta_min_rad)?;
         finite_all("safety.robotic.theta_max_rad", &rb.theta_max_rad)?;
         for i in 0..7 {
-            if rb.theta_min_rad[i] >= rb.theta_max_rad[i] {
-                return Err(invalid(
-                    &format!("safety.robotic.theta_min_rad[{i}]"),
-                    rb.theta_min_rad[i],
-                    format!("limits with min >= max (max is {})", rb.theta_max_rad[i]),
-                ));
-            }
-            positive(
-                &format!("safety.robotic.theta_dot_max_rad_s[{i}]"),
-                rb.theta_dot_max_rad_s[i],
-            )?;
-            let th = s.initial_theta_rad[i];
-            if th <= rb.theta_min_rad[i] || th >= rb.theta_max_rad[i] {
-                return Err(invalid(
-                    &format!("servicer.initial_theta_rad[{i}]"),
-                    th,
-                    format!(
-                        "must lie strictly inside the joint limits ({}, {})",
-                        rb.theta_min_rad[i], rb.theta_max_rad[i]
-                    ),
-                ));
-            }
+            self.validate_joint(i)?;
         }
         non_negative("safety.robotic.eps_theta", rb.eps_theta)?;
         non_negative("safety.robotic.eps_theta_dot", rb.eps_theta_dot)?;
@@ -404,8 +440,40 @@ impl Scenario {
                 rb.link_sphere_jerk_bound_m_s3[i],
             )?;
         }
+        Ok(())
+    }
 
-        let so = &sf.solver;
+    /// Joint `i`'s limits are ordered, its rate limit positive, and the initial
+    /// angle strictly inside the limits.
+    fn validate_joint(&self, i: usize) -> Result<(), ScenarioError> {
+        let rb = &self.safety.robotic;
+        if rb.theta_min_rad[i] >= rb.theta_max_rad[i] {
+            return Err(invalid(
+                &format!("safety.robotic.theta_min_rad[{i}]"),
+                rb.theta_min_rad[i],
+                format!("limits with min >= max (max is {})", rb.theta_max_rad[i]),
+            ));
+        }
+        positive(
+            &format!("safety.robotic.theta_dot_max_rad_s[{i}]"),
+            rb.theta_dot_max_rad_s[i],
+        )?;
+        let th = self.servicer.initial_theta_rad[i];
+        if th <= rb.theta_min_rad[i] || th >= rb.theta_max_rad[i] {
+            return Err(invalid(
+                &format!("servicer.initial_theta_rad[{i}]"),
+                th,
+                format!(
+                    "must lie strictly inside the joint limits ({}, {})",
+                    rb.theta_min_rad[i], rb.theta_max_rad[i]
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    fn validate_safety_solver(&self) -> Result<(), ScenarioError> {
+        let so = &self.safety.solver;
         if so.max_iterations == 0 {
             return Err(invalid("safety.solver.max_iterations", 0, "must be >= 1"));
         }
@@ -416,8 +484,11 @@ impl Scenario {
                 "must be in (0, 1e-3]",
             ));
         }
-        positive("safety.solver.slack_weight", so.slack_weight)?;
-        let fb = &sf.fallback;
+        positive("safety.solver.slack_weight", so.slack_weight)
+    }
+
+    fn validate_safety_fallback(&self) -> Result<(), ScenarioError> {
+        let fb = &self.safety.fallback;
         positive(
             "safety.fallback.translational_brake_time_s",
             fb.translational_brake_time_s,
@@ -429,8 +500,16 @@ impl Scenario {
         positive(
             "safety.fallback.robotic_brake_time_s",
             fb.robotic_brake_time_s,
-        )?;
+        )
+    }
 
+    fn validate_nominal(&self) -> Result<(), ScenarioError> {
+        self.validate_nominal_translational()?;
+        self.validate_nominal_attitude()?;
+        self.validate_nominal_robotic()
+    }
+
+    fn validate_nominal_translational(&self) -> Result<(), ScenarioError> {
         let nt = &self.nominal.translational;
         if nt.horizon_steps == 0 {
             return Err(invalid(
@@ -440,20 +519,24 @@ impl Scenario {
             ));
         }
         positive("nominal.translational.gfc_distance_m", nt.gfc_distance_m)?;
-        if nt.gfc_distance_m <= tr.caz_radius_m {
+        let caz_radius_m = self.safety.translational.caz_radius_m;
+        if nt.gfc_distance_m <= caz_radius_m {
             return Err(invalid(
                 "nominal.translational.gfc_distance_m",
                 nt.gfc_distance_m,
                 format!(
                     "the Go-for-Capture point must lie outside the CAZ (R_CAZ = {} m)",
-                    tr.caz_radius_m
+                    caz_radius_m
                 ),
             ));
         }
         non_negative("nominal.translational.weight_position", nt.weight_position)?;
         non_negative("nominal.translational.weight_velocity", nt.weight_velocity)?;
         positive("nominal.translational.weight_force", nt.weight_force)?;
-        non_negative("nominal.translational.weight_terminal", nt.weight_terminal)?;
+        non_negative("nominal.translational.weight_terminal", nt.weight_terminal)
+    }
+
+    fn validate_nominal_attitude(&self) -> Result<(), ScenarioError> {
         let na = &self.nominal.attitude;
         non_negative("nominal.attitude.kp_nm_per_rad", na.kp_nm_per_rad)?;
         non_negative("nominal.attitude.kd_nm_s_per_rad", na.kd_nm_s_per_rad)?;
@@ -462,37 +545,17 @@ impl Scenario {
             na.sync_gain_nm_s_per_rad,
         )?;
         match (na.law, &na.mpc) {
-            (crate::AttitudeLawKind::Mpc, None) => {
-                return Err(invalid(
-                    "nominal.attitude.law",
-                    "mpc",
-                    "needs a [nominal.attitude.mpc] table (horizon_steps and the weights)",
-                ));
-            }
-            (_, Some(m)) => {
-                if m.horizon_steps == 0 || m.horizon_steps > 1000 {
-                    return Err(invalid(
-                        "nominal.attitude.mpc.horizon_steps",
-                        m.horizon_steps,
-                        "must be 1..=1000",
-                    ));
-                }
-                non_negative(
-                    "nominal.attitude.mpc.weight_pointing_per_rad2",
-                    m.weight_pointing_per_rad2,
-                )?;
-                non_negative(
-                    "nominal.attitude.mpc.weight_rate_s2_per_rad2",
-                    m.weight_rate_s2_per_rad2,
-                )?;
-                positive(
-                    "nominal.attitude.mpc.weight_torque_per_nm2",
-                    m.weight_torque_per_nm2,
-                )?;
-                non_negative("nominal.attitude.mpc.weight_terminal", m.weight_terminal)?;
-            }
-            _ => {}
+            (crate::AttitudeLawKind::Mpc, None) => Err(invalid(
+                "nominal.attitude.law",
+                "mpc",
+                "needs a [nominal.attitude.mpc] table (horizon_steps and the weights)",
+            )),
+            (_, Some(m)) => validate_attitude_mpc(m),
+            _ => Ok(()),
         }
+    }
+
+    fn validate_nominal_robotic(&self) -> Result<(), ScenarioError> {
         let nr = &self.nominal.robotic;
         non_negative("nominal.robotic.kp_per_s2", nr.kp_per_s2)?;
         non_negative("nominal.robotic.kd_per_s", nr.kd_per_s)?;
@@ -500,7 +563,30 @@ impl Scenario {
             return Err(invalid("nominal.robotic.ik_iterations", 0, "must be >= 1"));
         }
         positive("nominal.robotic.ik_damping", nr.ik_damping)?;
-        positive("nominal.robotic.ik_tolerance_m", nr.ik_tolerance_m)?;
-        Ok(())
+        positive("nominal.robotic.ik_tolerance_m", nr.ik_tolerance_m)
     }
+}
+
+/// The attitude MPC's horizon and weights.
+fn validate_attitude_mpc(m: &crate::NominalAttitudeMpc) -> Result<(), ScenarioError> {
+    if m.horizon_steps == 0 || m.horizon_steps > 1000 {
+        return Err(invalid(
+            "nominal.attitude.mpc.horizon_steps",
+            m.horizon_steps,
+            "must be 1..=1000",
+        ));
+    }
+    non_negative(
+        "nominal.attitude.mpc.weight_pointing_per_rad2",
+        m.weight_pointing_per_rad2,
+    )?;
+    non_negative(
+        "nominal.attitude.mpc.weight_rate_s2_per_rad2",
+        m.weight_rate_s2_per_rad2,
+    )?;
+    positive(
+        "nominal.attitude.mpc.weight_torque_per_nm2",
+        m.weight_torque_per_nm2,
+    )?;
+    non_negative("nominal.attitude.mpc.weight_terminal", m.weight_terminal)
 }

@@ -82,6 +82,59 @@ pub enum ProfileError {
     Period(f64),
 }
 
+/// The header (line `line`) names exactly [`PROFILE_COLUMNS`], in order.
+fn check_header(line: usize, header: &str) -> Result<(), ProfileError> {
+    let names: Vec<&str> = header.split(',').map(str::trim).collect();
+    for (i, expected) in PROFILE_COLUMNS.iter().enumerate() {
+        let found = names.get(i).copied().unwrap_or("");
+        if found != *expected {
+            return Err(ProfileError::Header {
+                line,
+                index: i + 1,
+                found: found.into(),
+                expected: (*expected).into(),
+            });
+        }
+    }
+    if names.len() != PROFILE_COLUMNS.len() {
+        return Err(ProfileError::Columns {
+            line,
+            expected: PROFILE_COLUMNS.len(),
+            found: names.len(),
+        });
+    }
+    Ok(())
+}
+
+/// The finite numbers of one row (line `line`), in [`PROFILE_COLUMNS`] order.
+fn parse_row(line: usize, text: &str) -> Result<[f64; PROFILE_COLUMNS.len()], ProfileError> {
+    let cells: Vec<&str> = text.split(',').map(str::trim).collect();
+    if cells.len() != PROFILE_COLUMNS.len() {
+        return Err(ProfileError::Columns {
+            line,
+            expected: PROFILE_COLUMNS.len(),
+            found: cells.len(),
+        });
+    }
+    let mut v = [0.0; PROFILE_COLUMNS.len()];
+    for (k, cell) in cells.iter().enumerate() {
+        let x: f64 = cell.parse().map_err(|_| ProfileError::NotANumber {
+            line,
+            column: PROFILE_COLUMNS[k].into(),
+            value: (*cell).into(),
+        })?;
+        if !x.is_finite() {
+            return Err(ProfileError::NotFinite {
+                line,
+                column: PROFILE_COLUMNS[k].into(),
+                value: x,
+            });
+        }
+        v[k] = x;
+    }
+    Ok(v)
+}
+
 /// A parsed, validated command profile.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CommandProfile {
@@ -100,52 +153,11 @@ impl CommandProfile {
             .enumerate()
             .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
         let (header_index, header) = lines.next().ok_or(ProfileError::Empty)?;
-        let names: Vec<&str> = header.split(',').map(str::trim).collect();
-        for (i, expected) in PROFILE_COLUMNS.iter().enumerate() {
-            let found = names.get(i).copied().unwrap_or("");
-            if found != *expected {
-                return Err(ProfileError::Header {
-                    line: header_index + 1,
-                    index: i + 1,
-                    found: found.into(),
-                    expected: (*expected).into(),
-                });
-            }
-        }
-        if names.len() != PROFILE_COLUMNS.len() {
-            return Err(ProfileError::Columns {
-                line: header_index + 1,
-                expected: PROFILE_COLUMNS.len(),
-                found: names.len(),
-            });
-        }
+        check_header(header_index + 1, header)?;
         let mut rows: Vec<(f64, Command)> = Vec::new();
         for (i, line) in lines {
             let line_no = i + 1;
-            let cells: Vec<&str> = line.split(',').map(str::trim).collect();
-            if cells.len() != PROFILE_COLUMNS.len() {
-                return Err(ProfileError::Columns {
-                    line: line_no,
-                    expected: PROFILE_COLUMNS.len(),
-                    found: cells.len(),
-                });
-            }
-            let mut v = [0.0; 14];
-            for (k, cell) in cells.iter().enumerate() {
-                let x: f64 = cell.parse().map_err(|_| ProfileError::NotANumber {
-                    line: line_no,
-                    column: PROFILE_COLUMNS[k].into(),
-                    value: (*cell).into(),
-                })?;
-                if !x.is_finite() {
-                    return Err(ProfileError::NotFinite {
-                        line: line_no,
-                        column: PROFILE_COLUMNS[k].into(),
-                        value: x,
-                    });
-                }
-                v[k] = x;
-            }
+            let v = parse_row(line_no, line)?;
             let nearest = (v[0] / period_s).round() * period_s;
             if (v[0] - nearest).abs() > GRID_TOLERANCE_S {
                 return Err(ProfileError::OffGrid {

@@ -85,8 +85,9 @@ fn rows<const R: usize, const C: usize>(m: &nalgebra::SMatrix<f64, R, C>) -> Vec
         .collect()
 }
 
-/// Evaluates the model at `s`.
-pub fn evaluate_model(robot: &Robot, s: &ModelState) -> Result<ModelReport, ModelStateError> {
+/// Every component finite, and the quaternion of unit norm (within 1e-6): the
+/// quaternion normalised.
+fn checked_attitude(s: &ModelState) -> Result<quat::Quat, ModelStateError> {
     let checks: [(&'static str, &[f64]); 9] = [
         ("position", &s.position),
         ("quaternion", &s.quaternion),
@@ -107,7 +108,37 @@ pub fn evaluate_model(robot: &Robot, s: &ModelState) -> Result<ModelReport, Mode
     if (n - 1.0).abs() > 1e-6 {
         return Err(ModelStateError::Quaternion(s.quaternion, n));
     }
-    let q = quat::normalized(&s.quaternion).ok_or(ModelStateError::Quaternion(s.quaternion, n))?;
+    quat::normalized(&s.quaternion).ok_or(ModelStateError::Quaternion(s.quaternion, n))
+}
+
+/// The collision spheres at the state `kin`, placed in the inertial frame by the base
+/// position `p0` and attitude `r_ib`.
+fn sphere_reports(
+    robot: &Robot,
+    kin: &sc_multibody::Kinematics,
+    p0: &Vector3<f64>,
+    r_ib: &nalgebra::Matrix3<f64>,
+) -> Vec<PointReport> {
+    robot
+        .sphere_states(kin)
+        .into_iter()
+        .enumerate()
+        .map(|(i, sp)| {
+            let cs = &robot.collision_spheres()[i];
+            PointReport {
+                name: format!("{}#{}", cs.urdf_link, cs.urdf_index),
+                radius: sp.radius,
+                position_b: sp.center.into(),
+                position_i: (p0 + r_ib * sp.center).into(),
+                jacobian_b: rows(&sp.jacobian),
+            }
+        })
+        .collect()
+}
+
+/// Evaluates the model at `s`.
+pub fn evaluate_model(robot: &Robot, s: &ModelState) -> Result<ModelReport, ModelStateError> {
+    let q = checked_attitude(s)?;
     let r_ib = quat::to_matrix(&q);
     let v3 = |a: [f64; 3]| Vector3::new(a[0], a[1], a[2]);
     let theta = Vector7::from_column_slice(&s.theta);
@@ -132,21 +163,7 @@ pub fn evaluate_model(robot: &Robot, s: &ModelState) -> Result<ModelReport, Mode
     let ee = robot.ee_position(&kin);
     let jee = robot.ee_jacobian(&kin);
     let jee_lin: nalgebra::SMatrix<f64, 3, NJ> = jee.fixed_rows::<3>(0).into();
-    let spheres = robot
-        .sphere_states(&kin)
-        .into_iter()
-        .enumerate()
-        .map(|(i, sp)| {
-            let cs = &robot.collision_spheres()[i];
-            PointReport {
-                name: format!("{}#{}", cs.urdf_link, cs.urdf_index),
-                radius: sp.radius,
-                position_b: sp.center.into(),
-                position_i: (p0 + r_ib * sp.center).into(),
-                jacobian_b: rows(&sp.jacobian),
-            }
-        })
-        .collect();
+    let spheres = sphere_reports(robot, &kin, &p0, &r_ib);
     Ok(ModelReport {
         conventions: "nu = [v_base (base frame), omega_base (base frame), theta_dot]; \
                       quaternion scalar-first base->inertial; no gravity"
