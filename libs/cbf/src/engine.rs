@@ -65,6 +65,15 @@ pub struct Outcome<const M: usize> {
     pub second_opinion: bool,
 }
 
+/// What the engine measured over one filter step ([`Engine::take_tally`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SolverTally {
+    /// Wall time spent solving [ns].
+    pub qp_ns: u64,
+    /// A solve took Clarabel's second opinion.
+    pub second_opinion: bool,
+}
+
 /// The QP of one filter: `M` inputs, at most `N` rows (barrier rows + bound rows).
 pub struct Engine<const M: usize, const N: usize> {
     qp: ActiveSetQp<M, N>,
@@ -111,6 +120,12 @@ impl<const M: usize, const N: usize> Engine<M, N> {
         self.skip_enabled = on;
     }
 
+    /// Verification only: the active-set solver's settings (it keeps no state between
+    /// solves, so replacing it changes nothing else).
+    pub fn set_settings(&mut self, settings: Settings) {
+        self.qp = ActiveSetQp::new(settings);
+    }
+
     /// The wall time spent solving since the last call [ns] (and restarts the count).
     pub fn take_qp_ns(&mut self) -> u64 {
         std::mem::take(&mut self.qp_ns)
@@ -119,6 +134,15 @@ impl<const M: usize, const N: usize> Engine<M, N> {
     /// Whether a solve since the last call took Clarabel's second opinion (and resets).
     pub fn take_second_opinion(&mut self) -> bool {
         std::mem::take(&mut self.second_opinion)
+    }
+
+    /// The solver's time and second-opinion flag since the last call (and resets both):
+    /// what one filter step spent in its solves.
+    pub fn take_tally(&mut self) -> SolverTally {
+        SolverTally {
+            qp_ns: self.take_qp_ns(),
+            second_opinion: self.take_second_opinion(),
+        }
     }
 
     /// Solves for `u_nom` with barrier `rows` (physical weights `weights`, > 0) and hard
