@@ -789,9 +789,11 @@ fn check_report<const N: usize>(r: &FilterReport<N>, sane: bool) -> Result<(), T
         prop_assert!(r.faults != 0, "a fallback is always explained: {r:?}");
     }
     prop_assert_eq!(r.faults & !faults::ALL, 0);
-    if r.faults & faults::QP_INFEASIBLE_RELAXED != 0 {
-        prop_assert_eq!(r.status, FilterStatus::Relaxed);
-    }
+    // the relaxed problem is flagged exactly when it gave the command
+    prop_assert_eq!(
+        r.faults & faults::QP_INFEASIBLE_RELAXED != 0,
+        r.status == FilterStatus::Relaxed
+    );
     prop_assert!(r.violation >= 0.0 || r.violation.is_nan() && !sane);
     if sane {
         prop_assert!(r.violation.is_finite(), "{r:?}");
@@ -1090,6 +1092,14 @@ where
             "case {k}: {:?}",
             out.report
         );
+        let relaxed = out.report.status == FilterStatus::Relaxed;
+        assert_eq!(
+            out.report.faults & faults::QP_INFEASIBLE_RELAXED != 0,
+            relaxed,
+            "case {k}: {:?}",
+            out.report
+        );
+        assert_eq!(out.report.violation > 0.0, relaxed, "case {k}");
         if out.report.status != FilterStatus::Solved {
             continue;
         }
