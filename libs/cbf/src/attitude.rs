@@ -20,11 +20,13 @@
 //! ([`xi_att_from_force`]); it enters `ḧ_ATT`'s drift only.
 
 use crate::barrier::{RelDegOne, RelDegTwo, Row};
-use crate::common::{self, BOX_MARGIN, FilterOutput, clamp_box, in_range3, unit_quat};
+use crate::common::{
+    self, BOX_MARGIN, FilterOutput, FilterReport, clamp_box, in_range3, unit_quat,
+};
 use crate::engine::{Engine, LastProblem, Outcome, SolverTally};
 use crate::filter::{Coupling, SafetyFilter};
 use crate::sampled::{Decay, RateBounds, RateDecay, RelDeg1, RelDeg2, SampleBounds};
-use crate::step::{self, FilterStep, Invalid, Solved};
+use crate::step::{self, Actuated, FilterStep, Invalid, Solved};
 use crate::{Formulation, qp::SolverParams};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use sc_core::{Observation, Subsystem};
@@ -331,14 +333,12 @@ pub(crate) struct Prepared {
     rho: Vector3<f64>,
 }
 
-/// The QP the attitude command was solved with: the barrier rows (for the acceleration
-/// cap that certified it, or valid for any torque) and the hard rows (with the cap's rows
-/// when capped).
-pub(crate) struct Solution {
+/// A command certified by an acceleration cap and the QP it was solved with: the barrier
+/// rows for that cap and the hard rows with the cap's rows.
+struct Capped {
     outcome: Outcome<3>,
     rows: [Row<3>; ROWS],
     hard: [Row<3>; HARD + 6],
-    n_hard: usize,
 }
 
 /// Caps on the body's angular acceleration per axis [rad/s²] that the certificate tries
@@ -707,10 +707,10 @@ impl AttitudeFilter {
         p: &Prepared,
         u_nom: &Vector3<f64>,
         hard: &[Row<3>; HARD],
-    ) -> Option<Solution> {
+    ) -> Option<Capped> {
         let first = (x.p * u_nom + x.r).amax();
         let floor = x.r.amax();
-        let mut best: Option<(f64, Solution)> = None;
+        let mut best: Option<(f64, Capped)> = None;
         for (k, cap) in std::iter::once(first).chain(ACCEL_CAPS).enumerate() {
             if cap < floor || (k > 0 && cap == first) {
                 continue;
@@ -729,11 +729,10 @@ impl AttitudeFilter {
                 (outcome.u - u_nom).norm()
             };
             if k == 0 || best.as_ref().is_none_or(|b| dist < b.0) {
-                let solution = Solution {
+                let solution = Capped {
                     outcome,
                     rows,
                     hard: with_cap,
-                    n_hard: HARD + 6,
                 };
                 if k == 0 {
                     return Some(solution);
@@ -785,7 +784,6 @@ struct Checked {
 impl FilterStep<3, N> for AttitudeFilter {
     type Input = AttitudeInput;
     type Prepared = Prepared;
-    type Solution = Solution;
 
     fn bound(&self) -> f64 {
         self.params.torque_max
@@ -839,37 +837,40 @@ impl FilterStep<3, N> for AttitudeFilter {
 
     /// The acceleration-cap certificate (sampled-data rows); without one, the rows valid
     /// for any torque, relaxed in tiers ([`TIERS`]) when they cannot all hold.
-    fn solve_qp(&mut self, x: &AttitudeInput, p: &Prepared, u_nom: &Vector3<f64>) -> Solution {
+    fn solve_qp(
+        &mut self,
+        x: &AttitudeInput,
+        p: &Prepared,
+        u_nom: &Vector3<f64>,
+        report: &mut FilterReport<N>,
+    ) -> Actuated<3> {
         let hard = self.hard_rows(x);
-        if p_formulation_sampled(&self.params)
-            && let Some(s) = self.certified_by_caps(x, p, u_nom, &hard)
-        {
-            return s;
+        let capped = if p_formulation_sampled(&self.params) {
+            self.certified_by_caps(x, p, u_nom, &hard)
+        } else {
+            None
+        };
+        if let Some(c) = capped {
+            let solved = Solved {
+                outcome: &c.outcome,
+                rows: &c.rows,
+                weights: &p.weights,
+                hard: &c.hard,
+                certifying: &c.rows,
+            };
+            return step::conclude(self, x, p, u_nom, solved, report);
         }
         let outcome = self
             .engine
             .solve_tiered(u_nom, &p.rows, &p.weights, &TIERS, &hard);
-        Solution {
-            outcome,
-            rows: p.rows,
-            hard: std::array::from_fn(|k| {
-                hard.get(k).copied().unwrap_or(Row {
-                    a: Vector3::zeros(),
-                    c: 1.0,
-                })
-            }),
-            n_hard: HARD,
-        }
-    }
-
-    fn solved<'a>(p: &'a Prepared, s: &'a Solution) -> Solved<'a, 3> {
-        Solved {
-            outcome: &s.outcome,
-            rows: &s.rows,
+        let solved = Solved {
+            outcome: &outcome,
+            rows: &p.rows,
             weights: &p.weights,
-            hard: &s.hard[..s.n_hard],
-            certifying: &s.rows,
-        }
+            hard: &hard,
+            certifying: &p.rows,
+        };
+        step::conclude(self, x, p, u_nom, solved, report)
     }
 }
 

@@ -28,13 +28,13 @@
 //! budget the attitude filter assumes, `|(Q (τ_M − τ_hold))_i| ≤ β_i` (six hard rows).
 
 use crate::barrier::{RelDegOne, RelDegTwo, Row};
-use crate::common::{self, BOX_MARGIN, FilterOutput, clamp_box};
+use crate::common::{self, BOX_MARGIN, FilterOutput, FilterReport, clamp_box};
 use crate::engine::{Engine, Kind, LastProblem, Outcome, SolverTally};
 use crate::filter::{Coupling, SafetyFilter};
 use crate::sampled::{
     Decay, RateBounds, RateDecay, SampleBounds, braking_barrier, hdot_required_of, phi_required_of,
 };
-use crate::step::{self, FilterStep, Invalid, Solved};
+use crate::step::{self, Actuated, FilterStep, Invalid, Solved};
 use crate::{Formulation, qp::SolverParams};
 use nalgebra::{SMatrix, SVector, Vector3, Vector6};
 use sc_core::{Observation, Subsystem};
@@ -332,21 +332,17 @@ pub(crate) struct Prepared {
     hard: [Row<NJ>; 2 * NJ + 6],
 }
 
-/// The robotic command and the rows behind it.
-pub(crate) struct Solution {
-    /// How the command came about, over all solves of the step (its multipliers are not
-    /// recorded).
-    outcome: Outcome<NJ>,
-    /// The rows of the sample's own prediction.
-    local: [Row<NJ>; N],
-    /// The rows the command was solved with (`None`: `local`).
+/// The rows behind a robotic command besides the local ones, written where
+/// [`FilterStep::solve_qp`] keeps them (they are large).
+struct RowsBehind {
+    /// The rows the command was solved with (`None`: the local rows).
     solved: Option<[Row<NJ>; N]>,
-    /// The rows that certify it (`None`: `local`).
+    /// The rows that certify it (`None`: the local rows).
     certifying: Option<[Row<NJ>; N]>,
 }
 
 /// What the a-posteriori certificate ([`RoboticFilter::certify`]) found besides the rows
-/// (which it writes into the [`Solution`]).
+/// (which it writes into the [`RowsBehind`]).
 struct Certificate {
     /// The last hard solve taken.
     res: Outcome<NJ>,
@@ -490,6 +486,13 @@ impl RoboticFilter {
     }
 
     fn terms(&self, x: &RoboticInput) -> Result<RoboticTerms, Invalid> {
+        Self::checked(x)?;
+        Ok(self.terms_of(x))
+    }
+
+    /// The input's checks: the state valid ([`Self::state_valid`]), then the coupling and
+    /// the upstream state the verification integrates with in range.
+    fn checked(x: &RoboticInput) -> Result<(), Invalid> {
         if !Self::state_valid(x) {
             return Err(Invalid::State);
         }
@@ -500,14 +503,20 @@ impl RoboticFilter {
         {
             return Err(Invalid::Coupling);
         }
+        Ok(())
+    }
+
+    /// The barrier terms of a checked input (paper eqs. "CBF-joint-angle",
+    /// "CBF-joint-velocity", "CBF-link-base").
+    fn terms_of(&self, x: &RoboticInput) -> RoboticTerms {
         let p = &self.params;
         let rates: [_; NJ] = std::array::from_fn(|i| joint_velocity(i, x, p.theta_dot_max[i]));
-        Ok(RoboticTerms {
+        RoboticTerms {
             theta: std::array::from_fn(|i| joint_angle(i, x, p.theta_min[i], p.theta_max[i])),
             theta_dot_max: std::array::from_fn(|i| rates[i][0]),
             theta_dot_min: std::array::from_fn(|i| rates[i][1]),
             link_base: std::array::from_fn(|k| link_base(&x.spheres[k], x)),
-        })
+        }
     }
 
     /// Weights of the rows in the relaxed problem — the deceleration the formulation budgets
@@ -710,20 +719,21 @@ impl RoboticFilter {
         step::filter_with(self, x, tau_nom)
     }
 
-    /// The a-posteriori certificate: solve with the sample's own prediction (`s.local`),
-    /// then check the command against rows whose in-sample bounds are valid for its own
-    /// accelerations; if it falls short, solve with those rows and check again. Writes the
-    /// rows the command was solved with (`s.solved`) and, when certified, the rows that
+    /// The a-posteriori certificate: solve with the sample's own prediction (the `local`
+    /// rows), then check the command against rows whose in-sample bounds are valid for its
+    /// own accelerations; if it falls short, solve with those rows and check again. Writes
+    /// the rows the command was solved with (`s.solved`) and, when certified, the rows that
     /// certify it (`s.certifying`).
     fn certify(
         &mut self,
         x: &RoboticInput,
         p: &Prepared,
         u_nom: &Vector7,
-        s: &mut Solution,
+        local: &[Row<NJ>; N],
+        s: &mut RowsBehind,
     ) -> Certificate {
         let accel = |u: &Vector7| x.a * u + x.drift + x.xi;
-        let res = self.engine.solve(u_nom, &s.local, &p.weights, &p.hard);
+        let res = self.engine.solve(u_nom, local, &p.weights, &p.hard);
         let mut c = Certificate {
             res,
             iterations: res.iterations,
@@ -741,7 +751,7 @@ impl RoboticFilter {
             // the certifying rows' offsets with the normals every level shares: `phi`
             // of the certifying rows, bit for bit, without building them
             let off = self.barrier_offsets(x, &p.terms, Level::Certified(cap));
-            if s.local
+            if local
                 .iter()
                 .zip(&off)
                 .all(|(r, c0)| c0 + r.a.dot(&c.res.u) >= 0.0)
@@ -751,7 +761,7 @@ impl RoboticFilter {
                 // problem), not necessarily of the certifying rows (`safe-capture
                 // verify-qp` measured up to 3e-2 of the bound between the two under
                 // attack when the dump held the certifying rows).
-                s.certifying = Some(with_offsets(&s.local, &off));
+                s.certifying = Some(with_offsets(local, &off));
                 break;
             }
             // the next candidate may accelerate more; bound it by twice as much
@@ -777,6 +787,60 @@ impl RoboticFilter {
             }
         }
         c
+    }
+
+    /// The command and how it came about, over all solves of the step (no multipliers
+    /// are recorded): first the a-posteriori certificate; where it fails (near the limits),
+    /// the verification with the servicer model (sampled-data rows only: the paper's rows
+    /// are for comparison); otherwise the last solve as it is, the braking law when it
+    /// failed. Writes the rows behind the command into `behind`.
+    fn command(
+        &mut self,
+        x: &RoboticInput,
+        p: &Prepared,
+        u_nom: &Vector7,
+        local: &[Row<NJ>; N],
+        behind: &mut RowsBehind,
+    ) -> Outcome<NJ> {
+        let c = self.certify(x, p, u_nom, local, behind);
+        let mut o = Outcome {
+            kind: c.res.kind,
+            u: c.res.u,
+            violation: 0.0,
+            iterations: c.iterations,
+            row_duals: [0.0; 64],
+            second_opinion: false,
+        };
+        if behind.certifying.is_some() {
+            if o.kind != Kind::Skipped {
+                o.kind = Kind::Solved;
+            }
+            o.second_opinion = c.res.second_opinion;
+            return o;
+        }
+        let verified = if self.params.formulation == Formulation::SampledData {
+            self.verified(x, p, u_nom, &mut o.iterations)
+        } else {
+            None
+        };
+        if let Some(v) = verified {
+            (o.kind, o.violation) = if v.violation > 0.0 {
+                (Kind::Relaxed, v.violation)
+            } else {
+                (Kind::Solved, 0.0)
+            };
+            o.u = v.u;
+            o.second_opinion = v.second_opinion;
+            behind.solved = Some(v.rows);
+            behind.certifying = Some(v.rows);
+            return o;
+        }
+        match c.res.kind {
+            Kind::Relaxed => o.violation = c.res.violation,
+            Kind::Failed => o.u = self.brake(x),
+            Kind::Skipped | Kind::Solved => {}
+        }
+        o
     }
 
     /// The verification path: solve with the sample's own prediction, simulate the sample,
@@ -1105,7 +1169,6 @@ pub fn robotic_input_from_model(
 impl FilterStep<NJ, N> for RoboticFilter {
     type Input = RoboticInput;
     type Prepared = Prepared;
-    type Solution = Solution;
 
     fn bound(&self) -> f64 {
         self.params.torque_max
@@ -1120,8 +1183,9 @@ impl FilterStep<NJ, N> for RoboticFilter {
     }
 
     fn prepare(&self, x: &RoboticInput) -> Result<Prepared, Invalid> {
+        Self::checked(x)?;
         Ok(Prepared {
-            terms: self.terms(x)?,
+            terms: self.terms_of(x),
             weights: self.weights(),
             hard: self.hard_rows(x),
         })
@@ -1140,72 +1204,29 @@ impl FilterStep<NJ, N> for RoboticFilter {
         self.brake(x)
     }
 
-    /// First the a-posteriori certificate; where it fails (near the limits), the
-    /// verification with the servicer model (sampled-data rows only: the paper's rows are
-    /// for comparison); otherwise the last solve as it is.
-    fn solve_qp(&mut self, x: &RoboticInput, p: &Prepared, u_nom: &Vector7) -> Solution {
-        // built in place: the rows are large
-        let mut s = Solution {
-            outcome: Outcome {
-                kind: Kind::Failed,
-                u: *u_nom,
-                violation: 0.0,
-                iterations: 0,
-                row_duals: [0.0; 64],
-                second_opinion: false,
-            },
-            local: self.barrier_rows(x, &p.terms, Level::Local, &[0.0; N]),
+    /// The command ([`RoboticFilter::command`]) with the rows it was solved with and the
+    /// rows that certify it, kept here (they are large).
+    fn solve_qp(
+        &mut self,
+        x: &RoboticInput,
+        p: &Prepared,
+        u_nom: &Vector7,
+        report: &mut FilterReport<N>,
+    ) -> Actuated<NJ> {
+        let local = self.barrier_rows(x, &p.terms, Level::Local, &[0.0; N]);
+        let mut behind = RowsBehind {
             solved: None,
             certifying: None,
         };
-        let c = self.certify(x, p, u_nom, &mut s);
-        let o = &mut s.outcome;
-        o.iterations = c.iterations;
-        if s.certifying.is_some() {
-            o.kind = if c.res.kind == Kind::Skipped {
-                Kind::Skipped
-            } else {
-                Kind::Solved
-            };
-            o.u = c.res.u;
-            o.second_opinion = c.res.second_opinion;
-            return s;
-        }
-        let verified = if self.params.formulation == Formulation::SampledData {
-            self.verified(x, p, u_nom, &mut o.iterations)
-        } else {
-            None
-        };
-        if let Some(v) = verified {
-            (o.kind, o.violation) = if v.violation > 0.0 {
-                (Kind::Relaxed, v.violation)
-            } else {
-                (Kind::Solved, 0.0)
-            };
-            o.u = v.u;
-            o.second_opinion = v.second_opinion;
-            s.solved = Some(v.rows);
-            s.certifying = Some(v.rows);
-            return s;
-        }
-        let res = c.res;
-        o.kind = res.kind;
-        (o.u, o.violation) = match res.kind {
-            Kind::Relaxed => (res.u, res.violation),
-            Kind::Failed => (self.brake(x), 0.0),
-            Kind::Skipped | Kind::Solved => (res.u, 0.0),
-        };
-        s
-    }
-
-    fn solved<'a>(p: &'a Prepared, s: &'a Solution) -> Solved<'a, NJ> {
-        Solved {
-            outcome: &s.outcome,
-            rows: s.solved.as_ref().unwrap_or(&s.local),
+        let outcome = self.command(x, p, u_nom, &local, &mut behind);
+        let solved = Solved {
+            outcome: &outcome,
+            rows: behind.solved.as_ref().unwrap_or(&local),
             weights: &p.weights,
             hard: &p.hard,
-            certifying: s.certifying.as_ref().unwrap_or(&s.local),
-        }
+            certifying: behind.certifying.as_ref().unwrap_or(&local),
+        };
+        step::conclude(self, x, p, u_nom, solved, report)
     }
 }
 

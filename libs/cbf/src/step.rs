@@ -9,7 +9,8 @@
 //!    [`faults::INVALID_STATE`] or [`faults::INVALID_COUPLING`].
 //! 2. **Resolve the nominal**: a missing or invalid nominal is replaced by the substitute
 //!    nominal, the filter's braking law (*own*) — the QP still runs.
-//! 3. **Solve** (*own*): the filter's QP on its rows, with its certificate or verification.
+//! 3. **Solve** (*own*): the filter's QP on its rows, with its certificate or verification;
+//!    it ends in [`conclude`] with the rows it solved with.
 //! 4. **Conclude**: record the solved problem (`--dump-qp`), map how the command came
 //!    about to the report's status and fault flags, brake when no solver produced a
 //!    command, clamp to the input bounds as the last line of defence (in the filter's
@@ -63,9 +64,6 @@ pub(crate) trait FilterStep<const M: usize, const N: usize> {
     type Input;
     /// The validated input with its barrier terms and rows.
     type Prepared;
-    /// The result of the filter's own QP step (see [`Self::solved`]).
-    type Solution;
-
     /// The bound `‖u‖∞ ≤ bound` of its commands (in its actuator frame).
     fn bound(&self) -> f64;
 
@@ -88,16 +86,16 @@ pub(crate) trait FilterStep<const M: usize, const N: usize> {
     /// produce one.
     fn braking_law(&self, x: &Self::Input, p: &Self::Prepared) -> SVector<f64, M>;
 
-    /// The filter's own QP step on the resolved nominal `u_nom`.
+    /// The filter's own QP step on the resolved nominal `u_nom` (its rows, its certificate
+    /// or verification), handed to [`conclude`] with the rows it was solved with — kept
+    /// where the filter built them, so that nothing large is copied.
     fn solve_qp(
         &mut self,
         x: &Self::Input,
         p: &Self::Prepared,
         u_nom: &SVector<f64, M>,
-    ) -> Self::Solution;
-
-    /// The solution as the shared conclusion reads it.
-    fn solved<'a>(p: &'a Self::Prepared, s: &'a Self::Solution) -> Solved<'a, M>;
+        report: &mut FilterReport<N>,
+    ) -> Actuated<M>;
 
     /// The last line of defence: the command inside the input bounds in the actuator frame
     /// — `(u, actuated, flagged)` with `flagged` when the clamp changed it. By default the
@@ -176,13 +174,12 @@ where
     report.h = F::barrier_values(p);
     let (u_nom, flag) = common::resolve_nominal(nominal, f.bound(), || f.braking_law(x, p));
     report.faults |= flag;
-    let solution = f.solve_qp(x, p, &u_nom);
-    conclude(f, x, p, &u_nom, F::solved(p, &solution), report)
+    f.solve_qp(x, p, &u_nom, report)
 }
 
-/// Records the problem, reports how the command came about, brakes when no solver produced
-/// one, clamps and evaluates the certifying rows.
-fn conclude<F, const M: usize, const N: usize>(
+/// The end of every filter's QP step: records the problem, reports how the command came
+/// about, brakes when no solver produced one, clamps and evaluates the certifying rows.
+pub(crate) fn conclude<F, const M: usize, const N: usize>(
     f: &mut F,
     x: &F::Input,
     p: &F::Prepared,

@@ -18,8 +18,10 @@
 //! rows `±R_BH f_H ≤ F` (not a box on `f_H`, which would allow `‖f_B‖∞` up to √3 F).
 
 use crate::barrier::{RelDegOne, RelDegTwo, Row};
-use crate::common::{self, BOX_MARGIN, FilterOutput, clamp_box, in_range3, unit_quat};
-use crate::engine::{Engine, LastProblem, Outcome, SolverTally};
+use crate::common::{
+    self, BOX_MARGIN, FilterOutput, FilterReport, clamp_box, in_range3, unit_quat,
+};
+use crate::engine::{Engine, LastProblem, SolverTally};
 use crate::filter::{Coupling, SafetyFilter};
 use crate::sampled::{RateBounds, RelDeg1, RelDeg2, SampleBounds};
 use crate::step::{self, Actuated, FilterStep, Invalid, Solved};
@@ -496,7 +498,6 @@ impl TranslationalFilter {
 impl FilterStep<3, N> for TranslationalFilter {
     type Input = TranslationalInput;
     type Prepared = Prepared;
-    type Solution = Outcome<3>;
 
     fn bound(&self) -> f64 {
         self.params.force_max
@@ -562,21 +563,20 @@ impl FilterStep<3, N> for TranslationalFilter {
 
     fn solve_qp(
         &mut self,
-        _: &TranslationalInput,
+        x: &TranslationalInput,
         p: &Prepared,
         u_nom: &Vector3<f64>,
-    ) -> Outcome<3> {
-        self.engine.solve(u_nom, &p.rows, &p.weights, &p.bounds)
-    }
-
-    fn solved<'a>(p: &'a Prepared, s: &'a Outcome<3>) -> Solved<'a, 3> {
-        Solved {
-            outcome: s,
+        report: &mut FilterReport<N>,
+    ) -> Actuated<3> {
+        let outcome = self.engine.solve(u_nom, &p.rows, &p.weights, &p.bounds);
+        let solved = Solved {
+            outcome: &outcome,
             rows: &p.rows,
             weights: &p.weights,
             hard: &p.bounds,
             certifying: &p.rows[..N],
-        }
+        };
+        step::conclude(self, x, p, u_nom, solved, report)
     }
 
     /// The actuated force `f_B = R_BH f_H` must be finite and inside the box; a clamped
