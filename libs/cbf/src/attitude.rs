@@ -21,18 +21,17 @@
 
 use crate::barrier::{RelDegOne, RelDegTwo, Row};
 use crate::common::{
-    self, BOX_MARGIN, FilterOutput, FilterReport, FilterStatus, clamp_box, faults, in_range3,
-    unit_quat,
+    self, BOX_MARGIN, FilterOutput, FilterReport, clamp_box, in_range3, unit_quat,
 };
-use crate::engine::{Engine, Kind, LastProblem};
+use crate::engine::{Engine, LastProblem, Outcome, SolverTally};
 use crate::filter::{Coupling, SafetyFilter};
 use crate::sampled::{Decay, RateBounds, RateDecay, RelDeg1, RelDeg2, SampleBounds};
+use crate::step::{self, Actuated, FilterStep, Invalid, Solved};
 use crate::{Formulation, qp::SolverParams};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use sc_core::{Observation, Subsystem};
 use sc_models::quat::{self, Quat};
 use sc_multibody::Robot;
-use std::time::Instant;
 
 /// Constraint names in report order.
 pub const NAMES: [&str; 7] = [
@@ -323,7 +322,8 @@ pub struct AttitudeTerms {
     pub boresight: [RelDegOne<3>; 4],
 }
 
-struct Prepared {
+/// Validated, preprocessed input.
+pub(crate) struct Prepared {
     /// `P⁻¹`: the base's articulated inertia [kg m²] (for the braking law).
     inertia: Matrix3<f64>,
     terms: AttitudeTerms,
@@ -333,9 +333,12 @@ struct Prepared {
     rho: Vector3<f64>,
 }
 
-enum Invalid {
-    State,
-    Coupling,
+/// A command certified by an acceleration cap and the QP it was solved with: the barrier
+/// rows for that cap and the hard rows with the cap's rows.
+struct Capped {
+    outcome: Outcome<3>,
+    rows: [Row<3>; ROWS],
+    hard: [Row<3>; HARD + 6],
 }
 
 /// Caps on the body's angular acceleration per axis [rad/s²] that the certificate tries
@@ -490,94 +493,6 @@ impl AttitudeFilter {
         (los, rate, boresight)
     }
 
-    fn prepare(&self, x: &AttitudeInput) -> Result<Prepared, Invalid> {
-        let p = &self.params;
-        let ok = in_range3(&x.omega_b, MAX_RATE_RAD_S)
-            && in_range3(&x.omega_target_b, MAX_RATE_RAD_S)
-            && in_range3(&x.r_r, MAX_RANGE_M)
-            && in_range3(&x.grasp_r, MAX_RANGE_M)
-            && in_range3(&x.v_r, MAX_SPEED_M_S)
-            && in_range3(&x.grasp_vel_r, MAX_SPEED_M_S)
-            && in_range3(&x.a_drift_r, MAX_ACCEL_M_S2)
-            && in_range3(&x.grasp_acc_r, MAX_ACCEL_M_S2)
-            && in_range3(&x.r, MAX_ACCEL_M_S2)
-            && common::finite(&x.joint_coupling)
-            && common::finite(&x.joint_coupling_force);
-        if !ok {
-            return Err(Invalid::State);
-        }
-        let q = unit_quat(&x.q_rb).ok_or(Invalid::State)?;
-        let (gain, inertia) = checked_gain(&x.p).ok_or(Invalid::State)?;
-        let rho = x.grasp_r - x.r_r;
-        if rho.norm() < MIN_LOS_M {
-            return Err(Invalid::State);
-        }
-        if !in_range3(&x.xi_r, MAX_ACCEL_M_S2) {
-            return Err(Invalid::Coupling);
-        }
-        let rho_dot = x.grasp_vel_r - x.v_r;
-        let rho_ddot = x.grasp_acc_r - x.a_drift_r - x.xi_r;
-        let los_dir = line_of_sight_direction(&rho, &rho_dot, &rho_ddot);
-        let r_br = quat::to_matrix(&q).transpose();
-        let los = line_of_sight(
-            &r_br,
-            &x.omega_b,
-            &gain,
-            &x.r,
-            &p.boresight_b,
-            &los_dir,
-            p.cos_beta,
-        );
-        let omega = omega_limits(&x.omega_b, &gain, &x.r, &p.omega_max, &p.omega_min);
-        let boresight = boresight_rate(
-            &x.omega_b,
-            &gain,
-            &x.r,
-            &p.boresight_b,
-            p.boresight_rate_max,
-        );
-        let terms = AttitudeTerms {
-            los,
-            omega,
-            boresight,
-        };
-        let rows: [Row<3>; ROWS] = match p.formulation {
-            Formulation::SampledData => self.sampled_rows(x, &rho, &terms, None),
-            Formulation::Paper => {
-                let mut rows = [los.row(p.gamma, p.eps_att, p.u_max_att); ROWS];
-                for (k, o) in omega.iter().enumerate() {
-                    rows[1 + k] = o.row(p.gamma_omega, p.eps_omega);
-                }
-                // the paper has no boresight-rate limit: rows that never bind
-                for r in rows.iter_mut().skip(N) {
-                    *r = Row {
-                        a: Vector3::zeros(),
-                        c: 1.0,
-                    };
-                }
-                rows
-            }
-        };
-        if !rows.iter().all(Row::is_finite) {
-            return Err(Invalid::State);
-        }
-        // the relaxed problem's weights: each row's violation is measured against the
-        // deceleration the formulation budgets for it — μ (u_max of H) for the line of
-        // sight, the paper's ε_ω for a rate row
-        let mut weights = [0.0; ROWS];
-        weights[0] = p.u_max_att;
-        for w in weights.iter_mut().skip(1) {
-            *w = p.eps_omega;
-        }
-        Ok(Prepared {
-            inertia,
-            terms,
-            rows,
-            weights,
-            rho,
-        })
-    }
-
     /// The sampled-data rows ([`NAMES`] order) for commands with body acceleration at most
     /// `accel` (`None`: any torque in the box).
     fn sampled_rows(
@@ -657,156 +572,179 @@ impl AttitudeFilter {
         x: &AttitudeInput,
         tau_nom: Option<&Vector3<f64>>,
     ) -> FilterOutput<3, N> {
-        let t0 = Instant::now();
-        // the thread's CPU clock inside the wall interval: CPU ≤ wall
-        let c0 = crate::common::thread_cpu_ns();
-        let mut report = FilterReport::<N>::default();
-        self.engine.take_qp_ns();
-        self.engine.take_second_opinion();
-        let u = self.filter_inner(x, tau_nom, &mut report);
-        report.solve_cpu_ns = crate::common::thread_cpu_ns().saturating_sub(c0);
-        report.qp_time_ns = self.engine.take_qp_ns();
-        // (the flag comes from the outcome whose command is used)
-        self.engine.take_second_opinion();
-        report.solve_time_ns = t0.elapsed().as_nanos().min(u64::MAX as u128) as u64;
-        FilterOutput {
-            u,
-            actuated: u,
-            report,
+        step::filter_with(self, x, tau_nom)
+    }
+
+    /// The input's checks: every quantity finite and in range, the attitude a unit
+    /// quaternion, `P` symmetric positive definite, the line of sight defined, then the
+    /// coupling ξ_att in range. The attitude, `(P, P⁻¹)` and `ρ = R_RT p_G,T − r_R`.
+    fn checked(&self, x: &AttitudeInput) -> Result<Checked, Invalid> {
+        let ok = in_range3(&x.omega_b, MAX_RATE_RAD_S)
+            && in_range3(&x.omega_target_b, MAX_RATE_RAD_S)
+            && in_range3(&x.r_r, MAX_RANGE_M)
+            && in_range3(&x.grasp_r, MAX_RANGE_M)
+            && in_range3(&x.v_r, MAX_SPEED_M_S)
+            && in_range3(&x.grasp_vel_r, MAX_SPEED_M_S)
+            && in_range3(&x.a_drift_r, MAX_ACCEL_M_S2)
+            && in_range3(&x.grasp_acc_r, MAX_ACCEL_M_S2)
+            && in_range3(&x.r, MAX_ACCEL_M_S2)
+            && common::finite(&x.joint_coupling)
+            && common::finite(&x.joint_coupling_force);
+        if !ok {
+            return Err(Invalid::State);
+        }
+        let q = unit_quat(&x.q_rb).ok_or(Invalid::State)?;
+        let (gain, inertia) = checked_gain(&x.p).ok_or(Invalid::State)?;
+        let rho = x.grasp_r - x.r_r;
+        if rho.norm() < MIN_LOS_M {
+            return Err(Invalid::State);
+        }
+        if !in_range3(&x.xi_r, MAX_ACCEL_M_S2) {
+            return Err(Invalid::Coupling);
+        }
+        Ok(Checked {
+            q,
+            gain,
+            inertia,
+            rho,
+        })
+    }
+
+    /// The barrier terms of paper eqs. "CBF-ATT" and "CBF-omega" and the boresight rate,
+    /// with ξ_att in the line of sight's `ρ̈`.
+    fn terms(&self, x: &AttitudeInput, c: &Checked) -> AttitudeTerms {
+        let p = &self.params;
+        let rho_dot = x.grasp_vel_r - x.v_r;
+        let rho_ddot = x.grasp_acc_r - x.a_drift_r - x.xi_r;
+        let los_dir = line_of_sight_direction(&c.rho, &rho_dot, &rho_ddot);
+        let r_br = quat::to_matrix(&c.q).transpose();
+        let los = line_of_sight(
+            &r_br,
+            &x.omega_b,
+            &c.gain,
+            &x.r,
+            &p.boresight_b,
+            &los_dir,
+            p.cos_beta,
+        );
+        let omega = omega_limits(&x.omega_b, &c.gain, &x.r, &p.omega_max, &p.omega_min);
+        let boresight = boresight_rate(
+            &x.omega_b,
+            &c.gain,
+            &x.r,
+            &p.boresight_b,
+            p.boresight_rate_max,
+        );
+        AttitudeTerms {
+            los,
+            omega,
+            boresight,
         }
     }
 
-    fn filter_inner(
+    /// The paper's rows (`safety.formulation = "paper"`, for comparison).
+    fn paper_rows(&self, t: &AttitudeTerms) -> [Row<3>; ROWS] {
+        let p = &self.params;
+        let mut rows = [t.los.row(p.gamma, p.eps_att, p.u_max_att); ROWS];
+        for (k, o) in t.omega.iter().enumerate() {
+            rows[1 + k] = o.row(p.gamma_omega, p.eps_omega);
+        }
+        // the paper has no boresight-rate limit: rows that never bind
+        for r in rows.iter_mut().skip(N) {
+            *r = Row {
+                a: Vector3::zeros(),
+                c: 1.0,
+            };
+        }
+        rows
+    }
+
+    /// The relaxed problem's weights: each row's violation is measured against the
+    /// deceleration the formulation budgets for it — μ (u_max of H) for the line of sight,
+    /// the paper's ε_ω for a rate row.
+    fn weights(&self) -> [f64; ROWS] {
+        let p = &self.params;
+        let mut weights = [0.0; ROWS];
+        weights[0] = p.u_max_att;
+        for w in weights.iter_mut().skip(1) {
+            *w = p.eps_omega;
+        }
+        weights
+    }
+
+    /// The torque box and the contract rows, then the six rows `cap ∓ (P τ + r)_i ≥ 0`
+    /// that keep the body's angular acceleration within `cap` per axis.
+    fn capped_hard_rows(x: &AttitudeInput, hard: &[Row<3>; HARD], cap: f64) -> [Row<3>; HARD + 6] {
+        std::array::from_fn(|k| {
+            if k < HARD {
+                return hard[k];
+            }
+            let i = (k - HARD) / 2;
+            let row: Vector3<f64> = x.p.row(i).transpose();
+            if (k - HARD).is_multiple_of(2) {
+                Row {
+                    a: -row,
+                    c: cap - x.r[i],
+                }
+            } else {
+                Row {
+                    a: row,
+                    c: cap + x.r[i],
+                }
+            }
+        })
+    }
+
+    /// The certificate (docs/SAFETY.md, "The acceleration cap"): rows whose in-sample
+    /// bounds hold for commands that accelerate the body by at most `cap` per axis, solved
+    /// together with the rows that keep the command's acceleration within `cap` — any
+    /// solution is certified. The caps tried: the nominal's own acceleration (the nearest
+    /// command), then [`ACCEL_CAPS`] (easier for the barrier rows); the certified command
+    /// nearest the nominal wins. `None` when no cap gives a hard solution.
+    fn certified_by_caps(
         &mut self,
         x: &AttitudeInput,
-        tau_nom: Option<&Vector3<f64>>,
-        report: &mut FilterReport<N>,
-    ) -> Vector3<f64> {
-        let tmax = self.params.torque_max;
-        let p = match self.prepare(x) {
-            Ok(p) => p,
-            Err(Invalid::State) => {
-                report.faults |= faults::INVALID_STATE;
-                return clamp_box(&self.brake(x), tmax).0;
+        p: &Prepared,
+        u_nom: &Vector3<f64>,
+        hard: &[Row<3>; HARD],
+    ) -> Option<Capped> {
+        let first = (x.p * u_nom + x.r).amax();
+        let floor = x.r.amax();
+        let mut best: Option<(f64, Capped)> = None;
+        for (k, cap) in std::iter::once(first).chain(ACCEL_CAPS).enumerate() {
+            if cap < floor || (k > 0 && cap == first) {
+                continue;
             }
-            Err(Invalid::Coupling) => {
-                report.faults |= faults::INVALID_COUPLING;
-                return clamp_box(&self.brake(x), tmax).0;
-            }
-        };
-        report.h[0] = p.terms.los.h;
-        for (k, o) in p.terms.omega.iter().enumerate() {
-            report.h[1 + k] = o.h;
-        }
-        let (u_nom, flag) =
-            common::resolve_nominal(tau_nom, tmax, || self.brake_with(&p.inertia, x));
-        report.faults |= flag;
-        // The certificate: rows whose in-sample bounds hold for commands that accelerate
-        // the body by at most `cap` per axis, solved together with the rows that keep the
-        // command's acceleration within `cap` — any solution is certified. The caps tried:
-        // the nominal's own acceleration (the nearest command), then smaller ones (easier
-        // for the barrier rows); last, the rows valid for any torque in the box.
-        let sampled = p_formulation_sampled(&self.params);
-        let accel_inf = |u: &Vector3<f64>| (x.p * u + x.r).amax();
-        let hard = self.hard_rows(x);
-        let mut res = None;
-        let mut rows = p.rows;
-        // the hard rows the command was solved with (the cap's rows added when certified)
-        let mut solved_hard = [Row::<3> {
-            a: Vector3::zeros(),
-            c: 1.0,
-        }; HARD + 6];
-        solved_hard[..HARD].copy_from_slice(&hard);
-        let mut n_hard = HARD;
-        if sampled {
-            let first = accel_inf(&u_nom);
-            let floor = x.r.amax();
-            let mut best: Option<(
-                f64,
-                crate::engine::Outcome<3>,
-                [Row<3>; ROWS],
-                [Row<3>; HARD + 6],
-            )> = None;
-            for (k, cap) in std::iter::once(first).chain(ACCEL_CAPS).enumerate() {
-                if cap < floor || (k > 0 && cap == first) {
-                    continue;
+            let c = 3f64.sqrt() * cap;
+            let rows = self.sampled_rows(x, &p.rho, &p.terms, Some((c, c)));
+            let with_cap = Self::capped_hard_rows(x, hard, cap);
+            // only a hard solution is taken here (a relaxed one is not certified): an
+            // infeasible cap costs no relaxation
+            let Some(outcome) = self.engine.solve_hard(u_nom, &rows, &with_cap) else {
+                continue;
+            };
+            let dist = if k == 0 {
+                0.0
+            } else {
+                (outcome.u - u_nom).norm()
+            };
+            if k == 0 || best.as_ref().is_none_or(|b| dist < b.0) {
+                let solution = Capped {
+                    outcome,
+                    rows,
+                    hard: with_cap,
+                };
+                if k == 0 {
+                    return Some(solution);
                 }
-                let c = 3f64.sqrt() * cap;
-                let r_cap = self.sampled_rows(x, &p.rho, &p.terms, Some((c, c)));
-                let mut with_cap = [Row::<3> {
-                    a: Vector3::zeros(),
-                    c: 0.0,
-                }; HARD + 6];
-                with_cap[..HARD].copy_from_slice(&hard);
-                for i in 0..3 {
-                    let row: Vector3<f64> = x.p.row(i).transpose();
-                    with_cap[HARD + 2 * i] = Row {
-                        a: -row,
-                        c: cap - x.r[i],
-                    };
-                    with_cap[HARD + 2 * i + 1] = Row {
-                        a: row,
-                        c: cap + x.r[i],
-                    };
-                }
-                // only a hard solution is taken here (a relaxed one is not certified):
-                // an infeasible cap costs no relaxation
-                if let Some(out) = self.engine.solve_hard(&u_nom, &r_cap, &with_cap) {
-                    if k == 0 {
-                        best = Some((0.0, out, r_cap, with_cap));
-                        break;
-                    }
-                    let dist = (out.u - u_nom).norm();
-                    if best.as_ref().is_none_or(|b| dist < b.0) {
-                        best = Some((dist, out, r_cap, with_cap));
-                    }
-                    if dist == 0.0 {
-                        // the nominal itself: no later cap can come nearer
-                        break;
-                    }
-                }
+                best = Some((dist, solution));
             }
-            if let Some((_, out, r_cap, with_cap)) = best {
-                res = Some(out);
-                rows = r_cap;
-                solved_hard = with_cap;
-                n_hard = HARD + 6;
+            if dist == 0.0 {
+                // the nominal itself: no later cap can come nearer
+                break;
             }
         }
-        let res = match res {
-            Some(r) => r,
-            None => self
-                .engine
-                .solve_tiered(&u_nom, &p.rows, &p.weights, &TIERS, &hard),
-        };
-        self.last
-            .record(&u_nom, &rows, &p.weights, &solved_hard[..n_hard], &res);
-        report.iterations = res.iterations;
-        report.violation = res.violation;
-        if res.second_opinion {
-            report.faults |= faults::QP_SECOND_OPINION;
-        }
-        let mut tau = res.u;
-        match res.kind {
-            Kind::Skipped => report.status = FilterStatus::Skipped,
-            Kind::Solved => report.status = FilterStatus::Solved,
-            Kind::Relaxed => {
-                report.status = FilterStatus::Relaxed;
-                report.faults |= faults::QP_INFEASIBLE_RELAXED;
-            }
-            Kind::Failed => {
-                report.status = FilterStatus::Fallback;
-                report.faults |= faults::QP_FAILED_FALLBACK;
-                tau = self.brake_with(&p.inertia, x);
-            }
-        }
-        let (tau, clamped) = clamp_box(&tau, tmax);
-        if clamped {
-            report.faults |= faults::OUTPUT_CLAMPED;
-        }
-        let barrier_rows: [Row<3>; N] = std::array::from_fn(|i| rows[i]);
-        common::evaluate_rows(&barrier_rows, &tau, report);
-        tau
+        best.map(|b| b.1)
     }
 
     /// Verification only: force the solver even when the nominal is feasible.
@@ -830,6 +768,112 @@ impl AttitudeFilter {
         ))
     }
 }
+/// What [`AttitudeFilter::checked`] found valid.
+struct Checked {
+    /// The unit attitude `q_RB`.
+    q: Quat,
+    /// `(P, P⁻¹)`.
+    gain: Matrix3<f64>,
+    inertia: Matrix3<f64>,
+    /// `ρ = R_RT p_G,T − r_R` [m, F_R].
+    rho: Vector3<f64>,
+}
+
+/// The attitude filter's own parts of the shared step ([`crate::step`]): its rows, the
+/// acceleration-cap certificate, the tiers of its relaxed problem and its braking law.
+impl FilterStep<3, N> for AttitudeFilter {
+    type Input = AttitudeInput;
+    type Prepared = Prepared;
+
+    fn bound(&self) -> f64 {
+        self.params.torque_max
+    }
+
+    fn take_tally(&mut self) -> SolverTally {
+        self.engine.take_tally()
+    }
+
+    fn last_problem(&mut self) -> &mut LastProblem<3> {
+        &mut self.last
+    }
+
+    /// The rows valid for any torque in the box.
+    fn prepare(&self, x: &AttitudeInput) -> Result<Prepared, Invalid> {
+        let c = self.checked(x)?;
+        let terms = self.terms(x, &c);
+        let rows = match self.params.formulation {
+            Formulation::SampledData => self.sampled_rows(x, &c.rho, &terms, None),
+            Formulation::Paper => self.paper_rows(&terms),
+        };
+        if !rows.iter().all(Row::is_finite) {
+            return Err(Invalid::State);
+        }
+        Ok(Prepared {
+            inertia: c.inertia,
+            terms,
+            rows,
+            weights: self.weights(),
+            rho: c.rho,
+        })
+    }
+
+    /// The braking law from the input alone (zero when it cannot be evaluated).
+    fn refused(&self, x: &AttitudeInput) -> Vector3<f64> {
+        clamp_box(&self.brake(x), self.params.torque_max).0
+    }
+
+    fn barrier_values(p: &Prepared) -> [f64; N] {
+        let mut h = [0.0; N];
+        h[0] = p.terms.los.h;
+        for (k, o) in p.terms.omega.iter().enumerate() {
+            h[1 + k] = o.h;
+        }
+        h
+    }
+
+    fn braking_law(&self, x: &AttitudeInput, p: &Prepared) -> Vector3<f64> {
+        self.brake_with(&p.inertia, x)
+    }
+
+    /// The acceleration-cap certificate (sampled-data rows); without one, the rows valid
+    /// for any torque, relaxed in tiers ([`TIERS`]) when they cannot all hold.
+    fn solve_qp(
+        &mut self,
+        x: &AttitudeInput,
+        p: &Prepared,
+        u_nom: &Vector3<f64>,
+        report: &mut FilterReport<N>,
+    ) -> Actuated<3> {
+        let hard = self.hard_rows(x);
+        let capped = if p_formulation_sampled(&self.params) {
+            self.certified_by_caps(x, p, u_nom, &hard)
+        } else {
+            None
+        };
+        if let Some(c) = capped {
+            let solved = Solved {
+                outcome: &c.outcome,
+                rows: &c.rows,
+                weights: &p.weights,
+                hard: &c.hard,
+                certifying: &c.rows,
+            };
+            return step::conclude(self, x, p, u_nom, solved, report);
+        }
+        let outcome = self
+            .engine
+            .solve_tiered(u_nom, &p.rows, &p.weights, &TIERS, &hard);
+        let solved = Solved {
+            outcome: &outcome,
+            rows: &p.rows,
+            weights: &p.weights,
+            hard: &hard,
+            certifying: &p.rows,
+        };
+        step::conclude(self, x, p, u_nom, solved, report)
+    }
+}
+
 impl SafetyFilter<3, N> for AttitudeFilter {
     const SUBSYSTEM: Subsystem = Subsystem::Attitude;
     const NAMES: [&'static str; N] = NAMES;
@@ -851,16 +895,16 @@ impl SafetyFilter<3, N> for AttitudeFilter {
         AttitudeFilter::filter_with(self, x, nominal)
     }
 
-    fn invalid_state(&self) -> FilterOutput<3, N> {
-        common::invalid_state_output()
-    }
-
     fn dump_qp(&self) -> crate::QpDump {
         AttitudeFilter::dump_qp(self)
     }
 
     fn set_skip_enabled(&mut self, on: bool) {
         AttitudeFilter::set_skip_enabled(self, on)
+    }
+
+    fn set_solver_settings(&mut self, settings: sc_qp::Settings) {
+        self.engine.set_settings(settings);
     }
 
     fn input_bound(&self) -> f64 {

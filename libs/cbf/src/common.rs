@@ -276,14 +276,15 @@ pub fn box_rows<const M: usize>(limit: f64) -> Vec<Row<M>> {
     v
 }
 
-/// Fills `h`, `phi` and the active mask from the rows at the returned command.
+/// Fills `phi` and the active mask from the first `N` rows (the barrier rows in report
+/// order) at the returned command.
 pub fn evaluate_rows<const M: usize, const N: usize>(
-    rows: &[Row<M>; N],
+    rows: &[Row<M>],
     u: &SVector<f64, M>,
     report: &mut FilterReport<N>,
 ) {
     report.active = 0;
-    for (i, r) in rows.iter().enumerate() {
+    for (i, r) in rows.iter().enumerate().take(N) {
         let phi = r.phi(u);
         report.phi[i] = phi;
         if phi <= ACTIVE_TOL * r.a.norm().max(1.0) {

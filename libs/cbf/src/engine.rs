@@ -65,6 +65,15 @@ pub struct Outcome<const M: usize> {
     pub second_opinion: bool,
 }
 
+/// What the engine measured over one filter step ([`Engine::take_tally`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SolverTally {
+    /// Wall time spent solving [ns].
+    pub qp_ns: u64,
+    /// A solve took Clarabel's second opinion.
+    pub second_opinion: bool,
+}
+
 /// The QP of one filter: `M` inputs, at most `N` rows (barrier rows + bound rows).
 pub struct Engine<const M: usize, const N: usize> {
     qp: ActiveSetQp<M, N>,
@@ -111,6 +120,12 @@ impl<const M: usize, const N: usize> Engine<M, N> {
         self.skip_enabled = on;
     }
 
+    /// Verification only: the active-set solver's settings (it keeps no state between
+    /// solves, so replacing it changes nothing else).
+    pub fn set_settings(&mut self, settings: Settings) {
+        self.qp = ActiveSetQp::new(settings);
+    }
+
     /// The wall time spent solving since the last call [ns] (and restarts the count).
     pub fn take_qp_ns(&mut self) -> u64 {
         std::mem::take(&mut self.qp_ns)
@@ -119,6 +134,15 @@ impl<const M: usize, const N: usize> Engine<M, N> {
     /// Whether a solve since the last call took Clarabel's second opinion (and resets).
     pub fn take_second_opinion(&mut self) -> bool {
         std::mem::take(&mut self.second_opinion)
+    }
+
+    /// The solver's time and second-opinion flag since the last call (and resets both):
+    /// what one filter step spent in its solves.
+    pub fn take_tally(&mut self) -> SolverTally {
+        SolverTally {
+            qp_ns: self.take_qp_ns(),
+            second_opinion: self.take_second_opinion(),
+        }
     }
 
     /// Solves for `u_nom` with barrier `rows` (physical weights `weights`, > 0) and hard
@@ -309,81 +333,112 @@ impl<const M: usize, const N: usize> Engine<M, N> {
         nb: usize,
         n: usize,
     ) -> Option<(sc_qp::Solution<M, N>, f64, u32)> {
-        let mut fixed = [false; N];
-        let mut allowance = [0.0; N];
-        let mut a = self.a;
-        let mut b = self.b;
-        let mut w = [0.0; N];
+        let mut allowed = Allowances {
+            fixed: [false; N],
+            allowance: [0.0; N],
+        };
         let mut iterations = 0;
         let mut worst = 0.0f64;
         let last_tier = (0..nb).map(|i| self.tier[i]).max().unwrap_or(0);
         for tier in 0..=last_tier {
-            let in_tier = |i: usize| i < nb && self.tier[i] == tier;
-            if !(0..nb).any(in_tier) {
+            if !(0..nb).any(|i| self.tier[i] == tier) {
                 continue;
             }
-            for _ in 0..nb {
-                for i in 0..n {
-                    // rows of later tiers are left out (a row that always holds)
-                    let later = i < nb && self.tier[i] > tier;
-                    a[i] = if later { [0.0; M] } else { self.a[i] };
-                    let soft = in_tier(i) && !fixed[i];
-                    w[i] = if soft { self.w[i] } else { 0.0 };
-                    b[i] = if later {
-                        -1.0
-                    } else {
-                        self.b[i]
-                            - if fixed[i] {
-                                self.w[i] * allowance[i]
-                            } else {
-                                0.0
-                            }
-                    };
-                }
-                let lv = self.qp.least_violation(&a, &b, &w, n);
-                iterations += lv.iterations;
-                if lv.status != Status::Optimal {
-                    return None;
-                }
-                if lv.t <= 0.0 {
-                    break;
-                }
-                worst = worst.max(lv.t);
-                // rounding must not make the fixed rows' set empty: a relative 1e-9 of room
-                let t = lv.t * (1.0 + 1e-9) + 1e-12;
-                let mut any = false;
-                for i in 0..nb {
-                    if in_tier(i) && !fixed[i] && lv.dual[i] > 0.0 {
-                        fixed[i] = true;
-                        allowance[i] = t;
-                        any = true;
-                    }
-                }
-                if !any {
-                    // a degenerate dual: give every remaining row of the tier the same allowance
-                    for i in 0..nb {
-                        if in_tier(i) && !fixed[i] {
-                            fixed[i] = true;
-                            allowance[i] = t;
-                        }
-                    }
-                }
-                if (0..nb).filter(|i| in_tier(*i)).all(|i| fixed[i]) {
-                    break;
-                }
-            }
+            iterations += self.relax_tier(tier, nb, n, &mut allowed, &mut worst)?;
         }
-        for i in 0..n {
-            b[i] = self.b[i]
-                - if fixed[i] {
-                    self.w[i] * allowance[i]
-                } else {
-                    0.0
-                };
+        // the command nearest the nominal among those within the allowances
+        let mut b = self.b;
+        for (i, bi) in b.iter_mut().enumerate().take(n) {
+            *bi = self.b[i] - allowed.offset(&self.w, i);
         }
         let sol = self.qp.solve(x0, &self.a, &b, n);
         iterations += sol.iterations;
         (sol.status == Status::Optimal).then_some((sol, worst, iterations))
+    }
+
+    /// The rounds of one priority tier: each round the least common violation `t` of the
+    /// tier's rows not yet fixed (the earlier tiers' and this tier's fixed rows held to
+    /// their allowances, the later tiers' rows left out); the rows that make `t` necessary
+    /// (the support of the LP's optimal dual) are fixed at `t`, until the rest hold
+    /// exactly. Raises `worst` to every round's `t`; returns the iterations, `None` when an
+    /// LP fails.
+    fn relax_tier(
+        &mut self,
+        tier: u8,
+        nb: usize,
+        n: usize,
+        allowed: &mut Allowances<N>,
+        worst: &mut f64,
+    ) -> Option<u32> {
+        let in_tier = |i: usize| i < nb && self.tier[i] == tier;
+        let mut a = self.a;
+        let mut b = self.b;
+        let mut w = [0.0; N];
+        let mut iterations = 0;
+        for _ in 0..nb {
+            for i in 0..n {
+                // rows of later tiers are left out (a row that always holds)
+                let later = i < nb && self.tier[i] > tier;
+                a[i] = if later { [0.0; M] } else { self.a[i] };
+                let soft = in_tier(i) && !allowed.fixed[i];
+                w[i] = if soft { self.w[i] } else { 0.0 };
+                b[i] = if later {
+                    -1.0
+                } else {
+                    self.b[i] - allowed.offset(&self.w, i)
+                };
+            }
+            let lv = self.qp.least_violation(&a, &b, &w, n);
+            iterations += lv.iterations;
+            if lv.status != Status::Optimal {
+                return None;
+            }
+            if lv.t <= 0.0 {
+                break;
+            }
+            *worst = worst.max(lv.t);
+            // rounding must not make the fixed rows' set empty: a relative 1e-9 of room
+            let t = lv.t * (1.0 + 1e-9) + 1e-12;
+            let supporting = |i: usize| lv.dual[i] > 0.0;
+            if !(0..nb).any(|i| in_tier(i) && !allowed.fixed[i] && supporting(i)) {
+                // a degenerate dual: give every remaining row of the tier the same allowance
+                allowed.fix(t, in_tier);
+            } else {
+                allowed.fix(t, |i| in_tier(i) && supporting(i));
+            }
+            if (0..nb).filter(|i| in_tier(*i)).all(|i| allowed.fixed[i]) {
+                break;
+            }
+        }
+        Some(iterations)
+    }
+}
+
+/// The allowances of the lexicographic relaxation: row `i`, once fixed, may be violated
+/// by `w_i · allowance_i`.
+struct Allowances<const N: usize> {
+    fixed: [bool; N],
+    allowance: [f64; N],
+}
+
+impl<const N: usize> Allowances<N> {
+    /// How far row `i`'s offset is relaxed: `w_i · allowance_i` once fixed, else 0.
+    fn offset(&self, w: &[f64; N], i: usize) -> f64 {
+        if self.fixed[i] {
+            w[i] * self.allowance[i]
+        } else {
+            0.0
+        }
+    }
+
+    /// Fixes the allowance `t` of every row not yet fixed that `which` selects.
+    fn fix(&mut self, t: f64, which: impl Fn(usize) -> bool) {
+        for i in 0..N {
+            if !self.fixed[i] && which(i) {
+                self.fixed[i] = true;
+                self.allowance[i] = t;
+            }
+        }
     }
 }
 

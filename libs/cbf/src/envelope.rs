@@ -42,6 +42,103 @@ fn lcg(s: &mut u64) -> f64 {
     ((*s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
 }
 
+/// The envelope's limits from the scenario.
+struct Envelope {
+    theta_min: Vector7,
+    theta_max: Vector7,
+    theta_dot_max: Vector7,
+    /// Per-axis body-rate limit [rad/s].
+    omega_max: Vector3<f64>,
+    /// The arm-reaction contract `β` [rad/s²].
+    beta: Vector3<f64>,
+    force_max: f64,
+    torque_max: f64,
+    joint_torque_max: f64,
+    period: f64,
+}
+
+impl Envelope {
+    fn from_scenario(s: &sc_scenario::Scenario) -> Self {
+        let rb = &s.safety.robotic;
+        let at = &s.safety.attitude;
+        Self {
+            theta_min: Vector7::from(rb.theta_min_rad),
+            theta_max: Vector7::from(rb.theta_max_rad),
+            theta_dot_max: Vector7::from(rb.theta_dot_max_rad_s),
+            omega_max: Vector3::from(at.omega_max_rad_s)
+                .abs()
+                .sup(&Vector3::from(at.omega_min_rad_s).abs()),
+            beta: Vector3::from(at.arm_reaction_budget_rad_s2),
+            force_max: s.limits.force_max_n,
+            torque_max: s.limits.torque_max_nm,
+            joint_torque_max: s.limits.joint_torque_max_nm,
+            period: s.mission.control_period_s,
+        }
+    }
+
+    /// A state and the base's force and torque, uniform inside the limits:
+    /// `(θ, θ̇, ω_B, f_B, τ_B)`.
+    fn draw(&self, rng: &mut u64) -> (Vector7, Vector7, Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+        let mut r = || lcg(rng);
+        let (tmin, tmax) = (&self.theta_min, &self.theta_max);
+        let th =
+            Vector7::from_fn(|i, _| 0.5 * (tmin[i] + tmax[i]) + 0.5 * (tmax[i] - tmin[i]) * r());
+        let thd = Vector7::from_fn(|i, _| self.theta_dot_max[i] * r());
+        let w = Vector3::from_fn(|i, _| self.omega_max[i] * r());
+        let f = Vector3::from_fn(|_, _| self.force_max * r());
+        let tb = Vector3::from_fn(|_, _| self.torque_max * r());
+        (th, thd, w, f, tb)
+    }
+
+    /// Joint torques of the envelope: random in the box, the part beyond the holding
+    /// torque `hold` scaled into the contract (reaction `Q` on the base within `β`), then
+    /// towards `hold` until the joint accelerations `A (τ − c_eff)` are ones the
+    /// joint-rate rows admit (`|θ̈_i| ≤ 2 θ̇_max,i / T`). `None` when none is.
+    fn joint_torque(
+        &self,
+        rng: &mut u64,
+        hold: &Vector7,
+        q: &nalgebra::SMatrix<f64, 3, 7>,
+        a: &nalgebra::SMatrix<f64, 7, 7>,
+    ) -> Option<Vector7> {
+        let mut r = || lcg(rng);
+        let beta = &self.beta;
+        let lim = self.joint_torque_max;
+        let mut delta = Vector7::from_fn(|_, _| lim * r()) - hold;
+        let qt = q * delta;
+        let k = (0..3)
+            .map(|i| {
+                if beta[i] > 0.0 {
+                    qt[i].abs() / beta[i]
+                } else {
+                    0.0
+                }
+            })
+            .fold(1.0f64, f64::max);
+        delta /= k;
+        let tm = (hold + delta).map(|t| t.clamp(-lim, lim));
+        let admitted = |t: &Vector7| {
+            let qdd = a * (t - hold);
+            (0..7).all(|i| qdd[i].abs() <= 2.0 * self.theta_dot_max[i] / self.period)
+        };
+        if admitted(&tm) {
+            return Some(tm);
+        }
+        // towards the holding torque (θ̈ = 0)
+        let (mut lo, mut hi) = (0.0, 1.0);
+        let from = |s: f64| hold + (tm - hold) * s;
+        for _ in 0..40 {
+            let mid = 0.5 * (lo + hi);
+            if admitted(&from(mid)) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        admitted(&from(lo)).then(|| from(lo))
+    }
+}
+
 /// Samples the envelope of scenario `s` with the servicer model `robot`.
 pub fn sample(
     s: &sc_scenario::Scenario,
@@ -49,27 +146,11 @@ pub fn sample(
     samples: usize,
     seed: u64,
 ) -> EnvelopeMaxima {
-    let rb = &s.safety.robotic;
-    let at = &s.safety.attitude;
-    let lim = &s.limits;
-    let tmin = Vector7::from(rb.theta_min_rad);
-    let tmax = Vector7::from(rb.theta_max_rad);
-    let tdmax = Vector7::from(rb.theta_dot_max_rad_s);
-    let wmax = Vector3::from(at.omega_max_rad_s)
-        .abs()
-        .sup(&Vector3::from(at.omega_min_rad_s).abs());
-    let beta = Vector3::from(at.arm_reaction_budget_rad_s2);
-    let period = s.mission.control_period_s;
+    let env = Envelope::from_scenario(s);
     let mut out = EnvelopeMaxima::default();
     let mut rng = seed.max(1);
     for _ in 0..samples {
-        let mut r = || lcg(&mut rng);
-        let th =
-            Vector7::from_fn(|i, _| 0.5 * (tmin[i] + tmax[i]) + 0.5 * (tmax[i] - tmin[i]) * r());
-        let thd = Vector7::from_fn(|i, _| tdmax[i] * r());
-        let w = Vector3::from_fn(|i, _| wmax[i] * r());
-        let f = Vector3::from_fn(|_, _| lim.force_max_n * r());
-        let tb = Vector3::from_fn(|_, _| lim.torque_max_nm * r());
+        let (th, thd, w, f, tb) = env.draw(&mut rng);
         let Some(bd) = robot.base_angular_dynamics(&th, &thd, &w, &f) else {
             continue;
         };
@@ -81,95 +162,75 @@ pub fn sample(
             continue;
         };
         let a = ch.inverse();
-        // joint torques: random in the box, scaled into the contract, then towards zero
-        // until the joint accelerations are ones the joint-rate rows admit
-        // the arm's torque beyond holding its rates, scaled into the contract
-        let hold = red.c_eff;
-        let mut delta = Vector7::from_fn(|_, _| lim.joint_torque_max_nm * r()) - hold;
-        let qt = bd.q * delta;
-        let k = (0..3)
-            .map(|i| {
-                if beta[i] > 0.0 {
-                    qt[i].abs() / beta[i]
-                } else {
-                    0.0
-                }
-            })
-            .fold(1.0f64, f64::max);
-        delta /= k;
-        let mut tm =
-            (hold + delta).map(|t| t.clamp(-lim.joint_torque_max_nm, lim.joint_torque_max_nm));
-        let admitted = |t: &Vector7| {
-            let qdd = a * (t - red.c_eff);
-            (0..7).all(|i| qdd[i].abs() <= 2.0 * tdmax[i] / period)
+        let Some(tm) = env.joint_torque(&mut rng, &red.c_eff, &bd.q, &a) else {
+            continue;
         };
-        if !admitted(&tm) {
-            // towards the holding torque (θ̈ = 0)
-            let (mut lo, mut hi) = (0.0, 1.0);
-            let from = |s: f64| hold + (tm - hold) * s;
-            for _ in 0..40 {
-                let mid = 0.5 * (lo + hi);
-                if admitted(&from(mid)) {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            if !admitted(&from(lo)) {
-                continue;
-            }
-            tm = from(lo);
-        }
         let mut u = Vector13::zeros();
         u.fixed_rows_mut::<3>(0).copy_from(&f);
         u.fixed_rows_mut::<3>(3).copy_from(&tb);
         u.fixed_rows_mut::<7>(6).copy_from(&tm);
-        let Some(acc) = robot.forward_dynamics_sim(&th, &w, &thd, &u) else {
-            continue;
-        };
-        let wd: Vector3<f64> = acc.fixed_rows::<3>(3).into();
-        let qdd: Vector7 = acc.fixed_rows::<7>(6).into();
-        // d/dt along the state's own motion, central differences (the body-fixed base
-        // force and torque and the joint torques are held, as in a sample)
-        let d = 1e-5;
-        let at_ = |e: f64| {
-            robot.forward_dynamics_sim(&(th + thd * e), &(w + wd * e), &(thd + qdd * e), &u)
-        };
-        let qdd_at = |_e: f64| qdd;
-        let (Some(p), Some(m)) = (at_(d), at_(-d)) else {
-            continue;
-        };
-        let jerk = (p - m) / (2.0 * d);
-        // the link spheres' centres: p̈ = J θ̈ + J̇ θ̇, differentiated the same way
-        let sphere_acc = |e: f64, qdd: &Vector7| {
-            let th_e = th + thd * e;
-            let thd_e = thd + qdd_at(e) * e;
-            let kin = robot.kinematics_vel(&th_e, &thd_e);
-            let mut out = [Vector3::zeros(); 21];
-            for (k, (idx, _)) in robot.arm_spheres().take(21).enumerate() {
-                if let Some(sp) = robot.sphere_state(&kin, idx) {
-                    out[k] = sp.jacobian * qdd + sp.jdot_qdot;
-                }
-            }
-            out
-        };
-        let qdd_p: Vector7 = p.fixed_rows::<7>(6).into();
-        let qdd_m: Vector7 = m.fixed_rows::<7>(6).into();
-        let (ap, am) = (sphere_acc(d, &qdd_p), sphere_acc(-d, &qdd_m));
-        for k in 0..21 {
-            out.sphere_jerk[k] = out.sphere_jerk[k].max(((ap[k] - am[k]) / (2.0 * d)).norm());
+        if record_jerks(&mut out, robot, &th, &thd, &w, &u) {
+            out.samples += 1;
         }
-        out.angular_accel = out.angular_accel.max(wd.norm());
-        for i in 0..3 {
-            out.angular_jerk = out.angular_jerk.max(jerk[3 + i].abs());
-        }
-        for i in 0..7 {
-            out.joint_jerk[i] = out.joint_jerk[i].max(jerk[6 + i].abs());
-        }
-        out.samples += 1;
     }
     out
 }
+
+/// The accelerations at one state under the held input `u` and their rates of change,
+/// `d/dt` by central differences along the state's own motion (the body-fixed base force
+/// and torque and the joint torques are held, as in a sample), into the maxima. `false`
+/// when the model cannot be evaluated there.
+fn record_jerks(
+    out: &mut EnvelopeMaxima,
+    robot: &Robot,
+    th: &Vector7,
+    thd: &Vector7,
+    w: &Vector3<f64>,
+    u: &Vector13,
+) -> bool {
+    let Some(acc) = robot.forward_dynamics_sim(th, w, thd, u) else {
+        return false;
+    };
+    let wd: Vector3<f64> = acc.fixed_rows::<3>(3).into();
+    let qdd: Vector7 = acc.fixed_rows::<7>(6).into();
+    let d = CENTRAL_DIFFERENCE_STEP_S;
+    let at_ =
+        |e: f64| robot.forward_dynamics_sim(&(th + thd * e), &(w + wd * e), &(thd + qdd * e), u);
+    let (Some(p), Some(m)) = (at_(d), at_(-d)) else {
+        return false;
+    };
+    let jerk = (p - m) / (2.0 * d);
+    // the link spheres' centres: p̈ = J θ̈ + J̇ θ̇, differentiated the same way
+    let sphere_acc = |e: f64, qdd_e: &Vector7| {
+        let th_e = th + thd * e;
+        let thd_e = thd + qdd * e;
+        let kin = robot.kinematics_vel(&th_e, &thd_e);
+        let mut acc = [Vector3::zeros(); 21];
+        for (k, (idx, _)) in robot.arm_spheres().take(21).enumerate() {
+            if let Some(sp) = robot.sphere_state(&kin, idx) {
+                acc[k] = sp.jacobian * qdd_e + sp.jdot_qdot;
+            }
+        }
+        acc
+    };
+    let qdd_p: Vector7 = p.fixed_rows::<7>(6).into();
+    let qdd_m: Vector7 = m.fixed_rows::<7>(6).into();
+    let (ap, am) = (sphere_acc(d, &qdd_p), sphere_acc(-d, &qdd_m));
+    for k in 0..21 {
+        out.sphere_jerk[k] = out.sphere_jerk[k].max(((ap[k] - am[k]) / (2.0 * d)).norm());
+    }
+    out.angular_accel = out.angular_accel.max(wd.norm());
+    for i in 0..3 {
+        out.angular_jerk = out.angular_jerk.max(jerk[3 + i].abs());
+    }
+    for i in 0..7 {
+        out.joint_jerk[i] = out.joint_jerk[i].max(jerk[6 + i].abs());
+    }
+    true
+}
+
+/// Time step of the central differences along the state's motion [s].
+const CENTRAL_DIFFERENCE_STEP_S: f64 = 1e-5;
 
 /// One configured envelope bound against its sampled maximum.
 #[derive(Debug, Clone, PartialEq)]

@@ -52,14 +52,20 @@ pub trait SafetyFilter<const M: usize, const N: usize> {
     ) -> FilterOutput<M, N>;
 
     /// The defined output when the input cannot be built (a state the model cannot
-    /// evaluate): a bounded braking command, flagged.
-    fn invalid_state(&self) -> FilterOutput<M, N>;
+    /// evaluate): zero command, status `Fallback`, flagged [`crate::faults::INVALID_STATE`].
+    fn invalid_state(&self) -> FilterOutput<M, N> {
+        crate::common::invalid_state_output()
+    }
 
     /// The last QP handed to the solver (for `--dump-qp` and offline checks).
     fn dump_qp(&self) -> QpDump;
 
     /// Verification only: with `false` the solver runs even for a feasible nominal.
     fn set_skip_enabled(&mut self, on: bool);
+
+    /// Verification only: the exact solver's settings (small iteration limits reach the
+    /// second opinion and the braking law on demand).
+    fn set_solver_settings(&mut self, settings: sc_qp::Settings);
 
     /// The bound `‖actuated‖∞ ≤ bound` of every command it outputs.
     fn input_bound(&self) -> f64;

@@ -16,7 +16,9 @@
 //!   lexicographic relaxation; [`qp`]: the Clarabel engine, the independent reference.
 //! * [`monitor`]: every barrier from the true state; [`envelope`]: the model's bounds over
 //!   the certified envelope.
-//! * [`common`]: outputs, reports, [`faults`] flags.
+//! * [`common`]: outputs, reports, [`faults`] flags; `step`: the one filter step the three
+//!   filters share (resolve the nominal, solve, report, brake, clamp), each adding its own
+//!   rows, certificate and braking law.
 //!
 //! Every filter call is deterministic: the same input sequence gives bit-identical commands
 //! and reports (except `solve_time_ns`), and the result of a call does not depend on the
@@ -34,6 +36,7 @@ pub mod monitor;
 pub mod qp;
 pub mod robotic;
 pub mod sampled;
+mod step;
 pub mod translational;
 pub mod verify;
 

@@ -288,13 +288,7 @@ impl QpEngine {
         self.last_row_duals.iter_mut().for_each(|x| *x = 0.0);
         self.last_bound_duals.iter_mut().for_each(|x| *x = 0.0);
         if !dims_ok {
-            let r = QpResult {
-                outcome: QpOutcome::Failed,
-                iterations: 0,
-                slack: 0.0,
-            };
-            self.last = Some(r);
-            return r;
+            return self.finish(QpOutcome::Failed, 0, 0.0);
         }
         self.last_u_nom.copy_from_slice(u_nom);
         self.last_rows_a.copy_from_slice(rows_a);
@@ -303,31 +297,64 @@ impl QpEngine {
         self.last_g_max.copy_from_slice(g_max);
 
         // Skip path: u_nom feasible ⇒ unique minimiser.
-        let feasible = (0..nb).all(|i| {
-            let a = &rows_a[i * m..(i + 1) * m];
-            rows_c[i] + dot(a, u_nom) >= 0.0
-        }) && (0..ng).all(|k| dot(&g[k * m..(k + 1) * m], u_nom) <= g_max[k]);
-        if feasible && self.skip_enabled {
+        if Self::feasible(m, u_nom, rows_a, rows_c, g, g_max) && self.skip_enabled {
             u_out.copy_from_slice(u_nom);
             self.last_x.copy_from_slice(u_nom);
-            let r = QpResult {
-                outcome: QpOutcome::Skipped,
-                iterations: 0,
-                slack: 0.0,
-            };
-            self.last = Some(r);
+            return self.finish(QpOutcome::Skipped, 0, 0.0);
+        }
+        let hard_infeasible = self.condition_rows(rows_a, rows_c);
+        self.fill_hard(u_nom, rows_a, rows_c, g, g_max);
+        let mut iterations = 0;
+        if !hard_infeasible && let Some(r) = self.solve_hard(u_out, &mut iterations) {
             return r;
         }
+        self.fill_relaxed();
+        if let Some(r) = self.solve_relaxed(u_out, &mut iterations) {
+            return r;
+        }
+        self.finish(QpOutcome::Failed, iterations, 0.0)
+    }
 
-        // Row conditioning. With ‖u‖∞ ≤ U on the box, |a·u| ≤ ‖a‖₁U =: reach. A row with
-        // c ≥ reach can never bind inside the box and is replaced by the neutral row
-        // 0·u ≥ −1 (its multiplier is 0); a row with c < −reach cannot be met anywhere in
-        // the box, so the hard QP is infeasible and only the relaxed one is solved (that
-        // row scaled to unit violation). Every other row is scaled by σ = 1/‖a‖, so all
-        // right-hand sides stay of the order of U (Clarabel stalls on rows like
-        // 0·u ≥ −10⁸ that a near-zero ‖a‖ would otherwise produce).
+    /// Records and returns the result of a solve.
+    fn finish(&mut self, outcome: QpOutcome, iterations: u32, slack: f64) -> QpResult {
+        let r = QpResult {
+            outcome,
+            iterations,
+            slack,
+        };
+        self.last = Some(r);
+        r
+    }
+
+    /// `u_nom` satisfies every barrier row and every bound.
+    fn feasible(
+        m: usize,
+        u_nom: &[f64],
+        rows_a: &[f64],
+        rows_c: &[f64],
+        g: &[f64],
+        g_max: &[f64],
+    ) -> bool {
+        let nb = rows_c.len();
+        let ng = g_max.len();
+        (0..nb).all(|i| {
+            let a = &rows_a[i * m..(i + 1) * m];
+            rows_c[i] + dot(a, u_nom) >= 0.0
+        }) && (0..ng).all(|k| dot(&g[k * m..(k + 1) * m], u_nom) <= g_max[k])
+    }
+
+    /// Row conditioning. With `‖u‖∞ ≤ U` on the box, `|a·u| ≤ ‖a‖₁U =: reach`. A row with
+    /// `c ≥ reach` can never bind inside the box and is replaced by the neutral row
+    /// `0·u ≥ −1` (its multiplier is 0); a row with `c < −reach` cannot be met anywhere in
+    /// the box, so the hard QP is infeasible and only the relaxed one is solved (that row
+    /// scaled to unit violation). Every other row is scaled by `σ = 1/‖a‖`, so all
+    /// right-hand sides stay of the order of `U` (Clarabel stalls on rows like
+    /// `0·u ≥ −10⁸` that a near-zero `‖a‖` would otherwise produce). Returns whether the
+    /// hard QP is infeasible.
+    fn condition_rows(&mut self, rows_a: &[f64], rows_c: &[f64]) -> bool {
+        let m = self.m;
         let mut hard_infeasible = false;
-        for i in 0..nb {
+        for i in 0..self.nb {
             let a = &rows_a[i * m..(i + 1) * m];
             let c = rows_c[i];
             let reach = a.iter().map(|x| x.abs()).sum::<f64>() * self.u_inf;
@@ -343,8 +370,20 @@ impl QpEngine {
                 self.scale[i] = 1.0 / dot(a, a).sqrt();
             }
         }
+        hard_infeasible
+    }
 
-        // ---- hard problem
+    /// The hard problem's data: `q = −2u_nom`, the scaled barrier rows `−σ_i a_i` and the
+    /// bound rows `G` (column-major), `b = [σ_i c_i (1 if neutral); g]`.
+    fn fill_hard(
+        &mut self,
+        u_nom: &[f64],
+        rows_a: &[f64],
+        rows_c: &[f64],
+        g: &[f64],
+        g_max: &[f64],
+    ) {
+        let (m, nb, ng) = (self.m, self.nb, self.ng);
         let rows_h = nb + ng;
         for j in 0..m {
             self.q_h[j] = -2.0 * u_nom[j];
@@ -363,37 +402,41 @@ impl QpEngine {
             };
         }
         self.b_h[nb..].copy_from_slice(g_max);
-        let mut iterations = 0;
-        if let Some(s) = self.hard.as_mut().filter(|_| !hard_infeasible) {
-            let upd = s.update_q(&self.q_h).is_ok()
-                && s.update_A(&self.a_h).is_ok()
-                && s.update_b(&self.b_h).is_ok();
-            if upd {
-                s.solve();
-                let sol = &s.solution;
-                iterations += sol.iterations;
-                self.last_status = Some(sol.status);
-                self.last_hard_status = Some(sol.status);
-                if accepted(sol.status) && sol.x.iter().all(|x| x.is_finite()) {
-                    u_out.copy_from_slice(&sol.x);
-                    self.last_x.copy_from_slice(&sol.x);
-                    for i in 0..nb {
-                        self.last_row_duals[i] = sol.z[i] * self.scale[i];
-                    }
-                    self.last_bound_duals.copy_from_slice(&sol.z[nb..nb + ng]);
-                    let r = QpResult {
-                        outcome: QpOutcome::Solved,
-                        iterations,
-                        slack: 0.0,
-                    };
-                    self.last = Some(r);
-                    return r;
-                }
-            }
-        }
+    }
 
-        // ---- relaxed problem: x = [u; s]
-        let rows_r = nb + ng + 1;
+    /// The hard problem with Clarabel; `Some` when it is solved (the minimiser in `u_out`).
+    fn solve_hard(&mut self, u_out: &mut [f64], iterations: &mut u32) -> Option<QpResult> {
+        let (nb, ng) = (self.nb, self.ng);
+        let s = self.hard.as_mut()?;
+        let upd = s.update_q(&self.q_h).is_ok()
+            && s.update_A(&self.a_h).is_ok()
+            && s.update_b(&self.b_h).is_ok();
+        if !upd {
+            return None;
+        }
+        s.solve();
+        let sol = &s.solution;
+        *iterations += sol.iterations;
+        self.last_status = Some(sol.status);
+        self.last_hard_status = Some(sol.status);
+        if !(accepted(sol.status) && sol.x.iter().all(|x| x.is_finite())) {
+            return None;
+        }
+        u_out.copy_from_slice(&sol.x);
+        self.last_x.copy_from_slice(&sol.x);
+        for i in 0..nb {
+            self.last_row_duals[i] = sol.z[i] * self.scale[i];
+        }
+        self.last_bound_duals.copy_from_slice(&sol.z[nb..nb + ng]);
+        Some(self.finish(QpOutcome::Solved, *iterations, 0.0))
+    }
+
+    /// The relaxed problem's data, `x = [u; s]`: the hard problem's columns, then the slack
+    /// column (`−s` on the non-neutral barrier rows, 0 on the bounds, `−s ≤ 0` last).
+    fn fill_relaxed(&mut self) {
+        let (m, nb, ng) = (self.m, self.nb, self.ng);
+        let rows_h = nb + ng;
+        let rows_r = rows_h + 1;
         for j in 0..m {
             self.q_r[j] = self.q_h[j];
             for i in 0..rows_h {
@@ -404,45 +447,38 @@ impl QpEngine {
         self.q_r[m] = 0.0;
         let sc = m * rows_r;
         for i in 0..rows_r {
-            // slack column: −s on (non-neutral) barrier rows, 0 on bounds, −s ≤ 0 last
             let on = (i < nb && !self.neutral[i]) || i == rows_h;
             self.a_r[sc + i] = if on { -1.0 } else { 0.0 };
         }
         self.b_r[..rows_h].copy_from_slice(&self.b_h);
         self.b_r[rows_h] = 0.0;
-        if let Some(s) = self.relaxed.as_mut() {
-            let upd = s.update_q(&self.q_r).is_ok()
-                && s.update_A(&self.a_r).is_ok()
-                && s.update_b(&self.b_r).is_ok();
-            if upd {
-                s.solve();
-                let sol = &s.solution;
-                iterations += sol.iterations;
-                self.last_status = Some(sol.status);
-                if accepted(sol.status) && sol.x.iter().all(|x| x.is_finite()) {
-                    u_out.copy_from_slice(&sol.x[..m]);
-                    self.last_x.copy_from_slice(&sol.x[..m]);
-                    for i in 0..nb {
-                        self.last_row_duals[i] = sol.z[i] * self.scale[i];
-                    }
-                    self.last_bound_duals.copy_from_slice(&sol.z[nb..nb + ng]);
-                    let r = QpResult {
-                        outcome: QpOutcome::Relaxed,
-                        iterations,
-                        slack: sol.x[m].max(0.0),
-                    };
-                    self.last = Some(r);
-                    return r;
-                }
-            }
+    }
+
+    /// The relaxed problem with Clarabel; `Some` when it is solved (the command in `u_out`).
+    fn solve_relaxed(&mut self, u_out: &mut [f64], iterations: &mut u32) -> Option<QpResult> {
+        let (m, nb, ng) = (self.m, self.nb, self.ng);
+        let s = self.relaxed.as_mut()?;
+        let upd = s.update_q(&self.q_r).is_ok()
+            && s.update_A(&self.a_r).is_ok()
+            && s.update_b(&self.b_r).is_ok();
+        if !upd {
+            return None;
         }
-        let r = QpResult {
-            outcome: QpOutcome::Failed,
-            iterations,
-            slack: 0.0,
-        };
-        self.last = Some(r);
-        r
+        s.solve();
+        let sol = &s.solution;
+        *iterations += sol.iterations;
+        self.last_status = Some(sol.status);
+        if !(accepted(sol.status) && sol.x.iter().all(|x| x.is_finite())) {
+            return None;
+        }
+        u_out.copy_from_slice(&sol.x[..m]);
+        self.last_x.copy_from_slice(&sol.x[..m]);
+        for i in 0..nb {
+            self.last_row_duals[i] = sol.z[i] * self.scale[i];
+        }
+        self.last_bound_duals.copy_from_slice(&sol.z[nb..nb + ng]);
+        let slack = sol.x[m].max(0.0);
+        Some(self.finish(QpOutcome::Relaxed, *iterations, slack))
     }
 
     /// The last problem and its solution (allocates; not for the hot path).

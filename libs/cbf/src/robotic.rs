@@ -28,18 +28,17 @@
 //! budget the attitude filter assumes, `|(Q (τ_M − τ_hold))_i| ≤ β_i` (six hard rows).
 
 use crate::barrier::{RelDegOne, RelDegTwo, Row};
-use crate::common::{
-    self, BOX_MARGIN, FilterOutput, FilterReport, FilterStatus, clamp_box, faults,
-};
-use crate::engine::{Engine, Kind, LastProblem, Outcome};
+use crate::common::{self, BOX_MARGIN, FilterOutput, FilterReport, clamp_box};
+use crate::engine::{Engine, Kind, LastProblem, Outcome, SolverTally};
 use crate::filter::{Coupling, SafetyFilter};
 use crate::sampled::{
     Decay, RateBounds, RateDecay, SampleBounds, braking_barrier, hdot_required_of, phi_required_of,
 };
+use crate::step::{self, Actuated, FilterStep, Invalid, Solved};
 use crate::{Formulation, qp::SolverParams};
 use nalgebra::{SMatrix, SVector, Vector3, Vector6};
 use sc_core::{Observation, Subsystem};
-use sc_multibody::{Robot, Vector13};
+use sc_multibody::{CollisionSphere, Robot, Vector13};
 use std::sync::Arc;
 
 /// Joint-space vector and matrix.
@@ -325,9 +324,46 @@ impl RoboticTerms {
     }
 }
 
-enum Invalid {
-    State,
-    Coupling,
+/// Validated input: the barrier terms, the rows' weights and the hard rows (input bounds,
+/// then the contract with the attitude filter).
+pub(crate) struct Prepared {
+    terms: RoboticTerms,
+    weights: [f64; N],
+    hard: [Row<NJ>; 2 * NJ + 6],
+}
+
+/// The rows behind a robotic command besides the local ones, written where
+/// [`FilterStep::solve_qp`] keeps them (they are large).
+struct RowsBehind {
+    /// The rows the command was solved with (`None`: the local rows).
+    solved: Option<[Row<NJ>; N]>,
+    /// The rows that certify it (`None`: the local rows).
+    certifying: Option<[Row<NJ>; N]>,
+}
+
+/// What the a-posteriori certificate ([`RoboticFilter::certify`]) found besides the rows
+/// (which it writes into the [`RowsBehind`]).
+struct Certificate {
+    /// The last hard solve taken.
+    res: Outcome<NJ>,
+    /// Solver iterations of all its solves.
+    iterations: u32,
+}
+
+/// A command of the verification path ([`RoboticFilter::verified`]).
+struct Verified {
+    u: Vector7,
+    /// The (tightened) rows it was solved with.
+    rows: [Row<NJ>; N],
+    /// Its violation when it came from the relaxed problem or did not verify (0 otherwise).
+    violation: f64,
+    /// It is Clarabel's second opinion.
+    second_opinion: bool,
+}
+
+/// Rows of relative degree two: the joint angles and the link spheres (not the rates).
+fn is_rel_deg_two(j: usize) -> bool {
+    !(NJ..3 * NJ).contains(&j)
 }
 
 /// Rounds of the a-posteriori certificate before the verification path.
@@ -359,6 +395,14 @@ struct Verdict {
     shortfall: [f64; N],
     /// The smallest barrier value over the sample, each divided by its weight.
     worst: f64,
+}
+
+impl Verdict {
+    /// Row `j` fell short by `short`.
+    fn fail(&mut self, j: usize, short: f64) {
+        self.ok = false;
+        self.shortfall[j] = self.shortfall[j].max(short);
+    }
 }
 
 /// The robotic CBF-QP safety filter (paper eq. "robotic_qp").
@@ -442,6 +486,13 @@ impl RoboticFilter {
     }
 
     fn terms(&self, x: &RoboticInput) -> Result<RoboticTerms, Invalid> {
+        Self::checked(x)?;
+        Ok(self.terms_of(x))
+    }
+
+    /// The input's checks: the state valid ([`Self::state_valid`]), then the coupling and
+    /// the upstream state the verification integrates with in range.
+    fn checked(x: &RoboticInput) -> Result<(), Invalid> {
         if !Self::state_valid(x) {
             return Err(Invalid::State);
         }
@@ -452,14 +503,20 @@ impl RoboticFilter {
         {
             return Err(Invalid::Coupling);
         }
+        Ok(())
+    }
+
+    /// The barrier terms of a checked input (paper eqs. "CBF-joint-angle",
+    /// "CBF-joint-velocity", "CBF-link-base").
+    fn terms_of(&self, x: &RoboticInput) -> RoboticTerms {
         let p = &self.params;
         let rates: [_; NJ] = std::array::from_fn(|i| joint_velocity(i, x, p.theta_dot_max[i]));
-        Ok(RoboticTerms {
+        RoboticTerms {
             theta: std::array::from_fn(|i| joint_angle(i, x, p.theta_min[i], p.theta_max[i])),
             theta_dot_max: std::array::from_fn(|i| rates[i][0]),
             theta_dot_min: std::array::from_fn(|i| rates[i][1]),
             link_base: std::array::from_fn(|k| link_base(&x.spheres[k], x)),
-        })
+        }
     }
 
     /// Weights of the rows in the relaxed problem — the deceleration the formulation budgets
@@ -659,181 +716,131 @@ impl RoboticFilter {
         x: &RoboticInput,
         tau_nom: Option<&Vector7>,
     ) -> FilterOutput<NJ, N> {
-        let t0 = std::time::Instant::now();
-        // the thread's CPU clock inside the wall interval: CPU ≤ wall
-        let c0 = crate::common::thread_cpu_ns();
-        let mut report = FilterReport::<N>::default();
-        self.engine.take_qp_ns();
-        self.engine.take_second_opinion();
-        let u = self.filter_inner(x, tau_nom, &mut report);
-        report.solve_cpu_ns = crate::common::thread_cpu_ns().saturating_sub(c0);
-        report.qp_time_ns = self.engine.take_qp_ns();
-        // (the flag comes from the outcome whose command is used)
-        self.engine.take_second_opinion();
-        report.solve_time_ns = t0.elapsed().as_nanos().min(u64::MAX as u128) as u64;
-        FilterOutput {
-            u,
-            actuated: u,
-            report,
-        }
+        step::filter_with(self, x, tau_nom)
     }
 
-    fn filter_inner(
+    /// The a-posteriori certificate: solve with the sample's own prediction (the `local`
+    /// rows), then check the command against rows whose in-sample bounds are valid for its
+    /// own accelerations; if it falls short, solve with those rows and check again. Writes
+    /// the rows the command was solved with (`s.solved`) and, when certified, the rows that
+    /// certify it (`s.certifying`).
+    fn certify(
         &mut self,
         x: &RoboticInput,
-        tau_nom: Option<&Vector7>,
-        report: &mut FilterReport<N>,
-    ) -> Vector7 {
-        let tmax = self.params.torque_max;
-        let terms = match self.terms(x) {
-            Ok(t) => t,
-            Err(Invalid::State) => {
-                report.faults |= faults::INVALID_STATE;
-                return clamp_box(&self.brake(x), tmax).0;
-            }
-            Err(Invalid::Coupling) => {
-                report.faults |= faults::INVALID_COUPLING;
-                return clamp_box(&self.brake(x), tmax).0;
-            }
-        };
-        report.h = terms.h();
-        let (u_nom, flag) = common::resolve_nominal(tau_nom, tmax, || self.brake(x));
-        report.faults |= flag;
-        let weights = self.weights();
-        let hard = self.hard_rows(x);
-        let zero = [0.0; N];
-        // 1. the a-posteriori certificate: solve with the sample's own prediction, then
-        // check the command against rows whose in-sample bounds are valid for its own
-        // accelerations; if it falls short, solve with those rows and check again.
+        p: &Prepared,
+        u_nom: &Vector7,
+        local: &[Row<NJ>; N],
+        s: &mut RowsBehind,
+    ) -> Certificate {
         let accel = |u: &Vector7| x.a * u + x.drift + x.xi;
-        let local = self.barrier_rows(x, &terms, Level::Local, &zero);
-        let mut res = self.engine.solve(&u_nom, &local, &weights, &hard);
-        report.iterations = res.iterations;
-        // the rows the returned command was solved with (the dump's problem) and the rows
-        // that certify it (evaluated into the report)
-        // (`None`: the local rows, not copied)
-        let mut solved_rows: Option<[Row<NJ>; N]> = None;
-        let mut final_rows: Option<[Row<NJ>; N]> = None;
-        let mut certified = false;
-        // the accelerations the rows `res` was solved with were built for (None: the
+        let res = self.engine.solve(u_nom, local, &p.weights, &p.hard);
+        let mut c = Certificate {
+            res,
+            iterations: res.iterations,
+        };
+        if !matches!(res.kind, Kind::Skipped | Kind::Solved) {
+            return c;
+        }
+        // the accelerations the rows `c.res` was solved with were built for (None: the
         // sample's own prediction, the loosest rows); the bounds grow with them joint by
         // joint, so rows built for the larger of both are tighter than those
         let mut solved_cap: Option<Vector7> = None;
-        if matches!(res.kind, Kind::Skipped | Kind::Solved) {
-            for _ in 0..CERTIFY_ROUNDS {
-                let own = accel(&res.u).abs();
-                let cap = solved_cap.map_or(own, |c| c.sup(&own));
-                // the certifying rows' offsets with the normals every level shares: `phi`
-                // of the certifying rows, bit for bit, without building them
-                let off = self.barrier_offsets(x, &terms, Level::Certified(cap));
-                if local
-                    .iter()
-                    .zip(&off)
-                    .all(|(r, c)| c + r.a.dot(&res.u) >= 0.0)
-                {
-                    // inside rows valid for its own accelerations: certified. It is the
-                    // minimiser of the rows it was solved with (`solved_rows`, the dump's
-                    // problem), not necessarily of the certifying rows (`safe-capture
-                    // verify-qp` measured up to 3e-2 of the bound between the two under
-                    // attack when the dump held the certifying rows).
-                    certified = true;
-                    final_rows = Some(with_offsets(&local, &off));
-                    break;
-                }
-                // the next candidate may accelerate more; bound it by twice as much
-                let grown = cap * 2.0;
-                let rows = self.barrier_rows(x, &terms, Level::Certified(grown), &zero);
-                let next = self.engine.solve(&u_nom, &rows, &weights, &hard);
-                report.iterations += next.iterations;
-                if !matches!(next.kind, Kind::Skipped | Kind::Solved) {
-                    break;
-                }
-                res = next;
-                solved_rows = Some(rows);
-                solved_cap = Some(grown);
-                if accel(&res.u)
-                    .abs()
-                    .iter()
-                    .zip(grown.iter())
-                    .all(|(a, g)| a <= g)
-                {
-                    // the rows' bounds cover the new command's accelerations
-                    certified = true;
-                    final_rows = Some(rows);
-                    break;
-                }
+        for _ in 0..CERTIFY_ROUNDS {
+            let own = accel(&c.res.u).abs();
+            let cap = solved_cap.map_or(own, |s| s.sup(&own));
+            // the certifying rows' offsets with the normals every level shares: `phi`
+            // of the certifying rows, bit for bit, without building them
+            let off = self.barrier_offsets(x, &p.terms, Level::Certified(cap));
+            if local
+                .iter()
+                .zip(&off)
+                .all(|(r, c0)| c0 + r.a.dot(&c.res.u) >= 0.0)
+            {
+                // inside rows valid for its own accelerations: certified. It is the
+                // minimiser of the rows it was solved with (`s.solved`, the dump's
+                // problem), not necessarily of the certifying rows (`safe-capture
+                // verify-qp` measured up to 3e-2 of the bound between the two under
+                // attack when the dump held the certifying rows).
+                s.certifying = Some(with_offsets(local, &off));
+                break;
+            }
+            // the next candidate may accelerate more; bound it by twice as much
+            let grown = cap * 2.0;
+            let rows = self.barrier_rows(x, &p.terms, Level::Certified(grown), &[0.0; N]);
+            let next = self.engine.solve(u_nom, &rows, &p.weights, &p.hard);
+            c.iterations += next.iterations;
+            if !matches!(next.kind, Kind::Skipped | Kind::Solved) {
+                break;
+            }
+            c.res = next;
+            s.solved = Some(rows);
+            solved_cap = Some(grown);
+            if accel(&c.res.u)
+                .abs()
+                .iter()
+                .zip(grown.iter())
+                .all(|(a, g)| a <= g)
+            {
+                // the rows' bounds cover the new command's accelerations
+                s.certifying = Some(rows);
+                break;
             }
         }
-        let mut tau = res.u;
-        if certified {
-            if res.second_opinion {
-                report.faults |= faults::QP_SECOND_OPINION;
-            }
-            report.status = if res.kind == Kind::Skipped {
-                FilterStatus::Skipped
-            } else {
-                FilterStatus::Solved
-            };
-        } else {
-            // 2. verification path (paper rows are never verified: comparison only)
-            let verified = if self.params.formulation == Formulation::SampledData {
-                self.verified(x, &terms, &u_nom, &weights, &hard, report)
-            } else {
-                None
-            };
-            match verified {
-                Some((u, rows, relaxed_violation)) => {
-                    tau = u;
-                    solved_rows = Some(rows);
-                    final_rows = Some(rows);
-                    if relaxed_violation > 0.0 {
-                        report.status = FilterStatus::Relaxed;
-                        report.faults |= faults::QP_INFEASIBLE_RELAXED;
-                        report.violation = relaxed_violation;
-                    } else {
-                        report.status = FilterStatus::Solved;
-                    }
-                }
-                None => match res.kind {
-                    Kind::Skipped => report.status = FilterStatus::Skipped,
-                    Kind::Solved => report.status = FilterStatus::Solved,
-                    Kind::Relaxed => {
-                        report.status = FilterStatus::Relaxed;
-                        report.faults |= faults::QP_INFEASIBLE_RELAXED;
-                        report.violation = res.violation;
-                    }
-                    Kind::Failed => {
-                        report.status = FilterStatus::Fallback;
-                        report.faults |= faults::QP_FAILED_FALLBACK;
-                        tau = self.brake(x);
-                    }
-                },
-            }
-        }
-        let kind = match report.status {
-            FilterStatus::Skipped => Kind::Skipped,
-            FilterStatus::Solved => Kind::Solved,
-            FilterStatus::Relaxed => Kind::Relaxed,
-            FilterStatus::Fallback => Kind::Failed,
-        };
-        let outcome = Outcome {
-            kind,
-            u: tau,
-            violation: report.violation,
-            iterations: report.iterations,
+        c
+    }
+
+    /// The command and how it came about, over all solves of the step (no multipliers
+    /// are recorded): first the a-posteriori certificate; where it fails (near the limits),
+    /// the verification with the servicer model (sampled-data rows only: the paper's rows
+    /// are for comparison); otherwise the last solve as it is, the braking law when it
+    /// failed. Writes the rows behind the command into `behind`.
+    fn command(
+        &mut self,
+        x: &RoboticInput,
+        p: &Prepared,
+        u_nom: &Vector7,
+        local: &[Row<NJ>; N],
+        behind: &mut RowsBehind,
+    ) -> Outcome<NJ> {
+        let c = self.certify(x, p, u_nom, local, behind);
+        let mut o = Outcome {
+            kind: c.res.kind,
+            u: c.res.u,
+            violation: 0.0,
+            iterations: c.iterations,
             row_duals: [0.0; 64],
             second_opinion: false,
         };
-        let solved_rows = solved_rows.as_ref().unwrap_or(&local);
-        let final_rows = final_rows.as_ref().unwrap_or(&local);
-        self.last
-            .record(&u_nom, solved_rows, &weights, &hard, &outcome);
-        let (tau, clamped) = clamp_box(&tau, tmax);
-        if clamped {
-            report.faults |= faults::OUTPUT_CLAMPED;
+        if behind.certifying.is_some() {
+            if o.kind != Kind::Skipped {
+                o.kind = Kind::Solved;
+            }
+            o.second_opinion = c.res.second_opinion;
+            return o;
         }
-        common::evaluate_rows(final_rows, &tau, report);
-        tau
+        let verified = if self.params.formulation == Formulation::SampledData {
+            self.verified(x, p, u_nom, &mut o.iterations)
+        } else {
+            None
+        };
+        if let Some(v) = verified {
+            (o.kind, o.violation) = if v.violation > 0.0 {
+                (Kind::Relaxed, v.violation)
+            } else {
+                (Kind::Solved, 0.0)
+            };
+            o.u = v.u;
+            o.second_opinion = v.second_opinion;
+            behind.solved = Some(v.rows);
+            behind.certifying = Some(v.rows);
+            return o;
+        }
+        match c.res.kind {
+            Kind::Relaxed => o.violation = c.res.violation,
+            Kind::Failed => o.u = self.brake(x),
+            Kind::Skipped | Kind::Solved => {}
+        }
+        o
     }
 
     /// The verification path: solve with the sample's own prediction, simulate the sample,
@@ -841,40 +848,45 @@ impl RoboticFilter {
     /// rows and, if it came from the relaxed problem, its violation), or — when none verifies
     /// within [`MAX_VERIFY_ROUNDS`] — the candidate whose worst barrier over the sample is
     /// best, flagged as relaxed. `None` without a model or when every solve failed.
+    /// `iterations` counts the solver's iterations and one per verification.
     fn verified(
         &mut self,
         x: &RoboticInput,
-        terms: &RoboticTerms,
+        p: &Prepared,
         u_nom: &Vector7,
-        weights: &[f64; N],
-        hard: &[Row<NJ>; 2 * NJ + 6],
-        report: &mut FilterReport<N>,
-    ) -> Option<(Vector7, [Row<NJ>; N], f64)> {
+        iterations: &mut u32,
+    ) -> Option<Verified> {
         let robot = self.robot.clone()?;
         let mut margin = [0.0; N];
-        let mut best: Option<(f64, Vector7, [Row<NJ>; N], bool)> = None;
+        let mut best: Option<(f64, Verified)> = None;
         for _ in 0..MAX_VERIFY_ROUNDS {
-            let rows = self.barrier_rows(x, terms, Level::Local, &margin);
-            let res = self.engine.solve(u_nom, &rows, weights, hard);
-            report.iterations += res.iterations;
+            let rows = self.barrier_rows(x, &p.terms, Level::Local, &margin);
+            let res = self.engine.solve(u_nom, &rows, &p.weights, &p.hard);
+            *iterations += res.iterations;
             if res.kind == Kind::Failed {
                 break;
             }
-            let v = self.verify(&robot, x, terms, &res.u, weights);
-            report.iterations += 1;
+            let v = self.verify(&robot, x, &p.terms, &res.u, &p.weights);
+            *iterations += 1;
+            let candidate = Verified {
+                u: res.u,
+                rows,
+                violation: 0.0,
+                second_opinion: res.second_opinion,
+            };
             if v.ok {
                 let violation = if res.kind == Kind::Relaxed {
                     res.violation
                 } else {
                     0.0
                 };
-                if res.second_opinion {
-                    report.faults |= faults::QP_SECOND_OPINION;
-                }
-                return Some((res.u, rows, violation));
+                return Some(Verified {
+                    violation,
+                    ..candidate
+                });
             }
             if best.as_ref().is_none_or(|b| v.worst > b.0) {
-                best = Some((v.worst, res.u, rows, res.second_opinion));
+                best = Some((v.worst, candidate));
             }
             for (m, s) in margin.iter_mut().zip(&v.shortfall) {
                 *m += VERIFY_GAIN * s;
@@ -882,16 +894,13 @@ impl RoboticFilter {
         }
         // a sample whose integration failed reports a full violation (the command itself
         // is still inside the box: the relaxed problem's hard rows hold)
-        best.map(|(worst, u, rows, second_opinion)| {
-            if second_opinion {
-                report.faults |= faults::QP_SECOND_OPINION;
-            }
-            let v = if worst.is_finite() {
+        best.map(|(worst, v)| Verified {
+            violation: if worst.is_finite() {
                 (-worst).max(f64::MIN_POSITIVE)
             } else {
                 1.0
-            };
-            (u, rows, v)
+            },
+            ..v
         })
     }
 
@@ -924,10 +933,6 @@ impl RoboticFilter {
             verdict.worst = f64::NEG_INFINITY;
             return verdict;
         };
-        let fail = |v: &mut Verdict, j: usize, short: f64| {
-            v.ok = false;
-            v.shortfall[j] = v.shortfall[j].max(short);
-        };
         for step in 1..=steps {
             let Some((th1, thd1, w1)) = rk4_internal(robot, &th, &thd, &w, &u, h) else {
                 verdict.ok = false;
@@ -938,68 +943,94 @@ impl RoboticFilter {
             thd = thd1;
             w = w1;
             let s = step as f64 * h;
-            let kin = robot.kinematics_vel(&th, &thd);
-            let mut hv = [0.0; N];
-            let mut hd = [0.0; N];
-            for i in 0..NJ {
-                let k = p.theta_max[i] + p.theta_min[i] - 2.0 * th[i];
-                hv[i] = (th[i] - p.theta_min[i]) * (p.theta_max[i] - th[i]);
-                hd[i] = thd[i] * k;
-                hv[NJ + i] = p.theta_dot_max[i] - thd[i];
-                hv[2 * NJ + i] = thd[i] + p.theta_dot_max[i];
-            }
-            for (k, (idx, _)) in robot.arm_spheres().take(NS).enumerate() {
-                if let Some(sp) = robot.sphere_state(&kin, idx) {
-                    let d = sp.center - base.center;
-                    let rr = sp.radius + base.radius;
-                    hv[3 * NJ + k] = d.dot(&d) - rr * rr;
-                    hd[3 * NJ + k] = 2.0 * d.dot(&(sp.jacobian * thd));
-                }
-            }
+            let (hv, hd) = self.barriers_along(robot, base, &th, &thd);
             for j in 0..N {
                 verdict.worst = verdict.worst.min(hv[j] / weights[j]);
-                let rel2 = !(NJ..3 * NJ).contains(&j);
                 if hv[j] < 0.0 {
                     // C1: the barrier inside the sample
-                    let short = if rel2 {
+                    let short = if is_rel_deg_two(j) {
                         2.0 * -hv[j] / (s * s)
                     } else {
                         -hv[j] / s
                     };
-                    fail(&mut verdict, j, short);
+                    verdict.fail(j, short);
                 }
-                if step == steps {
-                    // the next-sample conditions of the rows
-                    if rel2 {
-                        let (h0, hd0) = if j < NJ {
-                            (t0.theta[j].h, t0.theta[j].hdot)
-                        } else {
-                            (t0.link_base[j - 3 * NJ].h, t0.link_base[j - 3 * NJ].hdot)
-                        };
-                        let mu = if j < NJ { p.u_max_theta } else { p.u_max_lb };
-                        let kappa = (-p.gamma * p.period).exp() * braking_barrier(h0, hd0, mu);
-                        let got = braking_barrier(hv[j], hd[j], mu);
-                        if got < kappa {
-                            let gain = 0.5 * s * s + hd[j].abs() * s / mu;
-                            fail(&mut verdict, j, (kappa - got) / gain);
-                        }
-                    } else {
-                        let h0 = if j < 2 * NJ {
-                            t0.theta_dot_max[j - NJ].h
-                        } else {
-                            t0.theta_dot_min[j - 2 * NJ].h
-                        };
-                        let g = p.gamma_theta_dot;
-                        let floor = p.eps_theta_dot / g;
-                        let target = (-g * p.period).exp() * (h0 - floor) + floor;
-                        if hv[j] < target {
-                            fail(&mut verdict, j, (target - hv[j]) / s);
-                        }
-                    }
+                if step == steps
+                    && let Some(short) = self.next_sample_shortfall(j, t0, hv[j], hd[j], s)
+                {
+                    verdict.fail(j, short);
                 }
             }
         }
         verdict
+    }
+
+    /// Every barrier `h` and the rates `ḣ` of the relative-degree-two ones (joint angles,
+    /// link spheres) at the joint state `(θ, θ̇)` of the verification, [`NAMES`] order.
+    fn barriers_along(
+        &self,
+        robot: &Robot,
+        base: &CollisionSphere,
+        th: &Vector7,
+        thd: &Vector7,
+    ) -> ([f64; N], [f64; N]) {
+        let p = &self.params;
+        let kin = robot.kinematics_vel(th, thd);
+        let mut hv = [0.0; N];
+        let mut hd = [0.0; N];
+        for i in 0..NJ {
+            let k = p.theta_max[i] + p.theta_min[i] - 2.0 * th[i];
+            hv[i] = (th[i] - p.theta_min[i]) * (p.theta_max[i] - th[i]);
+            hd[i] = thd[i] * k;
+            hv[NJ + i] = p.theta_dot_max[i] - thd[i];
+            hv[2 * NJ + i] = thd[i] + p.theta_dot_max[i];
+        }
+        for (k, (idx, _)) in robot.arm_spheres().take(NS).enumerate() {
+            if let Some(sp) = robot.sphere_state(&kin, idx) {
+                let d = sp.center - base.center;
+                let rr = sp.radius + base.radius;
+                hv[3 * NJ + k] = d.dot(&d) - rr * rr;
+                hd[3 * NJ + k] = 2.0 * d.dot(&(sp.jacobian * thd));
+            }
+        }
+        (hv, hd)
+    }
+
+    /// How much larger row `j`'s `ḧ` (or `ḣ`) needed to be for its next-sample condition
+    /// to hold at the sample's end `s` with barrier value `h` and rate `ḣ` — (C2) for a
+    /// relative-degree-two row, the discretised rate condition for a joint-rate row —
+    /// `None` when it holds.
+    fn next_sample_shortfall(
+        &self,
+        j: usize,
+        t0: &RoboticTerms,
+        h: f64,
+        hd: f64,
+        s: f64,
+    ) -> Option<f64> {
+        let p = &self.params;
+        if is_rel_deg_two(j) {
+            let (h0, hd0) = if j < NJ {
+                (t0.theta[j].h, t0.theta[j].hdot)
+            } else {
+                (t0.link_base[j - 3 * NJ].h, t0.link_base[j - 3 * NJ].hdot)
+            };
+            let mu = if j < NJ { p.u_max_theta } else { p.u_max_lb };
+            let kappa = (-p.gamma * p.period).exp() * braking_barrier(h0, hd0, mu);
+            let got = braking_barrier(h, hd, mu);
+            let gain = 0.5 * s * s + hd.abs() * s / mu;
+            (got < kappa).then(|| (kappa - got) / gain)
+        } else {
+            let h0 = if j < 2 * NJ {
+                t0.theta_dot_max[j - NJ].h
+            } else {
+                t0.theta_dot_min[j - 2 * NJ].h
+            };
+            let g = p.gamma_theta_dot;
+            let floor = p.eps_theta_dot / g;
+            let target = (-g * p.period).exp() * (h0 - floor) + floor;
+            (h < target).then(|| (target - h) / s)
+        }
     }
 
     /// Verification only: force the solver even when the nominal is feasible.
@@ -1133,6 +1164,72 @@ pub fn robotic_input_from_model(
     })
 }
 
+/// The robotic filter's own parts of the shared step ([`crate::step`]): its 42 rows, the
+/// a-posteriori certificate, the verification with the servicer model and its braking law.
+impl FilterStep<NJ, N> for RoboticFilter {
+    type Input = RoboticInput;
+    type Prepared = Prepared;
+
+    fn bound(&self) -> f64 {
+        self.params.torque_max
+    }
+
+    fn take_tally(&mut self) -> SolverTally {
+        self.engine.take_tally()
+    }
+
+    fn last_problem(&mut self) -> &mut LastProblem<NJ> {
+        &mut self.last
+    }
+
+    fn prepare(&self, x: &RoboticInput) -> Result<Prepared, Invalid> {
+        Self::checked(x)?;
+        Ok(Prepared {
+            terms: self.terms_of(x),
+            weights: self.weights(),
+            hard: self.hard_rows(x),
+        })
+    }
+
+    /// The braking law from the input alone (zero when it cannot be evaluated).
+    fn refused(&self, x: &RoboticInput) -> Vector7 {
+        clamp_box(&self.brake(x), self.params.torque_max).0
+    }
+
+    fn barrier_values(p: &Prepared) -> [f64; N] {
+        p.terms.h()
+    }
+
+    fn braking_law(&self, x: &RoboticInput, _: &Prepared) -> Vector7 {
+        self.brake(x)
+    }
+
+    /// The command ([`RoboticFilter::command`]) with the rows it was solved with and the
+    /// rows that certify it, kept here (they are large).
+    fn solve_qp(
+        &mut self,
+        x: &RoboticInput,
+        p: &Prepared,
+        u_nom: &Vector7,
+        report: &mut FilterReport<N>,
+    ) -> Actuated<NJ> {
+        let local = self.barrier_rows(x, &p.terms, Level::Local, &[0.0; N]);
+        let mut behind = RowsBehind {
+            solved: None,
+            certifying: None,
+        };
+        let outcome = self.command(x, p, u_nom, &local, &mut behind);
+        let solved = Solved {
+            outcome: &outcome,
+            rows: behind.solved.as_ref().unwrap_or(&local),
+            weights: &p.weights,
+            hard: &p.hard,
+            certifying: behind.certifying.as_ref().unwrap_or(&local),
+        };
+        step::conclude(self, x, p, u_nom, solved, report)
+    }
+}
+
 impl SafetyFilter<NJ, N> for RoboticFilter {
     const SUBSYSTEM: Subsystem = Subsystem::Robotic;
     const NAMES: [&'static str; N] = NAMES;
@@ -1155,17 +1252,16 @@ impl SafetyFilter<NJ, N> for RoboticFilter {
         RoboticFilter::filter_with(self, x, nominal)
     }
 
-    /// Zero joint torque, flagged [`faults::INVALID_STATE`].
-    fn invalid_state(&self) -> FilterOutput<NJ, N> {
-        common::invalid_state_output()
-    }
-
     fn dump_qp(&self) -> crate::QpDump {
         RoboticFilter::dump_qp(self)
     }
 
     fn set_skip_enabled(&mut self, on: bool) {
         RoboticFilter::set_skip_enabled(self, on)
+    }
+
+    fn set_solver_settings(&mut self, settings: sc_qp::Settings) {
+        self.engine.set_settings(settings);
     }
 
     fn input_bound(&self) -> f64 {

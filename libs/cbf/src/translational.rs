@@ -19,18 +19,17 @@
 
 use crate::barrier::{RelDegOne, RelDegTwo, Row};
 use crate::common::{
-    self, BOX_MARGIN, FilterOutput, FilterReport, FilterStatus, clamp_box, faults, in_range3,
-    unit_quat,
+    self, BOX_MARGIN, FilterOutput, FilterReport, clamp_box, in_range3, unit_quat,
 };
-use crate::engine::{Engine, Kind, LastProblem};
+use crate::engine::{Engine, LastProblem, SolverTally};
 use crate::filter::{Coupling, SafetyFilter};
 use crate::sampled::{RateBounds, RelDeg1, RelDeg2, SampleBounds};
+use crate::step::{self, Actuated, FilterStep, Invalid, Solved};
 use crate::{Formulation, qp::SolverParams};
 use nalgebra::{Matrix3, Vector3};
 use sc_core::{Observation, Subsystem};
 use sc_models::quat::{self, Quat};
 use sc_multibody::Robot;
-use std::time::Instant;
 
 /// Constraint names in report order.
 pub const NAMES: [&str; 2] = ["approach_corridor", "collision_avoidance_zone"];
@@ -264,7 +263,7 @@ pub fn tangential_speed(
 }
 
 /// Validated, preprocessed input.
-struct Prepared {
+pub(crate) struct Prepared {
     r_bh: Matrix3<f64>,
     terms: [RelDegTwo<3>; N],
     /// The barrier rows ([`NAMES`] order) and the tangential-speed row.
@@ -297,7 +296,7 @@ impl TranslationalFilter {
     /// The barrier terms `(h, ḣ, ḧ_drift, ∂ḧ/∂f_H)` of both constraints, in [`NAMES`]
     /// order, or `None` for an invalid state.
     pub fn constraints(&self, x: &TranslationalInput) -> Option<[RelDegTwo<3>; N]> {
-        self.prepare(x).map(|p| p.terms)
+        self.prepare(x).ok().map(|p| p.terms)
     }
 
     /// The bounds on the model's error inside one sample, per barrier ([`NAMES`] order),
@@ -375,28 +374,17 @@ impl TranslationalFilter {
         )
     }
 
-    fn prepare(&self, x: &TranslationalInput) -> Option<Prepared> {
+    /// The corridor, zone and tangential-speed rows ([`NAMES`] order, then the tangential
+    /// speed) of the formulation, with their weights in the relaxed problem — each row's
+    /// violation measured against the deceleration the formulation budgets for it.
+    fn barrier_rows(
+        &self,
+        x: &TranslationalInput,
+        r_hr: &Matrix3<f64>,
+        axis: &CorridorAxis,
+        terms: &[RelDegTwo<3>; N],
+    ) -> ([Row<3>; N + 1], [f64; N + 1]) {
         let p = &self.params;
-        let rn = x.r_h.norm();
-        if !in_range3(&x.r_h, MAX_RANGE_M)
-            || rn < MIN_RANGE_M
-            || !in_range3(&x.v_h, MAX_SPEED_M_S)
-            || !in_range3(&x.omega_h, MAX_FRAME_RATE)
-            || !in_range3(&x.omega_dot_h, MAX_FRAME_RATE)
-            || !common::finite(&x.omega_b)
-        {
-            return None;
-        }
-        let q_hr = unit_quat(&x.q_hr)?;
-        let q_rb = unit_quat(&x.q_rb)?;
-        let r_hr = quat::to_matrix(&q_hr);
-        let r_bh = (r_hr * quat::to_matrix(&q_rb)).transpose();
-        let axis = corridor_axis(&r_hr, &p.axis_r, &x.omega_h, &x.omega_dot_h);
-        let a0 = cw_drift(p.mean_motion, &x.r_h, &x.v_h);
-        let terms = [
-            approach_corridor(&x.r_h, &x.v_h, &axis, &a0, p.mass, p.cos_psi),
-            collision_avoidance_zone(&x.r_h, &x.v_h, &a0, p.mass, p.r_caz),
-        ];
         let mu = [p.u_max_ac, p.u_max_caz];
         let c_t = tangential_coefficient(p);
         // the tangential speed in the inertially fixed F_R (where the corridor is fixed)
@@ -405,10 +393,10 @@ impl TranslationalFilter {
         let v_r = r_rh * (x.v_h + x.omega_h.cross(&x.r_h));
         let radial = r_rh * Vector3::x();
         let tidal = (radial * (3.0 * radial.dot(&r_r)) - r_r) * (p.mean_motion * p.mean_motion);
-        let tangential = tangential_speed(&r_r, &v_r, &tidal, &r_hr, p.mass, c_t);
+        let tangential = tangential_speed(&r_r, &v_r, &tidal, r_hr, p.mass, c_t);
         let rows: [Row<3>; N + 1] = match p.formulation {
             Formulation::SampledData => {
-                let (b, bt) = self.sample_bounds(&x.r_h, &x.v_h, &x.omega_b, &axis);
+                let (b, bt) = self.sample_bounds(&x.r_h, &x.v_h, &x.omega_b, axis);
                 [
                     RelDeg2::from(terms[0]).row(&b[0], mu[0], p.gamma),
                     RelDeg2::from(terms[1]).row(&b[1], mu[1], p.gamma),
@@ -430,27 +418,21 @@ impl TranslationalFilter {
             p.u_max_caz,
             2.0 * (c_t.max(0.0) * p.r_caz).sqrt() * p.force_max / p.mass,
         ];
-        // ‖f_B‖∞ ≤ F on the body-frame force f_B = R_BH f_H: rows F(1 − margin) ∓ (R_BH f_H)_k
-        let lim = p.force_max * (1.0 - BOX_MARGIN);
-        let bounds: [Row<3>; 6] = std::array::from_fn(|i| {
+        (rows, weights)
+    }
+
+    /// `‖f_B‖∞ ≤ F` on the body-frame force `f_B = R_BH f_H`: the six rows
+    /// `F(1 − margin) ∓ (R_BH f_H)_k ≥ 0`.
+    fn force_box(&self, r_bh: &Matrix3<f64>) -> [Row<3>; 6] {
+        let lim = self.params.force_max * (1.0 - BOX_MARGIN);
+        std::array::from_fn(|i| {
             let k = i / 2;
             let sign = if i % 2 == 0 { -1.0 } else { 1.0 };
             Row {
                 a: r_bh.row(k).transpose() * sign,
                 c: lim,
             }
-        });
-        if rows.iter().chain(&bounds).all(Row::is_finite) && common::finite(&r_bh) {
-            Some(Prepared {
-                r_bh,
-                terms,
-                rows,
-                weights,
-                bounds,
-            })
-        } else {
-            None
-        }
+        })
     }
 
     /// The braking law `f_H = sat(−m v_H / T)`, saturated so that `‖R_BH f_H‖∞ ≤ F`
@@ -458,8 +440,8 @@ impl TranslationalFilter {
     /// fails. Zero when the state is invalid.
     pub fn brake(&self, x: &TranslationalInput) -> (Vector3<f64>, Vector3<f64>) {
         match self.prepare(x) {
-            Some(p) => self.brake_prepared(x, &p),
-            None => (Vector3::zeros(), Vector3::zeros()),
+            Ok(p) => self.brake_prepared(x, &p),
+            Err(_) => (Vector3::zeros(), Vector3::zeros()),
         }
     }
 
@@ -489,74 +471,7 @@ impl TranslationalFilter {
         x: &TranslationalInput,
         f_nom_h: Option<&Vector3<f64>>,
     ) -> FilterOutput<3, N> {
-        let t0 = Instant::now();
-        // the thread's CPU clock inside the wall interval: CPU ≤ wall
-        let c0 = crate::common::thread_cpu_ns();
-        let mut report = FilterReport::<N>::default();
-        self.engine.take_qp_ns();
-        self.engine.take_second_opinion();
-        let out = self.filter_inner(x, f_nom_h, &mut report);
-        report.solve_cpu_ns = crate::common::thread_cpu_ns().saturating_sub(c0);
-        report.qp_time_ns = self.engine.take_qp_ns();
-        // (the flag comes from the outcome whose command is used)
-        self.engine.take_second_opinion();
-        report.solve_time_ns = t0.elapsed().as_nanos().min(u64::MAX as u128) as u64;
-        FilterOutput {
-            u: out.0,
-            actuated: out.1,
-            report,
-        }
-    }
-
-    fn filter_inner(
-        &mut self,
-        x: &TranslationalInput,
-        f_nom_h: Option<&Vector3<f64>>,
-        report: &mut FilterReport<N>,
-    ) -> (Vector3<f64>, Vector3<f64>) {
-        let fmax = self.params.force_max;
-        let Some(p) = self.prepare(x) else {
-            report.faults |= faults::INVALID_STATE;
-            report.status = FilterStatus::Fallback;
-            return (Vector3::zeros(), Vector3::zeros());
-        };
-        for (i, t) in p.terms.iter().enumerate() {
-            report.h[i] = t.h;
-        }
-        let (u_nom, flag) = common::resolve_nominal(f_nom_h, fmax, || self.brake_prepared(x, &p).0);
-        report.faults |= flag;
-        let res = self.engine.solve(&u_nom, &p.rows, &p.weights, &p.bounds);
-        if res.second_opinion {
-            report.faults |= faults::QP_SECOND_OPINION;
-        }
-        self.last
-            .record(&u_nom, &p.rows, &p.weights, &p.bounds, &res);
-        report.iterations = res.iterations;
-        report.violation = res.violation;
-        let mut f_h = res.u;
-        match res.kind {
-            Kind::Skipped => report.status = FilterStatus::Skipped,
-            Kind::Solved => report.status = FilterStatus::Solved,
-            Kind::Relaxed => {
-                report.status = FilterStatus::Relaxed;
-                report.faults |= faults::QP_INFEASIBLE_RELAXED;
-            }
-            Kind::Failed => {
-                report.status = FilterStatus::Fallback;
-                report.faults |= faults::QP_FAILED_FALLBACK;
-                f_h = self.brake_prepared(x, &p).0;
-            }
-        }
-        // Last line of defence: the actuated force must be finite and inside the box.
-        let f_b = p.r_bh * f_h;
-        let (f_b_c, clamped) = clamp_box(&f_b, fmax);
-        if clamped || !common::finite(&f_h) {
-            report.faults |= faults::OUTPUT_CLAMPED;
-            f_h = p.r_bh.transpose() * f_b_c;
-        }
-        let barrier_rows: [Row<3>; N] = [p.rows[0], p.rows[1]];
-        common::evaluate_rows(&barrier_rows, &f_h, report);
-        (f_h, f_b_c)
+        step::filter_with(self, x, f_nom_h)
     }
 
     /// Verification only: force the solver even when the nominal is feasible.
@@ -573,10 +488,115 @@ impl TranslationalFilter {
     /// weights in the relaxed problem, and the six bound rows at state `x` — for
     /// verification and `--dump-qp`.
     pub fn rows(&self, x: &TranslationalInput) -> Option<(Vec<Row<3>>, Vec<f64>, Vec<Row<3>>)> {
-        let p = self.prepare(x)?;
+        let p = self.prepare(x).ok()?;
         Some((p.rows.to_vec(), p.weights.to_vec(), p.bounds.to_vec()))
     }
 }
+
+/// The translational filter's own parts of the shared step ([`crate::step`]): its rows,
+/// its braking law and its force box in the body frame.
+impl FilterStep<3, N> for TranslationalFilter {
+    type Input = TranslationalInput;
+    type Prepared = Prepared;
+
+    fn bound(&self) -> f64 {
+        self.params.force_max
+    }
+
+    fn take_tally(&mut self) -> SolverTally {
+        self.engine.take_tally()
+    }
+
+    fn last_problem(&mut self) -> &mut LastProblem<3> {
+        &mut self.last
+    }
+
+    fn prepare(&self, x: &TranslationalInput) -> Result<Prepared, Invalid> {
+        let p = &self.params;
+        let rn = x.r_h.norm();
+        if !in_range3(&x.r_h, MAX_RANGE_M)
+            || rn < MIN_RANGE_M
+            || !in_range3(&x.v_h, MAX_SPEED_M_S)
+            || !in_range3(&x.omega_h, MAX_FRAME_RATE)
+            || !in_range3(&x.omega_dot_h, MAX_FRAME_RATE)
+            || !common::finite(&x.omega_b)
+        {
+            return Err(Invalid::State);
+        }
+        let q_hr = unit_quat(&x.q_hr).ok_or(Invalid::State)?;
+        let q_rb = unit_quat(&x.q_rb).ok_or(Invalid::State)?;
+        let r_hr = quat::to_matrix(&q_hr);
+        let r_bh = (r_hr * quat::to_matrix(&q_rb)).transpose();
+        let axis = corridor_axis(&r_hr, &p.axis_r, &x.omega_h, &x.omega_dot_h);
+        let a0 = cw_drift(p.mean_motion, &x.r_h, &x.v_h);
+        let terms = [
+            approach_corridor(&x.r_h, &x.v_h, &axis, &a0, p.mass, p.cos_psi),
+            collision_avoidance_zone(&x.r_h, &x.v_h, &a0, p.mass, p.r_caz),
+        ];
+        let (rows, weights) = self.barrier_rows(x, &r_hr, &axis, &terms);
+        let bounds = self.force_box(&r_bh);
+        if rows.iter().chain(&bounds).all(Row::is_finite) && common::finite(&r_bh) {
+            Ok(Prepared {
+                r_bh,
+                terms,
+                rows,
+                weights,
+                bounds,
+            })
+        } else {
+            Err(Invalid::State)
+        }
+    }
+
+    /// No force when the state cannot be trusted.
+    fn refused(&self, _: &TranslationalInput) -> Vector3<f64> {
+        Vector3::zeros()
+    }
+
+    fn barrier_values(p: &Prepared) -> [f64; N] {
+        p.terms.map(|t| t.h)
+    }
+
+    fn braking_law(&self, x: &TranslationalInput, p: &Prepared) -> Vector3<f64> {
+        self.brake_prepared(x, p).0
+    }
+
+    fn solve_qp(
+        &mut self,
+        x: &TranslationalInput,
+        p: &Prepared,
+        u_nom: &Vector3<f64>,
+        report: &mut FilterReport<N>,
+    ) -> Actuated<3> {
+        let outcome = self.engine.solve(u_nom, &p.rows, &p.weights, &p.bounds);
+        let solved = Solved {
+            outcome: &outcome,
+            rows: &p.rows,
+            weights: &p.weights,
+            hard: &p.bounds,
+            certifying: &p.rows[..N],
+        };
+        step::conclude(self, x, p, u_nom, solved, report)
+    }
+
+    /// The actuated force `f_B = R_BH f_H` must be finite and inside the box; a clamped
+    /// `f_B` is rotated back into the command.
+    fn actuate(&self, p: &Prepared, f_h: Vector3<f64>) -> Actuated<3> {
+        let f_b = p.r_bh * f_h;
+        let (f_b_c, clamped) = clamp_box(&f_b, self.params.force_max);
+        let flagged = clamped || !common::finite(&f_h);
+        Actuated {
+            u: if flagged {
+                p.r_bh.transpose() * f_b_c
+            } else {
+                f_h
+            },
+            actuated: f_b_c,
+            clamped: flagged,
+        }
+    }
+}
+
 impl SafetyFilter<3, N> for TranslationalFilter {
     const SUBSYSTEM: Subsystem = Subsystem::Translational;
     const NAMES: [&'static str; N] = NAMES;
@@ -604,16 +624,16 @@ impl SafetyFilter<3, N> for TranslationalFilter {
         TranslationalFilter::filter_with(self, x, nominal)
     }
 
-    fn invalid_state(&self) -> FilterOutput<3, N> {
-        common::invalid_state_output()
-    }
-
     fn dump_qp(&self) -> crate::QpDump {
         TranslationalFilter::dump_qp(self)
     }
 
     fn set_skip_enabled(&mut self, on: bool) {
         TranslationalFilter::set_skip_enabled(self, on)
+    }
+
+    fn set_solver_settings(&mut self, settings: sc_qp::Settings) {
+        self.engine.set_settings(settings);
     }
 
     fn input_bound(&self) -> f64 {

@@ -6,8 +6,12 @@
 
 use nalgebra::{DMatrix, DVector, SMatrix, SVector, Vector3, Vector6};
 use sc_cbf::attitude::{tidal_acceleration, xi_att_from_force};
+use sc_cbf::barrier::Row;
+use sc_cbf::common::NOMINAL_RANGE;
 use sc_cbf::robotic::{Vector7, robotic_input_from_model};
-use sc_cbf::{AttitudeInput, RoboticInput, TranslationalInput};
+use sc_cbf::{
+    AttitudeInput, FilterOutput, FilterStatus, QpDump, RoboticInput, TranslationalInput, faults,
+};
 use sc_models::quat::{self, Quat};
 use sc_multibody::Robot;
 use sc_scenario::Scenario;
@@ -490,4 +494,267 @@ pub fn exact_lp_min_last(g: &[Vec<f64>], h: &[f64]) -> Option<(f64, Vec<usize>)>
 
 pub fn dvec<const M: usize>(v: &SVector<f64, M>) -> DVector<f64> {
     DVector::from_column_slice(v.as_slice())
+}
+
+// ------------------------------------------------------------------ filter cases and QP checks
+// ------------------------------------------------------------------ cases
+
+/// States near the corridor wall or the CAZ, moving towards the boundary, with random
+/// nominal forces up to 1.5 F.
+pub fn tr_cases(seed: u64, count: usize) -> Vec<(TranslationalInput, Vector3<f64>)> {
+    let s = scenario();
+    let fmax = s.limits.force_max_n;
+    let mut rng = Lcg(seed);
+    (0..count)
+        .map(|k| {
+            let ang = (3.8 + 1.3 * rng.next()).to_radians();
+            let phi = std::f64::consts::PI * rng.next();
+            let dir = Vector3::new(-ang.cos(), ang.sin() * phi.cos(), ang.sin() * phi.sin());
+            let dist = if k % 2 == 0 {
+                4.5 + 3.0 * rng.next()
+            } else {
+                2.0 + 0.3 * rng.next()
+            };
+            let out = Vector3::new(0.0, phi.cos(), phi.sin());
+            let v = -dir * (0.03 * (1.0 + rng.next()))
+                + out * (0.004 * (1.0 + rng.next()))
+                + rng.v3(0.003);
+            let x = tr_input(&s, dir * dist, v, rng.unit_quat(), rng.v3(0.1));
+            (x, rng.v3(1.5 * fmax))
+        })
+        .collect()
+}
+
+/// Pointing errors of 2–5° (the cone is 5°), body rates up to 0.06 rad/s per axis, random
+/// arm states, upstream forces and nominal torques up to 1.5 T (many of these states are
+/// outside the braking-safe set: relaxed).
+pub fn att_cases(seed: u64, count: usize) -> Vec<(AttitudeInput, Vector3<f64>)> {
+    let s = scenario();
+    let robot = robot();
+    let tmax = s.limits.torque_max_nm;
+    let mut rng = Lcg(seed);
+    (0..count)
+        .map(|_| {
+            let com = Vector3::new(-2.8, 0.0, 0.0) + rng.v3(0.3);
+            let t = 40.0 * (1.0 + rng.next());
+            let st = ServicerState {
+                theta: theta_inside(&s, &mut rng, 0.1),
+                theta_dot: rng.v7(0.1),
+                omega_b: rng.v3(0.06),
+                q_rb: pointing(
+                    &s,
+                    &com,
+                    t,
+                    &rng.v3(1.0),
+                    (3.5 + 1.5 * rng.next()).to_radians(),
+                ),
+                com_r: com,
+                com_v_r: rng.v3(0.02),
+                t,
+                f_b: rng.v3(5.0),
+            };
+            (att_input(&s, &robot, &st), rng.v3(1.5 * tmax))
+        })
+        .collect()
+}
+
+/// One joint close to a limit and moving towards it, random nominal torques.
+pub fn rob_cases(seed: u64, count: usize) -> Vec<(RoboticInput, Vector7)> {
+    let s = scenario();
+    let robot = robot();
+    let mut rng = Lcg(seed);
+    (0..count)
+        .map(|_| {
+            let mut th = theta_inside(&s, &mut rng, 0.15);
+            let j = ((rng.next() + 1.0) * 3.5) as usize % 7;
+            let up = rng.next() > 0.0;
+            let mut thd = rng.v7(0.1);
+            if up {
+                th[j] = s.safety.robotic.theta_max_rad[j] - 0.05 * (1.2 + rng.next());
+                thd[j] = 0.2;
+            } else {
+                th[j] = s.safety.robotic.theta_min_rad[j] + 0.05 * (1.2 + rng.next());
+                thd[j] = -0.2;
+            }
+            (rob_input(&robot, th, thd), rng.v7(2.5))
+        })
+        .collect()
+}
+
+// ------------------------------------------------------------------ helpers
+
+pub fn assert_output_sane<const M: usize, const N: usize>(o: &FilterOutput<M, N>, bound: f64) {
+    assert!(
+        o.u.iter().chain(o.actuated.iter()).all(|x| x.is_finite()),
+        "{o:?}"
+    );
+    assert!(
+        o.actuated.amax() <= bound,
+        "{} > {bound}",
+        o.actuated.amax()
+    );
+}
+
+/// KKT at the solution of `qp` (multipliers of our own): rows hold and the stationarity
+/// residual vanishes, both relative to the input bound.
+pub fn check_kkt(qp: &Qp, u: &DVector<f64>, bound: f64, what: &str) {
+    let (viol, stat, lam) = kkt(qp, u, 1e-9 * bound);
+    assert!(
+        viol <= 1e-9 * bound,
+        "{what}: a row is violated by {viol:e}"
+    );
+    assert!(
+        stat <= 1e-9 * bound,
+        "{what}: stationarity residual {stat:e}, λ = {lam:?}"
+    );
+}
+
+/// The engine's barrier multipliers (`dump.row_duals`) are those of `½‖u − u_nom‖²`:
+/// `u − u_nom = Σ λ_i a_i` over all active rows (note: `QpDump`'s documentation states the
+/// Clarabel engine's convention `2(u − u_nom) = Σ λ_i a_i − Gᵀμ`). Compared with ours where
+/// the multipliers are unique (active rows independent); returns how many positive
+/// multipliers were compared.
+pub fn check_duals(d: &QpDump, qp: &Qp, u: &DVector<f64>, bound: f64, what: &str) -> usize {
+    let (_, _, lam) = kkt(qp, u, 1e-9 * bound);
+    let active: Vec<usize> = (0..lam.len()).filter(|&i| lam[i] > 0.0).collect();
+    if active.is_empty() {
+        return 0;
+    }
+    let a = nalgebra::DMatrix::from_fn(qp.m(), active.len(), |r, c| qp.a[active[c]][r]);
+    if active.len() > qp.m() || a.rank(1e-9) < active.len() {
+        return 0;
+    }
+    for (i, (engine, ours)) in d.row_duals.iter().zip(&lam).enumerate().take(qp.nb) {
+        assert!(
+            (engine - ours).abs() <= 1e-6 * (ours.abs() + engine.abs()) + 1e-12,
+            "{what}: row {i} multiplier {engine} vs KKT {ours}"
+        );
+    }
+    (0..qp.nb).filter(|&i| lam[i] > 0.0).count()
+}
+
+pub fn near(a: &DVector<f64>, b: &DVector<f64>, tol: f64) -> bool {
+    (a - b).amax() <= tol
+}
+
+// ------------------------------------------------------------------ relaxed problem
+
+/// Scales of the nominal along one direction: from a tenth of the bound to the largest
+/// nominal still accepted (`NOMINAL_RANGE × bound`).
+pub const SCALES: [f64; 5] = [0.1, 1.0, 10.0, 100.0, 0.999 * NOMINAL_RANGE];
+
+/// What the relaxed checks found, for the report line.
+#[derive(Default, Debug)]
+pub struct RelaxedStats {
+    pub cases: usize,
+    /// Commands compared with Clarabel's projection, and the largest distance to it
+    /// relative to `bound + ‖u_nom‖∞`.
+    pub compared: usize,
+    pub worst: f64,
+    /// Largest relative deviation of Clarabel's LP values from the exact ones.
+    pub lp_deviation: f64,
+}
+
+/// The relaxed command against the lexicographic LPs (Clarabel; exact vertices for ≤ 3
+/// inputs) + Clarabel's projection, for nominals of every magnitude along `dir`: `t*` is
+/// the same bits for all of them and equals the reference's; the command is the
+/// projection of the nominal onto the rows with the reference's allowances (KKT with
+/// multipliers of our own, and Clarabel's own solution where it resolves it).
+#[allow(clippy::too_many_arguments)] // a test helper: each argument is one axis of the check
+pub fn check_relaxed<const M: usize>(
+    what: &str,
+    bound: f64,
+    u_inf: f64,
+    rows: &(Vec<Row<M>>, Vec<f64>, Vec<Row<M>>),
+    tiers: &[u8],
+    dir: &SVector<f64, M>,
+    stats: &mut RelaxedStats,
+    mut run: impl FnMut(&SVector<f64, M>) -> (SVector<f64, M>, FilterStatus, f64, u32),
+) {
+    let (barrier, w, hard) = rows;
+    let mut t_ref = None;
+    stats.cases += 1;
+    // the allowances do not depend on the nominal (that is the point): computed once
+    let lex = lexicographic_tiered(&Qp::from_rows(dir, barrier, hard), w, tiers)
+        .unwrap_or_else(|e| panic!("{what}: {e}"));
+    stats.lp_deviation = stats.lp_deviation.max(lex.clarabel_lp_deviation);
+    for k in SCALES {
+        let un = dir * (k * bound / dir.amax());
+        let (u, status, t, flags) = run(&un);
+        assert_eq!(status, FilterStatus::Relaxed, "{what}: scale {k}");
+        assert_ne!(flags & faults::QP_INFEASIBLE_RELAXED, 0);
+        assert!(t > 0.0);
+        // the allowance cannot be bought: t* is the same for every nominal, bit for bit
+        match t_ref {
+            None => t_ref = Some(t),
+            Some(t0) => assert_eq!(
+                t.to_bits(),
+                f64::to_bits(t0),
+                "{what}: t* {t} at scale {k} vs {t0}"
+            ),
+        }
+        let qp = Qp::from_rows(&un, barrier, hard);
+        let t_tol = if M <= 3 { 1e-9 } else { 1e-6 };
+        assert!(
+            (t - lex.t1).abs() <= t_tol * lex.t1,
+            "{what}: t* {t} vs reference {}",
+            lex.t1
+        );
+        // the projection onto the relaxed rows, to 1e-7 of the problem's scale (the rows'
+        // gains differ by orders of magnitude: the allowances of later rounds are only as
+        // exact as the earlier rows' positions)
+        let u = dvec(&u);
+        let scale = bound + un.amax();
+        let (viol, stat, _) = kkt(&qp.relaxed(&lex.allowance), &u, 1e-7 * scale);
+        assert!(
+            viol <= 1e-7 * scale && stat <= 1e-7 * scale,
+            "{what} scale {k}: KKT violation {viol:e}, stationarity {stat:e}"
+        );
+        let relaxed = qp.relaxed(&lex.allowance);
+        let resolved = clarabel(&relaxed, u_inf).filter(|u_cl| {
+            // a reference that breaks the rows itself (interior-point tolerance on an
+            // ill-conditioned problem) is not one
+            let (v, st, _) = kkt(&relaxed, u_cl, 1e-7 * scale);
+            v <= 1e-9 * scale && st <= 1e-7 * scale
+        });
+        if let Some(u_cl) = resolved {
+            stats.compared += 1;
+            let err = (&u - &u_cl).amax() / scale;
+            stats.worst = stats.worst.max(err);
+            assert!(err <= 1e-6, "{what} scale {k}: {u} vs Clarabel {u_cl}");
+        }
+        // no barrier row is violated by more than t* of its weight, every hard row holds
+        let us = SVector::<f64, M>::from_column_slice(u.as_slice());
+        for (i, r) in barrier.iter().enumerate() {
+            assert!(
+                r.phi(&us) >= -w[i] * t * (1.0 + 1e-6) - 1e-9 * bound,
+                "{what}: row {i}"
+            );
+        }
+        for r in hard {
+            assert!(r.phi(&us) >= -1e-12 * scale);
+        }
+    }
+}
+
+/// A nominal, missing one time in ten.
+pub fn maybe<const M: usize>(rng: &mut Lcg, u: SVector<f64, M>) -> Option<SVector<f64, M>> {
+    (rng.next() > -0.8).then_some(u)
+}
+
+/// A robotic input near the start (the nominal is often feasible) or anywhere inside the
+/// limits, moving; its nominal near the holding torque or anywhere, missing one time in
+/// ten.
+pub fn rob_draw(rng: &mut Lcg) -> (RoboticInput, Option<Vector7>) {
+    let s = scenario();
+    let robot = robot();
+    let x = if rng.next() > 0.0 {
+        rob_input(&robot, theta0(&s) + rng.v7(1e-3), rng.v7(1e-3))
+    } else {
+        rob_input(&robot, theta_inside(&s, rng, 0.0), rng.v7(0.3))
+    };
+    let hold = -(x.m_eff * (x.drift + x.xi));
+    let k = if rng.next() > 0.0 { 1e-3 } else { 1.5 };
+    let u = hold + rng.v7(k * s.limits.joint_torque_max_nm);
+    (x, maybe(rng, u))
 }
