@@ -1,7 +1,7 @@
-//! The event ids that the ICD's C header (`sc_icd::c_header`) and the Python partner
-//! package publish are the ones sc-bus uses.
+//! The event ids that the ICD (`sc_icd::events`, in its C header and its Python partner
+//! package) publishes are the ones sc-bus uses.
 
-use sc_icd::c_header::events;
+use sc_icd::events;
 
 #[test]
 fn c_header_event_ids_are_sc_bus_ids() {

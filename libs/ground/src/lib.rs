@@ -3,8 +3,8 @@
 //!
 //! * [`launcher`]: starts every process from the config, supervises, tears down.
 //! * [`preflight`]: every role's program and the scenario checked before anything starts.
-//! * [`recorder`] / [`mcap_out`]: the telemetry recorder role (CSV, summary, MCAP for
-//!   Foxglove).
+//! * [`recorder`] / [`mcap`] (also reachable as `mcap_out`): the telemetry recorder
+//!   role (CSV, summary, MCAP for Foxglove).
 //! * [`latency`], [`hop_cost`], [`steal`], [`pm_qos`]: the latency bench of
 //!   `safe-capture bench latency` and what it needs.
 
@@ -12,7 +12,8 @@ pub mod error;
 pub mod hop_cost;
 pub mod latency;
 pub mod launcher;
-pub mod mcap_out;
+pub mod mcap;
+pub use self::mcap as mcap_out;
 pub mod pm_qos;
 pub mod preflight;
 pub mod recorder;

@@ -1,11 +1,12 @@
 /* safe_capture_icd.h -- the safe-capture ICD (docs/ICD.md) for C and C++ partners.
  *
- * GENERATED from the Rust crate sc-icd (libs/icd/src/c_header.rs); do not edit.
- * Regenerate: SC_WRITE_C_HEADER=1 cargo test -p sc-icd --test c_header
+ * GENERATED from the Rust crate sc-icd by sc-icd-gen (libs/icd-gen/src/c_header.rs);
+ * do not edit. Regenerate: SC_WRITE_ICD=1 cargo test -p sc-icd-gen
  *
  * Every message is the #[repr(C)] Rust struct of the same name: fixed size, 8-byte
  * aligned, no implicit padding (explicit _pad* fields are 0). Units and frames of
- * every field: docs/ICD.md and `cargo doc -p sc-icd`. Transport: iceoryx2 0.10.
+ * every field: the comment after it ([unit], frame, meaning), docs/ICD.md and
+ * `cargo doc -p sc-icd`. Transport: iceoryx2 0.10.
  */
 #ifndef SAFE_CAPTURE_ICD_H
 #define SAFE_CAPTURE_ICD_H
@@ -22,31 +23,31 @@ extern "C" {
 #define SC_ICD_ALIGNOF(t) _Alignof(t)
 #endif
 
-/* Array lengths */
-#define SC_N_JOINTS 7u
-#define SC_N_CONSTRAINTS_TRANSLATIONAL 2u
-#define SC_N_CONSTRAINTS_ATTITUDE 7u
-#define SC_N_CONSTRAINTS_ROBOTIC 42u
-#define SC_N_BARRIERS 51u
+/* Array lengths of the messages. */
+#define SC_N_JOINTS 7u /* Number of manipulator joints. */
+#define SC_N_CONSTRAINTS_TRANSLATIONAL 2u /* Number of translational safety constraints: AC (approach corridor), CAZ (collision-avoidance zone). */
+#define SC_N_CONSTRAINTS_ATTITUDE 7u /* Number of attitude safety constraints: ATT (pointing), ω1..3 upper, ω1..3 lower. */
+#define SC_N_CONSTRAINTS_ROBOTIC 42u /* Number of robotic safety constraints: θ limits 7, θ̇ upper 7, θ̇ lower 7, link-base 21. */
+#define SC_N_BARRIERS 51u /* Number of barriers of the whole safety layer (translational, attitude, robotic). */
 
 /* Service names (relative: a run's iceoryx2 global.prefix is "sc_<SC_RUN_ID>_"). Each pub/sub service has an event service of the same name. */
-#define SC_SERVICE_TICK "safe_capture/scheduler/tick"
-#define SC_SERVICE_CONTROL "safe_capture/scheduler/control"
-#define SC_SERVICE_SIM_STATE "safe_capture/sim/state"
-#define SC_SERVICE_PARTNER_STATE "safe_capture/partner/state"
-#define SC_SERVICE_NOMINAL_TRANSLATIONAL "safe_capture/nominal/translational"
-#define SC_SERVICE_NOMINAL_ATTITUDE "safe_capture/nominal/attitude"
-#define SC_SERVICE_NOMINAL_ROBOTIC "safe_capture/nominal/robotic"
-#define SC_SERVICE_SAFE_TRANSLATIONAL "safe_capture/safe/translational"
-#define SC_SERVICE_SAFE_ATTITUDE "safe_capture/safe/attitude"
-#define SC_SERVICE_SAFE_ROBOTIC "safe_capture/safe/robotic"
-#define SC_SERVICE_STEP_RESULT "safe_capture/sim/step_result"
-#define SC_SERVICE_HEALTH "safe_capture/health"
-#define SC_SERVICE_STAGE_DEADLINE "safe_capture/scheduler/deadline"
-#define SC_SERVICE_PREPARE "safe_capture/scheduler/prepare"
-#define SC_SERVICE_HANDSHAKE "safe_capture/handshake"
-#define SC_SERVICE_HANDSHAKE_READY "safe_capture/handshake/ready"
-#define SC_SERVICE_HANDSHAKE_GO "safe_capture/handshake/go"
+#define SC_SERVICE_TICK "safe_capture/scheduler/tick" /* Tick, QoS flight */
+#define SC_SERVICE_CONTROL "safe_capture/scheduler/control" /* Tick, QoS flight */
+#define SC_SERVICE_SIM_STATE "safe_capture/sim/state" /* SimState, QoS flight */
+#define SC_SERVICE_PARTNER_STATE "safe_capture/partner/state" /* SimState, QoS partner */
+#define SC_SERVICE_NOMINAL_TRANSLATIONAL "safe_capture/nominal/translational" /* NominalTranslational, QoS partner */
+#define SC_SERVICE_NOMINAL_ATTITUDE "safe_capture/nominal/attitude" /* NominalAttitude, QoS partner */
+#define SC_SERVICE_NOMINAL_ROBOTIC "safe_capture/nominal/robotic" /* NominalRobotic, QoS partner */
+#define SC_SERVICE_SAFE_TRANSLATIONAL "safe_capture/safe/translational" /* SafeTranslational, QoS flight */
+#define SC_SERVICE_SAFE_ATTITUDE "safe_capture/safe/attitude" /* SafeAttitude, QoS flight */
+#define SC_SERVICE_SAFE_ROBOTIC "safe_capture/safe/robotic" /* SafeRobotic, QoS flight */
+#define SC_SERVICE_STEP_RESULT "safe_capture/sim/step_result" /* StepResult, QoS flight */
+#define SC_SERVICE_HEALTH "safe_capture/health" /* Health, QoS flight */
+#define SC_SERVICE_STAGE_DEADLINE "safe_capture/scheduler/deadline" /* event only */
+#define SC_SERVICE_PREPARE "safe_capture/scheduler/prepare" /* event only */
+#define SC_SERVICE_HANDSHAKE "safe_capture/handshake" /* event only */
+#define SC_SERVICE_HANDSHAKE_READY "safe_capture/handshake/ready" /* event service `ready` of SC_SERVICE_HANDSHAKE */
+#define SC_SERVICE_HANDSHAKE_GO "safe_capture/handshake/go" /* event service `go` of SC_SERVICE_HANDSHAKE */
 
 /* iceoryx2 type names: give them when opening a service (iceoryx2 matches types by name, size and alignment) */
 #define SC_TYPE_NAME_TICK "safe_capture::v2::Tick"
@@ -60,73 +61,73 @@ extern "C" {
 #define SC_TYPE_NAME_STEP_RESULT "safe_capture::v1::StepResult"
 #define SC_TYPE_NAME_HEALTH "safe_capture::v1::Health"
 
-/* Event ids */
-#define SC_EVENT_SAMPLE 0u
-#define SC_EVENT_NOTIFIER_DEAD 1u
-#define SC_EVENT_NOTIFIER_DROPPED 2u
-#define SC_EVENT_ID_MAX 7u
-#define SC_EVENT_GO 3u
-#define SC_EVENT_HANDSHAKE_ID_OFFSET 8u
+/* Event ids of the partition's event services (`sc_bus::pubsub`, `sc_bus::handshake`; `libs/bus/tests/icd_constants.rs` checks them against sc-bus). */
+#define SC_EVENT_SAMPLE 0u /* A publisher notifies this after each send. */
+#define SC_EVENT_NOTIFIER_DEAD 1u /* iceoryx2 emits it when dead-node clean-up removes a crashed publisher's notifier. */
+#define SC_EVENT_NOTIFIER_DROPPED 2u /* iceoryx2 emits it when a publisher's notifier is dropped (it left). */
+#define SC_EVENT_ID_MAX 7u /* Largest event id on a data service. */
+#define SC_EVENT_GO 3u /* The coordinator's `go` on `<HANDSHAKE>/go`. */
+#define SC_EVENT_HANDSHAKE_ID_OFFSET 8u /* A participant notifies `<HANDSHAKE>/ready` with this + its role id. */
 
-/* due_mask bits (Tick, SimState): the subsystems due in a tick */
-#define SC_DUE_TRANSLATIONAL 1u
-#define SC_DUE_ATTITUDE 2u
-#define SC_DUE_ROBOTIC 4u
-#define SC_DUE_ALL 7u
+/* Bits of the `due_mask` fields (Tick, SimState; also `StepResult.fallback_mask` and `held_mask`): which subsystems' rate groups run in a tick (`sc_core::Subsystem::bit`). */
+#define SC_DUE_TRANSLATIONAL 1u /* Translational nominal controller and safety filter. */
+#define SC_DUE_ATTITUDE 2u /* Attitude nominal controller and safety filter. */
+#define SC_DUE_ROBOTIC 4u /* Robotic nominal controller and safety filter. */
+#define SC_DUE_ALL 7u /* All three. */
 
-/* Tick.command */
-#define SC_TICK_STEP 0u
-#define SC_TICK_STOP 1u
+/* Values of `Tick.command`. */
+#define SC_TICK_STEP 0u /* Run one control step. */
+#define SC_TICK_STOP 1u /* The run is over: every process finishes its outputs and exits. */
 
-/* Tick.clock_mode */
-#define SC_CLOCK_LOCK_STEP 0u
-#define SC_CLOCK_REAL_TIME 1u
-#define SC_CLOCK_SCALED 2u
+/* Values of `Tick.clock_mode`. */
+#define SC_CLOCK_LOCK_STEP 0u /* Lock-step: the next tick is sent as soon as the previous one completed. */
+#define SC_CLOCK_REAL_TIME 1u /* Real time: ticks paced by the wall clock at the rate-group period. */
+#define SC_CLOCK_SCALED 2u /* Scaled real time: paced at a configured multiple of real time. */
 
-/* StepResult.end */
-#define SC_END_RUNNING 0u
-#define SC_END_CAPTURED 1u
-#define SC_END_TIMEOUT 2u
-#define SC_END_SIMULATOR_FAILED 3u
+/* Values of `StepResult.end`. */
+#define SC_END_RUNNING 0u /* The mission goes on. */
+#define SC_END_CAPTURED 1u /* Captured: end-effector on the grasping point within tolerance. */
+#define SC_END_TIMEOUT 2u /* The configured duration elapsed. */
+#define SC_END_SIMULATOR_FAILED 3u /* The simulator failed (non-finite state or command). */
 
-/* StepResult.fault_flags, Health.last_fault_flags bits */
-#define SC_FAULT_STALE_INPUT 1u
-#define SC_FAULT_NON_FINITE_INPUT 2u
-#define SC_FAULT_SOLVER_FAILED 4u
-#define SC_FAULT_INFEASIBLE 8u
-#define SC_FAULT_SATURATED 16u
-#define SC_FAULT_NOMINAL_MISSING 32u
-#define SC_FAULT_DEADLINE_MISS 64u
-#define SC_FAULT_PEER_DEAD 128u
-#define SC_FAULT_REJECTED_COMMAND 256u
+/* Bits of `StepResult.fault_flags` and `Health.last_fault_flags`. */
+#define SC_FAULT_STALE_INPUT 1u /* Input older than one tick (stale state). */
+#define SC_FAULT_NON_FINITE_INPUT 2u /* Non-finite number in an input. */
+#define SC_FAULT_SOLVER_FAILED 4u /* QP solver failed; output falls back to the backup law. */
+#define SC_FAULT_INFEASIBLE 8u /* QP infeasible; constraints relaxed. */
+#define SC_FAULT_SATURATED 16u /* Output saturated at actuator limits. */
+#define SC_FAULT_NOMINAL_MISSING 32u /* Nominal command missing or invalid; filter used zero nominal input. */
+#define SC_FAULT_DEADLINE_MISS 64u /* Deadline missed. */
+#define SC_FAULT_PEER_DEAD 128u /* A peer process was detected dead. */
+#define SC_FAULT_REJECTED_COMMAND 256u /* The simulator rejected a safe command (not finite or beyond the input bounds, `sc_flight::admission`) and applied the filter's backup instead. */
 
-/* Role ids (Health.role; the handshake id is SC_EVENT_HANDSHAKE_ID_OFFSET + role) */
-#define SC_ROLE_SCHEDULER 0u
-#define SC_ROLE_SIMULATOR 1u
-#define SC_ROLE_NOMINAL_TRANSLATIONAL 2u
-#define SC_ROLE_NOMINAL_ATTITUDE 3u
-#define SC_ROLE_NOMINAL_ROBOTIC 4u
-#define SC_ROLE_SAFETY_TRANSLATIONAL 5u
-#define SC_ROLE_SAFETY_ATTITUDE 6u
-#define SC_ROLE_SAFETY_ROBOTIC 7u
-#define SC_ROLE_RECORDER 8u
+/* Values of `Health.state`. */
+#define SC_HEALTH_STARTING 0u /* Process started, ports being created. */
+#define SC_HEALTH_READY 1u /* Ports exist, handshake announced. */
+#define SC_HEALTH_RUNNING 2u /* Handling ticks. */
+#define SC_HEALTH_FAULTED 3u /* A fault was detected; see `last_fault_flags`. */
+#define SC_HEALTH_STOPPING 4u /* Shutting down. */
 
-/* Health.state */
-#define SC_HEALTH_STARTING 0u
-#define SC_HEALTH_READY 1u
-#define SC_HEALTH_RUNNING 2u
-#define SC_HEALTH_FAULTED 3u
-#define SC_HEALTH_STOPPING 4u
+/* Role ids, from the role table (sc_icd::ROLES, start order): Health.role; the handshake id is SC_EVENT_HANDSHAKE_ID_OFFSET + role */
+#define SC_ROLE_SCHEDULER 0u /* scheduler: rate groups, ticks (lock-step or real time), the end of the run, liveness of the peers */
+#define SC_ROLE_SIMULATOR 1u /* simulator: the plant: applies the re-validated safe commands (the backup when one is missing or rejected), publishes the state with the monitored barriers */
+#define SC_ROLE_NOMINAL_TRANSLATIONAL 2u /* nominal_translational: the nominal translational controller (MPC), replaceable by a partner's */
+#define SC_ROLE_NOMINAL_ATTITUDE 3u /* nominal_attitude: the nominal attitude controller (MPC), replaceable by a partner's */
+#define SC_ROLE_NOMINAL_ROBOTIC 4u /* nominal_robotic: the nominal robotic controller (joint-space PD), replaceable by a partner's */
+#define SC_ROLE_SAFETY_TRANSLATIONAL 5u /* safety_translational: the translational safety filter (approach corridor, collision-avoidance zone) */
+#define SC_ROLE_SAFETY_ATTITUDE 6u /* safety_attitude: the attitude safety filter (line of sight, body-rate limits), ξ = the translational safe force */
+#define SC_ROLE_SAFETY_ROBOTIC 7u /* safety_robotic: the robotic safety filter (joint angles and rates, link–base spheres), ξ = the translational and attitude safe commands */
+#define SC_ROLE_RECORDER 8u /* recorder: telemetry: the same telemetry.csv, timing.csv and summary.json as `safe-capture run`, plus recording.mcap and latency.csv */
 
-/* Tick -- safe_capture::v2::Tick, 40 B. Scheduler -> simulator, recorder (step); -> every process on the control service (stop). */
+/* Tick -- safe_capture::v2::Tick, 40 B. Scheduler → simulator, every other process (stop), recorder: start one control step. */
 typedef struct ScTick {
-    uint64_t tick;
-    uint32_t due_mask;
-    uint32_t clock_mode;
-    double t;
-    uint64_t send_ns;
-    uint32_t command;
-    uint32_t _pad0;
+    uint64_t tick; /* Tick index, starts at 0, +1 per tick of the fastest rate group [-] */
+    uint32_t due_mask; /* Subsystems due in this tick, bits of `due` (1 translational, 2 attitude, 4 robotic, 7 all) [-] */
+    uint32_t clock_mode; /* Clock mode, one of `clock_mode` (0 lock step, 1 real time, 2 scaled) [-] */
+    double t; /* Simulation time at which this step starts [s] */
+    uint64_t send_ns; /* Scheduler send stamp, host CLOCK_MONOTONIC [ns] */
+    uint32_t command; /* Step or stop (the run is over), one of `tick_command` (0 step, 1 stop) [-] */
+    uint32_t _pad0; /* Always 0 [-] */
 #if defined(__cplusplus) && __cplusplus >= 201703L
     /* the name iceoryx2's C++ API matches the payload type by */
     static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v2::Tick";
@@ -142,44 +143,44 @@ SC_ICD_STATIC_ASSERT(offsetof(ScTick, send_ns) == 24, "ScTick.send_ns: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScTick, command) == 32, "ScTick.command: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScTick, _pad0) == 36, "ScTick._pad0: offset");
 
-/* SimState -- safe_capture::v3::SimState, 1568 B. Simulator -> nominal controllers (partner/state), safety filters, recorder: the observation at the start of the step. */
+/* SimState -- safe_capture::v3::SimState, 1568 B. Simulator → nominal controllers, safety filters, recorder: the observation at the start of the step. Every field of `sc_core::Observation`, copied as f64, so that the stages compute exactly what they compute in one process. */
 typedef struct ScSimState {
-    uint64_t tick;
-    double t;
-    uint32_t due_mask;
-    uint32_t _pad0;
-    uint64_t tick_send_ns;
-    uint64_t recv_ns;
-    uint64_t publish_ns;
-    uint64_t step;
-    double r_h[3];
-    double v_h[3];
-    double r_r[3];
-    double v_r[3];
-    double q_hr[4];
-    double omega_h[3];
-    double omega_dot_h[3];
-    double mean_motion;
-    double q_rb[4];
-    double omega_b[3];
-    double theta[7];
-    double theta_dot[7];
-    double q_rt[4];
-    double omega_t[3];
-    double omega_dot_t[3];
-    double grasp_r[3];
-    double grasp_v_r[3];
-    double grasp_a_r[3];
-    double grasp_b[3];
-    double ee_b[3];
-    double ee_r[3];
-    double ee_v_r[3];
-    double com_h[3];
-    double com_v_h[3];
-    double com_r[3];
-    double com_v_r[3];
-    double barriers[51];
-    double barriers_between[51];
+    uint64_t tick; /* Tick index this state answers (= simulator step count at the base rate) [-] */
+    double t; /* Simulation time [s] */
+    uint32_t due_mask; /* Subsystems due in this tick, bits of `due` (1 translational, 2 attitude, 4 robotic, 7 all) [-] */
+    uint32_t _pad0; /* Always 0 [-] */
+    uint64_t tick_send_ns; /* Send stamp of the tick this state answers, host CLOCK_MONOTONIC [ns] */
+    uint64_t recv_ns; /* Stamp at which the simulator received the tick, host CLOCK_MONOTONIC [ns] */
+    uint64_t publish_ns; /* Publish stamp, host CLOCK_MONOTONIC [ns] */
+    uint64_t step; /* Simulator step counter [-] */
+    double r_h[3]; /* Servicer base origin relative to the target CoM, r_H, frame F_H [m] */
+    double v_h[3]; /* Derivative of r_H in the rotating Hill frame, frame F_H [m/s] */
+    double r_r[3]; /* Servicer base origin relative to the target CoM, r_R, frame F_R [m] */
+    double v_r[3]; /* Inertial derivative of r_R, frame F_R [m/s] */
+    double q_hr[4]; /* Attitude q_HR of F_R in F_H: rotates F_R vectors into F_H, frame F_R → F_H [-] */
+    double omega_h[3]; /* Angular velocity ω_H of F_H w.r.t. inertial, frame F_H [rad/s] */
+    double omega_dot_h[3]; /* Angular acceleration of F_H w.r.t. inertial, frame F_H [rad/s²] */
+    double mean_motion; /* Mean motion of the target orbit |ω_H| [rad/s] */
+    double q_rb[4]; /* Servicer attitude q_RB: rotates F_B vectors into F_R, frame F_B → F_R [-] */
+    double omega_b[3]; /* Servicer body rate ω_B w.r.t. inertial, frame F_B [rad/s] */
+    double theta[7]; /* Joint angles θ, frame M [rad] */
+    double theta_dot[7]; /* Joint rates θ̇, frame M [rad/s] */
+    double q_rt[4]; /* Target attitude q_RT: rotates F_T vectors into F_R, frame F_T → F_R [-] */
+    double omega_t[3]; /* Target body rate ω_T w.r.t. inertial, frame F_T [rad/s] */
+    double omega_dot_t[3]; /* Derivative of ω_T, frame F_T [rad/s²] */
+    double grasp_r[3]; /* Grasping point relative to the target CoM, frame F_R [m] */
+    double grasp_v_r[3]; /* Grasping point inertial velocity, frame F_R [m/s] */
+    double grasp_a_r[3]; /* Grasping point inertial acceleration, frame F_R [m/s²] */
+    double grasp_b[3]; /* Grasping point relative to the base origin, frame F_B [m] */
+    double ee_b[3]; /* End-effector position relative to the base origin, frame F_B [m] */
+    double ee_r[3]; /* End-effector position relative to the target CoM, frame F_R [m] */
+    double ee_v_r[3]; /* End-effector inertial velocity, frame F_R [m/s] */
+    double com_h[3]; /* Servicer system centre of mass relative to the target CoM, frame F_H [m] */
+    double com_v_h[3]; /* Derivative of com_h in the rotating Hill frame, frame F_H [m/s] */
+    double com_r[3]; /* Servicer system centre of mass relative to the target CoM, frame F_R [m] */
+    double com_v_r[3]; /* Inertial velocity of the servicer system centre of mass, frame F_R [m/s] */
+    double barriers[51]; /* Every barrier h at this state, from the simulator's own state (the safety monitor), in telemetry order; NaN (null in the MCAP) = not evaluated [unit per constraint] */
+    double barriers_between[51]; /* The smallest value of every barrier over the physics steps since the previous state message (this state included) [unit per constraint] */
 #if defined(__cplusplus) && __cplusplus >= 201703L
     /* the name iceoryx2's C++ API matches the payload type by */
     static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v3::SimState";
@@ -224,15 +225,15 @@ SC_ICD_STATIC_ASSERT(offsetof(ScSimState, com_v_r) == 728, "ScSimState.com_v_r: 
 SC_ICD_STATIC_ASSERT(offsetof(ScSimState, barriers) == 752, "ScSimState.barriers: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSimState, barriers_between) == 1160, "ScSimState.barriers_between: offset");
 
-/* NominalTranslational -- safe_capture::v2::NominalTranslational, 64 B. Nominal translational controller -> translational safety filter: f_h, Hill frame [N]. */
+/* NominalTranslational -- safe_capture::v2::NominalTranslational, 64 B. Nominal translational controller → translational safety filter, recorder. */
 typedef struct ScNominalTranslational {
-    uint64_t tick;
-    double t;
-    uint32_t valid;
-    uint32_t phase;
-    uint64_t recv_ns;
-    uint64_t publish_ns;
-    double f_h[3];
+    uint64_t tick; /* Tick index this command answers [-] */
+    double t; /* Simulation time of the state used [s] */
+    uint32_t valid; /* 1 if the controller ran on valid inputs, 0 otherwise [-] */
+    uint32_t phase; /* Index of the mission phase (0-based, scenario order) [-] */
+    uint64_t recv_ns; /* Stamp at which the state was received, host CLOCK_MONOTONIC [ns] */
+    uint64_t publish_ns; /* Publish stamp, host CLOCK_MONOTONIC [ns] */
+    double f_h[3]; /* Commanded force f_H, unsaturated, frame F_H [N] */
 #if defined(__cplusplus) && __cplusplus >= 201703L
     /* the name iceoryx2's C++ API matches the payload type by */
     static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v2::NominalTranslational";
@@ -248,15 +249,15 @@ SC_ICD_STATIC_ASSERT(offsetof(ScNominalTranslational, recv_ns) == 24, "ScNominal
 SC_ICD_STATIC_ASSERT(offsetof(ScNominalTranslational, publish_ns) == 32, "ScNominalTranslational.publish_ns: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScNominalTranslational, f_h) == 40, "ScNominalTranslational.f_h: offset");
 
-/* NominalAttitude -- safe_capture::v2::NominalAttitude, 64 B. Nominal attitude controller -> attitude safety filter: tau_b, base frame [N m]. */
+/* NominalAttitude -- safe_capture::v2::NominalAttitude, 64 B. Nominal attitude controller → attitude safety filter, recorder. */
 typedef struct ScNominalAttitude {
-    uint64_t tick;
-    double t;
-    uint32_t valid;
-    uint32_t phase;
-    uint64_t recv_ns;
-    uint64_t publish_ns;
-    double tau_b[3];
+    uint64_t tick; /* Tick index this command answers [-] */
+    double t; /* Simulation time of the state used [s] */
+    uint32_t valid; /* 1 if the controller ran on valid inputs, 0 otherwise [-] */
+    uint32_t phase; /* Index of the mission phase (0-based, scenario order) [-] */
+    uint64_t recv_ns; /* Stamp at which the state was received, host CLOCK_MONOTONIC [ns] */
+    uint64_t publish_ns; /* Publish stamp, host CLOCK_MONOTONIC [ns] */
+    double tau_b[3]; /* Commanded torque τ_B, unsaturated, frame F_B [N·m] */
 #if defined(__cplusplus) && __cplusplus >= 201703L
     /* the name iceoryx2's C++ API matches the payload type by */
     static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v2::NominalAttitude";
@@ -272,15 +273,15 @@ SC_ICD_STATIC_ASSERT(offsetof(ScNominalAttitude, recv_ns) == 24, "ScNominalAttit
 SC_ICD_STATIC_ASSERT(offsetof(ScNominalAttitude, publish_ns) == 32, "ScNominalAttitude.publish_ns: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScNominalAttitude, tau_b) == 40, "ScNominalAttitude.tau_b: offset");
 
-/* NominalRobotic -- safe_capture::v2::NominalRobotic, 96 B. Nominal robotic controller -> robotic safety filter: tau_m, joints [N m]. */
+/* NominalRobotic -- safe_capture::v2::NominalRobotic, 96 B. Nominal robotic controller → robotic safety filter, recorder. */
 typedef struct ScNominalRobotic {
-    uint64_t tick;
-    double t;
-    uint32_t valid;
-    uint32_t phase;
-    uint64_t recv_ns;
-    uint64_t publish_ns;
-    double tau_m[7];
+    uint64_t tick; /* Tick index this command answers [-] */
+    double t; /* Simulation time of the state used [s] */
+    uint32_t valid; /* 1 if the controller ran on valid inputs, 0 otherwise [-] */
+    uint32_t phase; /* Index of the mission phase (0-based, scenario order) [-] */
+    uint64_t recv_ns; /* Stamp at which the state was received, host CLOCK_MONOTONIC [ns] */
+    uint64_t publish_ns; /* Publish stamp, host CLOCK_MONOTONIC [ns] */
+    double tau_m[7]; /* Commanded joint torques τ_M, unsaturated, frame M [N·m] */
 #if defined(__cplusplus) && __cplusplus >= 201703L
     /* the name iceoryx2's C++ API matches the payload type by */
     static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v2::NominalRobotic";
@@ -296,25 +297,25 @@ SC_ICD_STATIC_ASSERT(offsetof(ScNominalRobotic, recv_ns) == 24, "ScNominalRoboti
 SC_ICD_STATIC_ASSERT(offsetof(ScNominalRobotic, publish_ns) == 32, "ScNominalRobotic.publish_ns: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScNominalRobotic, tau_m) == 40, "ScNominalRobotic.tau_m: offset");
 
-/* SafeTranslational -- safe_capture::v2::SafeTranslational, 160 B. Translational safety filter -> attitude/robotic filters, simulator, recorder. */
+/* SafeTranslational -- safe_capture::v2::SafeTranslational, 160 B. Translational safety filter → attitude and robotic filters, simulator, recorder. Constraint order: AC, CAZ. */
 typedef struct ScSafeTranslational {
-    uint64_t tick;
-    double t;
-    uint64_t recv_ns;
-    uint64_t publish_ns;
-    uint64_t active_mask;
-    uint64_t solve_ns;
-    uint32_t solver_status;
-    uint32_t iterations;
-    uint32_t fault_flags;
-    uint32_t n_constraints;
-    uint32_t phase;
-    uint32_t solve_cpu_ns;
-    double slack;
-    double h[2];
-    double phi[2];
-    double u[3];
-    double actuated[3];
+    uint64_t tick; /* Tick index this command answers [-] */
+    double t; /* Simulation time of the state used [s] */
+    uint64_t recv_ns; /* Stamp at which the last input of this tick arrived, host CLOCK_MONOTONIC [ns] */
+    uint64_t publish_ns; /* Publish stamp, host CLOCK_MONOTONIC [ns] */
+    uint64_t active_mask; /* Bit i set = constraint i active (Φ_i ≈ 0) [-] */
+    uint64_t solve_ns; /* Wall time of the filter call [ns] */
+    uint32_t solver_status; /* `sc_cbf::FilterStatus`: 0 skipped, 1 solved, 2 relaxed, 3 fallback [-] */
+    uint32_t iterations; /* QP solver iterations [-] */
+    uint32_t fault_flags; /* `sc_cbf::faults` bits (5 upstream_missing, 7 nominal_missing: docs/ICD.md) [-] */
+    uint32_t n_constraints; /* Number of constraints in `h` and `phi` [-] */
+    uint32_t phase; /* Mission phase of the nominal command filtered (0-based) [-] */
+    uint32_t solve_cpu_ns; /* CPU time of the filter call on its thread, saturating at u32::MAX [ns] */
+    double slack; /* Slack of the relaxed QP (0 otherwise), normalised rows [-] */
+    double h[2]; /* Barrier values h_i the filter evaluated; NaN (null in the MCAP) = not evaluated [unit per constraint] */
+    double phi[2]; /* CBF conditions Φ_i at the safe command [unit per constraint / s] */
+    double u[3]; /* Safe force f_H, frame F_H [N] */
+    double actuated[3]; /* Safe force f_B = R_BH f_H (what the thrusters apply), frame F_B [N] */
 #if defined(__cplusplus) && __cplusplus >= 201703L
     /* the name iceoryx2's C++ API matches the payload type by */
     static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v2::SafeTranslational";
@@ -340,25 +341,25 @@ SC_ICD_STATIC_ASSERT(offsetof(ScSafeTranslational, phi) == 96, "ScSafeTranslatio
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeTranslational, u) == 112, "ScSafeTranslational.u: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeTranslational, actuated) == 136, "ScSafeTranslational.actuated: offset");
 
-/* SafeAttitude -- safe_capture::v2::SafeAttitude, 240 B. Attitude safety filter -> robotic filter, simulator, recorder. */
+/* SafeAttitude -- safe_capture::v2::SafeAttitude, 240 B. Attitude safety filter → robotic filter, simulator, recorder. Constraint order: ATT, ω1..3 upper, ω1..3 lower. */
 typedef struct ScSafeAttitude {
-    uint64_t tick;
-    double t;
-    uint64_t recv_ns;
-    uint64_t publish_ns;
-    uint64_t active_mask;
-    uint64_t solve_ns;
-    uint32_t solver_status;
-    uint32_t iterations;
-    uint32_t fault_flags;
-    uint32_t n_constraints;
-    uint32_t phase;
-    uint32_t solve_cpu_ns;
-    double slack;
-    double h[7];
-    double phi[7];
-    double u[3];
-    double actuated[3];
+    uint64_t tick; /* Tick index this command answers [-] */
+    double t; /* Simulation time of the state used [s] */
+    uint64_t recv_ns; /* Stamp at which the last input of this tick arrived, host CLOCK_MONOTONIC [ns] */
+    uint64_t publish_ns; /* Publish stamp, host CLOCK_MONOTONIC [ns] */
+    uint64_t active_mask; /* Bit i set = constraint i active (Φ_i ≈ 0) [-] */
+    uint64_t solve_ns; /* Wall time of the filter call [ns] */
+    uint32_t solver_status; /* `sc_cbf::FilterStatus`: 0 skipped, 1 solved, 2 relaxed, 3 fallback [-] */
+    uint32_t iterations; /* QP solver iterations [-] */
+    uint32_t fault_flags; /* `sc_cbf::faults` bits (5 upstream_missing, 7 nominal_missing: docs/ICD.md) [-] */
+    uint32_t n_constraints; /* Number of constraints in `h` and `phi` [-] */
+    uint32_t phase; /* Mission phase of the nominal command filtered (0-based) [-] */
+    uint32_t solve_cpu_ns; /* CPU time of the filter call on its thread, saturating at u32::MAX [ns] */
+    double slack; /* Slack of the relaxed QP (0 otherwise), normalised rows [-] */
+    double h[7]; /* Barrier values h_i the filter evaluated; NaN (null in the MCAP) = not evaluated [unit per constraint] */
+    double phi[7]; /* CBF conditions Φ_i at the safe command [unit per constraint / s] */
+    double u[3]; /* Safe torque τ_B, frame F_B [N·m] */
+    double actuated[3]; /* Actuated torque τ_B (equals `u`), frame F_B [N·m] */
 #if defined(__cplusplus) && __cplusplus >= 201703L
     /* the name iceoryx2's C++ API matches the payload type by */
     static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v2::SafeAttitude";
@@ -384,25 +385,25 @@ SC_ICD_STATIC_ASSERT(offsetof(ScSafeAttitude, phi) == 136, "ScSafeAttitude.phi: 
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeAttitude, u) == 192, "ScSafeAttitude.u: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeAttitude, actuated) == 216, "ScSafeAttitude.actuated: offset");
 
-/* SafeRobotic -- safe_capture::v2::SafeRobotic, 864 B. Robotic safety filter -> simulator, recorder. */
+/* SafeRobotic -- safe_capture::v2::SafeRobotic, 864 B. Robotic safety filter → simulator, recorder. Constraint order: θ limits 0..7, θ̇ upper 7..14, θ̇ lower 14..21, link-base 21..42. */
 typedef struct ScSafeRobotic {
-    uint64_t tick;
-    double t;
-    uint64_t recv_ns;
-    uint64_t publish_ns;
-    uint64_t active_mask;
-    uint64_t solve_ns;
-    uint32_t solver_status;
-    uint32_t iterations;
-    uint32_t fault_flags;
-    uint32_t n_constraints;
-    uint32_t phase;
-    uint32_t solve_cpu_ns;
-    double slack;
-    double h[42];
-    double phi[42];
-    double u[7];
-    double actuated[7];
+    uint64_t tick; /* Tick index this command answers [-] */
+    double t; /* Simulation time of the state used [s] */
+    uint64_t recv_ns; /* Stamp at which the last input of this tick arrived, host CLOCK_MONOTONIC [ns] */
+    uint64_t publish_ns; /* Publish stamp, host CLOCK_MONOTONIC [ns] */
+    uint64_t active_mask; /* Bit i set = constraint i active (Φ_i ≈ 0) [-] */
+    uint64_t solve_ns; /* Wall time of the filter call [ns] */
+    uint32_t solver_status; /* `sc_cbf::FilterStatus`: 0 skipped, 1 solved, 2 relaxed, 3 fallback [-] */
+    uint32_t iterations; /* QP solver iterations [-] */
+    uint32_t fault_flags; /* `sc_cbf::faults` bits (5 upstream_missing, 7 nominal_missing: docs/ICD.md) [-] */
+    uint32_t n_constraints; /* Number of constraints in `h` and `phi` [-] */
+    uint32_t phase; /* Mission phase of the nominal command filtered (0-based) [-] */
+    uint32_t solve_cpu_ns; /* CPU time of the filter call on its thread, saturating at u32::MAX [ns] */
+    double slack; /* Slack of the relaxed QP (0 otherwise), normalised rows [-] */
+    double h[42]; /* Barrier values h_i the filter evaluated; NaN (null in the MCAP) = not evaluated [unit per constraint] */
+    double phi[42]; /* CBF conditions Φ_i at the safe command [unit per constraint / s] */
+    double u[7]; /* Safe joint torques τ_M, frame M [N·m] */
+    double actuated[7]; /* Actuated joint torques τ_M (equals `u`), frame M [N·m] */
 #if defined(__cplusplus) && __cplusplus >= 201703L
     /* the name iceoryx2's C++ API matches the payload type by */
     static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v2::SafeRobotic";
@@ -428,19 +429,19 @@ SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, phi) == 416, "ScSafeRobotic.phi: of
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, u) == 752, "ScSafeRobotic.u: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, actuated) == 808, "ScSafeRobotic.actuated: offset");
 
-/* StepResult -- safe_capture::v1::StepResult, 152 B. Simulator -> scheduler, recorder: the applied command and how the step ended. */
+/* StepResult -- safe_capture::v1::StepResult, 152 B. Simulator → scheduler, recorder: the command applied over the step and how the step ended. Sent once all due safe commands of the tick are in (or their deadline passed and the simulator used the filter's fallback). */
 typedef struct ScStepResult {
-    uint64_t tick;
-    double t;
-    uint32_t end;
-    uint32_t fallback_mask;
-    uint32_t held_mask;
-    uint32_t fault_flags;
-    uint64_t safe_recv_ns;
-    uint64_t publish_ns;
-    double force_b[3];
-    double torque_b[3];
-    double tau[7];
+    uint64_t tick; /* Tick index [-] */
+    double t; /* Simulation time at the start of the step [s] */
+    uint32_t end; /* How the step ended, one of `end` (0 running, 1 captured, 2 timeout, 3 simulator failed) [-] */
+    uint32_t fallback_mask; /* Subsystems (bits of `due`) whose command is the filter fallback computed by the simulator because the safe command was missing at the deadline (1 translational, 2 attitude, 4 robotic, 7 all) [-] */
+    uint32_t held_mask; /* Subsystems (bits of `due`) whose command was held from an earlier tick (slower rate group) (1 translational, 2 attitude, 4 robotic, 7 all) [-] */
+    uint32_t fault_flags; /* Partition fault flags, bits of `fault` (1 stale input, 2 non finite input, 4 solver failed, 8 infeasible, 16 saturated, 32 nominal missing, 64 deadline miss, 128 peer dead, 256 rejected command) [-] */
+    uint64_t safe_recv_ns; /* Stamp at which the robotic safe command (the tick's last) was delivered, host CLOCK_MONOTONIC [ns] */
+    uint64_t publish_ns; /* Publish stamp, host CLOCK_MONOTONIC [ns] */
+    double force_b[3]; /* Applied base force f_B, frame F_B [N] */
+    double torque_b[3]; /* Applied base torque τ_B, frame F_B [N·m] */
+    double tau[7]; /* Applied joint torques τ_M, frame M [N·m] */
 #if defined(__cplusplus) && __cplusplus >= 201703L
     /* the name iceoryx2's C++ API matches the payload type by */
     static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v1::StepResult";
@@ -460,17 +461,17 @@ SC_ICD_STATIC_ASSERT(offsetof(ScStepResult, force_b) == 48, "ScStepResult.force_
 SC_ICD_STATIC_ASSERT(offsetof(ScStepResult, torque_b) == 72, "ScStepResult.torque_b: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScStepResult, tau) == 96, "ScStepResult.tau: offset");
 
-/* Health -- safe_capture::v1::Health, 56 B. Recorder -> scheduler: progress (lock-step flow control). */
+/* Health -- safe_capture::v1::Health, 56 B. Recorder → scheduler: the recorder's progress (lock-step flow control); the fields are those of a health report any process could publish. */
 typedef struct ScHealth {
-    uint32_t role;
-    uint32_t pid;
-    uint32_t state;
-    uint32_t last_fault_flags;
-    uint64_t ticks_handled;
-    uint64_t deadline_misses;
-    uint64_t cycle_slips;
-    uint64_t last_tick;
-    uint64_t publish_ns;
+    uint32_t role; /* Role id: the role's position in the role table `ROLES` [-] */
+    uint32_t pid; /* Operating-system process id [-] */
+    uint32_t state; /* State, one of `health_state` (0 starting, 1 ready, 2 running, 3 faulted, 4 stopping) [-] */
+    uint32_t last_fault_flags; /* Last fault flags, bits of `fault` (1 stale input, 2 non finite input, 4 solver failed, 8 infeasible, 16 saturated, 32 nominal missing, 64 deadline miss, 128 peer dead, 256 rejected command) [-] */
+    uint64_t ticks_handled; /* Ticks handled since start [-] */
+    uint64_t deadline_misses; /* Deadline misses since start [-] */
+    uint64_t cycle_slips; /* Cycle slips (a tick answered late or skipped) since start [-] */
+    uint64_t last_tick; /* Last tick index handled [-] */
+    uint64_t publish_ns; /* Publish stamp, host CLOCK_MONOTONIC [ns] */
 #if defined(__cplusplus) && __cplusplus >= 201703L
     /* the name iceoryx2's C++ API matches the payload type by */
     static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v1::Health";

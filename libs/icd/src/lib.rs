@@ -1,9 +1,19 @@
 //! Interface control document (ICD) of the safe-capture partition: the fixed-size
-//! messages that the processes exchange over iceoryx2 shared memory.
+//! messages that the processes exchange over iceoryx2 shared memory, the constants
+//! a partner needs, the services and the role table.
 //!
-//! Rules every message follows (checked by compile-time guards here and by
-//! `tests/python_layout.rs` against the Python mirror `scripts/python/sc_partner/icd.py`,
-//! and by `tests/c_header.rs` against the generated C header `include/safe_capture_icd.h`):
+//! **One source.** Each message is declared once here, with the unit, frame and
+//! meaning of every field; the declaration gives both the Rust type and its
+//! description ([`spec::Message::SPEC`], all of them in [`MESSAGES`]). The same holds
+//! for the constant groups ([`CONSTANT_GROUPS`]) and the services
+//! ([`services::SERVICES`]). The ground crate `sc-icd-gen` renders these descriptions
+//! and the role table [`ROLES`] as the C header `include/safe_capture_icd.h`, the
+//! Python module `scripts/python/sc_partner/_icd.py`, the MCAP JSON schemas of the
+//! recorder and the tables of docs/ICD.md (checked in; `SC_WRITE_ICD=1 cargo test -p
+//! sc-icd-gen` rewrites them).
+//!
+//! Rules every message follows (checked by compile-time guards here, by
+//! `tests/python_layout.rs` against the Python module and by sc-icd-gen's C test):
 //! - `#[repr(C)]`, `Copy`, derives `ZeroCopySend` with an explicit, versioned
 //!   `#[type_name("safe_capture::v1::...")]` (the name iceoryx2 uses to match types
 //!   across processes and languages; a mismatch fails cleanly at open time).
@@ -14,34 +24,171 @@
 //! - times: `t` is simulation time [s]; `*_ns` are `CLOCK_MONOTONIC` stamps [ns]
 //!   of the machine (see [`monotonic_ns`]).
 //!
-//! Frames: F_H Hill (LVLH) frame of the target orbit, F_R reference frame,
-//! F_B servicer base (body) frame, F_T target body frame, M manipulator joint space.
-//! Quaternions are scalar-first `[w, x, y, z]`; `q_XY` rotates F_Y vectors into F_X.
+//! Frames ([`spec::Frame`]): F_H Hill (LVLH) frame of the target orbit, F_R reference
+//! frame, F_B servicer base (body) frame, F_T target body frame, M manipulator joint
+//! space. Quaternions are scalar-first `[w, x, y, z]`; `q_XY` rotates F_Y vectors into F_X.
 //!
-//! To add a field: append it before the end, keep 8-byte alignment, bump the
-//! size guard, the Python mirror and `docs/ICD.md`. To change meaning or order:
-//! create a `v2` type name.
+//! To add a field: append it before the end, keep 8-byte alignment, bump the size
+//! guard, regenerate the artefacts. To change meaning or order: create a `v2` type name.
 
 use iceoryx2::prelude::ZeroCopySend;
 
-pub mod c_header;
+#[macro_use]
+mod macros;
 pub mod roles;
 pub mod services;
+pub mod spec;
 pub use roles::{ROLES, Rate, Role, RoleKind};
 pub use sc_core::Subsystem;
+use sc_core::SubsystemSet;
 pub use services::ServiceName;
+pub use spec::Message;
 
-/// Number of manipulator joints.
-pub const N_JOINTS: usize = 7;
-/// Number of translational safety constraints: AC (approach corridor), CAZ (collision-avoidance zone).
-pub const N_CONSTRAINTS_TRANSLATIONAL: usize = 2;
-/// Number of attitude safety constraints: ATT (pointing), ω1..3 upper, ω1..3 lower.
-pub const N_CONSTRAINTS_ATTITUDE: usize = 7;
-/// Number of robotic safety constraints: θ limits 7, θ̇ upper 7, θ̇ lower 7, link-base 21.
-pub const N_CONSTRAINTS_ROBOTIC: usize = 42;
-/// Number of barriers of the whole safety layer (translational, attitude, robotic).
-pub const N_BARRIERS: usize =
-    N_CONSTRAINTS_TRANSLATIONAL + N_CONSTRAINTS_ATTITUDE + N_CONSTRAINTS_ROBOTIC;
+icd_constants! {
+    /// Array lengths of the messages.
+    pub mod lengths: usize = "" {
+        /// Number of manipulator joints.
+        N_JOINTS = 7,
+        /// Number of translational safety constraints: AC (approach corridor), CAZ
+        /// (collision-avoidance zone).
+        N_CONSTRAINTS_TRANSLATIONAL = 2,
+        /// Number of attitude safety constraints: ATT (pointing), ω1..3 upper, ω1..3 lower.
+        N_CONSTRAINTS_ATTITUDE = 7,
+        /// Number of robotic safety constraints: θ limits 7, θ̇ upper 7, θ̇ lower 7,
+        /// link-base 21.
+        N_CONSTRAINTS_ROBOTIC = 42,
+        /// Number of barriers of the whole safety layer (translational, attitude, robotic).
+        N_BARRIERS = N_CONSTRAINTS_TRANSLATIONAL + N_CONSTRAINTS_ATTITUDE + N_CONSTRAINTS_ROBOTIC,
+    }
+}
+pub use lengths::{
+    N_BARRIERS, N_CONSTRAINTS_ATTITUDE, N_CONSTRAINTS_ROBOTIC, N_CONSTRAINTS_TRANSLATIONAL,
+    N_JOINTS,
+};
+
+icd_constants! {
+    /// Event ids of the partition's event services (`sc_bus::pubsub`,
+    /// `sc_bus::handshake`; `libs/bus/tests/icd_constants.rs` checks them against sc-bus).
+    pub mod events: u32 = "EVENT" {
+        /// A publisher notifies this after each send.
+        SAMPLE = 0,
+        /// iceoryx2 emits it when dead-node clean-up removes a crashed publisher's notifier.
+        NOTIFIER_DEAD = 1,
+        /// iceoryx2 emits it when a publisher's notifier is dropped (it left).
+        NOTIFIER_DROPPED = 2,
+        /// Largest event id on a data service.
+        ID_MAX = 7,
+        /// The coordinator's `go` on `<HANDSHAKE>/go`.
+        GO = 3,
+        /// A participant notifies `<HANDSHAKE>/ready` with this + its role id.
+        HANDSHAKE_ID_OFFSET = 8,
+    }
+}
+
+icd_constants! {
+    /// Bits of the `due_mask` fields (Tick, SimState; also `StepResult.fallback_mask`
+    /// and `held_mask`): which subsystems' rate groups run in a tick
+    /// (`sc_core::Subsystem::bit`).
+    pub mod due: u32 = "DUE" {
+        /// Translational nominal controller and safety filter.
+        TRANSLATIONAL = Subsystem::Translational.bit(),
+        /// Attitude nominal controller and safety filter.
+        ATTITUDE = Subsystem::Attitude.bit(),
+        /// Robotic nominal controller and safety filter.
+        ROBOTIC = Subsystem::Robotic.bit(),
+        /// All three.
+        ALL = SubsystemSet::ALL.bits(),
+    }
+}
+
+icd_constants! {
+    /// Values of `Tick.command`.
+    pub mod tick_command: u32 = "TICK" {
+        /// Run one control step.
+        STEP = 0,
+        /// The run is over: every process finishes its outputs and exits.
+        STOP = 1,
+    }
+}
+
+icd_constants! {
+    /// Values of `Tick.clock_mode`.
+    pub mod clock_mode: u32 = "CLOCK" {
+        /// Lock-step: the next tick is sent as soon as the previous one completed.
+        LOCK_STEP = 0,
+        /// Real time: ticks paced by the wall clock at the rate-group period.
+        REAL_TIME = 1,
+        /// Scaled real time: paced at a configured multiple of real time.
+        SCALED = 2,
+    }
+}
+
+icd_constants! {
+    /// Values of `StepResult.end`.
+    pub mod end: u32 = "END" {
+        /// The mission goes on.
+        RUNNING = 0,
+        /// Captured: end-effector on the grasping point within tolerance.
+        CAPTURED = 1,
+        /// The configured duration elapsed.
+        TIMEOUT = 2,
+        /// The simulator failed (non-finite state or command).
+        SIMULATOR_FAILED = 3,
+    }
+}
+
+icd_constants! {
+    /// Bits of `StepResult.fault_flags` and `Health.last_fault_flags`.
+    pub mod fault: u32 = "FAULT" {
+        /// Input older than one tick (stale state).
+        STALE_INPUT = 1 << 0,
+        /// Non-finite number in an input.
+        NON_FINITE_INPUT = 1 << 1,
+        /// QP solver failed; output falls back to the backup law.
+        SOLVER_FAILED = 1 << 2,
+        /// QP infeasible; constraints relaxed.
+        INFEASIBLE = 1 << 3,
+        /// Output saturated at actuator limits.
+        SATURATED = 1 << 4,
+        /// Nominal command missing or invalid; filter used zero nominal input.
+        NOMINAL_MISSING = 1 << 5,
+        /// Deadline missed.
+        DEADLINE_MISS = 1 << 6,
+        /// A peer process was detected dead.
+        PEER_DEAD = 1 << 7,
+        /// The simulator rejected a safe command (not finite or beyond the input bounds,
+        /// `sc_flight::admission`) and applied the filter's backup instead.
+        REJECTED_COMMAND = 1 << 8,
+    }
+}
+
+icd_constants! {
+    /// Values of `Health.state`.
+    pub mod health_state: u32 = "HEALTH" {
+        /// Process started, ports being created.
+        STARTING = 0,
+        /// Ports exist, handshake announced.
+        READY = 1,
+        /// Handling ticks.
+        RUNNING = 2,
+        /// A fault was detected; see `last_fault_flags`.
+        FAULTED = 3,
+        /// Shutting down.
+        STOPPING = 4,
+    }
+}
+
+/// Every constant group of the ICD, in the order of the C header and docs/ICD.md.
+pub const CONSTANT_GROUPS: [&spec::ConstGroup; 8] = [
+    &lengths::GROUP,
+    &events::GROUP,
+    &due::GROUP,
+    &tick_command::GROUP,
+    &clock_mode::GROUP,
+    &end::GROUP,
+    &fault::GROUP,
+    &health_state::GROUP,
+];
 
 /// Monotonic clock stamp in ns (`CLOCK_MONOTONIC` of this machine, shared by all processes).
 pub fn monotonic_ns() -> u64 {
@@ -65,392 +212,318 @@ pub trait Zeroed: Sized + Copy {
     fn zeroed() -> Self;
 }
 
-macro_rules! zeroed {
-    ($($t:ty),*) => {$(
-        impl Zeroed for $t {
-            fn zeroed() -> Self {
-                // SAFETY: the type is repr(C) made only of integers and f64, for which
-                // the all-zero bit pattern is a valid value.
-                unsafe { core::mem::zeroed() }
+icd_message! {
+    /// Scheduler → simulator, every other process (stop), recorder: start one control step.
+    #[type_name("safe_capture::v2::Tick")]
+    pub struct Tick {
+        /// Tick index, starts at 0, +1 per tick of the fastest rate group
+        pub tick: u64 = ["-"],
+        /// Subsystems due in this tick, bits of `due`
+        pub due_mask: u32 = ["-"] => due,
+        /// Clock mode, one of `clock_mode`
+        pub clock_mode: u32 = ["-"] => clock_mode,
+        /// Simulation time at which this step starts
+        pub t: f64 = ["s"],
+        /// Scheduler send stamp, host CLOCK_MONOTONIC
+        pub send_ns: u64 = ["ns"],
+        /// Step or stop (the run is over), one of `tick_command`
+        pub command: u32 = ["-"] => tick_command,
+        /// Always 0
+        pub _pad0: u32 = ["-"],
+    }
+}
+
+icd_message! {
+    /// Simulator → nominal controllers, safety filters, recorder: the observation at
+    /// the start of the step. Every field of `sc_core::Observation`, copied as f64, so
+    /// that the stages compute exactly what they compute in one process.
+    #[type_name("safe_capture::v3::SimState")]
+    pub struct SimState {
+        /// Tick index this state answers (= simulator step count at the base rate)
+        pub tick: u64 = ["-"],
+        /// Simulation time
+        pub t: f64 = ["s"],
+        /// Subsystems due in this tick, bits of `due`
+        pub due_mask: u32 = ["-"] => due,
+        /// Always 0
+        pub _pad0: u32 = ["-"],
+        /// Send stamp of the tick this state answers, host CLOCK_MONOTONIC
+        pub tick_send_ns: u64 = ["ns"],
+        /// Stamp at which the simulator received the tick, host CLOCK_MONOTONIC
+        pub recv_ns: u64 = ["ns"],
+        /// Publish stamp, host CLOCK_MONOTONIC
+        pub publish_ns: u64 = ["ns"],
+        /// Simulator step counter
+        pub step: u64 = ["-"],
+        /// Servicer base origin relative to the target CoM, r_H
+        pub r_h: [f64; 3] = ["m", Hill, Xyz],
+        /// Derivative of r_H in the rotating Hill frame
+        pub v_h: [f64; 3] = ["m/s", Hill, Xyz],
+        /// Servicer base origin relative to the target CoM, r_R
+        pub r_r: [f64; 3] = ["m", Reference, Xyz],
+        /// Inertial derivative of r_R
+        pub v_r: [f64; 3] = ["m/s", Reference, Xyz],
+        /// Attitude q_HR of F_R in F_H: rotates F_R vectors into F_H
+        pub q_hr: [f64; 4] = ["-", HillFromReference, Wxyz],
+        /// Angular velocity ω_H of F_H w.r.t. inertial
+        pub omega_h: [f64; 3] = ["rad/s", Hill, Xyz],
+        /// Angular acceleration of F_H w.r.t. inertial
+        pub omega_dot_h: [f64; 3] = ["rad/s²", Hill, Xyz],
+        /// Mean motion of the target orbit |ω_H|
+        pub mean_motion: f64 = ["rad/s"],
+        /// Servicer attitude q_RB: rotates F_B vectors into F_R
+        pub q_rb: [f64; 4] = ["-", ReferenceFromBase, Wxyz],
+        /// Servicer body rate ω_B w.r.t. inertial
+        pub omega_b: [f64; 3] = ["rad/s", Base, Xyz],
+        /// Joint angles θ
+        pub theta: [f64; N_JOINTS] = ["rad", Joints, Joints],
+        /// Joint rates θ̇
+        pub theta_dot: [f64; N_JOINTS] = ["rad/s", Joints, Joints],
+        /// Target attitude q_RT: rotates F_T vectors into F_R
+        pub q_rt: [f64; 4] = ["-", ReferenceFromTarget, Wxyz],
+        /// Target body rate ω_T w.r.t. inertial
+        pub omega_t: [f64; 3] = ["rad/s", Target, Xyz],
+        /// Derivative of ω_T
+        pub omega_dot_t: [f64; 3] = ["rad/s²", Target, Xyz],
+        /// Grasping point relative to the target CoM
+        pub grasp_r: [f64; 3] = ["m", Reference, Xyz],
+        /// Grasping point inertial velocity
+        pub grasp_v_r: [f64; 3] = ["m/s", Reference, Xyz],
+        /// Grasping point inertial acceleration
+        pub grasp_a_r: [f64; 3] = ["m/s²", Reference, Xyz],
+        /// Grasping point relative to the base origin
+        pub grasp_b: [f64; 3] = ["m", Base, Xyz],
+        /// End-effector position relative to the base origin
+        pub ee_b: [f64; 3] = ["m", Base, Xyz],
+        /// End-effector position relative to the target CoM
+        pub ee_r: [f64; 3] = ["m", Reference, Xyz],
+        /// End-effector inertial velocity
+        pub ee_v_r: [f64; 3] = ["m/s", Reference, Xyz],
+        /// Servicer system centre of mass relative to the target CoM
+        pub com_h: [f64; 3] = ["m", Hill, Xyz],
+        /// Derivative of com_h in the rotating Hill frame
+        pub com_v_h: [f64; 3] = ["m/s", Hill, Xyz],
+        /// Servicer system centre of mass relative to the target CoM
+        pub com_r: [f64; 3] = ["m", Reference, Xyz],
+        /// Inertial velocity of the servicer system centre of mass
+        pub com_v_r: [f64; 3] = ["m/s", Reference, Xyz],
+        /// Every barrier h at this state, from the simulator's own state (the safety
+        /// monitor), in telemetry order; NaN (null in the MCAP) = not evaluated
+        pub barriers: [f64; N_BARRIERS] = ["unit per constraint", None, Barriers],
+        /// The smallest value of every barrier over the physics steps since the
+        /// previous state message (this state included)
+        pub barriers_between: [f64; N_BARRIERS] = ["unit per constraint", None, Barriers],
+    }
+}
+
+/// Declares a nominal command: the header every nominal controller fills, then the
+/// command itself.
+macro_rules! nominal_msg {
+    (
+        $(#[doc = $doc:literal])+
+        $name:ident = $type_name:literal,
+        $(#[doc = $cdoc:literal])+
+        $field:ident: [f64; $n:expr] = [$unit:literal, $frame:ident, $comp:ident]
+    ) => {
+        icd_message! {
+            $(#[doc = $doc])+
+            #[type_name($type_name)]
+            pub struct $name {
+                /// Tick index this command answers
+                pub tick: u64 = ["-"],
+                /// Simulation time of the state used
+                pub t: f64 = ["s"],
+                /// 1 if the controller ran on valid inputs, 0 otherwise
+                pub valid: u32 = ["-"],
+                /// Index of the mission phase (0-based, scenario order)
+                pub phase: u32 = ["-"],
+                /// Stamp at which the state was received, host CLOCK_MONOTONIC
+                pub recv_ns: u64 = ["ns"],
+                /// Publish stamp, host CLOCK_MONOTONIC
+                pub publish_ns: u64 = ["ns"],
+                $(#[doc = $cdoc])+
+                pub $field: [f64; $n] = [$unit, $frame, $comp],
             }
         }
-        impl Default for $t {
-            fn default() -> Self { <$t as Zeroed>::zeroed() }
-        }
-    )*};
-}
-
-/// Clock mode carried in [`Tick::clock_mode`].
-pub mod clock_mode {
-    /// Lock-step: the next tick is sent as soon as the previous one completed.
-    pub const LOCK_STEP: u32 = 0;
-    /// Real time: ticks paced by the wall clock at the rate-group period.
-    pub const REAL_TIME: u32 = 1;
-    /// Scaled real time: paced at a configured multiple of real time.
-    pub const SCALED: u32 = 2;
-}
-
-/// Mission phase carried in [`SimState::phase`].
-pub mod phase {
-    /// Approach.
-    pub const APPROACH: u32 = 1;
-    /// Synchronisation with the tumbling target.
-    pub const SYNCHRONISATION: u32 = 2;
-    /// Capture (manipulator reaches for the grasping point).
-    pub const CAPTURE: u32 = 3;
-}
-
-/// Values of [`Health::state`].
-pub mod health_state {
-    /// Process started, ports being created.
-    pub const STARTING: u32 = 0;
-    /// Ports exist, handshake announced.
-    pub const READY: u32 = 1;
-    /// Handling ticks.
-    pub const RUNNING: u32 = 2;
-    /// A fault was detected; see `last_fault_flags`.
-    pub const FAULTED: u32 = 3;
-    /// Shutting down.
-    pub const STOPPING: u32 = 4;
-}
-
-/// Bits of the `fault_flags` fields.
-pub mod fault {
-    /// Input older than one tick (stale state).
-    pub const STALE_INPUT: u32 = 1 << 0;
-    /// Non-finite number in an input.
-    pub const NON_FINITE_INPUT: u32 = 1 << 1;
-    /// QP solver failed; output falls back to the backup law.
-    pub const SOLVER_FAILED: u32 = 1 << 2;
-    /// QP infeasible; constraints relaxed.
-    pub const INFEASIBLE: u32 = 1 << 3;
-    /// Output saturated at actuator limits.
-    pub const SATURATED: u32 = 1 << 4;
-    /// Nominal command missing or invalid; filter used zero nominal input.
-    pub const NOMINAL_MISSING: u32 = 1 << 5;
-    /// Deadline missed.
-    pub const DEADLINE_MISS: u32 = 1 << 6;
-    /// A peer process was detected dead.
-    pub const PEER_DEAD: u32 = 1 << 7;
-    /// The simulator rejected a safe command (not finite or beyond the input bounds,
-    /// `sc_flight::admission`) and applied the filter's backup instead.
-    pub const REJECTED_COMMAND: u32 = 1 << 8;
-}
-
-/// Values of [`Tick::command`].
-pub mod tick_command {
-    /// Run one control step.
-    pub const STEP: u32 = 0;
-    /// The run is over: every process finishes its outputs and exits.
-    pub const STOP: u32 = 1;
-}
-
-/// Bits of the `due_mask` fields: which subsystems' rate groups run in a tick.
-pub mod due {
-    /// Translational nominal controller and safety filter.
-    pub const TRANSLATIONAL: u32 = 1 << 0;
-    /// Attitude nominal controller and safety filter.
-    pub const ATTITUDE: u32 = 1 << 1;
-    /// Robotic nominal controller and safety filter.
-    pub const ROBOTIC: u32 = 1 << 2;
-    /// All three.
-    pub const ALL: u32 = 7;
-}
-
-/// Values of [`StepResult::end`].
-pub mod end {
-    /// The mission goes on.
-    pub const RUNNING: u32 = 0;
-    /// Captured: end-effector on the grasping point within tolerance.
-    pub const CAPTURED: u32 = 1;
-    /// The configured duration elapsed.
-    pub const TIMEOUT: u32 = 2;
-    /// The simulator failed (non-finite state or command).
-    pub const SIMULATOR_FAILED: u32 = 3;
-}
-
-/// Scheduler → simulator, every other process (stop), recorder: start one control step.
-#[derive(Debug, Clone, Copy, ZeroCopySend, PartialEq)]
-#[repr(C)]
-#[type_name("safe_capture::v2::Tick")]
-pub struct Tick {
-    /// Tick index, starts at 0, +1 per tick of the fastest rate group [-].
-    pub tick: u64,
-    /// Subsystems due in this tick, bits of [`due`] [-].
-    pub due_mask: u32,
-    /// Clock mode, one of [`clock_mode`] [-].
-    pub clock_mode: u32,
-    /// Simulation time at which this step starts [s].
-    pub t: f64,
-    /// Scheduler send stamp, monotonic clock [ns].
-    pub send_ns: u64,
-    /// One of [`tick_command`] [-].
-    pub command: u32,
-    /// Always 0.
-    pub _pad0: u32,
-}
-
-/// Simulator → nominal controllers, safety filters, recorder: the observation at
-/// the start of the step. Every field of `sc_sim::Observation`, copied as f64, so
-/// that the stages compute exactly what they compute in one process.
-#[derive(Debug, Clone, Copy, ZeroCopySend, PartialEq)]
-#[repr(C)]
-#[type_name("safe_capture::v3::SimState")]
-pub struct SimState {
-    /// Tick index this state answers (= simulator step count at the base rate) [-].
-    pub tick: u64,
-    /// Simulation time [s].
-    pub t: f64,
-    /// Subsystems due in this tick, bits of [`due`] [-].
-    pub due_mask: u32,
-    /// Always 0.
-    pub _pad0: u32,
-    /// Send stamp of the tick this state answers, monotonic clock [ns].
-    pub tick_send_ns: u64,
-    /// Stamp at which the simulator received the tick, monotonic clock [ns].
-    pub recv_ns: u64,
-    /// Publish stamp, monotonic clock [ns].
-    pub publish_ns: u64,
-    /// Simulator step counter [-].
-    pub step: u64,
-    /// Servicer base origin relative to the target CoM, Hill frame F_H [m].
-    pub r_h: [f64; 3],
-    /// Its derivative in the rotating Hill frame F_H [m/s].
-    pub v_h: [f64; 3],
-    /// Servicer base origin relative to the target CoM, reference frame F_R [m].
-    pub r_r: [f64; 3],
-    /// Inertial derivative of `r_r`, in F_R [m/s].
-    pub v_r: [f64; 3],
-    /// q_HR, scalar-first, rotates F_R vectors into F_H [-].
-    pub q_hr: [f64; 4],
-    /// Angular velocity of F_H w.r.t. inertial, in F_H [rad/s].
-    pub omega_h: [f64; 3],
-    /// Angular acceleration of F_H w.r.t. inertial, in F_H [rad/s²].
-    pub omega_dot_h: [f64; 3],
-    /// Mean motion of the target orbit |ω_H| [rad/s].
-    pub mean_motion: f64,
-    /// Servicer attitude q_RB, scalar-first, rotates F_B vectors into F_R [-].
-    pub q_rb: [f64; 4],
-    /// Servicer body rate ω_B w.r.t. inertial, in F_B [rad/s].
-    pub omega_b: [f64; 3],
-    /// Joint angles θ [rad].
-    pub theta: [f64; N_JOINTS],
-    /// Joint rates θ̇ [rad/s].
-    pub theta_dot: [f64; N_JOINTS],
-    /// Target attitude q_RT, scalar-first, rotates F_T vectors into F_R [-].
-    pub q_rt: [f64; 4],
-    /// Target body rate ω_T w.r.t. inertial, in F_T [rad/s].
-    pub omega_t: [f64; 3],
-    /// Its derivative, in F_T [rad/s²].
-    pub omega_dot_t: [f64; 3],
-    /// Grasping point relative to the target CoM, F_R [m].
-    pub grasp_r: [f64; 3],
-    /// Grasping point inertial velocity, F_R [m/s].
-    pub grasp_v_r: [f64; 3],
-    /// Grasping point inertial acceleration, F_R [m/s²].
-    pub grasp_a_r: [f64; 3],
-    /// Grasping point relative to the base origin, F_B [m].
-    pub grasp_b: [f64; 3],
-    /// End-effector position relative to the base origin, F_B [m].
-    pub ee_b: [f64; 3],
-    /// End-effector position relative to the target CoM, F_R [m].
-    pub ee_r: [f64; 3],
-    /// End-effector inertial velocity, F_R [m/s].
-    pub ee_v_r: [f64; 3],
-    /// Servicer system centre of mass relative to the target CoM, Hill frame F_H [m].
-    pub com_h: [f64; 3],
-    /// Its derivative in the rotating Hill frame F_H [m/s].
-    pub com_v_h: [f64; 3],
-    /// Servicer system centre of mass relative to the target CoM, F_R [m].
-    pub com_r: [f64; 3],
-    /// Its inertial velocity, F_R [m/s].
-    pub com_v_r: [f64; 3],
-    /// Every barrier at this state, from the simulator's own state (the safety monitor),
-    /// in telemetry order (units per barrier, docs/ICD.md) [-].
-    pub barriers: [f64; N_BARRIERS],
-    /// The smallest value of every barrier over the physics steps since the previous
-    /// state message (this state included) [-].
-    pub barriers_between: [f64; N_BARRIERS],
-}
-
-macro_rules! nominal_msg {
-    ($(#[$m:meta])* $name:ident, $tn:literal, $field:ident, $n:expr, $doc:literal) => {
-        $(#[$m])*
-        #[derive(Debug, Clone, Copy, ZeroCopySend, PartialEq)]
-        #[repr(C)]
-        #[type_name($tn)]
-        pub struct $name {
-            /// Tick index this command answers [-].
-            pub tick: u64,
-            /// Simulation time of the state used [s].
-            pub t: f64,
-            /// 1 if the controller ran on valid inputs, 0 otherwise [-].
-            pub valid: u32,
-            /// Index of the mission phase (0-based, scenario order) [-].
-            pub phase: u32,
-            /// Stamp at which the state was received, monotonic clock [ns].
-            pub recv_ns: u64,
-            /// Publish stamp, monotonic clock [ns].
-            pub publish_ns: u64,
-            #[doc = $doc]
-            pub $field: [f64; $n],
-        }
     };
 }
 
-nominal_msg!(
+nominal_msg! {
     /// Nominal translational controller → translational safety filter, recorder.
-    NominalTranslational, "safe_capture::v2::NominalTranslational", f_h, 3,
-    "Commanded force f_H, Hill frame F_H, unsaturated [N]."
-);
-nominal_msg!(
+    NominalTranslational = "safe_capture::v2::NominalTranslational",
+    /// Commanded force f_H, unsaturated
+    f_h: [f64; 3] = ["N", Hill, Xyz]
+}
+nominal_msg! {
     /// Nominal attitude controller → attitude safety filter, recorder.
-    NominalAttitude, "safe_capture::v2::NominalAttitude", tau_b, 3,
-    "Commanded torque τ_B, base frame F_B, unsaturated [N·m]."
-);
-nominal_msg!(
+    NominalAttitude = "safe_capture::v2::NominalAttitude",
+    /// Commanded torque τ_B, unsaturated
+    tau_b: [f64; 3] = ["N·m", Base, Xyz]
+}
+nominal_msg! {
     /// Nominal robotic controller → robotic safety filter, recorder.
-    NominalRobotic, "safe_capture::v2::NominalRobotic", tau_m, N_JOINTS,
-    "Commanded joint torques τ_M, unsaturated [N·m]."
-);
+    NominalRobotic = "safe_capture::v2::NominalRobotic",
+    /// Commanded joint torques τ_M, unsaturated
+    tau_m: [f64; N_JOINTS] = ["N·m", Joints, Joints]
+}
 
+/// Declares a safe command: the safety filter's report (timing, solver, barriers and
+/// CBF conditions of its constraints), then the safe and the actuated command.
 macro_rules! safe_msg {
-    ($(#[$m:meta])* $name:ident, $tn:literal, $nc:expr, $nu:expr, $udoc:literal, $adoc:literal) => {
-        $(#[$m])*
-        #[derive(Debug, Clone, Copy, ZeroCopySend, PartialEq)]
-        #[repr(C)]
-        #[type_name($tn)]
-        pub struct $name {
-            /// Tick index this command answers [-].
-            pub tick: u64,
-            /// Simulation time of the state used [s].
-            pub t: f64,
-            /// Stamp at which the last input of this tick arrived, monotonic clock [ns].
-            pub recv_ns: u64,
-            /// Publish stamp, monotonic clock [ns].
-            pub publish_ns: u64,
-            /// Bit i set = constraint i active (Φ_i ≈ 0) [-].
-            pub active_mask: u64,
-            /// Wall time of the filter call [ns].
-            pub solve_ns: u64,
-            /// `sc_cbf::FilterStatus`: 0 skipped, 1 solved, 2 relaxed, 3 fallback [-].
-            pub solver_status: u32,
-            /// Interior-point iterations [-].
-            pub iterations: u32,
-            /// `sc_cbf::faults` bits (UPSTREAM_MISSING = 1<<5 when an input was missing) [-].
-            pub fault_flags: u32,
-            /// Number of constraints in `h`/`phi` [-].
-            pub n_constraints: u32,
-            /// Mission phase of the nominal command filtered (0-based) [-].
-            pub phase: u32,
-            /// CPU time of the filter call on its thread, saturating at u32::MAX [ns].
-            pub solve_cpu_ns: u32,
-            /// Slack of the relaxed QP (0 otherwise), normalised rows [-].
-            pub slack: f64,
-            /// Barrier values h_i (NaN when not evaluated) [see docs/ICD.md].
-            pub h: [f64; $nc],
-            /// CBF conditions Φ_i at the safe command [units of h per s].
-            pub phi: [f64; $nc],
-            #[doc = $udoc]
-            pub u: [f64; $nu],
-            #[doc = $adoc]
-            pub actuated: [f64; $nu],
+    (
+        $(#[doc = $doc:literal])+
+        $name:ident = $type_name:literal, $sub:ident, $nc:expr,
+        $(#[doc = $udoc:literal])+
+        u: [f64; $nu:expr] = [$unit:literal, $frame:ident, $comp:ident],
+        $(#[doc = $adoc:literal])+
+        actuated = [$aframe:ident]
+    ) => {
+        icd_message! {
+            $(#[doc = $doc])+
+            #[type_name($type_name)]
+            pub struct $name {
+                /// Tick index this command answers
+                pub tick: u64 = ["-"],
+                /// Simulation time of the state used
+                pub t: f64 = ["s"],
+                /// Stamp at which the last input of this tick arrived, host CLOCK_MONOTONIC
+                pub recv_ns: u64 = ["ns"],
+                /// Publish stamp, host CLOCK_MONOTONIC
+                pub publish_ns: u64 = ["ns"],
+                /// Bit i set = constraint i active (Φ_i ≈ 0)
+                pub active_mask: u64 = ["-"],
+                /// Wall time of the filter call
+                pub solve_ns: u64 = ["ns"],
+                /// `sc_cbf::FilterStatus`: 0 skipped, 1 solved, 2 relaxed, 3 fallback
+                pub solver_status: u32 = ["-"],
+                /// QP solver iterations
+                pub iterations: u32 = ["-"],
+                /// `sc_cbf::faults` bits (5 upstream_missing, 7 nominal_missing: docs/ICD.md)
+                pub fault_flags: u32 = ["-"],
+                /// Number of constraints in `h` and `phi`
+                pub n_constraints: u32 = ["-"],
+                /// Mission phase of the nominal command filtered (0-based)
+                pub phase: u32 = ["-"],
+                /// CPU time of the filter call on its thread, saturating at u32::MAX
+                pub solve_cpu_ns: u32 = ["ns"],
+                /// Slack of the relaxed QP (0 otherwise), normalised rows
+                pub slack: f64 = ["-"],
+                /// Barrier values h_i the filter evaluated; NaN (null in the MCAP) = not
+                /// evaluated
+                pub h: [f64; $nc] = ["unit per constraint", None, Constraints($sub)],
+                /// CBF conditions Φ_i at the safe command
+                pub phi: [f64; $nc] = ["unit per constraint / s", None, Rates($sub)],
+                $(#[doc = $udoc])+
+                pub u: [f64; $nu] = [$unit, $frame, $comp],
+                $(#[doc = $adoc])+
+                pub actuated: [f64; $nu] = [$unit, $aframe, $comp],
+            }
         }
     };
 }
 
-safe_msg!(
+safe_msg! {
     /// Translational safety filter → attitude and robotic filters, simulator, recorder.
     /// Constraint order: AC, CAZ.
-    SafeTranslational, "safe_capture::v2::SafeTranslational", N_CONSTRAINTS_TRANSLATIONAL, 3,
-    "Safe force f_H, Hill frame F_H [N].",
-    "Safe force f_B = R_BH f_H, base frame F_B (what the thrusters apply) [N]."
-);
-safe_msg!(
+    SafeTranslational = "safe_capture::v2::SafeTranslational", Translational,
+    N_CONSTRAINTS_TRANSLATIONAL,
+    /// Safe force f_H
+    u: [f64; 3] = ["N", Hill, Xyz],
+    /// Safe force f_B = R_BH f_H (what the thrusters apply)
+    actuated = [Base]
+}
+safe_msg! {
     /// Attitude safety filter → robotic filter, simulator, recorder.
     /// Constraint order: ATT, ω1..3 upper, ω1..3 lower.
-    SafeAttitude, "safe_capture::v2::SafeAttitude", N_CONSTRAINTS_ATTITUDE, 3,
-    "Safe torque τ_B, base frame F_B [N·m].",
-    "Actuated torque τ_B, base frame F_B (equals `u`) [N·m]."
-);
-safe_msg!(
+    SafeAttitude = "safe_capture::v2::SafeAttitude", Attitude, N_CONSTRAINTS_ATTITUDE,
+    /// Safe torque τ_B
+    u: [f64; 3] = ["N·m", Base, Xyz],
+    /// Actuated torque τ_B (equals `u`)
+    actuated = [Base]
+}
+safe_msg! {
     /// Robotic safety filter → simulator, recorder.
     /// Constraint order: θ limits 0..7, θ̇ upper 7..14, θ̇ lower 14..21, link-base 21..42.
-    SafeRobotic, "safe_capture::v2::SafeRobotic", N_CONSTRAINTS_ROBOTIC, N_JOINTS,
-    "Safe joint torques τ_M [N·m].",
-    "Actuated joint torques τ_M (equals `u`) [N·m]."
-);
-
-/// Simulator → scheduler, recorder: the command applied over the step and how the
-/// step ended. Sent once all due safe commands of the tick are in (or their
-/// deadline passed and the simulator used the filter's fallback).
-#[derive(Debug, Clone, Copy, ZeroCopySend, PartialEq)]
-#[repr(C)]
-#[type_name("safe_capture::v1::StepResult")]
-pub struct StepResult {
-    /// Tick index [-].
-    pub tick: u64,
-    /// Simulation time at the start of the step [s].
-    pub t: f64,
-    /// One of [`end`] [-].
-    pub end: u32,
-    /// Subsystems ([`due`] bits) whose command is the filter fallback computed by the
-    /// simulator because the safe command was missing at the deadline [-].
-    pub fallback_mask: u32,
-    /// Subsystems ([`due`] bits) whose command was held from an earlier tick (slower rate group) [-].
-    pub held_mask: u32,
-    /// Partition fault flags, bits of [`fault`] [-].
-    pub fault_flags: u32,
-    /// Stamp at which the robotic safe command (the tick's last) was delivered, monotonic [ns].
-    pub safe_recv_ns: u64,
-    /// Publish stamp, monotonic clock [ns].
-    pub publish_ns: u64,
-    /// Applied base force f_B, F_B [N].
-    pub force_b: [f64; 3],
-    /// Applied base torque τ_B, F_B [N·m].
-    pub torque_b: [f64; 3],
-    /// Applied joint torques τ_M [N·m].
-    pub tau: [f64; N_JOINTS],
+    SafeRobotic = "safe_capture::v2::SafeRobotic", Robotic, N_CONSTRAINTS_ROBOTIC,
+    /// Safe joint torques τ_M
+    u: [f64; N_JOINTS] = ["N·m", Joints, Joints],
+    /// Actuated joint torques τ_M (equals `u`)
+    actuated = [Joints]
 }
 
-/// Recorder → scheduler: the recorder's progress (lock-step flow control); the
-/// fields are those of a health report any process could publish.
-#[derive(Debug, Clone, Copy, ZeroCopySend, PartialEq)]
-#[repr(C)]
-#[type_name("safe_capture::v1::Health")]
-pub struct Health {
-    /// Role id, [`Role::id`] of the role table [-].
-    pub role: u32,
-    /// Operating-system process id [-].
-    pub pid: u32,
-    /// State, one of [`health_state`] [-].
-    pub state: u32,
-    /// Last fault flags, bits of [`fault`] [-].
-    pub last_fault_flags: u32,
-    /// Ticks handled since start [-].
-    pub ticks_handled: u64,
-    /// Deadline misses since start [-].
-    pub deadline_misses: u64,
-    /// Cycle slips (a tick answered late or skipped) since start [-].
-    pub cycle_slips: u64,
-    /// Last tick index handled [-].
-    pub last_tick: u64,
-    /// Publish stamp, monotonic clock [ns].
-    pub publish_ns: u64,
+icd_message! {
+    /// Simulator → scheduler, recorder: the command applied over the step and how the
+    /// step ended. Sent once all due safe commands of the tick are in (or their
+    /// deadline passed and the simulator used the filter's fallback).
+    #[type_name("safe_capture::v1::StepResult")]
+    pub struct StepResult {
+        /// Tick index
+        pub tick: u64 = ["-"],
+        /// Simulation time at the start of the step
+        pub t: f64 = ["s"],
+        /// How the step ended, one of `end`
+        pub end: u32 = ["-"] => end,
+        /// Subsystems (bits of `due`) whose command is the filter fallback computed by
+        /// the simulator because the safe command was missing at the deadline
+        pub fallback_mask: u32 = ["-"] => due,
+        /// Subsystems (bits of `due`) whose command was held from an earlier tick
+        /// (slower rate group)
+        pub held_mask: u32 = ["-"] => due,
+        /// Partition fault flags, bits of `fault`
+        pub fault_flags: u32 = ["-"] => fault,
+        /// Stamp at which the robotic safe command (the tick's last) was delivered, host
+        /// CLOCK_MONOTONIC
+        pub safe_recv_ns: u64 = ["ns"],
+        /// Publish stamp, host CLOCK_MONOTONIC
+        pub publish_ns: u64 = ["ns"],
+        /// Applied base force f_B
+        pub force_b: [f64; 3] = ["N", Base, Xyz],
+        /// Applied base torque τ_B
+        pub torque_b: [f64; 3] = ["N·m", Base, Xyz],
+        /// Applied joint torques τ_M
+        pub tau: [f64; N_JOINTS] = ["N·m", Joints, Joints],
+    }
 }
 
-zeroed!(
-    Tick,
-    SimState,
-    NominalTranslational,
-    NominalAttitude,
-    NominalRobotic,
-    SafeTranslational,
-    SafeAttitude,
-    SafeRobotic,
-    StepResult,
-    Health
-);
+icd_message! {
+    /// Recorder → scheduler: the recorder's progress (lock-step flow control); the
+    /// fields are those of a health report any process could publish.
+    #[type_name("safe_capture::v1::Health")]
+    pub struct Health {
+        /// Role id: the role's position in the role table `ROLES`
+        pub role: u32 = ["-"],
+        /// Operating-system process id
+        pub pid: u32 = ["-"],
+        /// State, one of `health_state`
+        pub state: u32 = ["-"] => health_state,
+        /// Last fault flags, bits of `fault`
+        pub last_fault_flags: u32 = ["-"] => fault,
+        /// Ticks handled since start
+        pub ticks_handled: u64 = ["-"],
+        /// Deadline misses since start
+        pub deadline_misses: u64 = ["-"],
+        /// Cycle slips (a tick answered late or skipped) since start
+        pub cycle_slips: u64 = ["-"],
+        /// Last tick index handled
+        pub last_tick: u64 = ["-"],
+        /// Publish stamp, host CLOCK_MONOTONIC
+        pub publish_ns: u64 = ["ns"],
+    }
+}
+
+/// Every message of the ICD, in the order of the C header and docs/ICD.md.
+pub const MESSAGES: [&spec::MessageSpec; 10] = [
+    &Tick::SPEC,
+    &SimState::SPEC,
+    &NominalTranslational::SPEC,
+    &NominalAttitude::SPEC,
+    &NominalRobotic::SPEC,
+    &SafeTranslational::SPEC,
+    &SafeAttitude::SPEC,
+    &SafeRobotic::SPEC,
+    &StepResult::SPEC,
+    &Health::SPEC,
+];
 
 /// The iceoryx2 type name of a message (the `#[type_name]` it was derived with).
 pub fn type_name_of<T: ZeroCopySend>() -> &'static str {
@@ -459,8 +532,8 @@ pub fn type_name_of<T: ZeroCopySend>() -> &'static str {
     unsafe { <T as ZeroCopySend>::type_name() }
 }
 
-// Size guards: change them only together with scripts/python/sc_partner/icd.py,
-// the C header (`c_header`) and docs/ICD.md.
+// Size guards: a change of one is a change of the ICD (regenerate the artefacts with
+// `SC_WRITE_ICD=1 cargo test -p sc-icd-gen`, and version the type name).
 const _: () = assert!(core::mem::size_of::<Tick>() == 40);
 const _: () = assert!(core::mem::size_of::<SimState>() == 1568);
 const _: () = assert!(core::mem::size_of::<NominalTranslational>() == 64);
@@ -478,6 +551,7 @@ const _: () = assert!(N_CONSTRAINTS_ROBOTIC <= 64);
 #[cfg(test)]
 mod tests {
     use super::*;
+    use spec::{Components, Frame, Scalar, UNIT_PER_CONSTRAINT, UNIT_PER_CONSTRAINT_PER_S};
 
     #[test]
     fn type_names_are_versioned() {
@@ -495,5 +569,137 @@ mod tests {
         let a = monotonic_ns();
         let b = monotonic_ns();
         assert!(a > 0 && b >= a);
+    }
+
+    /// The spec's type name is the one iceoryx2 uses (the `#[type_name]` attribute).
+    #[test]
+    fn spec_type_names_are_the_derived_ones() {
+        fn check<T: Message + ZeroCopySend>() {
+            assert_eq!(T::SPEC.type_name, type_name_of::<T>());
+            assert!(T::SPEC.type_name.ends_with(&format!("::{}", T::SPEC.name)));
+        }
+        check::<Tick>();
+        check::<SimState>();
+        check::<NominalTranslational>();
+        check::<NominalAttitude>();
+        check::<NominalRobotic>();
+        check::<SafeTranslational>();
+        check::<SafeAttitude>();
+        check::<SafeRobotic>();
+        check::<StepResult>();
+        check::<Health>();
+    }
+
+    /// Fields read back from `as_bytes` at the spec's offsets are the struct's fields.
+    #[test]
+    fn spec_offsets_address_the_fields() {
+        let mut s = SimState {
+            tick: 11,
+            due_mask: 5,
+            mean_motion: 1.5e-3,
+            ..Default::default()
+        };
+        s.theta[6] = -2.25;
+        s.barriers_between[50] = 7.0;
+        let b = s.as_bytes();
+        assert_eq!(b.len(), SimState::SPEC.size);
+        let at = |name: &str, k: usize| {
+            let f = SimState::SPEC.field(name).unwrap();
+            let o = f.offset + k * f.scalar.size();
+            b[o..o + f.scalar.size()].to_vec()
+        };
+        assert_eq!(at("tick", 0), 11u64.to_ne_bytes());
+        assert_eq!(at("due_mask", 0), 5u32.to_ne_bytes());
+        assert_eq!(at("mean_motion", 0), 1.5e-3f64.to_ne_bytes());
+        assert_eq!(at("theta", 6), (-2.25f64).to_ne_bytes());
+        assert_eq!(at("barriers_between", 50), 7.0f64.to_ne_bytes());
+    }
+
+    /// Every field is described: a meaning, a unit, components that fit its length,
+    /// a frame for every vector and quaternion (joint space for the joints' arrays), the
+    /// constraint units on the barrier arrays.
+    #[test]
+    fn every_field_is_described_consistently() {
+        for m in MESSAGES {
+            assert!(!m.doc.is_empty(), "{}", m.name);
+            assert!(m.fields_fill_every_byte(), "{}", m.name);
+            for f in m.fields {
+                let at = format!("{}.{}", m.name, f.name);
+                assert!(!f.meaning.is_empty() && !f.unit.is_empty(), "{at}");
+                assert!(!f.meaning.contains("  "), "{at}: {:?}", f.meaning);
+                let want_len = match f.components {
+                    Components::One => None,
+                    Components::Xyz => Some(3),
+                    Components::Wxyz => Some(4),
+                    Components::Joints => Some(N_JOINTS),
+                    Components::Barriers => Some(N_BARRIERS),
+                    Components::Constraints { subsystem, .. } => Some(
+                        [
+                            N_CONSTRAINTS_TRANSLATIONAL,
+                            N_CONSTRAINTS_ATTITUDE,
+                            N_CONSTRAINTS_ROBOTIC,
+                        ][subsystem.position()],
+                    ),
+                };
+                assert_eq!(f.len, want_len, "{at}: components {:?}", f.components);
+                let framed = match f.components {
+                    Components::Xyz | Components::Wxyz => f.frame != Frame::None,
+                    Components::Joints => f.frame == Frame::Joints,
+                    _ => f.frame == Frame::None,
+                };
+                assert!(framed, "{at}: frame {:?}", f.frame);
+                let unit = match f.components {
+                    Components::Barriers
+                    | Components::Constraints {
+                        per_second: false, ..
+                    } => Some(UNIT_PER_CONSTRAINT),
+                    Components::Constraints {
+                        per_second: true, ..
+                    } => Some(UNIT_PER_CONSTRAINT_PER_S),
+                    _ => None,
+                };
+                if let Some(u) = unit {
+                    assert_eq!(f.unit, u, "{at}");
+                }
+                if f.len.is_some() {
+                    assert_eq!(f.scalar, Scalar::F64, "{at}: arrays are f64");
+                }
+            }
+        }
+    }
+
+    /// The check of the layout guard can fail: a gap is found.
+    #[test]
+    fn a_gap_is_found() {
+        let mut fields = Tick::SPEC.fields.to_vec();
+        fields.remove(1);
+        let leaked: &'static [spec::FieldSpec] = Box::leak(fields.into_boxed_slice());
+        let gap = spec::MessageSpec {
+            fields: leaked,
+            ..Tick::SPEC
+        };
+        assert!(!gap.fields_fill_every_byte());
+    }
+
+    #[test]
+    fn constant_groups_hold_the_constants() {
+        assert_eq!(due::GROUP.items[2].name, "ROBOTIC");
+        assert_eq!(due::GROUP.items[2].value, 4);
+        assert_eq!(due::ALL, due::TRANSLATIONAL | due::ATTITUDE | due::ROBOTIC);
+        assert_eq!(lengths::GROUP.items[4].value, 51);
+        assert_eq!(
+            fault::GROUP.qualified(&fault::GROUP.items[8]),
+            "FAULT_REJECTED_COMMAND"
+        );
+        assert_eq!(
+            lengths::GROUP.qualified(&lengths::GROUP.items[0]),
+            "N_JOINTS"
+        );
+        for g in CONSTANT_GROUPS {
+            assert!(!g.doc.is_empty(), "{}", g.module);
+            for c in g.items {
+                assert!(!c.doc.is_empty(), "{}::{}", g.module, c.name);
+            }
+        }
     }
 }

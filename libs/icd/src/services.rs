@@ -21,80 +21,92 @@ impl core::fmt::Display for ServiceName {
     }
 }
 
-/// [`crate::Tick`] of the main rate group. Publisher: scheduler. Subscribers: simulator, recorder.
-pub const TICK: ServiceName = ServiceName("safe_capture/scheduler/tick");
-/// [`crate::Tick`] commands to every other process; today only the stop (`command ==
-/// tick_command::STOP`), sent with the stop tick. Publisher: scheduler. Subscribers:
-/// nominal controllers, safety filters (read at every wake-up, no listener). Kept apart
-/// from [`TICK`] so that a tick is delivered to the two processes that need it, not
-/// to all eight: each subscriber costs the scheduler's send, on the critical path.
-pub const CONTROL: ServiceName = ServiceName("safe_capture/scheduler/control");
-/// [`crate::SimState`]. Publisher: simulator. Subscribers: the three safety filters,
-/// recorder (the flight side: lossless).
-pub const SIM_STATE: ServiceName = ServiceName("safe_capture/sim/state");
-/// The same [`crate::SimState`] for the nominal controllers — the processes partners
-/// replace — on a newest-wins service: a partner that stops reading loses only its own
-/// states and can never make the simulator wait. Publisher: simulator (just after
-/// [`SIM_STATE`]: so the filters always have the state before any command answering it).
-/// Subscribers: the three nominal controllers (woken by it).
-pub const PARTNER_STATE: ServiceName = ServiceName("safe_capture/partner/state");
-/// [`crate::NominalTranslational`]. Publisher: nominal translational controller.
-/// Subscribers: translational safety filter, recorder.
-pub const NOMINAL_TRANSLATIONAL: ServiceName = ServiceName("safe_capture/nominal/translational");
-/// [`crate::NominalAttitude`]. Publisher: nominal attitude controller.
-/// Subscribers: attitude safety filter, recorder.
-pub const NOMINAL_ATTITUDE: ServiceName = ServiceName("safe_capture/nominal/attitude");
-/// [`crate::NominalRobotic`]. Publisher: nominal robotic controller.
-/// Subscribers: robotic safety filter, recorder.
-pub const NOMINAL_ROBOTIC: ServiceName = ServiceName("safe_capture/nominal/robotic");
-/// [`crate::SafeTranslational`]. Publisher: translational safety filter.
-/// Subscribers: attitude safety filter (woken by it: causal order), robotic safety
-/// filter (ξ), simulator, recorder.
-pub const SAFE_TRANSLATIONAL: ServiceName = ServiceName("safe_capture/safe/translational");
-/// [`crate::SafeAttitude`]. Publisher: attitude safety filter.
-/// Subscribers: robotic safety filter (woken by it: causal order), simulator, recorder.
-pub const SAFE_ATTITUDE: ServiceName = ServiceName("safe_capture/safe/attitude");
-/// [`crate::SafeRobotic`]. Publisher: robotic safety filter.
-/// Subscribers: simulator (woken by it: closes the step), recorder.
-pub const SAFE_ROBOTIC: ServiceName = ServiceName("safe_capture/safe/robotic");
-/// [`crate::StepResult`]. Publisher: simulator. Subscribers: scheduler (step completion), recorder.
-pub const STEP_RESULT: ServiceName = ServiceName("safe_capture/sim/step_result");
-/// [`crate::Health`]. Publisher: recorder (its progress: `last_tick` = the newest step
-/// result it took). Subscriber: scheduler (lock-step flow control: it stays at most
-/// `recorder_window_ticks` ticks ahead of the recorder).
-pub const HEALTH: ServiceName = ServiceName("safe_capture/health");
-/// Stage-deadline watchdog (event service, no payload). Notifier: scheduler, when a
-/// stage deadline of `[deadlines]` passed (counted from the tick) and the tick is
-/// unfinished. Listeners: the three safety filters, which wake on their nominal and
-/// upstream commands only, never on every state, and need this wake-up to apply
-/// their fallback to a tick whose nominal or upstream command is late.
-pub const STAGE_DEADLINE: ServiceName = ServiceName("safe_capture/scheduler/deadline");
-/// Pre-tick warm-up (event service, no payload), real-time mode only. Notifier:
-/// scheduler, `warmup_lead_us` before each tick. Listeners: the simulator, the
-/// nominal controllers and the safety filters, which rehearse their step on their
-/// latest inputs (nothing is published) so that the tick finds their code and data
-/// in the caches instead of cold after a period asleep.
-pub const PREPARE: ServiceName = ServiceName("safe_capture/scheduler/prepare");
-/// Start-up handshake (event services `<HANDSHAKE>/ready` and `<HANDSHAKE>/go`, no payload).
-/// Participants notify `ready` with their role id + 1; the coordinator (scheduler)
-/// notifies `go` once all expected participants were seen.
-pub const HANDSHAKE: ServiceName = ServiceName("safe_capture/handshake");
+icd_services! {
+    pubsub {
+        /// The ticks of the main rate group: each starts one control step (the simulator
+        /// wakes on it), the last one (`command = tick_command::STOP`) ends the run.
+        TICK = "safe_capture/scheduler/tick", Tick, Flight;
+        /// Tick commands to every other process; today only the stop, sent with the stop
+        /// tick (read at every wake-up, no listener). Kept apart from `TICK` so that a
+        /// tick is delivered to the two processes that need it, not to all eight: each
+        /// subscriber costs the scheduler's send, on the critical path.
+        CONTROL = "safe_capture/scheduler/control", Tick, Flight;
+        /// The state at the start of each step, for the flight side (lossless).
+        SIM_STATE = "safe_capture/sim/state", SimState, Flight;
+        /// The same state for the nominal controllers — the processes partners replace,
+        /// woken by it — on a newest-wins service: a partner that stops reading loses
+        /// only its own states and can never make the simulator wait. Published just
+        /// after `SIM_STATE`, so the filters always have the state before any command
+        /// answering it.
+        PARTNER_STATE = "safe_capture/partner/state", SimState, Partner;
+        /// The nominal translational command; the translational safety filter wakes on it.
+        NOMINAL_TRANSLATIONAL = "safe_capture/nominal/translational", NominalTranslational, Partner;
+        /// The nominal attitude command; the attitude safety filter wakes on it.
+        NOMINAL_ATTITUDE = "safe_capture/nominal/attitude", NominalAttitude, Partner;
+        /// The nominal robotic command; the robotic safety filter wakes on it.
+        NOMINAL_ROBOTIC = "safe_capture/nominal/robotic", NominalRobotic, Partner;
+        /// The translational safe command and filter report; the attitude safety filter
+        /// wakes on it (causal order), the robotic one takes it as ξ.
+        SAFE_TRANSLATIONAL = "safe_capture/safe/translational", SafeTranslational, Flight;
+        /// The attitude safe command and filter report; the robotic safety filter wakes on
+        /// it (causal order).
+        SAFE_ATTITUDE = "safe_capture/safe/attitude", SafeAttitude, Flight;
+        /// The robotic safe command and filter report; the simulator wakes on it (it
+        /// closes the step).
+        SAFE_ROBOTIC = "safe_capture/safe/robotic", SafeRobotic, Flight;
+        /// The applied command and the end of each step; the scheduler (step completion)
+        /// and the recorder wake on it.
+        STEP_RESULT = "safe_capture/sim/step_result", StepResult, Flight;
+        /// The recorder's progress (`last_tick` = the newest step result it took): the
+        /// scheduler's lock-step flow control keeps it at most `recorder_window_ticks`
+        /// ticks ahead of the recorder.
+        HEALTH = "safe_capture/health", Health, Flight;
+    }
+    events {
+        /// Stage-deadline watchdog (no payload): notified when a stage deadline of
+        /// `[deadlines]` passed (counted from the tick) and the tick is unfinished. The
+        /// safety filters wake on their nominal and upstream commands only, never on every
+        /// state, and need this wake-up to apply their fallback to a tick whose nominal or
+        /// upstream command is late.
+        STAGE_DEADLINE = "safe_capture/scheduler/deadline", [];
+        /// Pre-tick warm-up (no payload), real-time mode only: notified `warmup_lead_us`
+        /// before each tick; the listeners rehearse their step on their latest inputs
+        /// (nothing is published) so that the tick finds their code and data in the
+        /// caches instead of cold after a period asleep (optional for a third-party process).
+        PREPARE = "safe_capture/scheduler/prepare", [];
+        /// Start-up handshake (event services `<HANDSHAKE>/ready` and `<HANDSHAKE>/go`, no
+        /// payload): participants notify `ready` with `events::HANDSHAKE_ID_OFFSET` + their
+        /// role id; the coordinator (scheduler) notifies `go` once all expected
+        /// participants were seen.
+        HANDSHAKE = "safe_capture/handshake", ["ready", "go"];
+    }
+}
 
-/// All pub/sub services with their iceoryx2 type names, for tools and docs.
-pub const ALL: &[(ServiceName, &str)] = &[
-    (TICK, "safe_capture::v2::Tick"),
-    (CONTROL, "safe_capture::v2::Tick"),
-    (SIM_STATE, "safe_capture::v3::SimState"),
-    (PARTNER_STATE, "safe_capture::v3::SimState"),
-    (
-        NOMINAL_TRANSLATIONAL,
-        "safe_capture::v2::NominalTranslational",
-    ),
-    (NOMINAL_ATTITUDE, "safe_capture::v2::NominalAttitude"),
-    (NOMINAL_ROBOTIC, "safe_capture::v2::NominalRobotic"),
-    (SAFE_TRANSLATIONAL, "safe_capture::v2::SafeTranslational"),
-    (SAFE_ATTITUDE, "safe_capture::v2::SafeAttitude"),
-    (SAFE_ROBOTIC, "safe_capture::v2::SafeRobotic"),
-    (STEP_RESULT, "safe_capture::v1::StepResult"),
-    (HEALTH, "safe_capture::v1::Health"),
-];
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn services_carry_their_messages() {
+        let by = |c: &str| SERVICES.iter().find(|s| s.constant == c).unwrap();
+        assert_eq!(by("SIM_STATE").name, SIM_STATE);
+        assert_eq!(
+            by("PARTNER_STATE").message.unwrap().type_name,
+            "safe_capture::v3::SimState"
+        );
+        assert_eq!(by("HANDSHAKE").sub_services, ["ready", "go"]);
+        assert!(by("PREPARE").message.is_none());
+        let mut names: Vec<&str> = SERVICES.iter().map(|s| s.name.as_str()).collect();
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), SERVICES.len(), "service names are unique");
+        // every message type travels on some service
+        for m in crate::MESSAGES {
+            assert!(
+                SERVICES.iter().any(|s| s.message == Some(m)),
+                "{} has no service",
+                m.name
+            );
+        }
+    }
+}

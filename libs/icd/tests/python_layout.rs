@@ -1,254 +1,57 @@
-//! The Python mirror (`scripts/python/sc_partner/icd.py`) must have exactly the Rust layout:
-//! same size, alignment, field names, offsets and sizes, and the same iceoryx2 type name.
+//! The Python module of the partner SDK (`scripts/python/sc_partner/icd.py`, which
+//! re-exports the generated `_icd.py`) must have exactly the Rust layout — same size,
+//! alignment, field names, offsets and sizes, and the same iceoryx2 type name — and
+//! every constant of the ICD with the Rust value: array lengths, services, event ids,
+//! due bits, tick commands, clock modes, end codes, fault bits, health states and the
+//! role ids of the role table. Checked by running Python (standard library only).
 
-use core::mem::{align_of, offset_of, size_of};
-use sc_icd::*;
+use sc_icd::{CONSTANT_GROUPS, MESSAGES, ROLES, services::SERVICES};
+use serde_json::Value;
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::Command;
 
-struct Layout {
-    name: &'static str,
-    type_name: &'static str,
-    size: usize,
-    align: usize,
-    fields: Vec<(&'static str, usize, usize)>,
-}
-
-fn field_size<T, F>(_: fn(&T) -> &F) -> usize {
-    size_of::<F>()
-}
-
-macro_rules! layout {
-    ($t:ident { $($f:ident),* $(,)? }) => {
-        Layout {
-            name: stringify!($t),
-            type_name: type_name_of::<$t>(),
-            size: size_of::<$t>(),
-            align: align_of::<$t>(),
-            fields: vec![$((stringify!($f), offset_of!($t, $f), field_size(|s: &$t| &s.$f))),*],
-        }
-    };
-}
-
-fn rust_layouts() -> Vec<Layout> {
-    vec![
-        layout!(Tick {
-            tick,
-            due_mask,
-            clock_mode,
-            t,
-            send_ns,
-            command,
-            _pad0
-        }),
-        layout!(SimState {
-            tick,
-            t,
-            due_mask,
-            _pad0,
-            tick_send_ns,
-            recv_ns,
-            publish_ns,
-            step,
-            r_h,
-            v_h,
-            r_r,
-            v_r,
-            q_hr,
-            omega_h,
-            omega_dot_h,
-            mean_motion,
-            q_rb,
-            omega_b,
-            theta,
-            theta_dot,
-            q_rt,
-            omega_t,
-            omega_dot_t,
-            grasp_r,
-            grasp_v_r,
-            grasp_a_r,
-            grasp_b,
-            ee_b,
-            ee_r,
-            ee_v_r,
-            com_h,
-            com_v_h,
-            com_r,
-            com_v_r,
-            barriers,
-            barriers_between
-        }),
-        layout!(NominalTranslational {
-            tick,
-            t,
-            valid,
-            phase,
-            recv_ns,
-            publish_ns,
-            f_h
-        }),
-        layout!(NominalAttitude {
-            tick,
-            t,
-            valid,
-            phase,
-            recv_ns,
-            publish_ns,
-            tau_b
-        }),
-        layout!(NominalRobotic {
-            tick,
-            t,
-            valid,
-            phase,
-            recv_ns,
-            publish_ns,
-            tau_m
-        }),
-        layout!(SafeTranslational {
-            tick,
-            t,
-            recv_ns,
-            publish_ns,
-            active_mask,
-            solve_ns,
-            solver_status,
-            iterations,
-            fault_flags,
-            n_constraints,
-            phase,
-            solve_cpu_ns,
-            slack,
-            h,
-            phi,
-            u,
-            actuated
-        }),
-        layout!(SafeAttitude {
-            tick,
-            t,
-            recv_ns,
-            publish_ns,
-            active_mask,
-            solve_ns,
-            solver_status,
-            iterations,
-            fault_flags,
-            n_constraints,
-            phase,
-            solve_cpu_ns,
-            slack,
-            h,
-            phi,
-            u,
-            actuated
-        }),
-        layout!(SafeRobotic {
-            tick,
-            t,
-            recv_ns,
-            publish_ns,
-            active_mask,
-            solve_ns,
-            solver_status,
-            iterations,
-            fault_flags,
-            n_constraints,
-            phase,
-            solve_cpu_ns,
-            slack,
-            h,
-            phi,
-            u,
-            actuated
-        }),
-        layout!(StepResult {
-            tick,
-            t,
-            end,
-            fallback_mask,
-            held_mask,
-            fault_flags,
-            safe_recv_ns,
-            publish_ns,
-            force_b,
-            torque_b,
-            tau
-        }),
-        layout!(Health {
-            role,
-            pid,
-            state,
-            last_fault_flags,
-            ticks_handled,
-            deadline_misses,
-            cycle_slips,
-            last_tick,
-            publish_ns
-        }),
-    ]
-}
-
-#[test]
-fn rust_field_lists_cover_every_byte() {
-    // Guards the lists above: fields are contiguous and fill the struct, so no
-    // field can be missing from the comparison and no implicit padding exists.
-    for l in rust_layouts() {
-        let mut end = 0;
-        for (name, off, size) in &l.fields {
-            assert_eq!(*off, end, "{}.{name}: gap or overlap before it", l.name);
-            end = off + size;
-        }
-        assert_eq!(
-            end, l.size,
-            "{}: trailing padding or missing fields",
-            l.name
-        );
-    }
-}
-
-#[test]
-fn python_mirror_matches_rust_layout() {
-    // the module of the partner package, run from its source tree (standard library only)
+/// `python3 -m sc_partner.icd <flag>`, run from the package's source tree, as JSON.
+fn python_json(flag: &str) -> Value {
     let package = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scripts/python");
     let out = Command::new("python3")
         .current_dir(&package)
-        .args(["-m", "sc_partner.icd", "--layout-json"])
+        .env("PYTHONDONTWRITEBYTECODE", "1")
+        .args(["-m", "sc_partner.icd", flag])
         .output()
-        .expect("python3 must be installed to check the Python ICD mirror");
+        .expect("python3 must be installed to check the Python ICD module");
     assert!(
         out.status.success(),
-        "sc_partner.icd failed: {}",
+        "sc_partner.icd {flag} failed: {}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let py: serde_json::Value = serde_json::from_slice(&out.stdout).expect("layout JSON");
+    serde_json::from_slice(&out.stdout).expect("JSON")
+}
+
+#[test]
+fn python_module_matches_rust_layout() {
+    let py = python_json("--layout-json");
     let py = py.as_object().expect("object of types");
-    let rust = rust_layouts();
     assert_eq!(
         py.len(),
-        rust.len(),
+        MESSAGES.len(),
         "Python and Rust define different message sets"
     );
-    for l in rust {
+    for m in MESSAGES {
         let p = py
-            .get(l.name)
-            .unwrap_or_else(|| panic!("{} missing in sc_partner.icd", l.name));
-        assert_eq!(
-            p["type_name"].as_str(),
-            Some(l.type_name),
-            "{} type_name",
-            l.name
-        );
-        assert_eq!(p["size"].as_u64(), Some(l.size as u64), "{} size", l.name);
+            .get(m.name)
+            .unwrap_or_else(|| panic!("{} missing in sc_partner.icd", m.name));
+        assert_eq!(p["type_name"].as_str(), Some(m.type_name), "{}", m.name);
+        assert_eq!(p["size"].as_u64(), Some(m.size as u64), "{} size", m.name);
         assert_eq!(
             p["align"].as_u64(),
-            Some(l.align as u64),
+            Some(m.align as u64),
             "{} align",
-            l.name
+            m.name
         );
-        let pf = p["fields"].as_array().expect("fields");
-        let py_fields: Vec<(String, u64, u64)> = pf
+        let py_fields: Vec<(String, u64, u64)> = p["fields"]
+            .as_array()
+            .expect("fields")
             .iter()
             .map(|f| {
                 (
@@ -258,27 +61,57 @@ fn python_mirror_matches_rust_layout() {
                 )
             })
             .collect();
-        let rs_fields: Vec<(String, u64, u64)> = l
+        let rs_fields: Vec<(String, u64, u64)> = m
             .fields
             .iter()
-            .map(|(n, o, s)| (n.to_string(), *o as u64, *s as u64))
+            .map(|f| (f.name.to_string(), f.offset as u64, f.size() as u64))
             .collect();
         assert_eq!(
             py_fields, rs_fields,
             "{} fields (name, offset, size)",
-            l.name
+            m.name
         );
     }
 }
 
-#[test]
-fn service_table_matches_type_names() {
-    let names: Vec<&str> = services::ALL.iter().map(|(_, t)| *t).collect();
-    for l in rust_layouts() {
-        assert!(
-            names.contains(&l.type_name),
-            "{} has no service",
-            l.type_name
-        );
+/// Every constant the Python module must have, by its Python name.
+fn rust_constants() -> BTreeMap<String, Value> {
+    let mut c = BTreeMap::new();
+    for g in CONSTANT_GROUPS {
+        for item in g.items {
+            c.insert(g.qualified(item), item.value.into());
+        }
     }
+    for s in SERVICES {
+        let name = format!("SERVICE_{}", s.constant);
+        for sub in s.sub_services {
+            let sub_name = format!("{name}_{}", sub.to_ascii_uppercase());
+            c.insert(sub_name, format!("{}/{sub}", s.name).into());
+        }
+        c.insert(name, s.name.as_str().into());
+    }
+    for r in &ROLES {
+        c.insert(format!("ROLE_{}", r.constant_name()), r.id().into());
+    }
+    c
+}
+
+#[test]
+fn python_constants_are_the_rust_ones() {
+    let py = python_json("--constants-json");
+    let py = py.as_object().expect("object of constants");
+    let rust = rust_constants();
+    let mut bad = Vec::new();
+    for (name, value) in &rust {
+        if py.get(name) != Some(value) {
+            bad.push(format!("{name}: Rust {value}, Python {:?}", py.get(name)));
+        }
+    }
+    assert!(bad.is_empty(), "{bad:#?}");
+    // the role names, in id order, are the role table's
+    let names: Vec<&str> = ROLES.iter().map(|r| r.name).collect();
+    assert_eq!(py["ROLE_NAMES"], serde_json::json!(names));
+    // the comparison covers every group, every service and every role
+    assert!(rust.contains_key("DUE_ALL") && rust.contains_key("HEALTH_STOPPING"));
+    assert!(rust.contains_key("SERVICE_HANDSHAKE_GO") && rust.contains_key("ROLE_RECORDER"));
 }

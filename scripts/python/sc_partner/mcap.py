@@ -1,6 +1,6 @@
 """A minimal reader of the partition's MCAP recordings (standard library only).
 
-The recorder (``libs/partition/src/mcap_out.rs``) writes ``recording.mcap``: one
+The recorder (``libs/ground/src/mcap/``) writes ``recording.mcap``: one
 channel per service, named as the service, every message JSON-encoded (NaN and the
 infinities as ``null``), in LZ4-compressed chunks. This module reads exactly that:
 the MCAP records (https://mcap.dev/spec) and the LZ4 frame format, without the
