@@ -64,5 +64,5 @@ pub fn check_case(p: &HostilePartners, config: &Path, case: &CaseLabel) -> anyho
 
 /// Parses `--hostile <target>/<strategy>` of `launch`.
 pub fn parse_hostile(s: &str) -> anyhow::Result<CaseLabel> {
-    Ok(sc_redteam::partners::parse_partition_case(s).context("--hostile")?)
+    sc_redteam::partners::parse_partition_case(s).context("--hostile")
 }

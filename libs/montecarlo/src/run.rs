@@ -2,7 +2,7 @@
 
 use crate::config::MonteCarloConfig;
 use crate::hist::LogHistogram;
-use crate::sample::{Dispersion, apply, run_seed, sample};
+use crate::sample::{Dispersion, SampleError, apply, run_seed, sample};
 use sc_mission::summary::TimeStats;
 use sc_mission::{
     Executed, Executor, InProcess, Job, MissionEnd, Place, Setup, StepRecord, summarize,
@@ -229,20 +229,34 @@ fn failed(mut result: RunResult, error: String) -> RunOutput {
     }
 }
 
+/// Why run `k`'s dispersed scenario could not be made (the run fails).
+#[derive(Debug, thiserror::Error)]
+enum DispersionError {
+    #[error(transparent)]
+    Sample(#[from] SampleError),
+    #[error("cannot write {}: {error}", .dir.display())]
+    Write { dir: PathBuf, error: std::io::Error },
+    #[error("dispersed scenario rejected: {0}")]
+    Rejected(sc_scenario::ScenarioError),
+}
+
 /// Samples run `k`'s dispersion, saves its scenario into `run_dir/scenario.toml` and
 /// reads it back: a run executes exactly what was saved.
 fn dispersed_scenario(
     base: &CampaignBase,
     run_dir: &Path,
     result: &mut RunResult,
-) -> Result<Scenario, String> {
-    let d = sample(&base.config, &base.scenario, result.seed).map_err(|e| e.to_string())?;
+) -> Result<Scenario, DispersionError> {
+    let d = sample(&base.config, &base.scenario, result.seed)?;
     result.dispersion = Some(d);
     let text = run_scenario(base, &d).to_toml_string();
     std::fs::create_dir_all(run_dir)
         .and_then(|_| std::fs::write(run_dir.join("scenario.toml"), &text))
-        .map_err(|e| format!("cannot write {}: {e}", run_dir.display()))?;
-    Scenario::from_toml_str(&text, run_dir).map_err(|e| format!("dispersed scenario rejected: {e}"))
+        .map_err(|error| DispersionError::Write {
+            dir: run_dir.to_path_buf(),
+            error,
+        })?;
+    Scenario::from_toml_str(&text, run_dir).map_err(DispersionError::Rejected)
 }
 
 /// The job of run `k`: its scenario, read back from `run_dir`, with the campaign's
@@ -279,7 +293,7 @@ pub fn execute_with(
     };
     let scenario = match dispersed_scenario(base, run_dir, &mut result) {
         Ok(s) => s,
-        Err(e) => return failed(result, e),
+        Err(e) => return failed(result, e.to_string()),
     };
     let mut job = job(base, k, run_dir, scenario.clone());
     job.inject_failure = inject_failure;
