@@ -2,8 +2,9 @@
 //! default missions, as geometric mean and percentiles, in wall and thread CPU time.
 
 use sc_cbf::FilterStatus;
+use sc_core::{PerSubsystem, Subsystem};
 use sc_mission::summary::TimeStats;
-use sc_mission::{Mission, RunOptions, Setup};
+use sc_mission::{Executor, InProcess, Job, Setup, StepRecord};
 use sc_montecarlo::host::{HostLoad, HostSample};
 use sc_plots::paper::{PAPER_TOTAL_GEOMEAN_MS, PAPER_TOTAL_MAX_MS};
 use std::path::PathBuf;
@@ -105,51 +106,61 @@ impl SolverWork {
     }
 }
 
-pub fn run(a: Args) -> anyhow::Result<ExitCode> {
-    let case = a
-        .redteam
-        .as_deref()
-        .map(sc_redteam::Case::parse)
-        .transpose()
-        .map_err(|e| anyhow::anyhow!("--redteam: {e}"))?;
-    let setups = a
-        .scenario
-        .iter()
-        .map(|p| Setup::load(p))
-        .collect::<Result<Vec<_>, _>>()?;
-    let mut wall: [Vec<f64>; 4] = Default::default();
-    let mut cpu: [Vec<f64>; 4] = Default::default();
-    let mut qp: [Vec<f64>; 4] = Default::default();
-    let mut work: [SolverWork; 3] = Default::default();
-    let mut mission_wall = Vec::new();
+/// The names of the four timings of a step: the three filters, then the whole layer.
+const TIMINGS: [&str; 4] = ["translational", "attitude", "robotic", "total"];
+
+/// Every step's timings and solver work over all missions, and each mission's wall time.
+#[derive(Default)]
+struct Samples {
+    /// Per [`TIMINGS`]: wall time, thread CPU time, time in the QP solver [µs].
+    wall: [Vec<f64>; 4],
+    cpu: [Vec<f64>; 4],
+    qp: [Vec<f64>; 4],
+    work: PerSubsystem<SolverWork>,
+    mission_wall: Vec<f64>,
+}
+
+impl Samples {
+    fn add(&mut self, r: &StepRecord) {
+        let (t, c, q) = (r.solve_time_us(), r.solve_cpu_us(), r.qp_time_us());
+        for i in 0..4 {
+            self.wall[i].push(t[i]);
+            self.cpu[i].push(c[i]);
+            self.qp[i].push(q[i]);
+        }
+        let (t, a, ro) = (
+            &r.translational.report,
+            &r.attitude.report,
+            &r.robotic.report,
+        );
+        let w = &mut self.work;
+        w[Subsystem::Translational].push(t.status, t.iterations, t.active);
+        w[Subsystem::Attitude].push(a.status, a.iterations, a.active);
+        w[Subsystem::Robotic].push(ro.status, ro.iterations, ro.active);
+    }
+}
+
+/// Runs every mission in this process, `--repeat` times each scenario, collecting the
+/// timings; one progress line per mission on stderr.
+fn run_missions(
+    a: &Args,
+    setups: &[Setup],
+    case: Option<sc_redteam::Case>,
+) -> anyhow::Result<Samples> {
+    let mut samples = Samples::default();
     let tty = std::io::IsTerminal::is_terminal(&std::io::stderr());
-    let load_start = HostSample::now();
     let missions = a.repeat.max(1) * setups.len();
     for k in 0..missions {
         let setup = &setups[k % setups.len()];
         let started = std::time::Instant::now();
-        let mut m = Mission::new(setup.clone(), RunOptions::default())?;
-        m.nominal_override = case.map(|c| crate::cmd_run::adversary(setup, c));
-        if a.solve_all {
-            m.safety.translational.set_skip_enabled(false);
-            m.safety.attitude.set_skip_enabled(false);
-            m.safety.robotic.set_skip_enabled(false);
+        let mut job = Job::new(setup.clone());
+        if let Some(c) = &case {
+            job.nominals = sc_redteam::Adversary::nominals(setup, c);
         }
-        m.run(|_, r| {
-            let (t, c, q) = (r.solve_time_us(), r.solve_cpu_us(), r.qp_time_us());
-            for i in 0..4 {
-                wall[i].push(t[i]);
-                cpu[i].push(c[i]);
-                qp[i].push(q[i]);
-            }
-            let tr = &r.translational.report;
-            let at = &r.attitude.report;
-            let ro = &r.robotic.report;
-            work[0].push(tr.status, tr.iterations, tr.active);
-            work[1].push(at.status, at.iterations, at.active);
-            work[2].push(ro.status, ro.iterations, ro.active);
-        });
-        mission_wall.push(started.elapsed().as_secs_f64());
+        job.solve_every_qp = a.solve_all;
+        let executed = InProcess.execute(job)?;
+        executed.records.iter().for_each(|r| samples.add(r));
+        samples.mission_wall.push(started.elapsed().as_secs_f64());
         if tty {
             err!("\r  mission {}/{missions}", k + 1);
         } else {
@@ -159,20 +170,11 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     if tty {
         errln!();
     }
-    let names = ["translational", "attitude", "robotic", "total"];
-    let mut report = serde_json::Map::new();
-    outln!(
-        "safety-layer solve time per control step [us] ({missions} missions{}, {})",
-        a.redteam
-            .as_deref()
-            .map(|c| format!(" under red-team case {c}"))
-            .unwrap_or_default(),
-        if a.solve_all {
-            "every QP solved"
-        } else {
-            "skip path on"
-        }
-    );
+    Ok(samples)
+}
+
+/// Prints the table of every timing (wall, cpu, qp) and returns each one's JSON entry.
+fn timing_table(samples: &mut Samples) -> serde_json::Map<String, serde_json::Value> {
     outln!(
         "{:<14} {:<5} {:>7} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}",
         "filter",
@@ -185,16 +187,17 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         "p99.9",
         "max"
     );
-    for (i, n) in names.iter().enumerate() {
-        let w = stats(&mut wall[i]);
-        let c = stats(&mut cpu[i]);
-        let q = stats(&mut qp[i]);
+    let mut report = serde_json::Map::new();
+    for (i, n) in TIMINGS.iter().enumerate() {
+        let w = stats(&mut samples.wall[i]);
+        let c = stats(&mut samples.cpu[i]);
+        let q = stats(&mut samples.qp[i]);
         for (clock, s) in [("wall", &w), ("cpu", &c), ("qp", &q)] {
             outln!(
                 "{:<14} {:<5} {:>7} {:>9.2} {:>9.2} {:>9.2} {:>9.2} {:>9.2} {:>9.2}",
                 n,
                 clock,
-                wall[i].len(),
+                samples.wall[i].len(),
                 s[0],
                 s[1],
                 s[2],
@@ -203,32 +206,70 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
                 s[5]
             );
         }
-        let mut entry = json_stats(&w, wall[i].len());
-        entry["cpu"] = json_stats(&c, cpu[i].len());
-        entry["qp"] = json_stats(&q, qp[i].len());
-        if i < 3 {
-            let (im, ix) = SolverWork::mean_max(&work[i].iterations);
-            let (am, ax) = SolverWork::mean_max(&work[i].active_rows);
-            entry["solved_steps"] = serde_json::json!(work[i].iterations.len());
+        let mut entry = json_stats(&w, samples.wall[i].len());
+        entry["cpu"] = json_stats(&c, samples.cpu[i].len());
+        entry["qp"] = json_stats(&q, samples.qp[i].len());
+        if let Some(s) = Subsystem::parse(n) {
+            let work = &samples.work[s];
+            let (im, ix) = SolverWork::mean_max(&work.iterations);
+            let (am, ax) = SolverWork::mean_max(&work.active_rows);
+            entry["solved_steps"] = serde_json::json!(work.iterations.len());
             entry["iterations"] = serde_json::json!({"mean": im, "max": ix});
             entry["active_rows"] = serde_json::json!({"mean": am, "max": ax});
         }
         report.insert(n.to_string(), entry);
     }
+    report
+}
+
+/// Prints each filter's solved QPs, solver iterations and active rows.
+fn solver_work_table(work: &PerSubsystem<SolverWork>) {
     outln!("QPs solved (steps), solver iterations and active barrier rows per solved QP:");
-    for (i, n) in names[..3].iter().enumerate() {
-        let (im, ix) = SolverWork::mean_max(&work[i].iterations);
-        let (am, ax) = SolverWork::mean_max(&work[i].active_rows);
+    for (s, w) in work.iter() {
+        let (im, ix) = SolverWork::mean_max(&w.iterations);
+        let (am, ax) = SolverWork::mean_max(&w.active_rows);
         outln!(
             "{:<14} solved {:>7}  iterations mean {:>5.2} max {:>3}  active rows mean {:>5.2} max {:>3}",
-            n,
-            work[i].iterations.len(),
+            s.name(),
+            w.iterations.len(),
             im,
             ix,
             am,
             ax
         );
     }
+}
+
+pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    let case = a
+        .redteam
+        .as_deref()
+        .map(sc_redteam::Case::parse)
+        .transpose()
+        .map_err(|e| anyhow::anyhow!("--redteam: {e}"))?;
+    let setups = a
+        .scenario
+        .iter()
+        .map(|p| Setup::load(p))
+        .collect::<Result<Vec<_>, _>>()?;
+    let load_start = HostSample::now();
+    let mut samples = run_missions(&a, &setups, case)?;
+    let missions = samples.mission_wall.len();
+    outln!(
+        "safety-layer solve time per control step [us] ({missions} missions{}, {})",
+        a.redteam
+            .as_deref()
+            .map(|c| format!(" under red-team case {c}"))
+            .unwrap_or_default(),
+        if a.solve_all {
+            "every QP solved"
+        } else {
+            "skip path on"
+        }
+    );
+    let mut report = timing_table(&mut samples);
+    solver_work_table(&samples.work);
+    let mission_wall = &samples.mission_wall;
     let mean_wall = mission_wall.iter().sum::<f64>() / mission_wall.len() as f64;
     outln!("whole mission (simulator + nominal + filters) wall time: mean {mean_wall:.3} s");
     let load = HostLoad {

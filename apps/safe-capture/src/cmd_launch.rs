@@ -1,8 +1,11 @@
 //! `safe-capture launch`: the mission as a process partition (logic in sc-ground).
 
+use sc_ground::executor::{failure_reason, partner_overrides};
 use sc_ground::launcher::configured;
 use sc_ground::preflight::preflight;
-use sc_ground::{ClockMode, LaunchOptions, launch};
+use sc_ground::{ClockMode, LaunchOptions, LaunchReport, launch};
+use sc_mission::out_dir::Staged;
+use sc_redteam::{CaseLabel, HostilePartners};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -90,7 +93,9 @@ fn outcome(summary: Option<&serde_json::Value>, scheduler: Option<&serde_json::V
 /// samples lost): the run is no mission result.
 const INFRASTRUCTURE_FAILURE: i32 = 3;
 
-pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+/// The launch options of the arguments, the hostile partner processes of `--hostile`
+/// in place of their nominal controllers (checked that the script understands the case).
+fn options(a: &Args) -> anyhow::Result<(LaunchOptions, Option<(HostilePartners, CaseLabel)>)> {
     let mut opts = LaunchOptions {
         config: a.config.clone(),
         out: PathBuf::new(),
@@ -98,27 +103,59 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         max_ticks: a.max_ticks,
         ..Default::default()
     };
-    let mut partners = None;
-    if let Some(h) = &a.hostile {
-        let case = crate::redteam_partition::parse_hostile(h)?;
-        let cfg = sc_ground::PartitionConfig::load(&a.config)?;
-        let p = crate::redteam_partition::Partners::new(
-            &a.python,
-            &a.partner,
-            &a.config,
-            &cfg.base_dir.join(&cfg.scenario),
-            0,
-            None,
-            opts.clock.unwrap_or(ClockMode::LockStep),
-        )?;
-        opts.role_override = p.overrides(&case);
-        partners = Some((p, case));
-    }
+    let Some(h) = &a.hostile else {
+        return Ok((opts, None));
+    };
+    let case = crate::redteam_partition::parse_hostile(h)?;
+    // a config that does not load is named before the partner's interpreter
+    sc_ground::PartitionConfig::load(&a.config)?;
+    let p = crate::redteam_partition::hostile_partners(&a.python, &a.partner)?;
+    opts.role_override = partner_overrides(&p.processes(&case));
+    Ok((opts, Some((p, case))))
+}
+
+/// Reports a run that gave no mission result (the partial output kept apart) and its
+/// exit code.
+fn infrastructure_failure(
+    a: &Args,
+    rep: &LaunchReport,
+    staged: Staged,
+    scheduler: Option<&serde_json::Value>,
+) -> ExitCode {
+    let out = staged.path().to_path_buf();
+    // no mission result: say why, in one line; the partial output is kept apart
+    let what = if rep.interrupted {
+        format!(
+            "interrupted by SIGINT/SIGTERM{} (exit {}), no mission result",
+            ticks_run(scheduler)
+                .map(|n| format!(" after {n} ticks"))
+                .unwrap_or_default(),
+            rep.code
+        )
+    } else {
+        format!(
+            "infrastructure failure (exit {}), no mission result: {}",
+            rep.code,
+            failure_reason(rep, &out)
+        )
+    };
+    let kept = staged.abandon();
+    outln!(
+        "partition: {what}; wall {:.2} s -> {} (partial output; {} not replaced)",
+        rep.wall_s,
+        kept.as_deref().unwrap_or(&out).display(),
+        a.out.display()
+    );
+    ExitCode::from(rep.code.clamp(0, 255) as u8)
+}
+
+pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    let (mut opts, partners) = options(&a)?;
     // nothing starts unless the scenario and every program are there
     let cfg = configured(&opts)?;
     preflight(&cfg, &opts.bin_dir).map_err(|e| anyhow::anyhow!("{}: {e}", a.config.display()))?;
     if let Some((p, case)) = &partners {
-        p.check(case)?;
+        crate::redteam_partition::check_case(p, &a.config, case)?;
     }
     // the processes write into the staging folder; it replaces --out once they are done
     let staged = crate::out_folder::stage(&a.out, "launch", a.force)?;
@@ -127,30 +164,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let rep = launch(&opts)?;
     let scheduler = read_json(&out.join("scheduler.json"));
     if rep.code >= INFRASTRUCTURE_FAILURE {
-        // no mission result: say why, in one line; the partial output is kept apart
-        let what = if rep.interrupted {
-            format!(
-                "interrupted by SIGINT/SIGTERM{} (exit {}), no mission result",
-                ticks_run(scheduler.as_ref())
-                    .map(|n| format!(" after {n} ticks"))
-                    .unwrap_or_default(),
-                rep.code
-            )
-        } else {
-            format!(
-                "infrastructure failure (exit {}), no mission result: {}",
-                rep.code,
-                crate::montecarlo_partition::failure_reason(&rep, &out)
-            )
-        };
-        let kept = staged.abandon();
-        outln!(
-            "partition: {what}; wall {:.2} s -> {} (partial output; {} not replaced)",
-            rep.wall_s,
-            kept.as_deref().unwrap_or(&out).display(),
-            a.out.display()
-        );
-        return Ok(ExitCode::from(rep.code.clamp(0, 255) as u8));
+        return Ok(infrastructure_failure(&a, &rep, staged, scheduler.as_ref()));
     }
     let failed: Vec<String> = rep
         .exits

@@ -1,14 +1,14 @@
 //! `safe-capture montecarlo`: dispersed campaigns, in parallel, sharded, merged, rerun.
 
-use crate::montecarlo_partition::PartitionExecutor;
 use anyhow::Context;
-use sc_mission::{RunOptions, TelemetryWriter, summarize};
+use sc_core::Subsystem;
+use sc_ground::PartitionConfig;
+use sc_ground::executor::Partition;
+use sc_mission::{Execution, Executor, InProcess, RunOptions, TelemetryWriter, summarize};
 use sc_montecarlo::interrupt::{EXIT_FORCED, StopOnSignal};
-use sc_montecarlo::{
-    CampaignOptions, CampaignSummary, Execution, Executor, InProcess, MonteCarloConfig,
-};
+use sc_montecarlo::{CampaignOptions, CampaignSummary, MonteCarloConfig};
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Partition config of --mode partition unless --partition-config is given (in the
@@ -206,8 +206,7 @@ fn params(a: &RunArgs) -> anyhow::Result<Params> {
         .shard
         .as_deref()
         .map(sc_montecarlo::parse_shard)
-        .transpose()
-        .map_err(anyhow::Error::msg)?;
+        .transpose()?;
     let config = a
         .config
         .as_deref()
@@ -257,6 +256,39 @@ fn params(a: &RunArgs) -> anyhow::Result<Params> {
     })
 }
 
+/// `--mode partition`: the partition's executor, after checking the partition config and
+/// that every role's executable exists, before any run starts; and, when the config's
+/// schedule is not the scenario's single control period, a note that results will
+/// differ from in-process runs.
+fn partition_executor(
+    config: &Path,
+    keep_recordings: bool,
+    scenario: &Path,
+) -> anyhow::Result<(Partition, Option<String>)> {
+    let cfg = PartitionConfig::load(config).context("--partition-config")?;
+    let schedule = cfg.schedule().context("--partition-config")?;
+    // every role's program, as the launcher will find it (the scenario is the
+    // campaign's, checked by the campaign)
+    sc_ground::preflight::check_programs(&cfg, &None)
+        .map_err(|e| anyhow::anyhow!("--partition-config {}: {e}", config.display()))?;
+    let period = sc_scenario::Scenario::load(scenario)
+        .map(|s| s.mission.control_period_s)
+        .ok();
+    let note = match period {
+        Some(p) if schedule.period_s.iter().all(|(_, x)| *x == p) => None,
+        Some(p) => Some(format!(
+            "note: the schedule of {} (periods translational {} s, attitude {} s, robotic {} s) is not the scenario's control period {p} s: results will differ from --mode in-process",
+            config.display(),
+            schedule.period_s[Subsystem::Translational],
+            schedule.period_s[Subsystem::Attitude],
+            schedule.period_s[Subsystem::Robotic]
+        )),
+        None => None, // the campaign reports the scenario's problem
+    };
+    let executor = Partition::new(config).keep_recordings(keep_recordings);
+    Ok((executor, note))
+}
+
 fn campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
     a.figures.check()?;
     let p = params(&a)?;
@@ -287,7 +319,7 @@ fn campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
     let executor: Box<dyn Executor> = match p.mode {
         Mode::InProcess => {
             // the partition's launcher handles the signals of --mode partition itself
-            sc_montecarlo::interrupt::install().map_err(anyhow::Error::msg)?;
+            sc_montecarlo::interrupt::install()?;
             Box::new(StopOnSignal(InProcess))
         }
         Mode::Partition => {
@@ -295,7 +327,7 @@ fn campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
                 .partition_config
                 .clone()
                 .unwrap_or_else(|| crate::home::shipped(DEFAULT_PARTITION_CONFIG));
-            let (executor, note) = PartitionExecutor::new(&config, a.keep_recordings, &p.scenario)?;
+            let (executor, note) = partition_executor(&config, a.keep_recordings, &p.scenario)?;
             if let Some(n) = note {
                 errln!("{n}");
             }

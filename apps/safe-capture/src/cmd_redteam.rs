@@ -1,17 +1,18 @@
 //! `safe-capture redteam`: the red-team campaign against the safety layer.
 
-use crate::redteam_partition::{Partners, default_python};
+use crate::redteam_partition::{check_case, default_python, hostile_partners};
 use anyhow::Context;
-use rayon::prelude::*;
 use sc_ground::ClockMode;
-use sc_mission::Setup;
+use sc_ground::executor::Partition;
+use sc_mission::{Executor, InProcess, Setup};
 use sc_redteam::partners::{parse_partition_case, partition_cases};
-use sc_redteam::{Case, CaseLabel, CaseResult, Target, report};
+use sc_redteam::{
+    Adversaries, Campaign, Case, CaseError, CaseLabel, CaseResult, HostilePartners, Target, report,
+};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Attacks the safety layer with adversarial nominal controllers and measures the result
 /// from the simulator's true state.
@@ -146,61 +147,55 @@ fn selected(a: &Args, ticks: u64) -> anyhow::Result<Vec<CaseLabel>> {
         .collect())
 }
 
-pub fn run(a: Args) -> anyhow::Result<ExitCode> {
-    let setup = Setup::load(&a.scenario)?;
+/// The ticks of a partition run: `--max-ticks`, at most the mission's.
+fn run_ticks(a: &Args, setup: &Setup) -> u64 {
     let mission_ticks = setup.scenario.control_steps() as u64;
-    let ticks = if a.max_ticks > 0 {
+    if a.max_ticks > 0 {
         a.max_ticks.min(mission_ticks)
     } else {
         mission_ticks
-    };
-    let cases = selected(&a, ticks)?;
-    if a.list {
-        for c in &cases {
-            outln!("{}", c.name());
-        }
-        return Ok(ExitCode::SUCCESS);
     }
-    let partners = if a.partition {
-        if !(a.deadline_scale.is_finite() && a.deadline_scale >= 1.0) {
-            anyhow::bail!("--deadline-scale {}: must be >= 1", a.deadline_scale);
-        }
-        let p = Partners::new(
-            &a.python,
-            &a.partner,
-            &a.partition_config,
-            &a.scenario,
-            a.max_ticks,
-            Some(a.deadline_scale),
-            if a.real_time {
-                ClockMode::RealTime
-            } else {
-                ClockMode::LockStep
-            },
-        )?;
-        // every role's program, as the launcher will find it, before any case runs
-        let cfg = sc_ground::PartitionConfig::load(&a.partition_config)?;
-        sc_ground::preflight::check_programs(&cfg, &None).map_err(|e| {
-            anyhow::anyhow!("--partition-config {}: {e}", a.partition_config.display())
-        })?;
-        for c in &cases {
-            p.check(c)?;
-        }
-        Some(p)
-    } else {
-        None
-    };
-    // real-time runs side by side would measure each other
-    if let Some(j) = a.jobs.or(a.real_time.then_some(1)) {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(j.max(1))
-            .build_global()
-            .context("--jobs")?;
+}
+
+/// `--partition`: the hostile partners, after checking the deadline scale, every role's
+/// program and that the partner script understands every case.
+fn partition_partners(a: &Args, cases: &[CaseLabel]) -> anyhow::Result<HostilePartners> {
+    if !(a.deadline_scale.is_finite() && a.deadline_scale >= 1.0) {
+        anyhow::bail!("--deadline-scale {}: must be >= 1", a.deadline_scale);
     }
-    a.figures.check()?;
-    let staged = crate::out_folder::stage(&a.out, "redteam", a.force)?;
-    let out = staged.path().to_path_buf();
-    let started = std::time::Instant::now();
+    let p = hostile_partners(&a.python, &a.partner)?;
+    // every role's program, as the launcher will find it, before any case runs
+    let cfg = sc_ground::PartitionConfig::load(&a.partition_config)?;
+    sc_ground::preflight::check_programs(&cfg, &None)
+        .map_err(|e| anyhow::anyhow!("--partition-config {}: {e}", a.partition_config.display()))?;
+    for c in cases {
+        check_case(&p, &a.partition_config, c)?;
+    }
+    Ok(p)
+}
+
+/// The partition's executor of `--partition`: lock-step (scaled deadlines) or real
+/// time, every run's recordings kept in its case folder.
+fn partition_executor(a: &Args) -> Partition {
+    Partition::new(&a.partition_config)
+        .clock(if a.real_time {
+            ClockMode::RealTime
+        } else {
+            ClockMode::LockStep
+        })
+        .max_ticks(a.max_ticks)
+        .deadline_scale(Some(a.deadline_scale))
+        .keep_recordings(true)
+        .run_tag(std::process::id().to_string())
+}
+
+/// Runs the campaign's cases, showing the progress on stderr (a bar on a terminal, a
+/// line every 10 cases — every case through the partition — in a log).
+fn run_cases(
+    a: &Args,
+    campaign: &Campaign,
+    cases: &[CaseLabel],
+) -> Vec<Result<CaseResult, CaseError>> {
     let tty = std::io::stderr().is_terminal();
     let bar = (!a.quiet && tty).then(|| {
         let b = indicatif::ProgressBar::new(cases.len() as u64);
@@ -213,7 +208,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         b
     });
     let unsafe_count = Mutex::new(0usize);
-    let progress = |done: usize, total: usize, r: &Result<CaseResult, String>| {
+    let progress = |done: usize, total: usize, r: &Result<CaseResult, CaseError>| {
         let bad = match r {
             Ok(r) => !r.safe(),
             Err(_) => true,
@@ -229,50 +224,35 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             errln!("redteam: {done}/{total} cases, {} unsafe or failed", *u);
         }
     };
-    let results: Vec<Result<CaseResult, String>> = match &partners {
-        None => {
-            let in_process: Vec<Case> = cases
-                .iter()
-                .map(|c| Case::parse(&c.name()).map_err(anyhow::Error::msg))
-                .collect::<anyhow::Result<_>>()?;
-            let telemetry = a.telemetry.then_some(out.as_path());
-            sc_redteam::run_campaign_recorded(&setup, &in_process, &progress, telemetry)
-        }
-        Some(p) => {
-            let done = AtomicUsize::new(0);
-            let pid = std::process::id();
-            cases
-                .par_iter()
-                .enumerate()
-                .map(|(k, c)| {
-                    let out = out.join("cases").join(c.dir_name());
-                    let r = p.run_case(&setup, c, &out, &format!("rt{k}-{pid}"));
-                    let n = done.fetch_add(1, Ordering::SeqCst) + 1;
-                    progress(n, cases.len(), &r);
-                    r
-                })
-                .collect()
-        }
-    };
+    let results = campaign.run(cases, &progress);
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    let wall = started.elapsed().as_secs_f64();
-    let how = if a.real_time {
+    results
+}
+
+/// The report's paragraph on how the cases ran.
+fn how(a: &Args) -> &'static str {
+    if a.real_time {
         "Each case runs the mission through the process partition in real time (10 Hz on the wall clock, one case at a time), the hostile partner process `scripts/python/hostile_nominal.py` in place of the nominal controller process of its target (`all`: all three); the barriers come from the simulator's state as the recorder logged it (`cases/<case>/telemetry.csv`)."
     } else if a.partition {
         "Each case runs the mission through the process partition (lock-step), the hostile partner process `scripts/python/hostile_nominal.py` in place of the nominal controller process of its target (`all`: all three); the barriers come from the simulator's state as the recorder logged it (`cases/<case>/telemetry.csv`)."
     } else {
         report::IN_PROCESS
-    };
-    let s = report::write(&out, &setup, how, &cases, &results, wall).map_err(anyhow::Error::msg)?;
-    a.figures.export_dir(&out.join("figures"))?;
-    staged.commit()?;
-    for (c, r) in cases.iter().zip(&results) {
-        if let Err(e) = r {
-            errln!("redteam: {}: {e}", c.name());
-        }
     }
+}
+
+/// `" (<items>)"`-like text of a list, or nothing when it is empty.
+fn listed(items: &[String], before: &str, sep: &str, after: &str) -> String {
+    if items.is_empty() {
+        String::new()
+    } else {
+        format!("{before}{}{after}", items.join(sep))
+    }
+}
+
+/// The final line.
+fn verdict_line(a: &Args, s: &report::CampaignSummary, wall: f64) {
     outln!(
         "redteam{}: {} of {} cases safe{}{}; non-finite applied {}, out-of-bound applied {}; bystanders disturbed in {} cases{}; solve time geomean (worst case) {:.1} us, max {:.0} us; wall {:.1} s -> {}",
         match (a.partition, a.real_time) {
@@ -282,11 +262,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         },
         s.safe,
         s.cases,
-        if s.unsafe_cases.is_empty() {
-            String::new()
-        } else {
-            format!(" (unsafe: {})", s.unsafe_cases.join(", "))
-        },
+        listed(&s.unsafe_cases, " (unsafe: ", ", ", ")"),
         if s.errors.is_empty() {
             String::new()
         } else {
@@ -295,16 +271,63 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         s.nonfinite_applied,
         s.out_of_bounds_applied,
         s.bystanders_disturbed.len(),
-        if s.bystanders_disturbed.is_empty() {
-            String::new()
-        } else {
-            format!(" ({})", s.bystanders_disturbed.join(", "))
-        },
+        listed(&s.bystanders_disturbed, " (", ", ", ")"),
         s.solve_time_geomean_max_us,
         s.solve_time_max_us,
         wall,
         a.out.display()
     );
+}
+
+pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    let setup = Setup::load(&a.scenario)?;
+    let cases = selected(&a, run_ticks(&a, &setup))?;
+    if a.list {
+        for c in &cases {
+            outln!("{}", c.name());
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let partners = a
+        .partition
+        .then(|| partition_partners(&a, &cases))
+        .transpose()?;
+    // real-time runs side by side would measure each other
+    if let Some(j) = a.jobs.or(a.real_time.then_some(1)) {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(j.max(1))
+            .build_global()
+            .context("--jobs")?;
+    }
+    a.figures.check()?;
+    let staged = crate::out_folder::stage(&a.out, "redteam", a.force)?;
+    let out = staged.path().to_path_buf();
+    let started = std::time::Instant::now();
+    let partition = partition_executor(&a);
+    let scenario_file = std::path::absolute(&a.scenario).unwrap_or_else(|_| a.scenario.clone());
+    let (executor, adversaries): (&dyn Executor, _) = match partners {
+        Some(p) => (&partition, Adversaries::Partners(p)),
+        None => (&InProcess, Adversaries::InProcess),
+    };
+    let campaign = Campaign {
+        setup: &setup,
+        scenario_file: &scenario_file,
+        executor,
+        adversaries,
+        out: Some(&out),
+        telemetry: a.telemetry,
+    };
+    let results = run_cases(&a, &campaign, &cases);
+    let wall = started.elapsed().as_secs_f64();
+    let s = report::write(&out, &setup, how(&a), &cases, &results, wall)?;
+    a.figures.export_dir(&out.join("figures"))?;
+    staged.commit()?;
+    for (c, r) in cases.iter().zip(&results) {
+        if let Err(e) = r {
+            errln!("redteam: {}: {e}", c.name());
+        }
+    }
+    verdict_line(&a, &s, wall);
     Ok(
         if s.safe == s.cases && s.errors.is_empty() && s.bystanders_disturbed.is_empty() {
             ExitCode::SUCCESS

@@ -1,7 +1,10 @@
 //! `safe-capture run`: the whole mission in one process.
 
 use anyhow::Context;
-use sc_mission::{Mission, MissionEnd, RunOptions, Setup, StepRecord, TelemetryWriter, summarize};
+use sc_mission::{
+    ExecError, Executed, Executor, InProcess, Job, NominalSource, RunOptions, Setup, Sinks,
+    StepRecord, TelemetryWriter, summarize,
+};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -98,68 +101,46 @@ impl Nominals {
         Ok(Nominals::Reference)
     }
 
-    fn source(&self, setup: &Setup) -> Option<Box<dyn sc_mission::NominalOverride>> {
+    fn source(&self, setup: &Setup) -> NominalSource {
         match self {
-            Nominals::Reference => None,
-            Nominals::RedTeam(c) => Some(adversary(setup, *c)),
-            Nominals::Replay(r) => Some(Box::new(sc_mission::ReplayNominals::new(r))),
+            Nominals::Reference => NominalSource::Reference,
+            Nominals::RedTeam(c) => sc_redteam::Adversary::nominals(setup, c),
+            Nominals::Replay(r) => {
+                NominalSource::Override(Box::new(sc_mission::ReplayNominals::new(r)))
+            }
         }
     }
 }
 
-/// Runs one mission, writing telemetry into `out`; returns the records and how it ended.
-pub fn run_mission(
+/// One mission of `run`: what runs, and where its files go.
+struct MissionRun<'a> {
     setup: Setup,
     options: RunOptions,
-    out: &Path,
-    dump_qp: Option<&Path>,
-    quiet: bool,
-    nominal_override: Option<Box<dyn sc_mission::NominalOverride>>,
+    nominals: NominalSource,
     plant: Option<Box<dyn sc_sim::Plant + Send>>,
-) -> anyhow::Result<(Vec<StepRecord>, MissionEnd)> {
-    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
-    let open = |name: &str| -> anyhow::Result<std::io::BufWriter<std::fs::File>> {
-        let p = out.join(name);
-        Ok(std::io::BufWriter::new(
-            std::fs::File::create(&p).with_context(|| format!("cannot create {}", p.display()))?,
-        ))
-    };
-    let mut writer = TelemetryWriter::new(open("telemetry.csv")?, open("timing.csv")?)?;
-    let mut qp_file = match dump_qp {
-        Some(p) => Some(std::io::BufWriter::new(
-            std::fs::File::create(p).with_context(|| format!("cannot create {}", p.display()))?,
-        )),
-        None => None,
-    };
-    let duration = setup.scenario.mission.duration_s;
-    let mut mission = Mission::new(setup, options)?;
-    mission.nominal_override = nominal_override;
-    if let Some(p) = plant {
-        mission.set_plant(p).map_err(anyhow::Error::msg)?;
-    }
-    let mut records = Vec::new();
-    let mut io_err: Option<std::io::Error> = None;
+    /// Gets telemetry.csv and timing.csv.
+    out: &'a Path,
+    dump_qp: Option<&'a Path>,
+    /// No progress line.
+    quiet: bool,
+}
+
+/// A new buffered file at `p`.
+fn create(p: &Path) -> anyhow::Result<std::io::BufWriter<std::fs::File>> {
+    Ok(std::io::BufWriter::new(
+        std::fs::File::create(p).with_context(|| format!("cannot create {}", p.display()))?,
+    ))
+}
+
+/// Mission time between two progress lines [s].
+const PROGRESS_EVERY_S: f64 = 10.0;
+
+/// The progress line every [`PROGRESS_EVERY_S`] of mission time: on a terminal one line
+/// redrawn in place, in a log one line per report.
+fn progress_printer(duration: f64, tty: bool) -> impl FnMut(&StepRecord) {
     let mut last_print = 0.0;
-    // a terminal gets one line redrawn in place; a log gets one line per report
-    let tty = std::io::IsTerminal::is_terminal(&std::io::stderr());
-    let end = mission.run(|m, r| {
-        if let Err(e) = writer.write(r) {
-            io_err.get_or_insert(e);
-        }
-        if let Some(f) = qp_file.as_mut() {
-            let q = m.last_qps();
-            for (name, d) in [
-                ("translational", &q.translational),
-                ("attitude", &q.attitude),
-                ("robotic", &q.robotic),
-            ] {
-                let line = serde_json::json!({"step": r.step, "t_s": r.t, "filter": name, "qp": d});
-                if let Err(e) = writeln!(f, "{line}") {
-                    io_err.get_or_insert(e);
-                }
-            }
-        }
-        if !quiet && r.t - last_print >= 10.0 {
+    move |r: &StepRecord| {
+        if r.t - last_print >= PROGRESS_EVERY_S {
             last_print = r.t;
             let line = format!(
                 "  t = {:6.1} / {duration:.0} s  phase {}  grasp distance {:7.3} m",
@@ -173,80 +154,73 @@ pub fn run_mission(
                 errln!("{line}");
             }
         }
-        records.push(*r);
-    });
-    if !quiet && tty {
+    }
+}
+
+/// Runs one mission in this process ([`InProcess`]), writing its telemetry (and QPs)
+/// as it goes; returns the records and how it ended.
+fn run_mission(m: MissionRun<'_>) -> anyhow::Result<Executed> {
+    std::fs::create_dir_all(m.out).with_context(|| format!("cannot create {}", m.out.display()))?;
+    let mut writer = TelemetryWriter::new(
+        create(&m.out.join("telemetry.csv"))?,
+        create(&m.out.join("timing.csv"))?,
+    )?;
+    let mut qp_file = m.dump_qp.map(create).transpose()?;
+    let tty = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let mut progress = progress_printer(m.setup.scenario.mission.duration_s, tty);
+    let mut job = Job::new(m.setup);
+    job.options = m.options;
+    job.nominals = m.nominals;
+    job.plant = m.plant;
+    job.sinks = Sinks {
+        telemetry: Some(&mut writer),
+        dump_qp: qp_file.as_mut().map(|f| f as &mut dyn Write),
+        progress: (!m.quiet).then_some(&mut progress as &mut dyn FnMut(&StepRecord)),
+    };
+    let executed = InProcess.execute(job);
+    // the progress line ends once the mission ran (not when it could not start)
+    let ran = !matches!(executed, Err(ExecError::Setup(_) | ExecError::Plant(_)));
+    if !m.quiet && tty && ran {
         errln!();
     }
-    if let Some(e) = io_err {
-        return Err(e).context("writing telemetry");
-    }
+    let executed = executed?;
     writer.flush()?;
     if let Some(mut f) = qp_file {
         f.flush()?;
     }
-    Ok((records, end))
+    Ok(executed)
 }
 
-pub fn run(a: Args) -> anyhow::Result<ExitCode> {
-    let setup = Setup::load(&a.scenario)?;
-    let phase_names: Vec<String> = setup
-        .scenario
+/// Basilisk as the plant, a child process (`scripts/basilisk_plant.py`).
+fn basilisk(a: &Args) -> anyhow::Result<Box<dyn sc_sim::Plant + Send>> {
+    let script = crate::home::shipped("scripts/basilisk_plant.py");
+    let args = vec![
+        script.display().to_string(),
+        "--scenario".to_string(),
+        a.scenario.display().to_string(),
+    ];
+    Ok(Box::new(sc_sim::ProcessPlant::spawn(&a.python, &args)?))
+}
+
+/// The names of the scenario's phases.
+fn phase_names(scenario: &sc_scenario::Scenario) -> Vec<String> {
+    scenario
         .mission
         .phases
         .iter()
         .map(|p| p.name.clone())
-        .collect();
-    let options = RunOptions {
-        no_filter: a.no_filter,
-    };
-    let started = std::time::Instant::now();
-    let scenario = setup.scenario.clone();
-    let compare_setup = setup.clone();
-    let nominals = Nominals::from_args(&a)?;
-    let source = nominals.source(&setup);
-    // a new folder replaces an earlier run's as a whole (no stale nominal/ comparison)
-    a.figures.check()?;
-    let staged = crate::out_folder::stage(&a.out, "run", a.force)?;
-    let out = staged.path().to_path_buf();
-    let plant: Option<Box<dyn sc_sim::Plant + Send>> = if a.basilisk {
-        let script = crate::home::shipped("scripts/basilisk_plant.py");
-        let args = vec![
-            script.display().to_string(),
-            "--scenario".to_string(),
-            a.scenario.display().to_string(),
-        ];
-        Some(Box::new(sc_sim::ProcessPlant::spawn(&a.python, &args)?))
-    } else {
-        None
-    };
-    let (records, end) = run_mission(
-        setup,
-        options,
-        &out,
-        a.dump_qp.as_deref(),
-        a.quiet,
-        source,
-        plant,
-    )?;
-    let summary = summarize(&records, &end, &phase_names, !a.no_filter);
-    let path = out.join("summary.json");
-    std::fs::write(&path, serde_json::to_string_pretty(&summary)? + "\n")
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    if !a.no_figures {
-        write_figures(
-            &out,
-            &scenario,
-            &records,
-            compare_setup,
-            a.no_filter || a.no_compare || a.basilisk,
-            &nominals,
-        )?;
-        a.figures.export_dir(&out.join("figures"))?;
-    }
-    staged.commit()?;
-    let safe = summary.violated_constraints.is_empty() && summary.fault_count == 0;
-    let what = format!(
+        .collect()
+}
+
+/// Writes `summary` as `path` (pretty JSON).
+fn write_summary(path: &Path, summary: &sc_mission::Summary) -> anyhow::Result<()> {
+    std::fs::write(path, serde_json::to_string_pretty(summary)? + "\n")
+        .with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// What ran, for the final line: "Basilisk plant, red team all/greedy, filtered".
+fn what_ran(a: &Args) -> String {
+    format!(
         "{}{}{}",
         if a.basilisk { "Basilisk plant, " } else { "" },
         match (&a.redteam, &a.replay_nominals) {
@@ -259,9 +233,49 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         } else {
             "filtered"
         }
-    );
+    )
+}
+
+pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    let setup = Setup::load(&a.scenario)?;
+    let options = RunOptions {
+        no_filter: a.no_filter,
+    };
+    let started = std::time::Instant::now();
+    let scenario = setup.scenario.clone();
+    let compare_setup = setup.clone();
+    let nominals = Nominals::from_args(&a)?;
+    let source = nominals.source(&setup);
+    // a new folder replaces an earlier run's as a whole (no stale nominal/ comparison)
+    a.figures.check()?;
+    let staged = crate::out_folder::stage(&a.out, "run", a.force)?;
+    let out = staged.path().to_path_buf();
+    let plant = if a.basilisk {
+        Some(basilisk(&a)?)
+    } else {
+        None
+    };
+    let Executed { records, end } = run_mission(MissionRun {
+        setup,
+        options,
+        nominals: source,
+        plant,
+        out: &out,
+        dump_qp: a.dump_qp.as_deref(),
+        quiet: a.quiet,
+    })?;
+    let summary = summarize(&records, &end, &phase_names(&scenario), !a.no_filter);
+    write_summary(&out.join("summary.json"), &summary)?;
+    if !a.no_figures {
+        let alone = a.no_filter || a.no_compare || a.basilisk;
+        write_figures(&out, &scenario, &records, compare_setup, alone, &nominals)?;
+        a.figures.export_dir(&out.join("figures"))?;
+    }
+    staged.commit()?;
+    let safe = summary.violated_constraints.is_empty() && summary.fault_count == 0;
     outln!(
-        "{what}: {} at t = {:.1} s; min margin {} = {:.3e}; violated: [{}]; faults: {}; total solve time geomean {:.1} us, max {:.1} us; wall {:.2} s -> {}",
+        "{}: {} at t = {:.1} s; min margin {} = {:.3e}; violated: [{}]; faults: {}; total solve time geomean {:.1} us, max {:.1} us; wall {:.2} s -> {}",
+        what_ran(&a),
         summary.end,
         summary.final_time_s,
         summary.min_margin.0,
@@ -280,19 +294,6 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     })
 }
 
-/// A red-team adversary for `case` in `setup`'s scenario.
-pub(crate) fn adversary(
-    setup: &Setup,
-    case: sc_redteam::Case,
-) -> Box<dyn sc_mission::NominalOverride> {
-    Box::new(sc_redteam::Adversary::new(
-        &setup.scenario,
-        setup.robot.clone(),
-        case.target,
-        case.strategy,
-    ))
-}
-
 /// Writes the run's figures into `out/figures`; unless `alone`, first runs the nominal
 /// controllers alone into `out/nominal` and draws that run dashed.
 fn write_figures(
@@ -307,28 +308,20 @@ fn write_figures(
         None
     } else {
         let dir = out.join("nominal");
-        let phase_names: Vec<String> = scenario
-            .mission
-            .phases
-            .iter()
-            .map(|p| p.name.clone())
-            .collect();
         // the same nominal (or adversary) without the filters
         let source = nominals.source(&setup);
-        let (recs, end) = run_mission(
+        let Executed { records, end } = run_mission(MissionRun {
             setup,
-            RunOptions { no_filter: true },
-            &dir,
-            None,
-            true,
-            source,
-            None,
-        )?;
-        let summary = summarize(&recs, &end, &phase_names, false);
-        let path = dir.join("summary.json");
-        std::fs::write(&path, serde_json::to_string_pretty(&summary)? + "\n")
-            .with_context(|| format!("cannot write {}", path.display()))?;
-        Some(recs)
+            options: RunOptions { no_filter: true },
+            nominals: source,
+            plant: None,
+            out: &dir,
+            dump_qp: None,
+            quiet: true,
+        })?;
+        let summary = summarize(&records, &end, &phase_names(scenario), false);
+        write_summary(&dir.join("summary.json"), &summary)?;
+        Some(records)
     };
     sc_plots::run_figures(&out.join("figures"), scenario, records, nominal.as_deref())?;
     Ok(())

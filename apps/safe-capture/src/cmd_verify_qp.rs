@@ -4,7 +4,7 @@
 use anyhow::Context;
 use sc_cbf::QpOutcome;
 use sc_cbf::qp::QpDump;
-use sc_cbf::verify::{check, input_bound};
+use sc_cbf::verify::{Check, check, input_bound};
 use std::collections::BTreeMap;
 use std::io::BufRead;
 use std::path::PathBuf;
@@ -84,7 +84,43 @@ fn raise(slot: &mut (f64, u64), v: f64, step: u64) {
     }
 }
 
-pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+impl Worst {
+    /// Adds the check `c` of the QP of `step`, lengths relative to the input bound `u_inf`.
+    fn add(&mut self, c: &Check, u_inf: f64, step: u64) {
+        self.checked += 1;
+        raise(&mut self.violation, c.violation / u_inf, step);
+        raise(&mut self.stationarity, c.stationarity / u_inf, step);
+        match c.clarabel_distance {
+            Some(d) => raise(&mut self.clarabel, d / u_inf, step),
+            None => self.clarabel_failed += 1,
+        }
+        self.from_solution += usize::from(c.exact_from_solution);
+        match (c.exact_distance, c.clarabel_distance) {
+            (Some(d), _) => {
+                self.exact_n += 1;
+                raise(&mut self.exact, d / u_inf, step)
+            }
+            (None, Some(d)) => {
+                self.inexact += 1;
+                raise(&mut self.inexact_clarabel, d / u_inf, step);
+            }
+            (None, None) => {}
+        }
+    }
+
+    /// Every check within the tolerances of `a`.
+    fn within(&self, a: &Args) -> bool {
+        let kkt_ok = self.violation.0 <= a.feasibility_tolerance;
+        let exact_ok = self.exact.0 <= a.exact_tolerance;
+        // a QP without any reference (Clarabel failed, no KKT point found) is not verified
+        let unverified = self.checked - self.exact_n;
+        let cl_ok = self.inexact_clarabel.0 <= a.clarabel_tolerance && unverified == self.inexact;
+        kkt_ok && exact_ok && cl_ok
+    }
+}
+
+/// Checks every solved QP of the dump; the worst values per filter.
+fn check_dump(a: &Args) -> anyhow::Result<BTreeMap<String, Worst>> {
     let file = std::fs::File::open(&a.dump)
         .with_context(|| format!("cannot open {}", a.dump.display()))?;
     let mut worst: BTreeMap<String, Worst> = BTreeMap::new();
@@ -103,67 +139,50 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             ACTIVE_TOLERANCE * u_inf,
             EXACT_KKT_TOLERANCE * u_inf,
         );
-        let w = worst.entry(l.filter).or_default();
-        w.checked += 1;
-        raise(&mut w.violation, c.violation / u_inf, l.step);
-        raise(&mut w.stationarity, c.stationarity / u_inf, l.step);
-        match c.clarabel_distance {
-            Some(d) => raise(&mut w.clarabel, d / u_inf, l.step),
-            None => w.clarabel_failed += 1,
-        }
-        w.from_solution += usize::from(c.exact_from_solution);
-        match (c.exact_distance, c.clarabel_distance) {
-            (Some(d), _) => {
-                w.exact_n += 1;
-                raise(&mut w.exact, d / u_inf, l.step)
-            }
-            (None, Some(d)) => {
-                w.inexact += 1;
-                raise(&mut w.inexact_clarabel, d / u_inf, l.step);
-            }
-            (None, None) => {}
-        }
+        worst.entry(l.filter).or_default().add(&c, u_inf, l.step);
     }
+    Ok(worst)
+}
+
+/// The line of filter `f`'s worst values and verdict.
+fn filter_line(f: &str, w: &Worst, ok: bool) {
+    outln!(
+        "{f:<14} {:>6} QPs  violation {:.1e} (step {})  stationarity {:.1e} (step {})  distance to exact {:.1e} (step {}) on {}  to Clarabel {:.1e} (step {}){}{}  {}",
+        w.checked,
+        w.violation.0,
+        w.violation.1,
+        w.stationarity.0,
+        w.stationarity.1,
+        w.exact.0,
+        w.exact.1,
+        w.exact_n,
+        w.clarabel.0,
+        w.clarabel.1,
+        if w.inexact > 0 {
+            format!(
+                ", no exact reference for {} (to Clarabel {:.1e}, step {})",
+                w.inexact, w.inexact_clarabel.0, w.inexact_clarabel.1
+            )
+        } else {
+            String::new()
+        },
+        match (w.clarabel_failed, w.from_solution) {
+            (0, 0) => String::new(),
+            (f, s) => format!(
+                ", Clarabel failed on {f}, exact reference from the solution's own active set on {s}"
+            ),
+        },
+        if ok { "ok" } else { "BEYOND TOLERANCE" }
+    );
+}
+
+pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    let worst = check_dump(&a)?;
     let mut ok = true;
     for (f, w) in &worst {
-        let kkt_ok = w.violation.0 <= a.feasibility_tolerance;
-        let exact_ok = w.exact.0 <= a.exact_tolerance;
-        // a QP without any reference (Clarabel failed, no KKT point found) is not verified
-        let unverified = w.checked - w.exact_n;
-        let cl_ok = w.inexact_clarabel.0 <= a.clarabel_tolerance && unverified == w.inexact;
-        ok &= kkt_ok && exact_ok && cl_ok;
-        outln!(
-            "{f:<14} {:>6} QPs  violation {:.1e} (step {})  stationarity {:.1e} (step {})  distance to exact {:.1e} (step {}) on {}  to Clarabel {:.1e} (step {}){}{}  {}",
-            w.checked,
-            w.violation.0,
-            w.violation.1,
-            w.stationarity.0,
-            w.stationarity.1,
-            w.exact.0,
-            w.exact.1,
-            w.exact_n,
-            w.clarabel.0,
-            w.clarabel.1,
-            if w.inexact > 0 {
-                format!(
-                    ", no exact reference for {} (to Clarabel {:.1e}, step {})",
-                    w.inexact, w.inexact_clarabel.0, w.inexact_clarabel.1
-                )
-            } else {
-                String::new()
-            },
-            match (w.clarabel_failed, w.from_solution) {
-                (0, 0) => String::new(),
-                (f, s) => format!(
-                    ", Clarabel failed on {f}, exact reference from the solution's own active set on {s}"
-                ),
-            },
-            if kkt_ok && exact_ok && cl_ok {
-                "ok"
-            } else {
-                "BEYOND TOLERANCE"
-            }
-        );
+        let within = w.within(&a);
+        ok &= within;
+        filter_line(f, w, within);
     }
     let total: usize = worst.values().map(|w| w.checked).sum();
     let exact: usize = worst.values().map(|w| w.exact_n).sum();

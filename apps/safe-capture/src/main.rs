@@ -24,8 +24,7 @@ mod figure_format;
 mod home;
 // the output-folder policy's --out/--force, the same in every command
 mod out_folder;
-// `montecarlo --mode partition`: runs through the process partition
-mod montecarlo_partition;
+// the hostile partner processes of `redteam --partition` and `launch --hostile`
 mod redteam_partition;
 
 use clap::{Parser, Subcommand};

@@ -2,6 +2,8 @@
 //! and measures it — never part of the flight software.
 //!
 //! * [`launcher`]: starts every process from the config, supervises, tears down.
+//! * [`executor`]: the mission through the partition as an `sc_mission::Executor`
+//!   (launch, then the recorder's telemetry read back).
 //! * [`preflight`]: every role's program and the scenario checked before anything starts.
 //! * [`recorder`] / [`mcap`] (also reachable as `mcap_out`): the telemetry recorder
 //!   role (CSV, summary, MCAP for Foxglove).
@@ -9,6 +11,7 @@
 //!   `safe-capture bench latency` and what it needs.
 
 pub mod error;
+pub mod executor;
 pub mod hop_cost;
 pub mod latency;
 pub mod launcher;

@@ -4,9 +4,13 @@
 //!
 //! The partition (one process per module) calls the very same stage functions of
 //! [`stages`], so its results are bit-for-bit those of [`Mission`].
+//!
+//! Every command runs its missions through an [`Executor`] ([`executor`]): in this
+//! process ([`InProcess`]) or through the process partition.
 
 pub mod build;
 pub mod compare;
+pub mod executor;
 pub mod mission;
 pub mod nominal_source;
 pub mod out_dir;
@@ -16,8 +20,13 @@ pub mod setup;
 pub mod stages;
 pub mod summary;
 
+pub use executor::{
+    ExecError, Executed, Execution, Executor, InProcess, Job, Place, RecordSink, Sinks,
+};
 pub use mission::{Mission, MissionEnd, RunOptions, all_hold, capture_check, timeout_check};
-pub use nominal_source::{NominalCommand, NominalCommands, NominalOverride};
+pub use nominal_source::{
+    NominalCommand, NominalCommands, NominalOverride, NominalSource, PartnerProcess,
+};
 pub use record::{StepRecord, TelemetryWriter, parse_telemetry, telemetry_columns, timing_columns};
 pub use replay::ReplayNominals;
 pub use setup::{Setup, SetupError};

@@ -1,12 +1,16 @@
-//! Where a step's nominal commands come from when they are not the reference
-//! controllers': a partner's controller or a red-team adversary
-//! ([`NominalOverride`]). Whatever it returns — any values, or nothing — goes to the
-//! safety filters like a nominal command; the filters never trust it.
+//! Where a mission's nominal commands come from ([`NominalSource`]): the reference
+//! controllers, a replacement in this process ([`NominalOverride`]: a red-team
+//! adversary, a replay of a recorded run), or partner processes in place of the nominal
+//! controller processes of the partition ([`PartnerProcess`]). Whatever a replacement
+//! sends — any values, or nothing — goes to the safety filters like a nominal command;
+//! the filters never trust it.
 
 use nalgebra::Vector3;
+use sc_core::Subsystem;
 use sc_multibody::Vector7;
 use sc_nominal::NominalOutput;
 use sc_sim::Observation;
+use std::path::PathBuf;
 
 /// The nominal command of one subsystem for one step.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -55,4 +59,28 @@ pub trait NominalOverride: Send {
     /// The commands of the step at observation `o`; `reference` is what the reference
     /// controllers computed (an adversary may use or ignore it).
     fn commands(&mut self, o: &Observation, reference: &NominalOutput) -> NominalCommands;
+}
+
+/// A process that replaces the nominal controller process of one subsystem in the
+/// process partition (a partner's controller, or a hostile one): its program and
+/// arguments (the partition adds its own, see `sc_ground::launcher`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PartnerProcess {
+    /// The subsystem whose nominal controller it replaces.
+    pub subsystem: Subsystem,
+    pub program: PathBuf,
+    pub args: Vec<String>,
+}
+
+/// Where a mission's nominal commands come from.
+#[derive(Default)]
+pub enum NominalSource {
+    /// The reference controllers (`sc_nominal`), every subsystem.
+    #[default]
+    Reference,
+    /// Replaced step by step in this process (a red-team adversary, a replay).
+    Override(Box<dyn NominalOverride>),
+    /// Partner processes in place of the nominal controller processes of their
+    /// subsystems (the process partition only), in causal order.
+    Partners(Vec<PartnerProcess>),
 }

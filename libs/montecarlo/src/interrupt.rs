@@ -8,9 +8,7 @@
 //! [`EXIT_FORCED`]: the runs in flight are abandoned, and since a run's directory only
 //! gets its final name once the run is saved, nothing half-written looks complete.
 
-use crate::run::{Execution, Executor};
-use sc_mission::{MissionEnd, Setup, StepRecord};
-use std::path::Path;
+use sc_mission::{ExecError, Executed, Execution, Executor, Job};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Exit code of a process ended by a second SIGINT/SIGTERM: 128 + SIGINT, what a shell
@@ -38,16 +36,24 @@ extern "C" fn on_signal(_: libc::c_int) {
     }
 }
 
+/// A signal handler the system refused.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot install the {signal} handler: {error}")]
+pub struct InstallError {
+    pub signal: &'static str,
+    pub error: std::io::Error,
+}
+
 /// Installs the SIGINT and SIGTERM handlers of a graceful stop.
-pub fn install() -> Result<(), String> {
+pub fn install() -> Result<(), InstallError> {
     for (sig, name) in [(libc::SIGINT, "SIGINT"), (libc::SIGTERM, "SIGTERM")] {
         // SAFETY: the handler only touches an atomic and calls async-signal-safe functions.
         let previous = unsafe { libc::signal(sig, on_signal as *const () as libc::sighandler_t) };
         if previous == libc::SIG_ERR {
-            return Err(format!(
-                "cannot install the {name} handler: {}",
-                std::io::Error::last_os_error()
-            ));
+            return Err(InstallError {
+                signal: name,
+                error: std::io::Error::last_os_error(),
+            });
         }
     }
     Ok(())
@@ -62,14 +68,8 @@ pub fn requested() -> bool {
 pub struct StopOnSignal<E>(pub E);
 
 impl<E: Executor> Executor for StopOnSignal<E> {
-    fn execute(
-        &self,
-        k: usize,
-        setup: Setup,
-        run_dir: &Path,
-        inject_failure: bool,
-    ) -> Result<(Vec<StepRecord>, MissionEnd), String> {
-        self.0.execute(k, setup, run_dir, inject_failure)
+    fn execute(&self, job: Job<'_>) -> Result<Executed, ExecError> {
+        self.0.execute(job)
     }
 
     fn stopped(&self) -> bool {

@@ -1,6 +1,8 @@
 //! `report.md`: the campaign's numbers beside the paper's.
 
-use crate::campaign::{CampaignSummary, Spread};
+use crate::aggregate::{
+    CampaignSummary, Spread, TREND_SYNC_PEAK, TREND_TORQUE_PEAK, TREND_TORQUE_RMS,
+};
 use crate::run::RunResult;
 use std::fmt::Write;
 
@@ -57,15 +59,8 @@ fn host_load(load: &[crate::host::HostLoad]) -> String {
     )
 }
 
-/// The Markdown report.
-pub fn report(
-    s: &CampaignSummary,
-    results: &[RunResult],
-    grasp: Option<&str>,
-    phases: &[String],
-    execution: crate::run::Execution,
-) -> String {
-    let mut o = String::new();
+/// The title, what was run, and the notes on interruption, host load and execution.
+fn header(o: &mut String, s: &CampaignSummary, execution: sc_mission::Execution) {
     let _ = writeln!(o, "# Monte Carlo campaign\n");
     let shard = s
         .shard
@@ -86,7 +81,7 @@ pub fn report(
     if !s.host_load.is_empty() {
         let _ = writeln!(o, "{}\n", host_load(&s.host_load));
     }
-    if execution == crate::run::Execution::Partition {
+    if execution == sc_mission::Execution::Partition {
         let _ = writeln!(
             o,
             "Every run executed through the process partition (one process per module, \
@@ -103,17 +98,11 @@ pub fn report(
     let _ = writeln!(o, "| captured | {} / {} |", s.captured_runs, s.runs);
     let _ = writeln!(o, "| failed (error or panic) | {} |", s.failed_runs);
     let _ = writeln!(o, "| with filter faults | {} |\n", s.faulted_runs);
+}
 
-    let sync_phase = grasp
-        .and_then(|g| phases.iter().position(|p| p == g))
-        .and_then(|i| i.checked_sub(1))
-        .and_then(|i| phases.get(i));
+/// The solve-time rows of the table beside the paper.
+fn solve_time_rows(o: &mut String, s: &CampaignSummary) {
     let t = |n: &str| s.solve_time_us.get(n).copied().unwrap_or_default();
-    let _ = writeln!(o, "## Beside the paper\n");
-    let _ = writeln!(
-        o,
-        "| quantity | this campaign | paper (CasADi + OSQP, 100 runs) |\n|---|---|---|"
-    );
     let _ = writeln!(
         o,
         "| total solve time per step, geometric mean | {:.1} µs | {PAPER_TOTAL_GEOMEAN_MS} ms |",
@@ -139,6 +128,16 @@ pub fn report(
         c("total").geomean,
         c("total").max
     );
+}
+
+/// The rows of the table beside the paper on the synchronisation error and the joint
+/// torque: ranges over the runs, and their trends with the tumbling rate.
+fn result_rows(o: &mut String, s: &CampaignSummary, grasp: Option<&str>, phases: &[String]) {
+    // the synchronisation phase (II) is the one before grasping (III)
+    let sync_phase = grasp
+        .and_then(|g| phases.iter().position(|p| p == g))
+        .and_then(|i| i.checked_sub(1))
+        .and_then(|i| phases.get(i));
     if let Some(g) = grasp {
         let _ = writeln!(
             o,
@@ -162,18 +161,9 @@ pub fn report(
     );
     let corr = |v: Option<f64>| v.map_or("–".into(), |c| format!("{c:+.2}"));
     for (key, what) in [
-        (
-            crate::campaign::TREND_SYNC_PEAK,
-            "peak sync error in grasping",
-        ),
-        (
-            crate::campaign::TREND_TORQUE_RMS,
-            "RMS joint-torque norm in grasping",
-        ),
-        (
-            crate::campaign::TREND_TORQUE_PEAK,
-            "peak joint-torque norm in grasping",
-        ),
+        (TREND_SYNC_PEAK, "peak sync error in grasping"),
+        (TREND_TORQUE_RMS, "RMS joint-torque norm in grasping"),
+        (TREND_TORQUE_PEAK, "peak joint-torque norm in grasping"),
     ] {
         if let Some(t) = s.trend_with_tumble_rate.get(key) {
             let _ = writeln!(
@@ -185,6 +175,17 @@ pub fn report(
             );
         }
     }
+}
+
+/// Our numbers beside the paper's.
+fn beside_the_paper(o: &mut String, s: &CampaignSummary, grasp: Option<&str>, phases: &[String]) {
+    let _ = writeln!(o, "## Beside the paper\n");
+    let _ = writeln!(
+        o,
+        "| quantity | this campaign | paper (CasADi + OSQP, 100 runs) |\n|---|---|---|"
+    );
+    solve_time_rows(o, s);
+    result_rows(o, s, grasp, phases);
     let _ = writeln!(
         o,
         "| capture time, range | {} s | – |\n",
@@ -194,7 +195,10 @@ pub fn report(
         o,
         "Solve times are wall-clock measurements on this machine (what a deadline sees, including the time the thread was preempted); the thread CPU time row is the filters' own work (percentiles from a log histogram, ±0.05 %).\n"
     );
+}
 
+/// The ten barriers that came closest to their boundary.
+fn worst_margins(o: &mut String, s: &CampaignSummary) {
     let _ = writeln!(
         o,
         "## Worst barrier margins\n\n| constraint | worst min h | run |\n|---|---|---|"
@@ -213,50 +217,73 @@ pub fn report(
         );
     }
     let _ = writeln!(o);
+}
 
+/// A row of the table of runs that failed, were unsafe or did not capture.
+fn bad_run_row(o: &mut String, r: &RunResult) {
+    let (dist, off, az, w) = r
+        .dispersion
+        .map(|d| {
+            (
+                format!("{:.3}", d.distance_m),
+                format!("{:.3}", d.off_axis_deg),
+                format!("{:.1}", d.azimuth_deg),
+                format!("{:.4}", d.tumble_rate_rad_s),
+            )
+        })
+        .unwrap_or_default();
+    let outcome = match &r.metrics {
+        None => format!("failed: {}", r.error.as_deref().unwrap_or("")),
+        Some(m) => {
+            let mut v = Vec::new();
+            if !m.safe {
+                v.push(format!("violated {}", m.violated.join(", ")));
+            }
+            if !m.captured {
+                v.push(format!("not captured ({})", m.end));
+            }
+            v.join("; ")
+        }
+    };
+    let _ = writeln!(
+        o,
+        "| {} | {} | {dist} | {off} | {az} | {w} | {outcome} |",
+        r.run, r.seed
+    );
+}
+
+/// The runs that failed, were unsafe or did not capture, or that there are none.
+fn bad_runs(o: &mut String, results: &[RunResult]) {
     let bad: Vec<&RunResult> = results
         .iter()
         .filter(|r| r.failed() || !r.safe() || !r.captured())
         .collect();
     if bad.is_empty() {
         let _ = writeln!(o, "Every run completed safe and captured.");
-    } else {
-        let _ = writeln!(
-            o,
-            "## Runs that failed, were unsafe or did not capture\n\n| run | seed | distance [m] | off-axis [deg] | azimuth [deg] | tumble rate [rad/s] | outcome |\n|---|---|---|---|---|---|---|"
-        );
-        for r in bad {
-            let (dist, off, az, w) = r
-                .dispersion
-                .map(|d| {
-                    (
-                        format!("{:.3}", d.distance_m),
-                        format!("{:.3}", d.off_axis_deg),
-                        format!("{:.1}", d.azimuth_deg),
-                        format!("{:.4}", d.tumble_rate_rad_s),
-                    )
-                })
-                .unwrap_or_default();
-            let outcome = match &r.metrics {
-                None => format!("failed: {}", r.error.as_deref().unwrap_or("")),
-                Some(m) => {
-                    let mut v = Vec::new();
-                    if !m.safe {
-                        v.push(format!("violated {}", m.violated.join(", ")));
-                    }
-                    if !m.captured {
-                        v.push(format!("not captured ({})", m.end));
-                    }
-                    v.join("; ")
-                }
-            };
-            let _ = writeln!(
-                o,
-                "| {} | {} | {dist} | {off} | {az} | {w} | {outcome} |",
-                r.run, r.seed
-            );
-        }
+        return;
     }
+    let _ = writeln!(
+        o,
+        "## Runs that failed, were unsafe or did not capture\n\n| run | seed | distance [m] | off-axis [deg] | azimuth [deg] | tumble rate [rad/s] | outcome |\n|---|---|---|---|---|---|---|"
+    );
+    for r in bad {
+        bad_run_row(o, r);
+    }
+}
+
+/// The Markdown report.
+pub fn report(
+    s: &CampaignSummary,
+    results: &[RunResult],
+    grasp: Option<&str>,
+    phases: &[String],
+    execution: sc_mission::Execution,
+) -> String {
+    let mut o = String::new();
+    header(&mut o, s, execution);
+    beside_the_paper(&mut o, s, grasp, phases);
+    worst_margins(&mut o, s);
+    bad_runs(&mut o, results);
     let _ = writeln!(
         o,
         "\nFigures: figures/runtime.svg, figures/trajectories_xy.svg, figures/attitude_los.svg, figures/torque_vs_sync.svg, figures/barrier_minima.svg."

@@ -2,9 +2,11 @@
 
 use crate::config::MonteCarloConfig;
 use crate::hist::LogHistogram;
-use crate::sample::{Dispersion, apply, run_seed, sample};
+use crate::sample::{Dispersion, SampleError, apply, run_seed, sample};
 use sc_mission::summary::TimeStats;
-use sc_mission::{Mission, MissionEnd, RunOptions, Setup, StepRecord, summarize};
+use sc_mission::{
+    Executed, Executor, InProcess, Job, MissionEnd, Place, Setup, StepRecord, summarize,
+};
 use sc_plots::TracePoint;
 use sc_scenario::{RoboticMode, Scenario};
 use serde::{Deserialize, Serialize};
@@ -126,26 +128,6 @@ fn panic_message(p: Box<dyn std::any::Any + Send>) -> String {
     }
 }
 
-/// Runs a mission to its end, collecting every record. `inject_panic` panics at step 10
-/// (to test failure handling). Panics are caught and returned as errors.
-pub fn simulate(setup: Setup, inject_panic: bool) -> Result<(Vec<StepRecord>, MissionEnd), String> {
-    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(move || {
-        let mut mission = Mission::new(setup, RunOptions::default()).map_err(|e| e.to_string())?;
-        let mut records = Vec::with_capacity(mission.setup.scenario.control_steps() + 1);
-        let end = mission.run(|_, r| {
-            if inject_panic && r.step == 10 {
-                panic!("injected failure");
-            }
-            records.push(*r);
-        });
-        Ok::<_, String>((records, end))
-    }));
-    match outcome {
-        Ok(r) => r,
-        Err(p) => Err(format!("panicked: {}", panic_message(p))),
-    }
-}
-
 fn finite(x: Option<f64>) -> Option<f64> {
     x.filter(|v| v.is_finite())
 }
@@ -231,71 +213,66 @@ pub fn measure(
     (metrics, trace, timing)
 }
 
-/// How the runs of a campaign execute (recorded in `campaign.json` and the report).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Execution {
-    /// Simulator, nominal controllers and filters in this process ([`InProcess`]).
-    #[default]
-    InProcess,
-    /// Through the process partition, one process per module.
-    Partition,
-}
-
-impl Execution {
-    pub fn is_in_process(&self) -> bool {
-        *self == Execution::InProcess
-    }
-}
-
-/// Executes the mission of one run. Everything else of a run — sampling, the saved
-/// scenario, the metrics, trace and timing ([`measure`]) — is the same whatever the
-/// executor, so executors that reproduce the mission's records give the same results.
-pub trait Executor: Sync {
-    /// Runs the mission of run `k`, whose dispersed scenario `setup` was read back from
-    /// `run_dir/scenario.toml`; returns every step's record and how the mission ended,
-    /// or why the run failed (one line). `inject_failure` (tests) makes the run fail.
-    fn execute(
-        &self,
-        k: usize,
-        setup: Setup,
-        run_dir: &Path,
-        inject_failure: bool,
-    ) -> Result<(Vec<StepRecord>, MissionEnd), String>;
-
-    /// True once no further run may start (e.g. after Ctrl-C); a run that failed by then
-    /// is discarded, not recorded.
-    fn stopped(&self) -> bool {
-        false
-    }
-
-    /// What `campaign.json` records.
-    fn execution(&self) -> Execution;
-}
-
-/// The mission in this process ([`simulate`]); an injected failure panics at step 10.
-pub struct InProcess;
-
-impl Executor for InProcess {
-    fn execute(
-        &self,
-        _k: usize,
-        setup: Setup,
-        _run_dir: &Path,
-        inject_failure: bool,
-    ) -> Result<(Vec<StepRecord>, MissionEnd), String> {
-        simulate(setup, inject_failure)
-    }
-
-    fn execution(&self) -> Execution {
-        Execution::InProcess
-    }
-}
-
 /// Samples, saves and runs run `k` of the campaign in this process (files under
 /// `run_dir`); never panics, never fails: every problem ends up in the result as a failure.
 pub fn execute(base: &CampaignBase, k: usize, run_dir: &Path, inject_panic: bool) -> RunOutput {
     execute_with(base, k, run_dir, inject_panic, &InProcess)
+}
+
+/// A run that failed with `error` (one line).
+fn failed(mut result: RunResult, error: String) -> RunOutput {
+    result.error = Some(error.replace('\n', " "));
+    RunOutput {
+        result,
+        trace: Vec::new(),
+        timing: None,
+    }
+}
+
+/// Why run `k`'s dispersed scenario could not be made (the run fails).
+#[derive(Debug, thiserror::Error)]
+enum DispersionError {
+    #[error(transparent)]
+    Sample(#[from] SampleError),
+    #[error("cannot write {}: {error}", .dir.display())]
+    Write { dir: PathBuf, error: std::io::Error },
+    #[error("dispersed scenario rejected: {0}")]
+    Rejected(sc_scenario::ScenarioError),
+}
+
+/// Samples run `k`'s dispersion, saves its scenario into `run_dir/scenario.toml` and
+/// reads it back: a run executes exactly what was saved.
+fn dispersed_scenario(
+    base: &CampaignBase,
+    run_dir: &Path,
+    result: &mut RunResult,
+) -> Result<Scenario, DispersionError> {
+    let d = sample(&base.config, &base.scenario, result.seed)?;
+    result.dispersion = Some(d);
+    let text = run_scenario(base, &d).to_toml_string();
+    std::fs::create_dir_all(run_dir)
+        .and_then(|_| std::fs::write(run_dir.join("scenario.toml"), &text))
+        .map_err(|error| DispersionError::Write {
+            dir: run_dir.to_path_buf(),
+            error,
+        })?;
+    Scenario::from_toml_str(&text, run_dir).map_err(DispersionError::Rejected)
+}
+
+/// The job of run `k`: its scenario, read back from `run_dir`, with the campaign's
+/// servicer model; an executor outside this process reads `run_dir/scenario.toml` and
+/// writes into `run_dir/partition/`.
+fn job(base: &CampaignBase, k: usize, run_dir: &Path, scenario: Scenario) -> Job<'static> {
+    let mut job = Job::new(Setup {
+        scenario,
+        robot: base.setup.robot.clone(),
+    });
+    job.place = Some(Place {
+        name: format!("mc{k}"),
+        scenario_file: run_dir.join("scenario.toml"),
+        out: run_dir.join(crate::campaign::PARTITION_DIR),
+    });
+    job
 }
 
 /// [`execute`] with the mission executed by `executor`.
@@ -306,50 +283,27 @@ pub fn execute_with(
     inject_failure: bool,
     executor: &dyn Executor,
 ) -> RunOutput {
-    let seed = run_seed(base.seed, k);
     let mut result = RunResult {
         run: k,
-        seed,
+        seed: run_seed(base.seed, k),
         status: "failed".into(),
         error: None,
         dispersion: None,
         metrics: None,
     };
-    let fail = |mut result: RunResult, e: String| {
-        result.error = Some(e.replace('\n', " "));
-        RunOutput {
-            result,
-            trace: Vec::new(),
-            timing: None,
-        }
-    };
-    let d = match sample(&base.config, &base.scenario, seed) {
-        Ok(d) => d,
-        Err(e) => return fail(result, e),
-    };
-    result.dispersion = Some(d);
-    let text = run_scenario(base, &d).to_toml_string();
-    if let Err(e) = std::fs::create_dir_all(run_dir)
-        .and_then(|_| std::fs::write(run_dir.join("scenario.toml"), &text))
-    {
-        return fail(result, format!("cannot write {}: {e}", run_dir.display()));
-    }
-    // run exactly what was saved
-    let scenario = match Scenario::from_toml_str(&text, run_dir) {
+    let scenario = match dispersed_scenario(base, run_dir, &mut result) {
         Ok(s) => s,
-        Err(e) => return fail(result, format!("dispersed scenario rejected: {e}")),
+        Err(e) => return failed(result, e.to_string()),
     };
-    let setup = Setup {
-        scenario: scenario.clone(),
-        robot: base.setup.robot.clone(),
-    };
+    let mut job = job(base, k, run_dir, scenario.clone());
+    job.inject_failure = inject_failure;
     let executed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        executor.execute(k, setup, run_dir, inject_failure)
+        executor.execute(job).map_err(|e| e.to_string())
     }))
     .unwrap_or_else(|p| Err(format!("panicked: {}", panic_message(p))));
-    let (records, end) = match executed {
+    let Executed { records, end } = match executed {
         Ok(x) => x,
-        Err(e) => return fail(result, e),
+        Err(e) => return failed(result, e),
     };
     let (metrics, trace, timing) = measure(
         &scenario,
@@ -391,27 +345,40 @@ pub fn trace_csv(trace: &[TracePoint]) -> String {
     s
 }
 
+/// Why a `trace.csv` does not read back (line numbers from 1, the header's included).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TraceError {
+    #[error("line {line}: expected 9 fields, found {found}")]
+    Fields { line: usize, found: usize },
+    #[error("line {line}: `{field}` is not a number")]
+    NotANumber { line: usize, field: String },
+    #[error("line {line}: `{field}` is not a phase index")]
+    NotAPhase { line: usize, field: String },
+}
+
 /// Parses [`trace_csv`] output.
-pub fn parse_trace(text: &str) -> Result<Vec<TracePoint>, String> {
+pub fn parse_trace(text: &str) -> Result<Vec<TracePoint>, TraceError> {
     let mut out = Vec::new();
     for (i, line) in text.lines().enumerate().skip(1) {
         let f: Vec<&str> = line.split(',').collect();
         if f.len() != 9 {
-            return Err(format!(
-                "line {}: expected 9 fields, found {}",
-                i + 1,
-                f.len()
-            ));
+            return Err(TraceError::Fields {
+                line: i + 1,
+                found: f.len(),
+            });
         }
         let num = |j: usize| {
-            f[j].parse::<f64>()
-                .map_err(|_| format!("line {}: `{}` is not a number", i + 1, f[j]))
+            f[j].parse::<f64>().map_err(|_| TraceError::NotANumber {
+                line: i + 1,
+                field: f[j].into(),
+            })
         };
         out.push(TracePoint {
             t: num(0)?,
-            phase: f[1]
-                .parse()
-                .map_err(|_| format!("line {}: `{}` is not a phase index", i + 1, f[1]))?,
+            phase: f[1].parse().map_err(|_| TraceError::NotAPhase {
+                line: i + 1,
+                field: f[1].into(),
+            })?,
             r_r: [num(2)?, num(3)?, num(4)?],
             speed: num(5)?,
             los_deg: [num(6)?, num(7)?],

@@ -63,13 +63,23 @@ pub fn initial_los_deg(s: &sc_scenario::Scenario, r_r: &Vector3<f64>) -> f64 {
     c.clamp(-1.0, 1.0).acos().to_degrees()
 }
 
+/// Why no dispersion could be sampled.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SampleError {
+    #[error(
+        "no initial position within the line-of-sight margin after {} draws; reduce initial_position.los_margin_deg or the corridor cap",
+        MAX_DRAWS
+    )]
+    OutsideLineOfSight,
+}
+
 /// Samples run `seed`'s dispersion for scenario `s`. Errors when no draw in
 /// [`MAX_DRAWS`] satisfies the line-of-sight margin.
 pub fn sample(
     cfg: &MonteCarloConfig,
     s: &sc_scenario::Scenario,
     seed: u64,
-) -> Result<Dispersion, String> {
+) -> Result<Dispersion, SampleError> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let p = &cfg.initial_position;
     let axis = Vector3::from(s.safety.translational.corridor_axis);
@@ -101,9 +111,7 @@ pub fn sample(
             });
         }
     }
-    Err(format!(
-        "no initial position within the line-of-sight margin after {MAX_DRAWS} draws; reduce initial_position.los_margin_deg or the corridor cap"
-    ))
+    Err(SampleError::OutsideLineOfSight)
 }
 
 /// The scenario of a run: `base` with the dispersion applied.

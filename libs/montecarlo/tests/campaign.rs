@@ -1,13 +1,16 @@
 //! Campaigns: config rules, seeds and dispersions, shard/merge byte-identity, rerun,
 //! injected failures. Short missions (a few seconds) keep them fast.
 
-use sc_mission::{MissionEnd, Setup, StepRecord, TelemetryWriter, parse_telemetry};
-use sc_montecarlo::campaign::{WALL_CLOCK_FILES, WALL_CLOCK_KEYS};
+use sc_mission::{
+    ExecError, Executed, Execution, Executor, InProcess, Job, MissionEnd, TelemetryWriter,
+    parse_telemetry,
+};
 use sc_montecarlo::sample::{initial_los_deg, run_seed, sample};
 use sc_montecarlo::{
-    CampaignOptions, Execution, Executor, MonteCarloConfig, merge, parse_shard, rerun,
-    run_campaign, run_campaign_with, shard_runs,
+    CampaignOptions, MonteCarloConfig, merge, parse_shard, rerun, run_campaign, run_campaign_with,
+    shard_runs,
 };
+use sc_montecarlo::{WALL_CLOCK_FILES, WALL_CLOCK_KEYS};
 use sc_scenario::Scenario;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -195,7 +198,7 @@ fn an_unsatisfiable_los_margin_is_an_error() {
     c.initial_position.los_margin_deg = 4.999;
     c.initial_position.distance_min_m = 2.0;
     c.initial_position.distance_max_m = 2.0;
-    let e = sample(&c, &scenario(), 1).unwrap_err();
+    let e = sample(&c, &scenario(), 1).unwrap_err().to_string();
     assert!(e.contains("los_margin_deg"), "{e}");
 }
 
@@ -203,7 +206,7 @@ fn an_unsatisfiable_los_margin_is_an_error() {
 fn shards_partition_the_campaign() {
     assert_eq!(parse_shard("1/4").unwrap(), (1, 4));
     for bad in ["4/4", "1", "a/2", "0/0", "-1/2"] {
-        let e = parse_shard(bad).unwrap_err();
+        let e = parse_shard(bad).unwrap_err().to_string();
         assert!(e.contains(bad), "{e}");
     }
     let mut all: Vec<usize> = (0..3).flat_map(|i| shard_runs(10, Some((i, 3)))).collect();
@@ -344,18 +347,14 @@ struct ViaTelemetry {
 }
 
 impl Executor for ViaTelemetry {
-    fn execute(
-        &self,
-        k: usize,
-        setup: Setup,
-        _run_dir: &Path,
-        inject_failure: bool,
-    ) -> Result<(Vec<StepRecord>, MissionEnd), String> {
+    fn execute(&self, job: Job<'_>) -> Result<Executed, ExecError> {
+        let name = &job.place.as_ref().unwrap().name;
+        let k: usize = name.strip_prefix("mc").unwrap().parse().unwrap();
         if k >= self.stop_at {
             self.stopped.store(true, Ordering::SeqCst);
-            return Err("interrupted".into());
+            return Err(ExecError::Interrupted);
         }
-        let (records, end) = sc_montecarlo::run::simulate(setup, inject_failure)?;
+        let Executed { records, end } = InProcess.execute(job)?;
         let (mut tel, mut tim) = (Vec::new(), Vec::new());
         {
             let mut w = TelemetryWriter::new(&mut tel, &mut tim).unwrap();
@@ -369,9 +368,12 @@ impl Executor for ViaTelemetry {
             std::str::from_utf8(&tim).unwrap(),
             true,
         )
-        .map_err(|e| e.to_string())?;
+        .unwrap();
         let end = MissionEnd::from_name(end.name(), parsed.last().unwrap().t).unwrap();
-        Ok((parsed, end))
+        Ok(Executed {
+            records: parsed,
+            end,
+        })
     }
 
     fn stopped(&self) -> bool {

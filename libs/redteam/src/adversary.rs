@@ -3,13 +3,14 @@
 //! safety layer knows (the scenario, the servicer model, the true state) — a hostile
 //! partner is assumed to.
 
-use crate::strategy::{STALE_LAG, Strategy, Target};
+use crate::strategy::{STALE_LAG, Strategy, Target, barrier_names};
 use nalgebra::{SVector, Vector3};
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::{Rng, SeedableRng};
 use sc_cbf::monitor::{Barriers, Monitor};
-use sc_cbf::{attitude, robotic, translational};
-use sc_mission::{NominalCommand, NominalCommands, NominalOverride};
+use sc_cbf::robotic;
+use sc_core::{PerSubsystem, Subsystem};
+use sc_mission::{NominalCommand, NominalCommands, NominalOverride, NominalSource, Setup};
 use sc_models::quat;
 use sc_multibody::{Robot, Vector7};
 use sc_nominal::NominalOutput;
@@ -89,14 +90,24 @@ impl Adversary {
         }
     }
 
-    /// The command of every subsystem pushing towards barrier `i` of that subsystem
-    /// (indices into the subsystem's constraint names).
-    fn toward(&self, o: &Observation, which: [usize; 3]) -> Raw {
+    /// The adversary of `case` in `setup`'s scenario, as the mission's nominal source.
+    pub fn nominals(setup: &Setup, case: &crate::Case) -> NominalSource {
+        NominalSource::Override(Box::new(Self::new(
+            &setup.scenario,
+            setup.robot.clone(),
+            case.target,
+            case.strategy,
+        )))
+    }
+
+    /// The command of every subsystem pushing towards barrier `which[s]` of that
+    /// subsystem `s` (indices into the subsystem's constraint names).
+    fn toward(&self, o: &Observation, which: PerSubsystem<usize>) -> Raw {
         let g = &self.geometry;
         // translational: the CoM out of the corridor / into the zone (Hill frame)
         let r = o.com_h;
         let rhat = r / r.norm().max(1e-9);
-        let f_h = if which[0] == 0 {
+        let f_h = if which[Subsystem::Translational] == 0 {
             let d_h = quat::rotate(&o.q_hr, &g.axis_r);
             let grad = d_h - rhat * g.cos_psi;
             -unit_or(&grad, &perpendicular(&rhat)) * (OVERDRIVE * g.force_max)
@@ -105,7 +116,7 @@ impl Adversary {
         };
         // attitude: the boresight off the line of sight, or spin about an axis
         let tmax = OVERDRIVE * g.torque_max;
-        let tau_b = match which[1] {
+        let tau_b = match which[Subsystem::Attitude] {
             0 => {
                 let rho = o.grasp_r - o.com_r;
                 let s_b = quat::to_matrix(&o.q_rb).transpose() * rho;
@@ -123,7 +134,7 @@ impl Adversary {
         // into the base
         let nj = robotic::NJ;
         let tm = OVERDRIVE * g.joint_torque_max;
-        let k = which[2];
+        let k = which[Subsystem::Robotic];
         let tau_m = if k < nj {
             let mut t = Vector7::zeros();
             t[k] = tm * (o.theta[k] - g.theta_mid[k]).signum();
@@ -163,22 +174,18 @@ impl Adversary {
     }
 
     /// The index, per subsystem, of the barrier closest to its boundary (distance-normalised).
-    fn greedy_choice(&self, o: &Observation) -> [usize; 3] {
+    fn greedy_choice(&self, o: &Observation) -> PerSubsystem<usize> {
         let h = self.monitor.evaluate(&o.barrier_state());
-        let argmin = |from: usize, n: usize| {
-            (0..n)
+        PerSubsystem::from_fn(|s| {
+            let from = first_barrier(s);
+            (0..barrier_names(s).len())
                 .min_by(|&a, &b| {
                     let va = h[from + a] / self.geometry.scale[from + a];
                     let vb = h[from + b] / self.geometry.scale[from + b];
                     va.total_cmp(&vb)
                 })
                 .unwrap_or(0)
-        };
-        [
-            argmin(0, translational::N),
-            argmin(translational::N, attitude::N),
-            argmin(translational::N + attitude::N, robotic::N),
-        ]
+        })
     }
 
     fn greedy(&self, o: &Observation) -> Raw {
@@ -208,7 +215,11 @@ impl Adversary {
 
     fn raw(&mut self, o: &Observation) -> Option<Raw> {
         Some(match self.strategy {
-            Strategy::Toward(i) => self.toward(o, [i.min(1), i.min(6), i.min(41)]),
+            // the barrier of that index, or each subsystem's last
+            Strategy::Toward(i) => self.toward(
+                o,
+                PerSubsystem::from_fn(|s| i.min(barrier_names(s).len() - 1)),
+            ),
             Strategy::Greedy => self.greedy(o),
             Strategy::Random(_) => self.random(),
             Strategy::NonFinite => {
@@ -268,11 +279,11 @@ impl NominalOverride for Adversary {
     fn commands(&mut self, o: &Observation, _reference: &NominalOutput) -> NominalCommands {
         let raw = self.raw(o);
         self.step += 1;
-        let pick = |i: usize| self.target.covers(i);
+        let attacks = |s: Subsystem| self.target.attacks(s);
         NominalCommands {
-            translational: command(pick(0), raw.map(|r| r.f_h)),
-            attitude: command(pick(1), raw.map(|r| r.tau_b)),
-            robotic: command(pick(2), raw.map(|r| r.tau_m)),
+            translational: command(attacks(Subsystem::Translational), raw.map(|r| r.f_h)),
+            attitude: command(attacks(Subsystem::Attitude), raw.map(|r| r.tau_b)),
+            robotic: command(attacks(Subsystem::Robotic), raw.map(|r| r.tau_m)),
         }
     }
 }
@@ -285,6 +296,11 @@ fn command<T>(attacked: bool, v: Option<T>) -> NominalCommand<T> {
         (true, Some(u)) => NominalCommand::Given(u),
         (true, None) => NominalCommand::Missing,
     }
+}
+
+/// Index of subsystem `s`'s first barrier among all barriers ([`sc_mission::constraint_names`]).
+fn first_barrier(s: Subsystem) -> usize {
+    s.upstream_all().map(|u| barrier_names(u).len()).sum()
 }
 
 /// `v · k` keeping the direction (a zero vector stays zero; 1e300 × a unit component
@@ -306,4 +322,20 @@ fn perpendicular(v: &Vector3<f64>) -> Vector3<f64> {
         Vector3::y()
     };
     unit_or(&v.cross(&pick), &Vector3::z())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A subsystem's barriers follow those of the subsystems upstream of it.
+    #[test]
+    fn barriers_are_numbered_in_causal_order() {
+        assert_eq!(first_barrier(Subsystem::Translational), 0);
+        assert_eq!(first_barrier(Subsystem::Attitude), sc_cbf::translational::N);
+        assert_eq!(
+            first_barrier(Subsystem::Robotic),
+            sc_cbf::translational::N + sc_cbf::attitude::N
+        );
+    }
 }

@@ -1,18 +1,39 @@
 //! The red-team campaign: every case (a strategy against a target) runs the whole mission
-//! in one process with the adversary in place of the nominal controller(s), and the result
-//! is measured from the simulator's true state at every physics step (the safety monitor),
-//! never from a filter's report.
+//! with the adversary in place of the nominal controller(s) — in this process, or as
+//! hostile partner processes through the process partition, whichever
+//! [`sc_mission::Executor`] the campaign is given — and the result is measured from the
+//! simulator's true state at every physics step (the safety monitor), never from a
+//! filter's report.
 
 use crate::adversary::Adversary;
-use crate::strategy::{Case, CaseLabel, Target};
+use crate::partners::HostilePartners;
+use crate::strategy::{Case, CaseLabel, CaseNameError, Target};
 use rayon::prelude::*;
 use sc_cbf::faults;
+use sc_core::{PerSubsystem, Subsystem};
 use sc_mission::summary::TimeStats;
-use sc_mission::{Mission, MissionEnd, RunOptions, Setup, StepRecord, TelemetryWriter, summarize};
+use sc_mission::{
+    ExecError, Executed, Executor, Job, MissionEnd, NominalSource, Place, Setup, StepRecord,
+    TelemetryWriter, summarize,
+};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Per-filter step counts in files: `[translational, attitude, robotic]`.
+mod per_subsystem {
+    use sc_core::PerSubsystem;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &PerSubsystem<usize>, s: S) -> Result<S::Ok, S::Error> {
+        v.as_array().serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<PerSubsystem<usize>, D::Error> {
+        <[usize; 3]>::deserialize(d).map(PerSubsystem)
+    }
+}
 
 /// What one case measured.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -35,17 +56,20 @@ pub struct CaseResult {
     /// Applied commands outside the input bounds (`‖f_B‖∞ ≤ F`, `‖τ_B‖∞ ≤ T`,
     /// `‖τ_M‖∞ ≤ T_M`).
     pub out_of_bounds_applied: usize,
-    /// Per filter (translational, attitude, robotic): steps on the substitute nominal
-    /// (invalid or missing), on the relaxed problem, on the backup law.
-    pub substituted_steps: [usize; 3],
-    pub relaxed_steps: [usize; 3],
-    pub backup_steps: [usize; 3],
+    /// Per filter: steps on the substitute nominal (invalid or missing), on the relaxed
+    /// problem, on the backup law.
+    #[serde(with = "per_subsystem")]
+    pub substituted_steps: PerSubsystem<usize>,
+    #[serde(with = "per_subsystem")]
+    pub relaxed_steps: PerSubsystem<usize>,
+    #[serde(with = "per_subsystem")]
+    pub backup_steps: PerSubsystem<usize>,
     /// Per filter: steps on which it lacked or refused an input (its nominal missing or
     /// invalid, the upstream safe command missing, the coupling ξ invalid) or ran its
     /// backup law. On a subsystem the case does not attack — a bystander — any such step
     /// is a fault of the partition's isolation, not of the adversary.
-    #[serde(default)]
-    pub disturbed_steps: [usize; 3],
+    #[serde(default, with = "per_subsystem")]
+    pub disturbed_steps: PerSubsystem<usize>,
     /// Safety-layer time per step (wall clock) [µs].
     pub solve_time_us: TimeStats,
 }
@@ -60,9 +84,10 @@ impl CaseResult {
     /// Disturbed steps summed over the subsystems the case does not attack.
     pub fn bystander_disturbed_steps(&self) -> usize {
         let target = Target::parse(&self.target);
-        (0..3)
-            .filter(|&i| target.is_some_and(|t| !t.covers(i)))
-            .map(|i| self.disturbed_steps[i])
+        self.disturbed_steps
+            .iter()
+            .filter(|(s, _)| target.is_some_and(|t| !t.attacks(*s)))
+            .map(|(_, n)| n)
             .sum()
     }
 }
@@ -75,47 +100,174 @@ const DISTURBED: u32 = faults::INVALID_NOMINAL
     | faults::QP_FAILED_FALLBACK
     | faults::INVALID_STATE;
 
-/// Runs one case to the end of its mission.
-pub fn run_case(setup: &Setup, case: &Case) -> Result<CaseResult, String> {
-    run_case_recorded(setup, case, None)
+/// Why a case gave no result. One line each.
+#[derive(Debug, thiserror::Error)]
+pub enum CaseError {
+    #[error(transparent)]
+    Name(#[from] CaseNameError),
+    /// Its mission could not run (set up, launched, read back).
+    #[error(transparent)]
+    Run(#[from] ExecError),
+    /// Its telemetry could not be written.
+    #[error("{}: {error}", .dir.display())]
+    Telemetry { dir: PathBuf, error: std::io::Error },
 }
 
-/// [`run_case`], and with `telemetry` (a directory, created) its `telemetry.csv` and
-/// `timing.csv` written there as `safe-capture run` writes them.
-pub fn run_case_recorded(
-    setup: &Setup,
-    case: &Case,
-    telemetry: Option<&Path>,
-) -> Result<CaseResult, String> {
-    let adversary = Adversary::new(
-        &setup.scenario,
-        setup.robot.clone(),
-        case.target,
-        case.strategy,
-    );
-    let mut mission =
-        Mission::new(setup.clone(), RunOptions::default()).map_err(|e| e.to_string())?;
-    mission.nominal_override = Some(Box::new(adversary));
-    let mut records: Vec<StepRecord> = Vec::new();
-    let end = mission.run(|_, r| records.push(*r));
-    if let Some(dir) = telemetry {
-        write_telemetry(dir, &records).map_err(|e| format!("{}: {e}", dir.display()))?;
-    }
-    Ok(measure(setup, &case.label(), &records, &end))
+/// Where the nominal commands of the cases come from.
+pub enum Adversaries {
+    /// An [`Adversary`] in this process, playing the case's [`crate::Strategy`].
+    InProcess,
+    /// Hostile partner processes (through the process partition).
+    Partners(HostilePartners),
 }
 
-fn write_telemetry(dir: &Path, records: &[StepRecord]) -> std::io::Result<()> {
-    std::fs::create_dir_all(dir)?;
-    let file = |n: &str| std::fs::File::create(dir.join(n)).map(std::io::BufWriter::new);
-    let mut w = TelemetryWriter::new(file("telemetry.csv")?, file("timing.csv")?)?;
-    for r in records {
-        w.write(r)?;
+impl Adversaries {
+    /// The nominal source of `case` in `setup`'s scenario.
+    pub fn nominals(
+        &self,
+        setup: &Setup,
+        case: &CaseLabel,
+    ) -> Result<NominalSource, CaseNameError> {
+        match self {
+            Adversaries::InProcess => Ok(Adversary::nominals(setup, &Case::parse(&case.name())?)),
+            Adversaries::Partners(p) => Ok(p.nominals(case)),
+        }
     }
-    w.flush()
+}
+
+/// How a campaign runs its cases.
+pub struct Campaign<'a> {
+    pub setup: &'a Setup,
+    /// The file `setup` was read from (an executor outside this process reads it).
+    pub scenario_file: &'a Path,
+    pub executor: &'a dyn Executor,
+    pub adversaries: Adversaries,
+    /// The campaign's folder: each case's files go to `out/cases/<case>/`
+    /// ([`CaseLabel::dir_name`]; a partition run's outputs, the telemetry).
+    pub out: Option<&'a Path>,
+    /// Writes each case's `telemetry.csv` and `timing.csv` into its folder as
+    /// `safe-capture run` does (in process; the partition's recorder always does).
+    pub telemetry: bool,
+}
+
+impl Campaign<'_> {
+    /// The mission of case `k`, `case`, writing into `dir`.
+    fn job<'s>(
+        &self,
+        k: usize,
+        case: &CaseLabel,
+        dir: Option<&Path>,
+    ) -> Result<Job<'s>, CaseError> {
+        let mut job = Job::new(self.setup.clone());
+        job.nominals = self.adversaries.nominals(self.setup, case)?;
+        job.place = dir.map(|d| Place {
+            name: format!("rt{k}"),
+            scenario_file: self.scenario_file.to_path_buf(),
+            out: d.to_path_buf(),
+        });
+        Ok(job)
+    }
+
+    /// Runs case `k`, `case`, with its telemetry written into `dir`.
+    fn execute_recorded(
+        &self,
+        k: usize,
+        case: &CaseLabel,
+        dir: &Path,
+    ) -> Result<Executed, CaseError> {
+        let failed = |error| CaseError::Telemetry {
+            dir: dir.to_path_buf(),
+            error,
+        };
+        std::fs::create_dir_all(dir).map_err(failed)?;
+        let file = |n: &str| std::fs::File::create(dir.join(n)).map(std::io::BufWriter::new);
+        let (tel, tim) = (
+            file("telemetry.csv").map_err(failed)?,
+            file("timing.csv").map_err(failed)?,
+        );
+        let mut w = TelemetryWriter::new(tel, tim).map_err(failed)?;
+        let mut job = self.job(k, case, Some(dir))?;
+        job.sinks.telemetry = Some(&mut w);
+        let executed = self.executor.execute(job).map_err(|e| match e {
+            ExecError::Sink(error) => failed(error),
+            e => CaseError::Run(e),
+        })?;
+        w.flush().map_err(failed)?;
+        Ok(executed)
+    }
+
+    /// Runs case `k` of the campaign, `case`, to the end of its mission and measures it.
+    pub fn run_case(&self, k: usize, case: &CaseLabel) -> Result<CaseResult, CaseError> {
+        let dir = self.out.map(|o| o.join("cases").join(case.dir_name()));
+        let executed = match dir.as_deref().filter(|_| self.telemetry) {
+            Some(d) => self.execute_recorded(k, case, d)?,
+            None => self.executor.execute(self.job(k, case, dir.as_deref())?)?,
+        };
+        Ok(measure(self.setup, case, &executed.records, &executed.end))
+    }
+
+    /// Runs every case in parallel (rayon), calling `progress(done, total, result)` as
+    /// cases finish (from worker threads). Results come back in the order of `cases`.
+    pub fn run(
+        &self,
+        cases: &[CaseLabel],
+        progress: &Progress,
+    ) -> Vec<Result<CaseResult, CaseError>> {
+        let done = AtomicUsize::new(0);
+        cases
+            .par_iter()
+            .enumerate()
+            .map(|(k, case)| {
+                let r = self.run_case(k, case);
+                let n = done.fetch_add(1, Ordering::SeqCst) + 1;
+                progress(n, cases.len(), &r);
+                r
+            })
+            .collect()
+    }
+}
+
+/// The faults every filter flagged at one step.
+fn filter_faults(rec: &StepRecord) -> PerSubsystem<u32> {
+    PerSubsystem::from_fn(|s| match s {
+        Subsystem::Translational => rec.translational.report.faults,
+        Subsystem::Attitude => rec.attitude.report.faults,
+        Subsystem::Robotic => rec.robotic.report.faults,
+    })
+}
+
+/// Counts the applied commands that were non-finite or out of bounds, and per filter the
+/// steps on the substitute nominal, relaxed, on the backup and disturbed.
+fn count_steps(r: &mut CaseResult, records: &[StepRecord], lim: &sc_scenario::Limits) {
+    for rec in records {
+        let a = &rec.applied;
+        if !a.is_finite() {
+            r.nonfinite_applied += 1;
+        } else if a.force_b.amax() > lim.force_max_n
+            || a.torque_b.amax() > lim.torque_max_nm
+            || a.tau.amax() > lim.joint_torque_max_nm
+        {
+            r.out_of_bounds_applied += 1;
+        }
+        for (s, f) in filter_faults(rec).iter() {
+            if f & (faults::INVALID_NOMINAL | faults::NOMINAL_MISSING) != 0 {
+                r.substituted_steps[s] += 1;
+            }
+            if f & faults::QP_INFEASIBLE_RELAXED != 0 {
+                r.relaxed_steps[s] += 1;
+            }
+            if f & (faults::QP_FAILED_FALLBACK | faults::INVALID_STATE) != 0 {
+                r.backup_steps[s] += 1;
+            }
+            if f & DISTURBED != 0 {
+                r.disturbed_steps[s] += 1;
+            }
+        }
+    }
 }
 
 /// The result of a case from its records (in process, or read back from a partition
-/// run's telemetry with [`sc_mission::parse_telemetry`]).
+/// run's telemetry).
 pub fn measure(
     setup: &Setup,
     case: &CaseLabel,
@@ -130,7 +282,6 @@ pub fn measure(
         .map(|p| p.name.clone())
         .collect();
     let summary = summarize(records, end, &phases, true);
-    let lim = &setup.scenario.limits;
     let mut r = CaseResult {
         case: case.name(),
         target: case.target.name().into(),
@@ -151,81 +302,64 @@ pub fn measure(
         violated: summary.violated_constraints.clone(),
         nonfinite_applied: 0,
         out_of_bounds_applied: 0,
-        substituted_steps: [0; 3],
-        relaxed_steps: [0; 3],
-        backup_steps: [0; 3],
-        disturbed_steps: [0; 3],
+        substituted_steps: PerSubsystem::default(),
+        relaxed_steps: PerSubsystem::default(),
+        backup_steps: PerSubsystem::default(),
+        disturbed_steps: PerSubsystem::default(),
         solve_time_us: summary
             .solve_time_us
             .get("total")
             .copied()
             .unwrap_or_default(),
     };
-    for rec in records {
-        let a = &rec.applied;
-        if !a.is_finite() {
-            r.nonfinite_applied += 1;
-        } else if a.force_b.amax() > lim.force_max_n
-            || a.torque_b.amax() > lim.torque_max_nm
-            || a.tau.amax() > lim.joint_torque_max_nm
-        {
-            r.out_of_bounds_applied += 1;
-        }
-        let flags = [
-            rec.translational.report.faults,
-            rec.attitude.report.faults,
-            rec.robotic.report.faults,
-        ];
-        for (i, f) in flags.iter().enumerate() {
-            if f & (faults::INVALID_NOMINAL | faults::NOMINAL_MISSING) != 0 {
-                r.substituted_steps[i] += 1;
-            }
-            if f & faults::QP_INFEASIBLE_RELAXED != 0 {
-                r.relaxed_steps[i] += 1;
-            }
-            if f & (faults::QP_FAILED_FALLBACK | faults::INVALID_STATE) != 0 {
-                r.backup_steps[i] += 1;
-            }
-            if f & DISTURBED != 0 {
-                r.disturbed_steps[i] += 1;
-            }
-        }
-    }
+    count_steps(&mut r, records, &setup.scenario.limits);
     r
 }
 
 /// Called as cases finish: `(done, total, result)`.
-pub type Progress<'a> = dyn Fn(usize, usize, &Result<CaseResult, String>) + Sync + 'a;
+pub type Progress<'a> = dyn Fn(usize, usize, &Result<CaseResult, CaseError>) + Sync + 'a;
 
-/// Runs every case in parallel (rayon), calling `progress(done, total, result)` as cases
-/// finish (from worker threads). Results come back in the order of `cases`; a case whose
-/// mission cannot be set up is an `Err` with the reason.
-pub fn run_campaign(
-    setup: &Setup,
-    cases: &[Case],
-    progress: &Progress,
-) -> Vec<Result<CaseResult, String>> {
-    run_campaign_recorded(setup, cases, progress, None)
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-/// [`run_campaign`], and with `out` each case's telemetry in
-/// `out/cases/<case>/` ([`CaseLabel::dir_name`], [`run_case_recorded`]).
-pub fn run_campaign_recorded(
-    setup: &Setup,
-    cases: &[Case],
-    progress: &Progress,
-    out: Option<&Path>,
-) -> Vec<Result<CaseResult, String>> {
-    let done = AtomicUsize::new(0);
-    let total = cases.len();
-    cases
-        .par_iter()
-        .map(|c| {
-            let dir = out.map(|o| o.join("cases").join(c.label().dir_name()));
-            let r = run_case_recorded(setup, c, dir.as_deref());
-            let k = done.fetch_add(1, Ordering::SeqCst) + 1;
-            progress(k, total, &r);
-            r
-        })
-        .collect()
+    fn result(target: &str, disturbed: [usize; 3]) -> CaseResult {
+        CaseResult {
+            case: format!("{target}/greedy"),
+            target: target.into(),
+            strategy: "greedy".into(),
+            end: "timeout".into(),
+            final_time_s: 1.0,
+            steps: 10,
+            min_h: BTreeMap::new(),
+            violated: Vec::new(),
+            nonfinite_applied: 0,
+            out_of_bounds_applied: 0,
+            substituted_steps: PerSubsystem::default(),
+            relaxed_steps: PerSubsystem::default(),
+            backup_steps: PerSubsystem::default(),
+            disturbed_steps: PerSubsystem(disturbed),
+            solve_time_us: TimeStats::default(),
+        }
+    }
+
+    /// Only the subsystems a case does not attack count as disturbed bystanders.
+    #[test]
+    fn bystanders_are_the_subsystems_not_attacked() {
+        assert_eq!(
+            result("attitude", [1, 20, 300]).bystander_disturbed_steps(),
+            301
+        );
+        assert_eq!(result("all", [1, 20, 300]).bystander_disturbed_steps(), 0);
+    }
+
+    /// The per-filter counts are `[translational, attitude, robotic]` in JSON.
+    #[test]
+    fn per_filter_counts_are_arrays_in_json() {
+        let r = result("robotic", [4, 5, 6]);
+        let v = serde_json::to_value(&r).unwrap();
+        assert_eq!(v["disturbed_steps"], serde_json::json!([4, 5, 6]));
+        let back: CaseResult = serde_json::from_value(v).unwrap();
+        assert_eq!(back.disturbed_steps[Subsystem::Robotic], 6);
+    }
 }

@@ -10,5 +10,6 @@ pub mod scales;
 pub mod strategy;
 
 pub use adversary::Adversary;
-pub use campaign::{CaseResult, run_campaign, run_campaign_recorded, run_case, run_case_recorded};
-pub use strategy::{Case, CaseLabel, Strategy, Target};
+pub use campaign::{Adversaries, Campaign, CaseError, CaseResult, Progress};
+pub use partners::HostilePartners;
+pub use strategy::{Case, CaseLabel, CaseNameError, Strategy, Target};

@@ -4,18 +4,21 @@
 //! saturating, non-finite, huge) and how it misbehaves as a process (crash, hang, silence,
 //! bursts, late, stale or wrong ticks, garbage fields). The script's docstring defines each.
 //!
-//! The campaign itself (launching the partition, reading the telemetry back) is in the
-//! `safe-capture` app; the measurement is [`crate::campaign::measure`], the same as
-//! in process.
+//! A case runs through the process partition ([`HostilePartners`] gives its nominal
+//! source, `sc_ground::executor::Partition` runs it) and is measured by
+//! [`crate::campaign::measure`], the same as in process.
 
-use crate::strategy::{CaseLabel, Target};
+use crate::strategy::{CaseLabel, CaseNameError, Target};
+use sc_core::Subsystem;
+use sc_mission::{NominalSource, PartnerProcess};
+use std::path::PathBuf;
 
 /// The value strategies that aim at a subsystem's own boundaries (1.5 × the input bound).
 fn bangs(target: Target) -> &'static [&'static str] {
     match target {
-        Target::Translational => &["toward_zone", "off_corridor"],
-        Target::Attitude => &["spin:x", "spin:-y", "spin:z"],
-        Target::Robotic => &["joints:1", "joints:-1", "joint:7", "joint:-2"],
+        Target::One(Subsystem::Translational) => &["toward_zone", "off_corridor"],
+        Target::One(Subsystem::Attitude) => &["spin:x", "spin:-y", "spin:z"],
+        Target::One(Subsystem::Robotic) => &["joints:1", "joints:-1", "joint:7", "joint:-2"],
         // one process per role: only the values every role understands
         Target::All => &[],
     }
@@ -55,14 +58,13 @@ pub fn partition_cases(seeds: u64, ticks: u64) -> Vec<CaseLabel> {
 
 /// Parses `<target>/<strategy>` of a partition case (the strategy itself is checked by
 /// the hostile process, `hostile_nominal.py --check`).
-pub fn parse_partition_case(s: &str) -> Result<CaseLabel, String> {
-    let (t, st) = s.split_once('/').ok_or_else(|| {
-        format!("`{s}`: expected <target>/<strategy>, e.g. all/random:1+burst:40")
-    })?;
-    let target = Target::parse(t)
-        .ok_or_else(|| format!("`{t}` is not a target (translational, attitude, robotic, all)"))?;
+pub fn parse_partition_case(s: &str) -> Result<CaseLabel, CaseNameError> {
+    let (t, st) = s
+        .split_once('/')
+        .ok_or_else(|| CaseNameError::Form(s.into(), "all/random:1+burst:40"))?;
+    let target = Target::parse(t).ok_or_else(|| CaseNameError::Target(t.into()))?;
     if st.is_empty() || st.contains(char::is_whitespace) {
-        return Err(format!("`{s}`: empty strategy or one with spaces"));
+        return Err(CaseNameError::PartnerStrategy(s.into()));
     }
     Ok(CaseLabel {
         target,
@@ -70,13 +72,43 @@ pub fn parse_partition_case(s: &str) -> Result<CaseLabel, String> {
     })
 }
 
-/// The nominal roles a case replaces.
-pub fn roles(target: Target) -> &'static [&'static str] {
-    match target {
-        Target::Translational => &["translational"],
-        Target::Attitude => &["attitude"],
-        Target::Robotic => &["robotic"],
-        Target::All => &["translational", "attitude", "robotic"],
+/// The hostile partner program: `python script --role <subsystem> --strategy <s>`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct HostilePartners {
+    /// Python interpreter with the `iceoryx2` package.
+    pub python: PathBuf,
+    /// `hostile_nominal.py`.
+    pub script: PathBuf,
+}
+
+impl HostilePartners {
+    /// The script's arguments for the nominal controller of `s` playing `strategy`.
+    pub fn args(&self, s: Subsystem, strategy: &str) -> Vec<String> {
+        vec![
+            self.script.display().to_string(),
+            "--role".into(),
+            s.name().into(),
+            "--strategy".into(),
+            strategy.into(),
+        ]
+    }
+
+    /// One hostile process per subsystem the case attacks, in causal order.
+    pub fn processes(&self, case: &CaseLabel) -> Vec<PartnerProcess> {
+        case.target
+            .subsystems()
+            .iter()
+            .map(|s| PartnerProcess {
+                subsystem: s,
+                program: self.python.clone(),
+                args: self.args(s, &case.strategy),
+            })
+            .collect()
+    }
+
+    /// The case's nominal source: its hostile processes.
+    pub fn nominals(&self, case: &CaseLabel) -> NominalSource {
+        NominalSource::Partners(self.processes(case))
     }
 }
 

@@ -2,14 +2,15 @@
 //! case's smallest value of every barrier), `summary.json`, `report.md` and
 //! `figures/redteam_margins.svg`.
 
-use crate::campaign::CaseResult;
+use crate::campaign::{CaseError, CaseResult};
 use crate::scales::barrier_scales;
 use crate::strategy::CaseLabel;
+use sc_core::PerSubsystem;
 use sc_mission::Setup;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The campaign's verdict (`summary.json`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -38,22 +39,29 @@ pub struct CampaignSummary {
     pub wall_s: f64,
 }
 
-/// Writes every output into `dir`; returns the summary. `how` is the report's paragraph
-/// on how the cases were run.
-pub fn write(
-    dir: &Path,
-    setup: &Setup,
-    how: &str,
-    cases: &[CaseLabel],
-    results: &[Result<CaseResult, String>],
-    wall_s: f64,
-) -> Result<CampaignSummary, String> {
-    let io = |p: &Path, e: std::io::Error| format!("cannot write {}: {e}", p.display());
-    std::fs::create_dir_all(dir.join("figures")).map_err(|e| io(dir, e))?;
-    let names = sc_mission::constraint_names();
-    let scales = barrier_scales(&setup.scenario, &setup.robot);
-    let mut summary = CampaignSummary {
-        cases: cases.len(),
+/// Why the campaign's outputs could not be written. One line each.
+#[derive(Debug, thiserror::Error)]
+pub enum ReportError {
+    #[error("cannot write {}: {error}", .path.display())]
+    Write {
+        path: PathBuf,
+        error: std::io::Error,
+    },
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+    #[error(transparent)]
+    Figure(#[from] sc_plots::PlotError),
+}
+
+/// The header of `cases.csv`.
+const CASES_COLUMNS: &str = "case,target,strategy,end,final_time_s,steps,safe,violated,nonfinite_applied,out_of_bounds_applied,\
+substituted_translational,substituted_attitude,substituted_robotic,relaxed_translational,relaxed_attitude,relaxed_robotic,\
+backup_translational,backup_attitude,backup_robotic,bystander_disturbed_steps,worst_barrier,worst_normalised_margin,solve_geomean_us,solve_max_us\n";
+
+/// The campaign's verdict before any case.
+fn empty_summary(cases: usize, wall_s: f64) -> CampaignSummary {
+    CampaignSummary {
+        cases,
         safe: 0,
         unsafe_cases: Vec::new(),
         errors: Vec::new(),
@@ -64,15 +72,138 @@ pub fn write(
         solve_time_geomean_max_us: 0.0,
         solve_time_max_us: 0.0,
         wall_s,
+    }
+}
+
+/// Counts case `r` in the verdict.
+fn tally(summary: &mut CampaignSummary, r: &CaseResult) {
+    if r.safe() {
+        summary.safe += 1;
+    } else {
+        summary.unsafe_cases.push(r.case.clone());
+    }
+    if r.bystander_disturbed_steps() > 0 {
+        summary.bystanders_disturbed.push(r.case.clone());
+    }
+    summary.nonfinite_applied += r.nonfinite_applied;
+    summary.out_of_bounds_applied += r.out_of_bounds_applied;
+    summary.solve_time_geomean_max_us = summary
+        .solve_time_geomean_max_us
+        .max(r.solve_time_us.geomean);
+    summary.solve_time_max_us = summary.solve_time_max_us.max(r.solve_time_us.max);
+    for n in sc_mission::constraint_names() {
+        let h = min_h(r, n);
+        let e = summary
+            .worst
+            .entry(n.to_string())
+            .or_insert((f64::INFINITY, String::new()));
+        if h.is_nan() || h < e.0 {
+            *e = (h, r.case.clone());
+        }
+    }
+}
+
+/// The smallest value of barrier `name` in case `r` (NaN: none).
+fn min_h(r: &CaseResult, name: &str) -> f64 {
+    r.min_h.get(name).copied().unwrap_or(f64::NAN)
+}
+
+/// Every barrier's smallest value in case `r` over its scale, in
+/// [`sc_mission::constraint_names`] order.
+fn normalised(r: &CaseResult, scales: &sc_cbf::monitor::Barriers) -> Vec<f64> {
+    sc_mission::constraint_names()
+        .iter()
+        .enumerate()
+        .map(|(i, n)| min_h(r, n) / scales[i])
+        .collect()
+}
+
+/// The barrier closest to its boundary relative to its scale: its index and that margin.
+fn closest(normalised: &[f64]) -> (usize, f64) {
+    normalised
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1.total_cmp(b.1))
+        .map(|(i, v)| (i, *v))
+        .unwrap_or((0, f64::NAN))
+}
+
+/// The `cases.csv` line of case `r` (with a newline).
+fn cases_line(r: &CaseResult, normalised: &[f64]) -> String {
+    let names = sc_mission::constraint_names();
+    let (wi, wv) = closest(normalised);
+    let per = |v: &PerSubsystem<usize>| {
+        let [t, a, ro] = v.as_array();
+        format!("{t},{a},{ro}")
     };
-    let mut cases_csv = String::from(
-        "case,target,strategy,end,final_time_s,steps,safe,violated,nonfinite_applied,out_of_bounds_applied,\
-substituted_translational,substituted_attitude,substituted_robotic,relaxed_translational,relaxed_attitude,relaxed_robotic,\
-backup_translational,backup_attitude,backup_robotic,bystander_disturbed_steps,worst_barrier,worst_normalised_margin,solve_geomean_us,solve_max_us\n",
-    );
-    let mut min_csv = format!("case,{}\n", names.join(","));
-    let mut rows: Vec<String> = Vec::new();
-    let mut values: Vec<Vec<f64>> = Vec::new();
+    format!(
+        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+        r.case,
+        r.target,
+        r.strategy,
+        r.end,
+        r.final_time_s,
+        r.steps,
+        r.safe(),
+        r.violated.join(" "),
+        r.nonfinite_applied,
+        r.out_of_bounds_applied,
+        per(&r.substituted_steps),
+        per(&r.relaxed_steps),
+        per(&r.backup_steps),
+        r.bystander_disturbed_steps(),
+        names[wi],
+        wv,
+        r.solve_time_us.geomean,
+        r.solve_time_us.max,
+    )
+}
+
+/// The `min_h.csv` line of case `r` (with a newline).
+fn min_h_line(r: &CaseResult) -> String {
+    let values: Vec<String> = sc_mission::constraint_names()
+        .iter()
+        .map(|n| min_h(r, n).to_string())
+        .collect();
+    format!("{},{}\n", r.case, values.join(","))
+}
+
+/// The tables and the figure's data, case by case.
+struct Tables {
+    cases_csv: String,
+    min_csv: String,
+    /// The figure's rows (case names) and their normalised margins.
+    rows: Vec<String>,
+    values: Vec<Vec<f64>>,
+}
+
+/// Writes every output into `dir`; returns the summary. `how` is the report's paragraph
+/// on how the cases were run.
+pub fn write(
+    dir: &Path,
+    setup: &Setup,
+    how: &str,
+    cases: &[CaseLabel],
+    results: &[Result<CaseResult, CaseError>],
+    wall_s: f64,
+) -> Result<CampaignSummary, ReportError> {
+    let write = |name: &str, text: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).map_err(|error| ReportError::Write { path, error })
+    };
+    std::fs::create_dir_all(dir.join("figures")).map_err(|error| ReportError::Write {
+        path: dir.to_path_buf(),
+        error,
+    })?;
+    let names = sc_mission::constraint_names();
+    let scales = barrier_scales(&setup.scenario, &setup.robot);
+    let mut summary = empty_summary(cases.len(), wall_s);
+    let mut t = Tables {
+        cases_csv: CASES_COLUMNS.to_string(),
+        min_csv: format!("case,{}\n", names.join(",")),
+        rows: Vec::new(),
+        values: Vec::new(),
+    };
     for (case, r) in cases.iter().zip(results) {
         let r = match r {
             Ok(r) => r,
@@ -81,91 +212,18 @@ backup_translational,backup_attitude,backup_robotic,bystander_disturbed_steps,wo
                 continue;
             }
         };
-        if r.safe() {
-            summary.safe += 1;
-        } else {
-            summary.unsafe_cases.push(r.case.clone());
-        }
-        if r.bystander_disturbed_steps() > 0 {
-            summary.bystanders_disturbed.push(r.case.clone());
-        }
-        summary.nonfinite_applied += r.nonfinite_applied;
-        summary.out_of_bounds_applied += r.out_of_bounds_applied;
-        summary.solve_time_geomean_max_us = summary
-            .solve_time_geomean_max_us
-            .max(r.solve_time_us.geomean);
-        summary.solve_time_max_us = summary.solve_time_max_us.max(r.solve_time_us.max);
-        let normalised: Vec<f64> = names
-            .iter()
-            .enumerate()
-            .map(|(i, n)| r.min_h.get(*n).copied().unwrap_or(f64::NAN) / scales[i])
-            .collect();
-        let (wi, wv) = normalised
-            .iter()
-            .enumerate()
-            .min_by(|a, b| a.1.total_cmp(b.1))
-            .map(|(i, v)| (i, *v))
-            .unwrap_or((0, f64::NAN));
-        for n in &names {
-            let h = r.min_h.get(*n).copied().unwrap_or(f64::NAN);
-            let e = summary
-                .worst
-                .entry(n.to_string())
-                .or_insert((f64::INFINITY, String::new()));
-            if h.is_nan() || h < e.0 {
-                *e = (h, r.case.clone());
-            }
-        }
-        let _ = writeln!(
-            cases_csv,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            r.case,
-            r.target,
-            r.strategy,
-            r.end,
-            r.final_time_s,
-            r.steps,
-            r.safe(),
-            r.violated.join(" "),
-            r.nonfinite_applied,
-            r.out_of_bounds_applied,
-            r.substituted_steps[0],
-            r.substituted_steps[1],
-            r.substituted_steps[2],
-            r.relaxed_steps[0],
-            r.relaxed_steps[1],
-            r.relaxed_steps[2],
-            r.backup_steps[0],
-            r.backup_steps[1],
-            r.backup_steps[2],
-            r.bystander_disturbed_steps(),
-            names[wi],
-            wv,
-            r.solve_time_us.geomean,
-            r.solve_time_us.max,
-        );
-        let _ = writeln!(
-            min_csv,
-            "{},{}",
-            r.case,
-            names
-                .iter()
-                .map(|n| r.min_h.get(*n).copied().unwrap_or(f64::NAN).to_string())
-                .collect::<Vec<_>>()
-                .join(",")
-        );
-        rows.push(r.case.clone());
-        values.push(normalised);
+        tally(&mut summary, r);
+        let normalised = normalised(r, &scales);
+        t.cases_csv += &cases_line(r, &normalised);
+        t.min_csv += &min_h_line(r);
+        t.rows.push(r.case.clone());
+        t.values.push(normalised);
     }
-    let write = |name: &str, text: &str| {
-        let p = dir.join(name);
-        std::fs::write(&p, text).map_err(|e| io(&p, e))
-    };
-    write("cases.csv", &cases_csv)?;
-    write("min_h.csv", &min_csv)?;
+    write("cases.csv", &t.cases_csv)?;
+    write("min_h.csv", &t.min_csv)?;
     write(
         "summary.json",
-        &(serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())? + "\n"),
+        &(serde_json::to_string_pretty(&summary)? + "\n"),
     )?;
     write(
         "report.md",
@@ -175,27 +233,19 @@ backup_translational,backup_attitude,backup_robotic,bystander_disturbed_steps,wo
     sc_plots::redteam_margins(
         &dir.join("figures/redteam_margins.svg"),
         &sc_plots::RedTeamMargins {
-            cases: &rows,
+            cases: &t.rows,
             barriers: &barrier_names,
-            values: &values,
+            values: &t.values,
         },
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     Ok(summary)
 }
 
 /// How the in-process campaign runs its cases (the report's paragraph).
 pub const IN_PROCESS: &str = "Each case runs the whole mission in one process with the adversary in place of the nominal controller of its target (`all`: all three).";
 
-fn markdown(
-    s: &CampaignSummary,
-    how: &str,
-    cases: &[CaseLabel],
-    results: &[Result<CaseResult, String>],
-    scales: &sc_cbf::monitor::Barriers,
-) -> String {
-    let names = sc_mission::constraint_names();
-    let mut m = String::new();
+/// The report's verdict, isolation and columns paragraphs.
+fn markdown_header(m: &mut String, s: &CampaignSummary, how: &str) {
     let _ = writeln!(m, "# Red team of the safety layer\n");
     let _ = writeln!(
         m,
@@ -222,6 +272,42 @@ fn markdown(
         m,
         "{how} Columns: how the mission ended, the barrier closest to its boundary (value / barrier scale, `figures/redteam_margins.svg`), and per filter (translational/attitude/robotic) the steps on the substitute nominal, on the relaxed problem and on the backup law, and the steps on which a subsystem the case does not attack was disturbed.\n"
     );
+}
+
+/// A case's row of the report's table.
+fn markdown_row(r: &CaseResult, scales: &sc_cbf::monitor::Barriers) -> String {
+    let names = sc_mission::constraint_names();
+    let (wn, wv) = names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| (*n, min_h(r, n) / scales[i]))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap_or(("", f64::NAN));
+    format!(
+        "| {} | {} | {} | {} | {:.3e} | {:?} | {:?} | {:?} | {} | {:.1} / {:.0} |",
+        r.strategy,
+        r.end,
+        if r.safe() { "yes" } else { "**NO**" },
+        wn,
+        wv,
+        r.substituted_steps.as_array(),
+        r.relaxed_steps.as_array(),
+        r.backup_steps.as_array(),
+        r.bystander_disturbed_steps(),
+        r.solve_time_us.geomean,
+        r.solve_time_us.max
+    )
+}
+
+fn markdown(
+    s: &CampaignSummary,
+    how: &str,
+    cases: &[CaseLabel],
+    results: &[Result<CaseResult, CaseError>],
+    scales: &sc_cbf::monitor::Barriers,
+) -> String {
+    let mut m = String::new();
+    markdown_header(&mut m, s, how);
     let mut target = "";
     for (case, r) in cases.iter().zip(results) {
         if case.target.name() != target {
@@ -233,27 +319,7 @@ fn markdown(
         }
         match r {
             Ok(r) => {
-                let (wn, wv) = names
-                    .iter()
-                    .enumerate()
-                    .map(|(i, n)| (*n, r.min_h.get(*n).copied().unwrap_or(f64::NAN) / scales[i]))
-                    .min_by(|a, b| a.1.total_cmp(&b.1))
-                    .unwrap_or(("", f64::NAN));
-                let _ = writeln!(
-                    m,
-                    "| {} | {} | {} | {} | {:.3e} | {:?} | {:?} | {:?} | {} | {:.1} / {:.0} |",
-                    r.strategy,
-                    r.end,
-                    if r.safe() { "yes" } else { "**NO**" },
-                    wn,
-                    wv,
-                    r.substituted_steps,
-                    r.relaxed_steps,
-                    r.backup_steps,
-                    r.bystander_disturbed_steps(),
-                    r.solve_time_us.geomean,
-                    r.solve_time_us.max
-                );
+                let _ = writeln!(m, "{}", markdown_row(r, scales));
             }
             Err(e) => {
                 let _ = writeln!(m, "| {} | error: {e} | | | | | | | | |", case.strategy);

@@ -1,33 +1,29 @@
 //! The adversarial strategies and the subsystems they attack, with stable names for the
 //! command line and reports (`toward:approach_corridor`, `random:3`, `nonfinite`, …).
 
-use serde::{Deserialize, Serialize};
+use sc_core::{Subsystem, SubsystemSet};
 use std::fmt;
 
-/// Which nominal controller the adversary replaces.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+/// Which nominal controller(s) the adversary replaces: one subsystem's, or all three.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Target {
-    Translational,
-    Attitude,
-    Robotic,
+    One(Subsystem),
     /// All three at once.
     All,
 }
 
 impl Target {
     pub const ALL: [Target; 4] = [
-        Target::Translational,
-        Target::Attitude,
-        Target::Robotic,
+        Target::One(Subsystem::Translational),
+        Target::One(Subsystem::Attitude),
+        Target::One(Subsystem::Robotic),
         Target::All,
     ];
 
-    /// Stable name.
+    /// Stable name: the subsystem's, or `all`.
     pub fn name(&self) -> &'static str {
         match self {
-            Target::Translational => "translational",
-            Target::Attitude => "attitude",
-            Target::Robotic => "robotic",
+            Target::One(s) => s.name(),
             Target::All => "all",
         }
     }
@@ -37,25 +33,34 @@ impl Target {
         Self::ALL.into_iter().find(|t| t.name() == s)
     }
 
-    /// True if the adversary replaces subsystem `i` (0 translational, 1 attitude, 2 robotic).
-    pub fn covers(&self, i: usize) -> bool {
-        matches!(
-            (self, i),
-            (Target::All, _)
-                | (Target::Translational, 0)
-                | (Target::Attitude, 1)
-                | (Target::Robotic, 2)
-        )
+    /// The subsystems whose nominal controllers the adversary replaces.
+    pub fn subsystems(&self) -> SubsystemSet {
+        match self {
+            Target::One(s) => SubsystemSet::only(*s),
+            Target::All => SubsystemSet::ALL,
+        }
+    }
+
+    /// True if the adversary replaces the nominal controller of `s`.
+    pub fn attacks(&self, s: Subsystem) -> bool {
+        self.subsystems().contains(s)
     }
 
     /// The constraint names of the subsystem (empty for [`Target::All`]).
     pub fn barrier_names(&self) -> &'static [&'static str] {
         match self {
-            Target::Translational => &sc_cbf::names::TRANSLATIONAL,
-            Target::Attitude => &sc_cbf::names::ATTITUDE,
-            Target::Robotic => &sc_cbf::names::ROBOTIC,
+            Target::One(s) => barrier_names(*s),
             Target::All => &[],
         }
+    }
+}
+
+/// The constraint names of subsystem `s`, in telemetry order.
+pub fn barrier_names(s: Subsystem) -> &'static [&'static str] {
+    match s {
+        Subsystem::Translational => &sc_cbf::names::TRANSLATIONAL,
+        Subsystem::Attitude => &sc_cbf::names::ATTITUDE,
+        Subsystem::Robotic => &sc_cbf::names::ROBOTIC,
     }
 }
 
@@ -65,8 +70,33 @@ impl fmt::Display for Target {
     }
 }
 
+/// Why a case's name was refused. One line each.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CaseNameError {
+    #[error("`{0}`: expected <target>/<strategy>, e.g. {1}")]
+    Form(String, &'static str),
+    #[error("`{0}` is not a target (translational, attitude, robotic, all)")]
+    Target(String),
+    #[error(
+        "unknown strategy `{0}` (expected toward:<barrier>, greedy, random:<seed>, nonfinite, huge, frozen, stale or silent)"
+    )]
+    Strategy(String),
+    #[error("toward:<barrier> needs one subsystem, not `{0}`")]
+    TowardAll(Target),
+    #[error("`{barrier}` is not a barrier of the {target} subsystem ({})", .names.join(", "))]
+    Barrier {
+        barrier: String,
+        target: Target,
+        names: &'static [&'static str],
+    },
+    #[error("random:<seed> needs an integer seed, not `{0}`")]
+    Seed(String),
+    #[error("`{0}`: empty strategy or one with spaces")]
+    PartnerStrategy(String),
+}
+
 /// What the adversarial nominal controller sends.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Strategy {
     /// Bang-bang towards one boundary: every step the command (1.5 × the input bound)
     /// that decreases barrier `i` of the subsystem fastest (index into its names).
@@ -125,34 +155,27 @@ impl Strategy {
     }
 
     /// Parses [`Self::name`] for `target`.
-    pub fn parse(s: &str, target: Target) -> Result<Self, String> {
-        let bad = || {
-            format!(
-                "unknown strategy `{s}` (expected toward:<barrier>, greedy, random:<seed>, nonfinite, huge, frozen, stale or silent)"
-            )
-        };
+    pub fn parse(s: &str, target: Target) -> Result<Self, CaseNameError> {
         if let Some(b) = s.strip_prefix("toward:") {
             let names = target.barrier_names();
             return names
                 .iter()
                 .position(|n| *n == b)
                 .map(Strategy::Toward)
-                .ok_or_else(|| {
-                    if names.is_empty() {
-                        format!("toward:<barrier> needs one subsystem, not `{target}`")
-                    } else {
-                        format!(
-                            "`{b}` is not a barrier of the {target} subsystem ({})",
-                            names.join(", ")
-                        )
-                    }
+                .ok_or_else(|| match target {
+                    Target::All => CaseNameError::TowardAll(target),
+                    Target::One(_) => CaseNameError::Barrier {
+                        barrier: b.into(),
+                        target,
+                        names,
+                    },
                 });
         }
         if let Some(seed) = s.strip_prefix("random:") {
             return seed
                 .parse()
                 .map(Strategy::Random)
-                .map_err(|_| format!("random:<seed> needs an integer seed, not `{seed}`"));
+                .map_err(|_| CaseNameError::Seed(seed.into()));
         }
         Ok(match s {
             "greedy" => Strategy::Greedy,
@@ -161,13 +184,13 @@ impl Strategy {
             "frozen" => Strategy::Frozen,
             "stale" => Strategy::Stale,
             "silent" => Strategy::Silent,
-            _ => return Err(bad()),
+            _ => return Err(CaseNameError::Strategy(s.into())),
         })
     }
 }
 
 /// One red-team case: a strategy against a target.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Case {
     pub target: Target,
     pub strategy: Strategy,
@@ -176,7 +199,7 @@ pub struct Case {
 /// What names a case in the reports: its target and its strategy's name. In-process
 /// cases are [`Case`]s; the partition's hostile partner processes
 /// (`safe-capture redteam --partition`) have strategies of their own.
-#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct CaseLabel {
     pub target: Target,
     pub strategy: String,
@@ -216,13 +239,11 @@ impl Case {
     }
 
     /// Parses [`Self::name`].
-    pub fn parse(s: &str) -> Result<Self, String> {
+    pub fn parse(s: &str) -> Result<Self, CaseNameError> {
         let (t, st) = s
             .split_once('/')
-            .ok_or_else(|| format!("`{s}`: expected <target>/<strategy>, e.g. all/greedy"))?;
-        let target = Target::parse(t).ok_or_else(|| {
-            format!("`{t}` is not a target (translational, attitude, robotic, all)")
-        })?;
+            .ok_or_else(|| CaseNameError::Form(s.into(), "all/greedy"))?;
+        let target = Target::parse(t).ok_or_else(|| CaseNameError::Target(t.into()))?;
         Ok(Self {
             target,
             strategy: Strategy::parse(st, target)?,
@@ -262,5 +283,24 @@ mod tests {
         assert!(Case::parse("robotic/random:x").is_err());
         assert!(Case::parse("nowhere/greedy").is_err());
         assert_eq!(Case::all(5).len(), 2 + 7 + 42 + 4 * 11);
+    }
+
+    #[test]
+    fn a_target_is_one_subsystem_or_all_of_them() {
+        for t in Target::ALL {
+            assert_eq!(Target::parse(t.name()), Some(t));
+        }
+        let attitude = Target::parse("attitude").unwrap();
+        assert_eq!(attitude, Target::One(Subsystem::Attitude));
+        assert!(attitude.attacks(Subsystem::Attitude));
+        assert!(!attitude.attacks(Subsystem::Robotic));
+        assert_eq!(Target::All.subsystems(), SubsystemSet::ALL);
+        assert!(Target::All.barrier_names().is_empty());
+        assert_eq!(attitude.barrier_names(), &sc_cbf::names::ATTITUDE);
+        let e = Strategy::parse("toward:nothing", attitude).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("`nothing` is not a barrier of the attitude subsystem (")
+        );
     }
 }
