@@ -251,7 +251,6 @@ impl Executor for Partition {
     }
 }
 
-
 /// The role of the nominal controller a partner replaces.
 fn partner_role(p: &PartnerProcess) -> &'static Role {
     Role::of(RoleKind::Nominal(p.subsystem))
