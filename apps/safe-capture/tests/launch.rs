@@ -32,8 +32,8 @@ fn a_missing_scenario_or_program_stops_the_launch_before_anything_starts() {
     let d = tmp("launch-preflight");
     for (from, to, needles) in [
         (
-            "exec = \"sc-simulator\"",
-            "exec = \"bin/sc-simulator\"",
+            "[roles.simulator]\n",
+            "[roles.simulator]\nexec = \"bin/sc-simulator\"\n",
             &[
                 "role `simulator`: the executable",
                 "bin/sc-simulator does not exist",
@@ -41,13 +41,13 @@ fn a_missing_scenario_or_program_stops_the_launch_before_anything_starts() {
             ][..],
         ),
         (
-            "exec = \"sc-recorder\"",
-            "exec = \"sc-recorder-v2\"",
+            "[roles.recorder]\n",
+            "[roles.recorder]\nexec = \"sc-recorder-v2\"\n",
             &["role `recorder`: the executable `sc-recorder-v2` was found neither"],
         ),
         (
-            "exec = \"sc-nominal-attitude\"",
-            "exec = \"sh\"\nargs = [\"partners/attitude.sh\"]",
+            "[roles.nominal_attitude]\n",
+            "[roles.nominal_attitude]\nexec = \"sh\"\nargs = [\"partners/attitude.sh\"]\n",
             &["role `nominal_attitude`: the script \"partners/attitude.sh\""],
         ),
         (
@@ -127,7 +127,11 @@ fn a_missing_scenario_or_program_stops_the_launch_before_anything_starts() {
 fn a_process_that_fails_at_start_is_named_in_an_infrastructure_verdict() {
     let _cpu = exclusive();
     let d = tmp("launch-fails-at-start");
-    let cfg = partition_with(&d, "exec = \"sc-nominal-robotic\"", "exec = \"false\"");
+    let cfg = partition_with(
+        &d,
+        "[roles.nominal_robotic]\n",
+        "[roles.nominal_robotic]\nexec = \"false\"\n",
+    );
     // the default handshake timeout: the launch must not wait for it
     let default_timeout = std::fs::read_to_string(&cfg)
         .unwrap()
@@ -191,7 +195,10 @@ fn a_failed_launch_never_reports_an_old_run() {
     let d = tmp("stale-launch");
     let cfg = partition_toml_absolute_scenario()
         .replace("handshake_timeout_s = 30.0", "handshake_timeout_s = 2.0")
-        .replace("exec = \"sc-nominal-robotic\"", "exec = \"false\"");
+        .replace(
+            "[roles.nominal_robotic]\n",
+            "[roles.nominal_robotic]\nexec = \"false\"\n",
+        );
     assert!(cfg.contains("exec = \"false\"") && cfg.contains("handshake_timeout_s = 2.0"));
     std::fs::write(d.join("partition.toml"), cfg).unwrap();
     let out = d.join("out");

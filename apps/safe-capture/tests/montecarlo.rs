@@ -179,8 +179,8 @@ fn bad_montecarlo_arguments_are_one_line_errors() {
     std::fs::write(
         &missing_exec,
         partition_toml_absolute_scenario().replace(
-            "exec = \"sc-scheduler\"",
-            "exec = \"/nonexistent/sc-scheduler\"",
+            "[roles.scheduler]\n",
+            "[roles.scheduler]\nexec = \"/nonexistent/sc-scheduler\"\n",
         ),
     )
     .unwrap();

@@ -236,8 +236,8 @@ fn a_missing_partition_program_stops_the_campaign_before_any_case() {
     let Some(py) = python() else { return };
     let d = tmp("redteam-missing-exec");
     let cfg = partition_toml_absolute_scenario().replace(
-        "exec = \"sc-safety-robotic\"",
-        "exec = \"bin/sc-safety-robotic\"",
+        "[roles.safety_robotic]\n",
+        "[roles.safety_robotic]\nexec = \"bin/sc-safety-robotic\"\n",
     );
     assert!(cfg.contains("bin/sc-safety-robotic"));
     let p = d.join("partition.toml");
