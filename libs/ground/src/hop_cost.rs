@@ -63,15 +63,15 @@ impl Default for HopCostOptions {
 impl HopCostOptions {
     /// Parses the arguments (without the program name).
     pub fn parse(args: &[String]) -> Result<Self, BenchError> {
-        Self::parse_words(args).map_err(BenchError::Data)
-    }
-
-    fn parse_words(args: &[String]) -> Result<Self, String> {
+        let usage = |what: String| BenchError::Data(what);
         let mut o = Self::default();
         let mut it = args.iter();
         while let Some(a) = it.next() {
-            let mut val = || it.next().ok_or(format!("{a} needs a value ({USAGE})"));
-            let num = |s: &str| s.parse::<u64>().map_err(|e| format!("{a} {s}: {e}"));
+            let mut val = || {
+                it.next()
+                    .ok_or(usage(format!("{a} needs a value ({USAGE})")))
+            };
+            let num = |s: &str| s.parse::<u64>().map_err(|e| usage(format!("{a} {s}: {e}")));
             match a.as_str() {
                 "--n" => o.n = num(val()?)? as usize,
                 "--period-us" => o.period = Duration::from_micros(num(val()?)?),
@@ -81,15 +81,17 @@ impl HopCostOptions {
                 "--prewarm-us" => o.prewarm = Duration::from_micros(num(val()?)?),
                 "--cpus" => {
                     let v = val()?;
-                    let (a, b) = v.split_once(',').ok_or(format!("--cpus A,B ({USAGE})"))?;
+                    let (a, b) = v
+                        .split_once(',')
+                        .ok_or(usage(format!("--cpus A,B ({USAGE})")))?;
                     o.cpus = Some((num(a)? as usize, num(b)? as usize));
                 }
                 "--echo" => o.echo = true,
-                other => return Err(format!("unknown argument {other} ({USAGE})")),
+                other => return Err(usage(format!("unknown argument {other} ({USAGE})"))),
             }
         }
         if o.n == 0 {
-            return Err("--n must be at least 1".into());
+            return Err(usage("--n must be at least 1".into()));
         }
         Ok(o)
     }

@@ -33,10 +33,13 @@ impl CpuWakeupLatency {
 }
 
 /// What the launcher did about the CPU wake-up latency, for launch.json and reports.
-pub fn describe(requested: Option<u32>, held: &Result<CpuWakeupLatency, String>) -> String {
+pub fn describe(
+    requested: Option<u32>,
+    held: &Option<std::io::Result<CpuWakeupLatency>>,
+) -> String {
     match (requested, held) {
-        (None, _) => "system default (not requested)".into(),
-        (Some(_), Ok(h)) => format!("{} us (PM QoS held for the run)", h.us()),
-        (Some(us), Err(e)) => format!("system default ({us} us refused: {e})"),
+        (Some(_), Some(Ok(h))) => format!("{} us (PM QoS held for the run)", h.us()),
+        (Some(us), Some(Err(e))) => format!("system default ({us} us refused: {DEVICE}: {e})"),
+        _ => "system default (not requested)".into(),
     }
 }

@@ -202,13 +202,10 @@ pub fn launch(opts: &LaunchOptions) -> Result<LaunchReport, LaunchError> {
     // held until the launcher returns (after teardown); in both clock modes, since
     // every hop of a lock-step tick waits for a wake-up as well
     let wakeup_request = cfg.cpu_wakeup_latency_us;
-    let wakeup_held = match wakeup_request {
-        Some(us) => crate::pm_qos::CpuWakeupLatency::request(us)
-            .map_err(|e| format!("{}: {e}", crate::pm_qos::DEVICE)),
-        None => Err(String::new()),
-    };
-    if let (Some(_), Err(e)) = (wakeup_request, &wakeup_held) {
-        note!("launch: warning: CPU wake-up latency not set ({e})");
+    let wakeup_held = wakeup_request.map(crate::pm_qos::CpuWakeupLatency::request);
+    if let Some(Err(e)) = &wakeup_held {
+        let device = crate::pm_qos::DEVICE;
+        note!("launch: warning: CPU wake-up latency not set ({device}: {e})");
     }
     let stale_removed = clean_stale_runs(run.run_id());
     let _ = clean::reap_bounded(&run);
@@ -232,7 +229,7 @@ fn report(
     run: &RunScope,
     out: &Path,
     s: supervise::Supervised,
-    spawn_err: Option<String>,
+    spawn_err: Option<start::SpawnError>,
     quiet: bool,
 ) -> LaunchReport {
     if clean::reap_bounded(run).is_none() && !quiet {
@@ -250,7 +247,11 @@ fn report(
     }
     let leftovers = run.leftovers();
     let broken = s.failed || s.interrupted || spawn_err.is_some() || !leftovers.is_empty();
-    let (code, error) = verdict::judge(out, broken, spawn_err.or(s.early_err));
+    let (code, error) = verdict::judge(
+        out,
+        broken,
+        spawn_err.map(|e| e.to_string()).or(s.early_err),
+    );
     if let Some(e) = error.as_ref().filter(|_| !quiet) {
         note!("launch: {e}");
     }

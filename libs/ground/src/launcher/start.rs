@@ -93,7 +93,7 @@ pub(super) fn spawn_roles(
     eff: &Path,
     out: &Path,
     run: &RunScope,
-) -> (Vec<Started>, Option<String>) {
+) -> (Vec<Started>, Option<SpawnError>) {
     let mut procs = Vec::new();
     for role in ROLES.iter().map(|r| r.name) {
         match spawn_role(cfg, role, eff, out, run) {
@@ -112,16 +112,15 @@ fn spawn_role(
     eff: &Path,
     out: &Path,
     run: &RunScope,
-) -> Result<Child, String> {
+) -> Result<Child, SpawnError> {
     let e = &cfg.roles[role];
     let path = out.join("logs").join(format!("{role}.log"));
     let log = std::fs::File::create(&path)
         .and_then(|l| Ok((l.try_clone()?, l)))
-        .map_err(|err| {
-            format!(
-                "cannot open the log of role `{role}` ({}): {err}",
-                path.display()
-            )
+        .map_err(|source| SpawnError::Log {
+            role: role.to_string(),
+            path: path.display().to_string(),
+            source,
         })?;
     let mut cmd = Command::new(&e.exec);
     cmd.args(&e.args);
@@ -134,8 +133,28 @@ fn spawn_role(
         .stdin(Stdio::null())
         .stdout(log.0)
         .stderr(log.1);
-    cmd.spawn()
-        .map_err(|err| format!("cannot start role `{role}` ({}): {err}", e.exec))
+    cmd.spawn().map_err(|source| SpawnError::Exec {
+        role: role.to_string(),
+        exec: e.exec.clone(),
+        source,
+    })
+}
+
+/// Why a role's process could not be started.
+#[derive(Debug, thiserror::Error)]
+pub enum SpawnError {
+    #[error("cannot open the log of role `{role}` ({path}): {source}")]
+    Log {
+        role: String,
+        path: String,
+        source: std::io::Error,
+    },
+    #[error("cannot start role `{role}` ({exec}): {source}")]
+    Exec {
+        role: String,
+        exec: String,
+        source: std::io::Error,
+    },
 }
 
 /// The executable a role's `exec` names: a path relative to the config directory
