@@ -151,8 +151,8 @@ fn a_missing_role_executable_names_the_role_and_the_fix() {
     let p = shipped_with(
         &d,
         "partition.toml",
-        "[roles.simulator]\n",
-        "[roles.simulator]\nexec = \"bin/sc-simulator\"\n",
+        "\n[roles.simulator]\n",
+        "\n[roles.simulator]\nexec = \"bin/sc-simulator\"\n",
     );
     let o = check(&[p.to_str().unwrap()]);
     assert_invalid(
@@ -168,8 +168,8 @@ fn a_missing_role_executable_names_the_role_and_the_fix() {
     let p = shipped_with(
         &d,
         "partition.toml",
-        "[roles.safety_attitude]\n",
-        "[roles.safety_attitude]\nexec = \"sc-safety-attitude-v2\"\n",
+        "\n[roles.safety_attitude]\n",
+        "\n[roles.safety_attitude]\nexec = \"sc-safety-attitude-v2\"\n",
     );
     let o = check(&[p.to_str().unwrap()]);
     assert_invalid(
@@ -185,8 +185,8 @@ fn a_missing_role_executable_names_the_role_and_the_fix() {
     let p = shipped_with(
         &d,
         "partition.toml",
-        "[roles.nominal_translational]\n",
-        "[roles.nominal_translational]\nexec = \"sh\"\nargs = [\"partners/no_such_partner.sh\"]\n",
+        "\n[roles.nominal_translational]\n",
+        "\n[roles.nominal_translational]\nexec = \"sh\"\nargs = [\"partners/no_such_partner.sh\"]\n",
     );
     let o = check(&[p.to_str().unwrap()]);
     assert_invalid(
