@@ -8,8 +8,10 @@
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
+pub mod uncertainty;
 mod validate;
 
+pub use uncertainty::{Uncertainty, UncertaintySpec};
 pub use validate::ScenarioError;
 
 /// Three-vector as written in the file.
@@ -29,6 +31,11 @@ pub struct Scenario {
     pub limits: Limits,
     pub safety: Safety,
     pub nominal: Nominal,
+    /// The declared model, actuator and navigation errors (absent: the `exact` profile).
+    /// Once loaded, its three sections hold the resolved bounds, so that the scenario
+    /// written back (a Monte Carlo run's file) reproduces the run on its own.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uncertainty: Option<UncertaintySpec>,
     /// Directory the scenario was loaded from; relative paths resolve against it.
     #[serde(skip)]
     pub base_dir: PathBuf,
@@ -396,8 +403,46 @@ impl Scenario {
     pub fn from_toml_str(text: &str, base_dir: &Path) -> Result<Self, ScenarioError> {
         let mut s: Scenario = toml::from_str(text).map_err(|e| ScenarioError::parse(text, &e))?;
         s.base_dir = base_dir.to_path_buf();
+        if let Some(spec) = s.uncertainty.take() {
+            s.set_uncertainty(spec)?;
+        }
         s.validate()?;
         Ok(s)
+    }
+
+    /// Declares the uncertainty `spec` (e.g. from `--uncertainty`): its profile is read
+    /// and its bounds written into the scenario; the `exact` profile without sections of
+    /// its own (all bounds zero) removes the section: a scenario without uncertainty.
+    pub fn set_uncertainty(&mut self, spec: UncertaintySpec) -> Result<(), ScenarioError> {
+        let u = spec.resolve(&self.base_dir)?;
+        let truth_differs = spec.truth.is_some_and(|t| t != u);
+        self.uncertainty = (!u.is_exact() || truth_differs).then_some(UncertaintySpec {
+            model: Some(u.model),
+            actuators: Some(u.actuators),
+            navigation: Some(u.navigation),
+            truth: spec.truth.filter(|_| truth_differs),
+            ..spec
+        });
+        Ok(())
+    }
+
+    /// The declared bounds (all zero without an `[uncertainty]` section).
+    pub fn uncertainty_bounds(&self) -> Uncertainty {
+        let resolved = |s: &UncertaintySpec| Uncertainty {
+            model: s.model.unwrap_or_default(),
+            actuators: s.actuators.unwrap_or_default(),
+            navigation: s.navigation.unwrap_or_default(),
+        };
+        self.uncertainty.as_ref().map(resolved).unwrap_or_default()
+    }
+
+    /// The bounds the simulation draws its truth from: `uncertainty.truth` if given,
+    /// else the declared bounds.
+    pub fn uncertainty_truth_bounds(&self) -> Uncertainty {
+        self.uncertainty
+            .as_ref()
+            .and_then(|u| u.truth)
+            .unwrap_or_else(|| self.uncertainty_bounds())
     }
 
     /// The URDF path, resolved against the scenario's directory.

@@ -173,7 +173,28 @@ impl Scenario {
         self.validate_mission()?;
         self.validate_limits()?;
         self.validate_safety()?;
-        self.validate_nominal()
+        self.validate_nominal()?;
+        self.validate_uncertainty()
+    }
+
+    fn validate_uncertainty(&self) -> Result<(), ScenarioError> {
+        if let Some(t) = self.uncertainty.as_ref().and_then(|u| u.truth) {
+            t.validate("uncertainty.truth")?;
+        }
+        let u = self.uncertainty_bounds();
+        u.validate("uncertainty")?;
+        let age = u.navigation.measurement_age_s;
+        if age > self.mission.control_period_s {
+            return Err(invalid(
+                "uncertainty.navigation.measurement_age_s",
+                age,
+                format!(
+                    "at most one control period (mission.control_period_s = {})",
+                    self.mission.control_period_s
+                ),
+            ));
+        }
+        Ok(())
     }
 
     fn validate_orbit(&self) -> Result<(), ScenarioError> {
@@ -589,4 +610,93 @@ fn validate_attitude_mpc(m: &crate::NominalAttitudeMpc) -> Result<(), ScenarioEr
         m.weight_torque_per_nm2,
     )?;
     non_negative("nominal.attitude.mpc.weight_terminal", m.weight_terminal)
+}
+
+/// A relative bound above which a scaled mass or inertia could reach zero or flip a
+/// principal moment's order: the plant would no longer be a plant.
+const MAX_RELATIVE_MASS_ERROR: f64 = 0.5;
+/// A misalignment beyond the small-angle regime the margins assume [rad] (≈ 5.7°).
+const MAX_MISALIGNMENT_RAD: f64 = 0.1;
+
+impl crate::Uncertainty {
+    /// Every bound finite and ≥ 0; relative mass and inertia errors below
+    /// [`MAX_RELATIVE_MASS_ERROR`], scale errors and ripple below 1, misalignment below
+    /// [`MAX_MISALIGNMENT_RAD`]. `prefix` names the section in errors.
+    pub fn validate(&self, prefix: &str) -> Result<(), ScenarioError> {
+        let (m, a, n) = (&self.model, &self.actuators, &self.navigation);
+        let rel = MAX_RELATIVE_MASS_ERROR;
+        let checks: [(&str, f64, f64); 13] = [
+            ("model.servicer_mass_rel", m.servicer_mass_rel, rel),
+            ("model.servicer_inertia_rel", m.servicer_inertia_rel, rel),
+            ("model.servicer_com_m", m.servicer_com_m, f64::INFINITY),
+            ("model.link_mass_rel", m.link_mass_rel, rel),
+            ("model.link_inertia_rel", m.link_inertia_rel, rel),
+            ("model.target_inertia_rel", m.target_inertia_rel, rel),
+            (
+                "actuators.thruster_force_scale_rel",
+                a.thruster_force_scale_rel,
+                1.0,
+            ),
+            (
+                "actuators.thruster_misalignment_rad",
+                a.thruster_misalignment_rad,
+                MAX_MISALIGNMENT_RAD,
+            ),
+            (
+                "actuators.body_torque_scale_rel",
+                a.body_torque_scale_rel,
+                1.0,
+            ),
+            (
+                "actuators.joint_torque_scale_rel",
+                a.joint_torque_scale_rel,
+                1.0,
+            ),
+            (
+                "actuators.joint_torque_bias_nm",
+                a.joint_torque_bias_nm,
+                f64::INFINITY,
+            ),
+            (
+                "actuators.joint_torque_ripple_rel",
+                a.joint_torque_ripple_rel,
+                1.0,
+            ),
+            (
+                "navigation.measurement_age_s",
+                n.measurement_age_s,
+                f64::INFINITY,
+            ),
+        ];
+        for (key, v, below) in checks {
+            bounded(&format!("{prefix}.{key}"), v, below)?;
+        }
+        for (key, b) in n.errors() {
+            bounded(
+                &format!("{prefix}.navigation.{key}.bias"),
+                b.bias,
+                f64::INFINITY,
+            )?;
+            bounded(
+                &format!("{prefix}.navigation.{key}.noise"),
+                b.noise,
+                f64::INFINITY,
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// `v` finite, ≥ 0 and below `below`.
+fn bounded(key: &str, v: f64, below: f64) -> Result<(), ScenarioError> {
+    finite(key, v)?;
+    if v < 0.0 || v >= below {
+        let rule = if below.is_finite() {
+            format!("a bound: at least 0 and below {below}")
+        } else {
+            "a bound: at least 0".into()
+        };
+        return Err(invalid(key, v, rule));
+    }
+    Ok(())
 }
