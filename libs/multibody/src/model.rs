@@ -509,6 +509,36 @@ impl Robot {
     pub fn name(&self) -> &str {
         &self.name
     }
+    /// The same robot with other mass properties of body `k` (0: base, 1..=7: the arm's
+    /// links): mass × `mass_scale`, rotational inertia about the CoM × `inertia_scale`,
+    /// CoM moved by `com_offset` (body frame) [m]. The plant of a run whose model errs
+    /// (`[uncertainty.model]`); `None` for a body that does not exist or a scale that is
+    /// not positive and finite.
+    pub fn with_body_mass_properties(
+        &self,
+        k: usize,
+        mass_scale: f64,
+        inertia_scale: f64,
+        com_offset: Vector3<f64>,
+    ) -> Option<Robot> {
+        let positive = |x: f64| x.is_finite() && x > 0.0;
+        if !(positive(mass_scale)
+            && positive(inertia_scale)
+            && com_offset.iter().all(|x| x.is_finite()))
+        {
+            return None;
+        }
+        let body = *self.inertias.get(k)?;
+        let c = body.com();
+        let sc = crate::spatial::skew(&c);
+        let i_c = body.i_o + sc * sc * body.mass;
+        let mut robot = self.clone();
+        robot.inertias[k] =
+            Inertia::from_com(body.mass * mass_scale, c + com_offset, i_c * inertia_scale);
+        robot.total_mass = robot.inertias.iter().map(|i| i.mass).sum();
+        Some(robot)
+    }
+
     /// Total mass of base + arm (kg).
     pub fn total_mass(&self) -> f64 {
         self.total_mass

@@ -23,6 +23,7 @@ pub mod plant_process;
 mod profile;
 mod report;
 mod state;
+pub mod uncertainty;
 
 pub use observation::{TRAJECTORY_COLUMNS, TrajectoryRow};
 pub use plant::{Plant, PlantError, SIM_STATE_LEN};
@@ -31,3 +32,4 @@ pub use profile::{CommandProfile, GRID_TOLERANCE_S, PROFILE_COLUMNS, ProfileErro
 pub use report::{ModelReport, ModelState, evaluate_model};
 pub use sc_core::Observation;
 pub use state::{BarrierState, Command, SimError, SimState, Simulator};
+pub use uncertainty::{NavigationError, Realisation};

@@ -100,6 +100,8 @@ impl Simulator {
             });
         }
         let unit = |q: &[f64; 4]| (q.iter().map(|x| x * x).sum::<f64>() - 1.0).abs() < 1e-9;
+        self.history.clear();
+        self.history.push(self.state);
         for (j, s) in states.iter().enumerate() {
             let mut s = *s;
             if !s.to_array().iter().all(|x| x.is_finite()) || !unit(&s.q_it) || !unit(&s.q_ib) {
@@ -107,6 +109,7 @@ impl Simulator {
             }
             s.t = t0 + (j + 1) as f64 * h;
             at_physics_step(&self.barrier_state_of(&s));
+            self.history.push(s);
         }
         self.step += 1;
         let mut last = states[n - 1];

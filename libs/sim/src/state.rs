@@ -107,6 +107,9 @@ pub struct Simulator {
     pub(crate) p: Params,
     pub(crate) state: SimState,
     pub(crate) step: u64,
+    /// The states of the last control period at its physics steps, from its start to
+    /// its end (an old measurement for the navigation: [`Self::state_ago`]).
+    pub(crate) history: Vec<SimState>,
 }
 
 impl Simulator {
@@ -170,6 +173,7 @@ impl Simulator {
             p,
             state,
             step: 0,
+            history: Vec::new(),
         })
     }
 
@@ -181,6 +185,7 @@ impl Simulator {
     /// Replaces the state (e.g. to start from a recorded one).
     pub fn set_state(&mut self, s: SimState) {
         self.state = s;
+        self.history.clear();
     }
 
     /// Control steps taken so far.
@@ -273,18 +278,31 @@ impl Simulator {
         let mut x = self.state.pack();
         let h = self.p.physics_step;
         let t0 = self.state.t;
+        self.history.clear();
+        self.history.push(self.state);
         for j in 0..self.p.substeps {
             x = self
                 .rk4(&x, &u, h)
                 .ok_or(SimError::Diverged { t: self.state.t })?;
             let s = SimState::unpack(t0 + (j + 1) as f64 * h, &x);
             at_physics_step(&self.barrier_state_of(&s));
+            self.history.push(s);
         }
         self.step += 1;
         // time from the step count, so that it never accumulates rounding
         let period = h * self.p.substeps as f64;
         self.state = SimState::unpack(self.step as f64 * period, &x);
         Ok(())
+    }
+
+    /// The true state `k` physics steps ago (`k` ≤ the steps of a period); before the
+    /// first period, and for `k = 0`, the current state.
+    pub fn state_ago(&self, k: usize) -> SimState {
+        let n = self.history.len();
+        if k == 0 || n <= k {
+            return self.state;
+        }
+        self.history[n - 1 - k]
     }
 
     /// What the safety barriers depend on, at the current state.
