@@ -30,7 +30,7 @@ pub use nominal_source::{
 pub use record::{StepRecord, TelemetryWriter, parse_telemetry, telemetry_columns, timing_columns};
 pub use replay::ReplayNominals;
 pub use setup::{Setup, SetupError};
-pub use summary::{Summary, summarize};
+pub use summary::{Summary, UncertaintySummary, summarize};
 
 /// Names of all 51 constraints in telemetry order (translational, attitude, robotic).
 pub fn constraint_names() -> Vec<&'static str> {

@@ -7,7 +7,8 @@ use crate::stages;
 use sc_cbf::monitor::{Barriers, Monitor, min_into};
 use sc_cbf::{Actuation, ActuatorLimits, Nominals, QpDump, SafetyLayer};
 use sc_nominal::NominalControllers;
-use sc_sim::{Plant, Simulator};
+use sc_sim::{Plant, Realisation, Simulator};
+use std::sync::Arc;
 
 /// Options of a run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -97,18 +98,28 @@ pub struct Mission {
     pub nominal_override: Option<Box<dyn NominalOverride>>,
     /// Propagates the true state instead of the simulator's own RK4 ([`Self::set_plant`]).
     plant: Option<Box<dyn Plant + Send>>,
+    /// The run's realisation of the declared uncertainty: the plant the simulator
+    /// propagates, the actuators and the navigation the controllers and filters see
+    /// through. `None` for the `exact` profile (truth and knowledge are one).
+    pub realisation: Option<Realisation>,
     end: Option<MissionEnd>,
 }
 
 impl Mission {
     /// Builds a mission from a setup.
     pub fn new(setup: Setup, options: RunOptions) -> Result<Self, SetupError> {
-        let sim = Simulator::new(&setup.scenario, setup.robot.clone())
-            .map_err(|e| SetupError::Other(e.to_string()))?;
+        let realisation = draw_realisation(&setup)?;
+        // the simulator and the monitor see the truth; controllers and filters the model
+        let (truth, robot) = match &realisation {
+            Some(r) => (&r.true_scenario, Arc::new(r.true_robot.clone())),
+            None => (&setup.scenario, setup.robot.clone()),
+        };
+        let sim =
+            Simulator::new(truth, robot.clone()).map_err(|e| SetupError::Other(e.to_string()))?;
+        let monitor = Monitor::from_scenario(truth, robot);
         let nominal = NominalControllers::new(&setup.scenario, (*setup.robot).clone())
             .map_err(|e| SetupError::Other(e.to_string()))?;
         let safety = SafetyLayer::from_scenario(&setup.scenario, setup.robot.clone());
-        let monitor = Monitor::from_scenario(&setup.scenario, setup.robot.clone());
         Ok(Self {
             setup,
             sim,
@@ -119,6 +130,7 @@ impl Mission {
             between: None,
             nominal_override: None,
             plant: None,
+            realisation,
             end: None,
         })
     }
@@ -142,8 +154,16 @@ impl Mission {
     /// Computes the commands of the current step (nominal → translational → attitude →
     /// robotic filter), without advancing the simulator.
     pub fn compute(&mut self) -> StepRecord {
-        let o = self.sim.observe();
-        let barriers = self.monitor.evaluate(&o.barrier_state());
+        let truth = self.sim.observe();
+        let barriers = self.monitor.evaluate(&truth.barrier_state());
+        // what the controllers and filters know: the navigation's estimate
+        let (o, navigation_error) = match self.realisation.as_mut() {
+            Some(r) => {
+                let (estimate, error) = r.navigation.estimate(&self.sim);
+                (estimate, Some(error))
+            }
+            None => (truth, None),
+        };
         let barriers_between = self.between.unwrap_or(barriers);
         let nom = self.nominal.command(&stages::nominal_input(&o));
         let cmds = match self.nominal_override.as_mut() {
@@ -167,7 +187,8 @@ impl Mission {
             t: o.t,
             // the phase comes from the mission's own schedule, never from a controller
             phase: self.setup.scenario.phase_index(o.t),
-            obs: o,
+            obs: truth,
+            navigation_error,
             // a missing nominal is recorded as NaN
             f_h_nom: nominals.translational.unwrap_or(nan3),
             tau_b_nom: nominals.attitude.unwrap_or(nan3),
@@ -226,11 +247,16 @@ impl Mission {
         let mut between: Barriers = [f64::INFINITY; sc_cbf::monitor::N_ALL];
         let at_physics_step =
             |b: &sc_sim::BarrierState| min_into(&mut between, &monitor.evaluate(b));
+        // what the actuators deliver of the applied command
+        let delivered = match self.realisation.as_mut() {
+            Some(real) => real.actuators.deliver(&r.applied),
+            None => r.applied,
+        };
         let stepped = match self.plant.as_mut() {
             Some(p) => self
                 .sim
-                .step_with_plant(p.as_mut(), &r.applied, at_physics_step),
-            None => self.sim.step_with(&r.applied, at_physics_step),
+                .step_with_plant(p.as_mut(), &delivered, at_physics_step),
+            None => self.sim.step_with(&delivered, at_physics_step),
         };
         self.between = Some(between);
         if let Err(e) = stepped {
@@ -250,6 +276,19 @@ impl Mission {
         }
         self.end.clone().unwrap_or(MissionEnd::Timeout { t: 0.0 })
     }
+}
+
+/// The realisation of the scenario's declared uncertainty (`None` when it declares
+/// none), drawn from its seed.
+fn draw_realisation(setup: &Setup) -> Result<Option<Realisation>, SetupError> {
+    let bounds = setup.scenario.uncertainty_truth_bounds();
+    if setup.scenario.uncertainty.is_none() {
+        return Ok(None);
+    }
+    let seed = setup.scenario.uncertainty.as_ref().map_or(0, |u| u.seed);
+    Realisation::draw(&bounds, seed, &setup.scenario, &setup.robot)
+        .map(Some)
+        .map_err(|e| SetupError::Other(format!("uncertainty: {e}")))
 }
 
 /// True if phase `phase` grasps and the observation shows the end-effector on the

@@ -19,7 +19,11 @@ pub struct StepRecord {
     pub t: f64,
     /// Index of the mission phase (0-based, in the scenario's order).
     pub phase: usize,
+    /// The TRUE state's observation (the simulator's); the controllers and filters saw
+    /// the navigation's estimate, `navigation_error` away from it.
     pub obs: Observation,
+    /// The realised navigation errors of this step (`None`: the `exact` profile).
+    pub navigation_error: Option<sc_sim::NavigationError>,
     /// Nominal commands: force in F_H [N], torque in F_B [N m], joint torques [N m].
     pub f_h_nom: Vector3<f64>,
     pub tau_b_nom: Vector3<f64>,
@@ -557,6 +561,7 @@ fn read_record(c: &mut Fields, filtered: bool) -> Result<StepRecord, TelemetryEr
         t,
         phase,
         obs,
+        navigation_error: None,
         f_h_nom,
         tau_b_nom,
         tau_m_nom,

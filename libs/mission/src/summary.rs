@@ -3,6 +3,7 @@
 use crate::mission::MissionEnd;
 use crate::record::StepRecord;
 use sc_cbf::faults;
+use sc_sim::uncertainty::{NAVIGATION_ERROR_NAMES, NavigationError};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -115,6 +116,110 @@ pub struct Summary {
     pub fault_count: usize,
     /// Fault events (the first 1000).
     pub faults: Vec<FaultEvent>,
+    /// The declared uncertainty and the realised errors against it (absent for the
+    /// `exact` profile); see [`UncertaintySummary::of`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uncertainty: Option<UncertaintySummary>,
+}
+
+/// The declared uncertainty of a run and whether the realised errors stayed inside it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct UncertaintySummary {
+    pub profile: String,
+    pub seed: u64,
+    /// The largest realised navigation error of each kind over the run, and its bound.
+    pub navigation_max: BTreeMap<String, f64>,
+    pub navigation_bound: BTreeMap<String, f64>,
+    /// The keys whose realised error (plant, actuators, navigation) exceeded the
+    /// declared bound (empty: within). A simulation knows the truth; a flight system
+    /// checks only what it can measure.
+    pub outside_bounds: Vec<String>,
+}
+
+impl UncertaintySummary {
+    /// The summary of `records` under the scenario's declared uncertainty; `None` when
+    /// it declares none. The run's realisation is drawn again from its seed (it is a
+    /// function of the scenario, the robot and the seed) to compare the realised plant
+    /// and actuator errors with the declared bounds.
+    pub fn of(
+        records: &[StepRecord],
+        scenario: &sc_scenario::Scenario,
+        robot: &sc_multibody::Robot,
+    ) -> Option<Self> {
+        let spec = scenario.uncertainty.as_ref()?;
+        let declared = scenario.uncertainty_bounds();
+        let bounds = NavigationError::bounds(&declared.navigation);
+        let max = navigation_max(records);
+        let named = |v: &[f64]| -> BTreeMap<String, f64> {
+            NAVIGATION_ERROR_NAMES
+                .iter()
+                .map(|n| n.to_string())
+                .zip(v.iter().copied())
+                .collect()
+        };
+        let mut outside_bounds: Vec<String> = match sc_sim::Realisation::draw(
+            &scenario.uncertainty_truth_bounds(),
+            spec.seed,
+            scenario,
+            robot,
+        ) {
+            Ok(r) => [
+                r.plant.outside(&declared.model),
+                r.actuators.outside(&declared.actuators),
+            ]
+            .concat()
+            .into_iter()
+            .map(String::from)
+            .collect(),
+            Err(e) => vec![format!("realisation ({e})")],
+        };
+        outside_bounds.extend(
+            NAVIGATION_ERROR_NAMES
+                .iter()
+                .zip(max.iter().zip(bounds))
+                .filter(|(_, (m, b))| (**m).partial_cmp(b).is_none_or(|o| o.is_gt()))
+                .map(|(n, _)| format!("navigation.{n}")),
+        );
+        Some(Self {
+            profile: spec.profile.clone(),
+            seed: spec.seed,
+            navigation_max: named(&max),
+            navigation_bound: named(&bounds),
+            outside_bounds,
+        })
+    }
+
+    /// One line for the run's report.
+    pub fn line(&self) -> String {
+        let within = if self.outside_bounds.is_empty() {
+            "realised plant, actuator and navigation errors within the declared bounds".to_string()
+        } else {
+            format!(
+                "realised errors LEFT the declared bounds: [{}] — the promise does not cover this run",
+                self.outside_bounds.join(", ")
+            )
+        };
+        format!(
+            "uncertainty: profile {} (seed {}): {within}",
+            self.profile, self.seed
+        )
+    }
+}
+
+/// The largest realised navigation error of each kind over `records` (NaN if any was).
+fn navigation_max(records: &[StepRecord]) -> [f64; NAVIGATION_ERROR_NAMES.len()] {
+    let mut max = [0.0f64; NAVIGATION_ERROR_NAMES.len()];
+    for e in records.iter().filter_map(|r| r.navigation_error.as_ref()) {
+        for (m, v) in max.iter_mut().zip(e.values()) {
+            // a NaN error is outside every bound
+            *m = if v.is_nan() || m.is_nan() {
+                f64::NAN
+            } else {
+                m.max(v)
+            };
+        }
+    }
+    max
 }
 
 fn flag_names(bits: u32) -> Vec<String> {
@@ -356,6 +461,7 @@ impl Tally {
             joint_torque_norm_peak_nm: self.torque_peak,
             fault_count: self.fault_count,
             faults: self.fault_events,
+            uncertainty: None,
         }
     }
 }

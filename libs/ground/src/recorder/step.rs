@@ -122,6 +122,8 @@ pub fn record(
         // the mission's own schedule, as the simulator decides it
         phase: scenario.phase_index(o.t),
         obs: o,
+        // the partition refuses a scenario with uncertainty (sc_flight::admission)
+        navigation_error: None,
         // what the filter got: NaN where it ran on the substitute nominal (as in
         // process), never a message of another tick or one marked invalid
         f_h_nom: nominal_seen(held.nt.map(|m| convert::vec3(&m.f_h)), tr.report.faults),
