@@ -120,6 +120,10 @@ pub struct CampaignOptions {
     /// `out` holds another campaign (seed, runs, shard, config, base scenario, URDF or
     /// execution differ).
     pub resume: bool,
+    /// The declared uncertainty (`--uncertainty`), replacing the base scenario's
+    /// `[uncertainty]` section; every run draws its own realisation
+    /// ([`crate::run::run_scenario`]).
+    pub uncertainty: Option<sc_scenario::UncertaintySpec>,
 }
 
 /// Why a shard `i/N` was refused.
@@ -160,9 +164,15 @@ pub fn shard_runs(runs: usize, shard: Option<(usize, usize)>) -> Vec<usize> {
 }
 
 /// Loads the base scenario and checks the config against it.
-fn load_base(scenario: &Path, config: &MonteCarloConfig) -> Result<Setup, McError> {
-    let setup = Setup::load(scenario).map_err(|e| McError::Setup(e.to_string()))?;
-    config.check_against(&setup.scenario)?;
+fn load_base(opts: &CampaignOptions) -> Result<Setup, McError> {
+    let mut setup = Setup::load(&opts.scenario).map_err(|e| McError::Setup(e.to_string()))?;
+    if let Some(spec) = &opts.uncertainty {
+        let s = &mut setup.scenario;
+        s.set_uncertainty(spec.clone())
+            .and_then(|()| s.validate())
+            .map_err(|e| McError::Setup(format!("--uncertainty: {e}")))?;
+    }
+    opts.config.check_against(&setup.scenario)?;
     Ok(setup)
 }
 
@@ -438,7 +448,7 @@ pub fn run_campaign_with(
 ) -> Result<CampaignSummary, McError> {
     let started = std::time::Instant::now();
     let host_start = HostSample::now();
-    let setup = load_base(&opts.scenario, &opts.config)?;
+    let setup = load_base(opts)?;
     if opts.jobs == 0 {
         return Err(McError::Invalid(
             "--jobs 0: need at least one thread".into(),

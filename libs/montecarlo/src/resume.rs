@@ -85,7 +85,7 @@ pub(crate) fn derive_run(
 ) -> (u64, Result<(Dispersion, String), SampleError>) {
     let seed = run_seed(base.seed, k);
     let derived = sample(&base.config, &base.scenario, seed)
-        .map(|d| (d, run::run_scenario(base, &d).to_toml_string()));
+        .map(|d| (d, run::run_scenario(base, &d, seed).to_toml_string()));
     (seed, derived)
 }
 

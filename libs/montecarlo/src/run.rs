@@ -110,12 +110,28 @@ pub struct CampaignBase {
     pub urdf_name: String,
 }
 
-/// The dispersed scenario of run `k` as saved in `runs/K/scenario.toml` (URDF path
-/// relative to that directory).
-pub fn run_scenario(base: &CampaignBase, d: &Dispersion) -> Scenario {
+/// The dispersed scenario of the run with seed `seed` as saved in `runs/K/scenario.toml`
+/// (URDF path relative to that directory); a declared uncertainty gets the run's own
+/// seed ([`uncertainty_seed`]), so that every run draws its own plant and errors.
+pub fn run_scenario(base: &CampaignBase, d: &Dispersion, seed: u64) -> Scenario {
     let mut s = apply(&base.scenario, d);
     s.servicer.urdf = PathBuf::from("../..").join(&base.urdf_name);
+    if let Some(u) = s.uncertainty.as_mut() {
+        u.seed = uncertainty_seed(seed);
+    }
     s
+}
+
+/// The stream of a run's uncertainty seed, apart from its dispersion's draws.
+const UNCERTAINTY_STREAM: u64 = 1 << 32;
+
+/// The seed of the uncertainty realisation of the run with seed `run_seed`: the first
+/// word of ChaCha8 keyed by it on [`UNCERTAINTY_STREAM`].
+pub fn uncertainty_seed(run_seed: u64) -> u64 {
+    use rand_chacha::rand_core::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(run_seed);
+    rng.set_stream(UNCERTAINTY_STREAM);
+    rng.next_u64()
 }
 
 fn panic_message(p: Box<dyn std::any::Any + Send>) -> String {
@@ -249,7 +265,7 @@ fn dispersed_scenario(
 ) -> Result<Scenario, DispersionError> {
     let d = sample(&base.config, &base.scenario, result.seed)?;
     result.dispersion = Some(d);
-    let text = run_scenario(base, &d).to_toml_string();
+    let text = run_scenario(base, &d, result.seed).to_toml_string();
     std::fs::create_dir_all(run_dir)
         .and_then(|_| std::fs::write(run_dir.join("scenario.toml"), &text))
         .map_err(|error| DispersionError::Write {

@@ -57,6 +57,7 @@ fn options(scenario: PathBuf, out: PathBuf, runs: usize) -> CampaignOptions {
         inject_panic: Vec::new(),
         progress: false,
         resume: false,
+        uncertainty: None,
     }
 }
 
