@@ -48,6 +48,12 @@ pub fn preflight(
 pub fn check_scenario(cfg: &PartitionConfig) -> Result<PathBuf, ConfigError> {
     let path = cfg.scenario_path();
     match sc_scenario::Scenario::load(&path) {
+        // refused, not ignored: the partition has no navigation role yet, so its
+        // controllers and filters would act on the truth and its plant would be the model
+        Ok(s) if s.uncertainty.is_some() => err(format!(
+            "scenario = {:?} declares an `[uncertainty]` profile: the partition runs only the `exact` profile so far (the navigation role is issue #25); run it in one process with `safe-capture run`, or remove the section",
+            cfg.scenario
+        )),
         Ok(_) => Ok(path),
         Err(e @ sc_scenario::ScenarioError::Io { .. }) => err(format!(
             "scenario = {:?}: {e}; point `scenario` at a scenario file (a relative path is relative to the config's directory {})",
