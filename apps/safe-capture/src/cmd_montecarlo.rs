@@ -136,6 +136,10 @@ struct RunArgs {
     quiet: bool,
     #[command(flatten)]
     figures: crate::figure_format::FigureFormatArg,
+    /// Each run draws its own realisation of the profile, seeded from the run's seed and
+    /// saved in its scenario.toml.
+    #[command(flatten)]
+    uncertainty: crate::uncertainty_arg::UncertaintyArg,
 
     /// Test hook: make these runs panic (also SC_MONTECARLO_INJECT_PANIC=K,K,...).
     #[arg(long, value_name = "K", value_delimiter = ',', hide = true)]
@@ -354,6 +358,7 @@ fn campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
         inject_panic: inject,
         progress: !a.quiet,
         resume: a.resume,
+        uncertainty: a.uncertainty.spec_per_run()?,
     };
     let s = sc_montecarlo::run_campaign_with(&opts, executor.as_ref())?;
     a.figures.export_dir(&opts.out.join("figures"))?;

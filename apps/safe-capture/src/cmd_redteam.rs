@@ -56,6 +56,9 @@ pub struct Args {
     force: bool,
     #[command(flatten)]
     figures: crate::figure_format::FigureFormatArg,
+    /// Every case runs under one realisation of the profile (`--uncertainty-seed`).
+    #[command(flatten)]
+    uncertainty: crate::uncertainty_arg::UncertaintyArg,
     /// Random strategies per target (`random:1` … `random:N`).
     #[arg(long, value_name = "N", default_value_t = 5)]
     seeds: u64,
@@ -280,7 +283,13 @@ fn verdict_line(a: &Args, s: &report::CampaignSummary, wall: f64) {
 }
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
-    let setup = Setup::load(&a.scenario)?;
+    let mut setup = Setup::load(&a.scenario)?;
+    a.uncertainty.apply(&mut setup.scenario)?;
+    if a.partition && !setup.scenario.uncertainty_bounds().is_exact() {
+        anyhow::bail!(
+            "--partition: the partition runs only the `exact` uncertainty profile (no navigation role yet); drop --partition to run the cases in process"
+        );
+    }
     let cases = selected(&a, run_ticks(&a, &setup))?;
     if a.list {
         for c in &cases {

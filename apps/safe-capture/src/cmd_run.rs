@@ -49,6 +49,8 @@ pub struct Args {
     no_figures: bool,
     #[command(flatten)]
     figures: crate::figure_format::FigureFormatArg,
+    #[command(flatten)]
+    uncertainty: crate::uncertainty_arg::UncertaintyArg,
     /// Replace nominal controllers by a red-team adversary, `<target>/<strategy>`
     /// (`safe-capture redteam --list` lists them), e.g. `all/random:3` or
     /// `robotic/toward:theta_dot_max_7`.
@@ -237,12 +239,14 @@ fn what_ran(a: &Args) -> String {
 }
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
-    let setup = Setup::load(&a.scenario)?;
+    let mut setup = Setup::load(&a.scenario)?;
+    a.uncertainty.apply(&mut setup.scenario)?;
     let options = RunOptions {
         no_filter: a.no_filter,
     };
     let started = std::time::Instant::now();
     let scenario = setup.scenario.clone();
+    let robot = setup.robot.clone();
     let compare_setup = setup.clone();
     let nominals = Nominals::from_args(&a)?;
     let source = nominals.source(&setup);
@@ -264,7 +268,8 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         dump_qp: a.dump_qp.as_deref(),
         quiet: a.quiet,
     })?;
-    let summary = summarize(&records, &end, &phase_names(&scenario), !a.no_filter);
+    let mut summary = summarize(&records, &end, &phase_names(&scenario), !a.no_filter);
+    summary.uncertainty = sc_mission::UncertaintySummary::of(&records, &scenario, &robot);
     write_summary(&out.join("summary.json"), &summary)?;
     if !a.no_figures {
         let alone = a.no_filter || a.no_compare || a.basilisk;
@@ -272,7 +277,14 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         a.figures.export_dir(&out.join("figures"))?;
     }
     staged.commit()?;
-    let safe = summary.violated_constraints.is_empty() && summary.fault_count == 0;
+    let within = summary
+        .uncertainty
+        .as_ref()
+        .is_none_or(|u| u.outside_bounds.is_empty());
+    let safe = summary.violated_constraints.is_empty() && summary.fault_count == 0 && within;
+    if let Some(u) = &summary.uncertainty {
+        outln!("{}", u.line());
+    }
     outln!(
         "{}: {} at t = {:.1} s; min margin {} = {:.3e}; violated: [{}]; faults: {}; total solve time geomean {:.1} us, max {:.1} us; wall {:.2} s -> {}",
         what_ran(&a),

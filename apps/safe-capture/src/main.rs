@@ -26,6 +26,7 @@ mod home;
 mod out_folder;
 // the hostile partner processes of `redteam --partition` and `launch --hostile`
 mod redteam_partition;
+mod uncertainty_arg;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;

@@ -1,0 +1,148 @@
+//! The declared uncertainty as a user meets it (docs/UNCERTAINTY.md): `exact` changes
+//! nothing, a realisation is reproducible from its seed, a truth drawn outside the
+//! declared bounds is said and fails the run, and the partition refuses what it cannot
+//! run yet.
+
+use std::path::Path;
+use std::process::Output;
+
+mod common;
+use common::{cli, root, short_scenario, text, tmp};
+
+/// Seconds simulated per run: long enough for every subsystem to act.
+const DURATION_S: f64 = 8.0;
+
+fn run(scenario: &Path, out: &Path, extra: &[&str]) -> Output {
+    let (s, o) = (scenario.to_str().unwrap(), out.to_str().unwrap());
+    let mut args = vec![
+        "run",
+        "--quiet",
+        "--no-compare",
+        "--no-figures",
+        "--scenario",
+        s,
+        "--out",
+        o,
+    ];
+    args.extend_from_slice(extra);
+    cli(&args, &[])
+}
+
+fn telemetry(out: &Path) -> Vec<u8> {
+    std::fs::read(out.join("telemetry.csv")).unwrap()
+}
+
+#[test]
+fn the_exact_profile_is_the_run_without_a_profile() {
+    let d = tmp("unc-exact");
+    let s = short_scenario(&d.0, DURATION_S);
+    let plain = run(&s, &d.0.join("plain"), &[]);
+    let exact = run(&s, &d.0.join("exact"), &["--uncertainty", "exact"]);
+    assert_eq!(plain.status.code(), exact.status.code(), "{}", text(&exact));
+    assert!(
+        telemetry(&d.0.join("plain")) == telemetry(&d.0.join("exact")),
+        "telemetry differs under `exact`"
+    );
+}
+
+#[test]
+fn a_realisation_is_reproducible_from_its_seed_and_said_within_bounds() {
+    let d = tmp("unc-seed");
+    // the whole default mission: a safe capture exits 0
+    let s = root().join("config/scenario.toml");
+    let args = ["--uncertainty", "realistic", "--uncertainty-seed", "3"];
+    let a = run(&s, &d.0.join("a"), &args);
+    let b = run(&s, &d.0.join("b"), &args);
+    assert_eq!(a.status.code(), Some(0), "{}", text(&a));
+    let c = run(
+        &s,
+        &d.0.join("c"),
+        &["--uncertainty", "realistic", "--uncertainty-seed", "4"],
+    );
+    let out = text(&a);
+    assert!(
+        out.contains("uncertainty: profile realistic (seed 3): realised plant, actuator and navigation errors within the declared bounds"),
+        "{out}"
+    );
+    assert_eq!(b.status.code(), a.status.code(), "{}", text(&b));
+    assert_ne!(c.status.code(), Some(2), "{}", text(&c));
+    assert!(
+        telemetry(&d.0.join("a")) == telemetry(&d.0.join("b")),
+        "same seed, other run"
+    );
+    assert!(
+        telemetry(&d.0.join("a")) != telemetry(&d.0.join("c")),
+        "the seed changes nothing"
+    );
+    let exact = run(&s, &d.0.join("e"), &[]);
+    assert_eq!(exact.status.code(), Some(0), "{}", text(&exact));
+    assert!(
+        telemetry(&d.0.join("a")) != telemetry(&d.0.join("e")),
+        "`realistic` ran the exact truth"
+    );
+}
+
+#[test]
+fn a_truth_outside_the_declared_bounds_is_said_and_fails_the_run() {
+    let d = tmp("unc-truth");
+    // the whole default mission (it captures under `realistic`): exit 1 is the verdict on
+    // the bounds, not a timeout
+    let s = root().join("config/scenario.toml");
+    let o = run(
+        &s,
+        &d.0.join("o"),
+        &["--uncertainty", "exact", "--uncertainty-truth", "realistic"],
+    );
+    let out = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{out}");
+    assert!(out.contains("LEFT the declared bounds"), "{out}");
+    assert!(out.contains("model.servicer_mass_rel"), "{out}");
+}
+
+#[test]
+fn a_campaign_refuses_one_seed_for_all_its_runs() {
+    let o = cli(
+        &[
+            "montecarlo",
+            "--runs",
+            "2",
+            "--uncertainty",
+            "realistic",
+            "--uncertainty-seed",
+            "3",
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("--uncertainty-seed"), "{}", text(&o));
+}
+
+#[test]
+fn the_partition_refuses_a_profile_it_cannot_run_yet() {
+    let d = tmp("unc-partition");
+    let s = short_scenario(&d.0, DURATION_S);
+    let mut text_s = std::fs::read_to_string(&s).unwrap();
+    text_s.push_str("\n[uncertainty]\nprofile = \"realistic\"\n");
+    std::fs::write(&s, text_s).unwrap();
+    let cfg = std::fs::read_to_string(root().join("config/partition.toml")).unwrap();
+    let cfg = cfg.replacen(
+        "scenario = \"scenario.toml\"",
+        &format!("scenario = {:?}", s.display().to_string()),
+        1,
+    );
+    assert!(cfg.contains(&s.display().to_string()), "no scenario line");
+    let p = d.0.join("partition.toml");
+    std::fs::write(&p, cfg).unwrap();
+    let o = cli(
+        &[
+            "launch",
+            "--config",
+            p.to_str().unwrap(),
+            "--out",
+            d.0.join("o").to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("`[uncertainty]`"), "{}", text(&o));
+}
