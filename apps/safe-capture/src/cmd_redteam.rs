@@ -285,7 +285,7 @@ fn verdict_line(a: &Args, s: &report::CampaignSummary, wall: f64) {
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let mut setup = Setup::load(&a.scenario)?;
     a.uncertainty.apply(&mut setup.scenario)?;
-    if a.partition && !setup.scenario.uncertainty_bounds().is_exact() {
+    if a.partition && setup.scenario.uncertainty.is_some() {
         anyhow::bail!(
             "--partition: the partition runs only the `exact` uncertainty profile (no navigation role yet); drop --partition to run the cases in process"
         );

@@ -146,3 +146,25 @@ fn the_partition_refuses_a_profile_it_cannot_run_yet() {
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(text(&o).contains("`[uncertainty]`"), "{}", text(&o));
 }
+
+#[test]
+fn a_partition_campaign_with_a_profile_is_refused_before_any_run() {
+    let d = tmp("unc-mc-partition");
+    let o = cli(
+        &[
+            "montecarlo",
+            "--runs",
+            "2",
+            "--mode",
+            "partition",
+            "--uncertainty",
+            "realistic",
+            "--out",
+            d.0.join("o").to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("--mode partition"), "{}", text(&o));
+    assert!(!d.0.join("o").exists(), "a run was started");
+}
