@@ -15,7 +15,10 @@ use std::process::ExitCode;
 /// Writes to OUT: telemetry.csv (deterministic, one row per control step: time, phase,
 /// states, nominal and safe commands, every barrier value h, filter status and faults),
 /// timing.csv (filter solve times), summary.json (captured, capture_time_s, constraints,
-/// interventions, solve_time_us, faults), and the figures into OUT/figures (SVG): approach
+/// interventions, solve_time_us, faults; with --uncertainty whether the realised errors
+/// stayed within the declared bounds), navigation.csv (with a declared uncertainty only:
+/// the realised navigation errors and every barrier on knowledge, `hk_*`, beside the
+/// truth's `h_*` in telemetry.csv), and the figures into OUT/figures (SVG): approach
 /// trajectory with corridor and sphere, every barrier over time, range rate, sync error,
 /// joint torques, line of sight. The figures compare with a nominal-only run (dashed),
 /// which is run too and written to OUT/nominal (skip with --no-compare).
@@ -215,6 +218,21 @@ fn phase_names(scenario: &sc_scenario::Scenario) -> Vec<String> {
 }
 
 /// Writes `summary` as `path` (pretty JSON).
+/// `navigation.csv` — the realised navigation errors and every barrier on knowledge —
+/// when the run had knowledge apart from the truth (a declared uncertainty).
+fn write_knowledge(path: &Path, records: &[StepRecord]) -> anyhow::Result<()> {
+    if records.iter().all(|r| r.navigation_error.is_none()) {
+        return Ok(());
+    }
+    let mut f = create(path)?;
+    writeln!(f, "{}", sc_mission::knowledge_columns().join(","))?;
+    for line in records.iter().filter_map(sc_mission::knowledge_line) {
+        writeln!(f, "{line}")?;
+    }
+    f.flush()?;
+    Ok(())
+}
+
 fn write_summary(path: &Path, summary: &sc_mission::Summary) -> anyhow::Result<()> {
     std::fs::write(path, serde_json::to_string_pretty(summary)? + "\n")
         .with_context(|| format!("cannot write {}", path.display()))
@@ -268,6 +286,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         dump_qp: a.dump_qp.as_deref(),
         quiet: a.quiet,
     })?;
+    write_knowledge(&out.join("navigation.csv"), &records)?;
     let mut summary = summarize(&records, &end, &phase_names(&scenario), !a.no_filter);
     summary.uncertainty = sc_mission::UncertaintySummary::of(&records, &scenario, &robot);
     write_summary(&out.join("summary.json"), &summary)?;

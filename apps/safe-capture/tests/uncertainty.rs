@@ -168,3 +168,55 @@ fn a_partition_campaign_with_a_profile_is_refused_before_any_run() {
     assert!(text(&o).contains("--mode partition"), "{}", text(&o));
     assert!(!d.0.join("o").exists(), "a run was started");
 }
+
+/// Both sides: the truth's barriers in telemetry.csv, knowledge's and the realised
+/// navigation errors in navigation.csv — each error within its declared bound.
+#[test]
+fn the_realised_errors_and_the_barriers_on_knowledge_are_recorded() {
+    let d = tmp("unc-knowledge");
+    let s = short_scenario(&d.0, DURATION_S);
+    let o = run(
+        &s,
+        &d.0.join("o"),
+        &["--uncertainty", "realistic", "--uncertainty-seed", "5"],
+    );
+    assert_ne!(o.status.code(), Some(2), "{}", text(&o));
+    let nav = std::fs::read_to_string(d.0.join("o/navigation.csv")).unwrap();
+    let tel = std::fs::read_to_string(d.0.join("o/telemetry.csv")).unwrap();
+    let mut lines = nav.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(
+        rows.len(),
+        tel.lines().count() - 1,
+        "a row per control step"
+    );
+    // realistic: bias + noise per quantity (docs/UNCERTAINTY.md)
+    let bound = |name: &str| match name {
+        "nav_err_relative_position_m" => 0.02,
+        "nav_err_target_attitude_rad" => 0.01,
+        "nav_err_joint_rate_rad_s" => 2e-4,
+        _ => f64::INFINITY,
+    };
+    let mut seen_error = false;
+    for (j, name) in header.iter().enumerate() {
+        for r in &rows {
+            assert!(r[j].is_finite(), "{name}");
+            if name.starts_with("nav_err_") {
+                assert!(r[j] <= bound(name) * (1.0 + 1e-12), "{name} = {}", r[j]);
+                seen_error |= r[j] > 0.0;
+            }
+        }
+    }
+    assert!(seen_error, "no navigation error realised");
+    assert!(
+        header.iter().any(|h| *h == "hk_line_of_sight"),
+        "{header:?}"
+    );
+    // the exact profile writes none
+    let e = run(&s, &d.0.join("e"), &[]);
+    assert_ne!(e.status.code(), Some(2), "{}", text(&e));
+    assert!(!d.0.join("e/navigation.csv").exists());
+}

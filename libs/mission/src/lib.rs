@@ -27,7 +27,10 @@ pub use mission::{Mission, MissionEnd, RunOptions, all_hold, capture_check, time
 pub use nominal_source::{
     NominalCommand, NominalCommands, NominalOverride, NominalSource, PartnerProcess,
 };
-pub use record::{StepRecord, TelemetryWriter, parse_telemetry, telemetry_columns, timing_columns};
+pub use record::{
+    StepRecord, TelemetryWriter, knowledge_columns, knowledge_line, parse_telemetry,
+    telemetry_columns, timing_columns,
+};
 pub use replay::ReplayNominals;
 pub use setup::{Setup, SetupError};
 pub use summary::{Summary, UncertaintySummary, summarize};

@@ -102,6 +102,8 @@ pub struct Mission {
     /// propagates, the actuators and the navigation the controllers and filters see
     /// through. `None` for the `exact` profile (truth and knowledge are one).
     pub realisation: Option<Realisation>,
+    /// The barriers on knowledge (the declared model), with a realisation only.
+    knowledge_monitor: Option<Monitor>,
     end: Option<MissionEnd>,
 }
 
@@ -120,6 +122,9 @@ impl Mission {
         let nominal = NominalControllers::new(&setup.scenario, (*setup.robot).clone())
             .map_err(|e| SetupError::Other(e.to_string()))?;
         let safety = SafetyLayer::from_scenario(&setup.scenario, setup.robot.clone());
+        let knowledge_monitor = realisation
+            .is_some()
+            .then(|| Monitor::from_scenario(&setup.scenario, setup.robot.clone()));
         Ok(Self {
             setup,
             sim,
@@ -131,6 +136,7 @@ impl Mission {
             nominal_override: None,
             plant: None,
             realisation,
+            knowledge_monitor,
             end: None,
         })
     }
@@ -164,6 +170,10 @@ impl Mission {
             }
             None => (truth, None),
         };
+        let knowledge_barriers = self
+            .knowledge_monitor
+            .as_ref()
+            .map(|m| m.evaluate(&o.barrier_state()));
         let barriers_between = self.between.unwrap_or(barriers);
         let nom = self.nominal.command(&stages::nominal_input(&o));
         let cmds = match self.nominal_override.as_mut() {
@@ -189,6 +199,7 @@ impl Mission {
             phase: self.setup.scenario.phase_index(o.t),
             obs: truth,
             navigation_error,
+            knowledge_barriers,
             // a missing nominal is recorded as NaN
             f_h_nom: nominals.translational.unwrap_or(nan3),
             tau_b_nom: nominals.attitude.unwrap_or(nan3),

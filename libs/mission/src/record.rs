@@ -24,6 +24,10 @@ pub struct StepRecord {
     pub obs: Observation,
     /// The realised navigation errors of this step (`None`: the `exact` profile).
     pub navigation_error: Option<sc_sim::NavigationError>,
+    /// Every barrier on knowledge — the navigation's estimate with the declared model,
+    /// what the filters act on — in [`crate::constraint_names`] order (`None`: the
+    /// `exact` profile, where knowledge is the truth).
+    pub knowledge_barriers: Option<Barriers>,
     /// Nominal commands: force in F_H [N], torque in F_B [N m], joint torques [N m].
     pub f_h_nom: Vector3<f64>,
     pub tau_b_nom: Vector3<f64>,
@@ -155,6 +159,30 @@ pub fn timing_columns() -> Vec<String> {
     .iter()
     .map(|s| s.to_string())
     .collect()
+}
+
+/// Columns of `navigation.csv` (written when the scenario declares an uncertainty):
+/// the realised navigation errors of each control step (`nav_err_*`, each against the
+/// truth at the measurement's time, docs/UNCERTAINTY.md) and every barrier on knowledge
+/// (`hk_*`: the estimate with the declared model — what the filters saw; `h_*` in
+/// `telemetry.csv` is the truth's).
+pub fn knowledge_columns() -> Vec<String> {
+    let mut c: Vec<String> = vec!["step".into(), "t_s".into()];
+    c.extend(
+        sc_sim::uncertainty::NAVIGATION_ERROR_NAMES
+            .iter()
+            .map(|n| format!("nav_err_{n}")),
+    );
+    c.extend(crate::constraint_names().iter().map(|n| format!("hk_{n}")));
+    c
+}
+
+/// One record as a `navigation.csv` line, if it has knowledge apart from the truth.
+pub fn knowledge_line(r: &StepRecord) -> Option<String> {
+    let (e, h) = (r.navigation_error?, r.knowledge_barriers?);
+    let mut v: Vec<String> = vec![r.step.to_string(), r.t.to_string()];
+    v.extend(e.values().iter().chain(h.iter()).map(|x| x.to_string()));
+    Some(v.join(","))
 }
 
 /// Formats one record as a `telemetry.csv` line (without newline).
@@ -562,6 +590,7 @@ fn read_record(c: &mut Fields, filtered: bool) -> Result<StepRecord, TelemetryEr
         phase,
         obs,
         navigation_error: None,
+        knowledge_barriers: None,
         f_h_nom,
         tau_b_nom,
         tau_m_nom,

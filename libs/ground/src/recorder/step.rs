@@ -124,6 +124,7 @@ pub fn record(
         obs: o,
         // the partition refuses a scenario with uncertainty (sc_flight::admission)
         navigation_error: None,
+        knowledge_barriers: None,
         // what the filter got: NaN where it ran on the substitute nominal (as in
         // process), never a message of another tick or one marked invalid
         f_h_nom: nominal_seen(held.nt.map(|m| convert::vec3(&m.f_h)), tr.report.faults),
