@@ -396,12 +396,16 @@ fn report(s: &CampaignSummary, out: &std::path::Path) -> ExitCode {
         .min_by(|a, b| a.1.total_cmp(&b.1));
     let t = s.solve_time_us.get("total").copied().unwrap_or_default();
     outln!(
-        "montecarlo: {} runs{} (seed {}): {} safe, {} captured, {} failed; worst margin {}; total solve time geomean {:.1} us, max {:.1} us; wall {:.1} s -> {}",
+        "montecarlo: {} runs{} (seed {}{}): {} safe, {} captured, {} failed; worst margin {}; total solve time geomean {:.1} us, max {:.1} us; wall {:.1} s -> {}",
         s.runs,
         s.shard
             .map(|[i, n]| format!(" of shard {i}/{n}"))
             .unwrap_or_default(),
         s.seed,
+        s.uncertainty
+            .as_ref()
+            .map(|u| format!(", uncertainty {u}: safe on the simulated truth"))
+            .unwrap_or_default(),
         s.safe_runs,
         s.captured_runs,
         s.failed_runs,

@@ -217,3 +217,44 @@ fn the_realised_errors_and_the_barriers_on_knowledge_are_recorded() {
     assert_ne!(e.status.code(), Some(2), "{}", text(&e));
     assert!(!d.0.join("e/navigation.csv").exists());
 }
+
+/// A campaign under a profile says so — on its last line, in report.md and in
+/// summary.json — and every run's realisation is saved to be rerun.
+#[test]
+fn a_campaign_under_a_profile_says_so() {
+    let d = tmp("unc-mc");
+    let out = d.0.join("o");
+    let o = cli(
+        &[
+            "montecarlo",
+            "--runs",
+            "3",
+            "--uncertainty",
+            "realistic",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_ne!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(
+        text(&o).contains("(seed 1, uncertainty realistic: safe on the simulated truth)"),
+        "{}",
+        text(&o)
+    );
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        report.contains("Declared uncertainty: profile `realistic`"),
+        "{report}"
+    );
+    let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    assert!(
+        summary.contains("\"uncertainty\": \"realistic\""),
+        "{summary}"
+    );
+    let run = std::fs::read_to_string(out.join("runs/0/scenario.toml")).unwrap();
+    assert!(
+        run.contains("[uncertainty]") && run.contains("profile = \"realistic\""),
+        "{run}"
+    );
+}

@@ -128,6 +128,10 @@ pub struct CampaignSummary {
     /// Present when the campaign stopped early (Ctrl-C): completed of planned runs.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub interrupted: Option<Interruption>,
+    /// The declared uncertainty profile of the runs (absent: `exact`): "safe" is then
+    /// on the simulated truth, with the plant and the estimate drawn from it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uncertainty: Option<String>,
 }
 
 /// What a summary records beside the runs: the wall time and host load of the sessions
@@ -393,6 +397,7 @@ fn empty_summary(info: &CampaignInfo, sessions: &Sessions, runs: usize) -> Campa
             completed_runs: runs,
             planned_runs: planned,
         }),
+        uncertainty: info.uncertainty.clone(),
     }
 }
 

@@ -98,6 +98,10 @@ pub struct CampaignInfo {
     /// refuse to mix runs of different builds. Absent in campaigns of earlier versions.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub build: Option<sc_mission::build::BuildInfo>,
+    /// The declared uncertainty profile every run drew its realisation from
+    /// (docs/UNCERTAINTY.md; absent: `exact`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uncertainty: Option<String>,
 }
 
 /// How a campaign is run.
@@ -313,6 +317,11 @@ fn info_of(opts: &CampaignOptions, setup: &Setup, executor: &dyn Executor) -> Ca
         config: opts.config.clone(),
         execution: executor.execution(),
         build: Some(sc_mission::build::current()),
+        uncertainty: setup
+            .scenario
+            .uncertainty
+            .as_ref()
+            .map(|u| u.profile.clone()),
     }
 }
 

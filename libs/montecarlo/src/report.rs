@@ -71,6 +71,12 @@ fn header(o: &mut String, s: &CampaignSummary, execution: sc_mission::Execution)
         "{} runs (campaign of {}{shard}, seed {}), wall time {:.1} s.\n",
         s.runs, s.campaign_runs, s.seed, s.wall_time_s
     );
+    if let Some(u) = &s.uncertainty {
+        let _ = writeln!(
+            o,
+            "Declared uncertainty: profile `{u}` (docs/UNCERTAINTY.md). Each run's plant, actuators and navigation errors were drawn from its run seed; \"safe\" is every barrier ≥ 0 on the simulated truth.\n"
+        );
+    }
     if let Some(i) = &s.interrupted {
         let _ = writeln!(
             o,
