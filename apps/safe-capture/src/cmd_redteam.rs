@@ -245,6 +245,29 @@ fn how(a: &Args) -> &'static str {
     }
 }
 
+/// The declared uncertainty the cases ran under, as ` (uncertainty P, seed N)`, or
+/// nothing under `exact`.
+fn under(scenario: &sc_scenario::Scenario) -> String {
+    scenario
+        .uncertainty
+        .as_ref()
+        .map(|u| format!(" (uncertainty {}, seed {})", u.profile, u.seed))
+        .unwrap_or_default()
+}
+
+/// The report's paragraph on how the cases ran, with the declared uncertainty if any.
+fn how_with_uncertainty(a: &Args, scenario: &sc_scenario::Scenario) -> String {
+    match &scenario.uncertainty {
+        None => how(a).to_string(),
+        Some(u) => format!(
+            "{} Every case ran under the declared uncertainty profile `{}` (seed {}, docs/UNCERTAINTY.md): the simulator propagates a plant, actuators and navigation errors drawn from it while the controllers and filters act on the declared model and the navigation's estimate; \"safe\" is on the simulated truth.",
+            how(a),
+            u.profile,
+            u.seed
+        ),
+    }
+}
+
 /// `" (<items>)"`-like text of a list, or nothing when it is empty.
 fn listed(items: &[String], before: &str, sep: &str, after: &str) -> String {
     if items.is_empty() {
@@ -255,9 +278,9 @@ fn listed(items: &[String], before: &str, sep: &str, after: &str) -> String {
 }
 
 /// The final line.
-fn verdict_line(a: &Args, s: &report::CampaignSummary, wall: f64) {
+fn verdict_line(a: &Args, s: &report::CampaignSummary, wall: f64, under: &str) {
     outln!(
-        "redteam{}: {} of {} cases safe{}{}; non-finite applied {}, out-of-bound applied {}; bystanders disturbed in {} cases{}; solve time geomean (worst case) {:.1} us, max {:.0} us; wall {:.1} s -> {}",
+        "redteam{}{under}: {} of {} cases safe{}{}; non-finite applied {}, out-of-bound applied {}; bystanders disturbed in {} cases{}; solve time geomean (worst case) {:.1} us, max {:.0} us; wall {:.1} s -> {}",
         match (a.partition, a.real_time) {
             (true, true) => " (partition, real time)",
             (true, false) => " (partition)",
@@ -328,7 +351,14 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     };
     let results = run_cases(&a, &campaign, &cases);
     let wall = started.elapsed().as_secs_f64();
-    let s = report::write(&out, &setup, how(&a), &cases, &results, wall)?;
+    let s = report::write(
+        &out,
+        &setup,
+        &how_with_uncertainty(&a, &setup.scenario),
+        &cases,
+        &results,
+        wall,
+    )?;
     a.figures.export_dir(&out.join("figures"))?;
     staged.commit()?;
     for (c, r) in cases.iter().zip(&results) {
@@ -336,7 +366,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             errln!("redteam: {}: {e}", c.name());
         }
     }
-    verdict_line(&a, &s, wall);
+    verdict_line(&a, &s, wall, &under(&setup.scenario));
     Ok(
         if s.safe == s.cases && s.errors.is_empty() && s.bystanders_disturbed.is_empty() {
             ExitCode::SUCCESS

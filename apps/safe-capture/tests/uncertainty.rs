@@ -258,3 +258,35 @@ fn a_campaign_under_a_profile_says_so() {
         "{run}"
     );
 }
+
+/// A red team under a profile says so on its last line and in its report.
+#[test]
+fn a_red_team_under_a_profile_says_so() {
+    let d = tmp("unc-rt");
+    let out = d.0.join("o");
+    let o = cli(
+        &[
+            "redteam",
+            "--uncertainty",
+            "realistic",
+            "--uncertainty-seed",
+            "1",
+            "--cases",
+            "robotic/frozen",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_ne!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(
+        text(&o).contains("redteam (uncertainty realistic, seed 1): "),
+        "{}",
+        text(&o)
+    );
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        report.contains("declared uncertainty profile `realistic` (seed 1"),
+        "{report}"
+    );
+}
