@@ -290,3 +290,84 @@ fn a_red_team_under_a_profile_says_so() {
         "{report}"
     );
 }
+
+/// Errors at the edge of their bounds are not reported as outside them: noise only (no
+/// bias), and a measurement one whole control period old.
+#[test]
+fn errors_at_the_edge_of_their_bounds_are_within_them() {
+    let d = tmp("unc-edge");
+    let text_p = std::fs::read_to_string(root().join("config/uncertainty/realistic.toml")).unwrap();
+    let mut edge = String::new();
+    for line in text_p.lines() {
+        let l = if line.contains("{ bias =") {
+            let (key, rest) = line.split_once('=').unwrap();
+            let noise = rest
+                .split("noise =")
+                .nth(1)
+                .unwrap()
+                .trim_matches([' ', '}']);
+            format!("{key}= {{ bias = 0.0, noise = {noise} }}")
+        } else if line.starts_with("measurement_age_s") {
+            "measurement_age_s = 0.1".to_string()
+        } else {
+            line.to_string()
+        };
+        edge.push_str(&l);
+        edge.push('\n');
+    }
+    assert!(
+        edge.contains("joint_angle_rad = { bias = 0.0, noise = 1e-4 }"),
+        "{edge}"
+    );
+    let p = d.0.join("edge.toml");
+    std::fs::write(&p, edge).unwrap();
+    let s = root().join("config/scenario.toml");
+    for seed in ["1", "2"] {
+        let o = run(
+            &s,
+            &d.0.join(seed),
+            &[
+                "--uncertainty",
+                p.to_str().unwrap(),
+                "--uncertainty-seed",
+                seed,
+            ],
+        );
+        assert!(
+            text(&o).contains("errors within the declared bounds"),
+            "{}",
+            text(&o)
+        );
+    }
+}
+
+#[test]
+fn campaigns_and_basilisk_refuse_what_they_cannot_check() {
+    for args in [
+        &[
+            "montecarlo",
+            "--runs",
+            "1",
+            "--uncertainty",
+            "exact",
+            "--uncertainty-truth",
+            "realistic",
+        ][..],
+        &[
+            "redteam",
+            "--cases",
+            "robotic/frozen",
+            "--uncertainty",
+            "exact",
+            "--uncertainty-truth",
+            "realistic",
+        ][..],
+    ] {
+        let o = cli(args, &[]);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", text(&o));
+        assert!(text(&o).contains("--uncertainty-truth"), "{}", text(&o));
+    }
+    let o = cli(&["run", "--basilisk", "--uncertainty", "realistic"], &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("--basilisk"), "{}", text(&o));
+}

@@ -177,7 +177,11 @@ impl UncertaintySummary {
             NAVIGATION_ERROR_NAMES
                 .iter()
                 .zip(max.iter().zip(bounds))
-                .filter(|(_, (m, b))| (**m).partial_cmp(b).is_none_or(|o| o.is_gt()))
+                .filter(|(_, (m, b))| {
+                    let allowed =
+                        *b * (1.0 + 1e-9) + sc_sim::uncertainty::NAVIGATION_ERROR_ROUNDING;
+                    (**m).partial_cmp(&allowed).is_none_or(|o| o.is_gt())
+                })
                 .map(|(n, _)| format!("navigation.{n}")),
         );
         Some(Self {

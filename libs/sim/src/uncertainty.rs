@@ -72,12 +72,20 @@ fn truncated(rng: &mut ChaCha8Rng, bound: f64) -> Vector3<f64> {
     v * (bound / v.norm())
 }
 
-/// The scalar version of [`truncated`].
+/// The scalar version of [`truncated`]: redrawn outside the bound (a clamp would put
+/// 0.27 % of the draws exactly on it), projected only after the last redraw.
 fn truncated1(rng: &mut ChaCha8Rng, bound: f64) -> f64 {
+    const REDRAWS: usize = 8;
     if bound == 0.0 {
         return 0.0;
     }
-    let x = normal(rng) * bound / 3.0;
+    let mut x = 0.0;
+    for _ in 0..REDRAWS {
+        x = normal(rng) * bound / 3.0;
+        if x.abs() <= bound {
+            return x;
+        }
+    }
     x.clamp(-bound, bound)
 }
 
@@ -291,6 +299,16 @@ pub struct NavigationError {
     pub measurement_age_s: f64,
 }
 
+/// Relative rounding allowed when a measurement age is turned into physics steps.
+const AGE_ROUNDING: f64 = 1e-9;
+
+/// How far a realised navigation error may exceed its bound before it counts as
+/// outside it, in the quantity's own unit: the error is recomputed as the difference of
+/// the estimate and the truth, whose rounding (a few ulps of the state, ≲ 1e-14 here) a
+/// bound at the edge would otherwise cross; and the age is whole physics steps, equal
+/// to the declared age up to [`AGE_ROUNDING`].
+pub const NAVIGATION_ERROR_ROUNDING: f64 = 1e-12;
+
 /// Names of [`NavigationError`]'s fields, in order (telemetry columns, summaries).
 pub const NAVIGATION_ERROR_NAMES: [&str; 10] = [
     "relative_position_m",
@@ -414,8 +432,11 @@ impl Navigation {
     }
 
     /// The measurement's age in whole physics steps of `truth` (at most one period).
+    /// (`0.03 / 0.01` is 2.9999999999999996 in floating point: the quotient is rounded
+    /// up by [`AGE_ROUNDING`] before it is floored.)
     fn age_steps(&self, truth: &Simulator) -> usize {
-        let steps = (self.bounds.measurement_age_s / truth.p.physics_step).floor();
+        let q = self.bounds.measurement_age_s / truth.p.physics_step;
+        let steps = (q * (1.0 + AGE_ROUNDING)).floor();
         (steps as usize).min(truth.p.substeps)
     }
 
@@ -447,7 +468,8 @@ impl Navigation {
         self.knower.step = truth.step;
         // the declared errors are those of the measurement at its time; its age is
         // reported apart (the motion over the age is the margins' to cover)
-        let age_s = truth.state.t - measured.t;
+        // whole physics steps (a difference of two times would add its rounding)
+        let age_s = age as f64 * truth.p.physics_step;
         let error = error_of(&est, &measured, &grasp, age_s);
         (self.knower.observe(), error)
     }
