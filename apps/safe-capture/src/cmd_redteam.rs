@@ -307,6 +307,7 @@ fn verdict_line(a: &Args, s: &report::CampaignSummary, wall: f64, under: &str) {
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let mut setup = Setup::load(&a.scenario)?;
+    a.uncertainty.refuse_truth("redteam")?;
     a.uncertainty.apply(&mut setup.scenario)?;
     if a.partition && setup.scenario.uncertainty.is_some() {
         anyhow::bail!(

@@ -259,6 +259,12 @@ fn what_ran(a: &Args) -> String {
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let mut setup = Setup::load(&a.scenario)?;
     a.uncertainty.apply(&mut setup.scenario)?;
+    if a.basilisk && setup.scenario.uncertainty.is_some() {
+        // Basilisk propagates the scenario file's model, not the drawn plant
+        anyhow::bail!(
+            "--basilisk: the Basilisk plant runs the declared model only; a declared uncertainty (--uncertainty or the scenario's [uncertainty]) runs with the built-in simulator"
+        );
+    }
     let options = RunOptions {
         no_filter: a.no_filter,
     };

@@ -68,12 +68,25 @@ impl UncertaintyArg {
     /// The chosen profile for a campaign whose runs draw their own seeds: an explicit
     /// `--uncertainty-seed` is refused rather than ignored.
     pub fn spec_per_run(&self) -> anyhow::Result<Option<UncertaintySpec>> {
+        self.refuse_truth("montecarlo")?;
         if self.uncertainty_seed.is_some() {
             anyhow::bail!(
                 "--uncertainty-seed: every run draws its own realisation from its run seed; change the campaign's --seed instead"
             );
         }
         self.spec(0)
+    }
+
+    /// `--uncertainty-truth` is for one run, whose summary checks the realised errors
+    /// against the declared bounds; a campaign (`cmd`) does not check them per run, so it
+    /// refuses the flag rather than report such runs as covered.
+    pub fn refuse_truth(&self, cmd: &str) -> anyhow::Result<()> {
+        if self.uncertainty_truth.is_some() {
+            anyhow::bail!(
+                "--uncertainty-truth: only `run` checks the realised errors against the declared bounds; `{cmd}` would not say that its runs left them"
+            );
+        }
+        Ok(())
     }
 
     /// Declares the chosen profile in `scenario` (nothing without `--uncertainty`); the
