@@ -529,12 +529,12 @@ impl Robot {
             return None;
         }
         let body = *self.inertias.get(k)?;
-        let c = body.com();
-        let sc = crate::spatial::skew(&c);
-        let i_c = body.i_o + sc * sc * body.mass;
         let mut robot = self.clone();
-        robot.inertias[k] =
-            Inertia::from_com(body.mass * mass_scale, c + com_offset, i_c * inertia_scale);
+        robot.inertias[k] = Inertia::from_com(
+            body.mass * mass_scale,
+            body.com() + com_offset,
+            body.i_com() * inertia_scale,
+        );
         robot.total_mass = robot.inertias.iter().map(|i| i.mass).sum();
         Some(robot)
     }
@@ -549,10 +549,7 @@ impl Robot {
     }
     /// Rotational inertia of the base body about its CoM, base frame (kg m²).
     pub fn base_inertia_com(&self) -> Matrix3<f64> {
-        let i = &self.inertias[0];
-        let c = i.com();
-        let sc = crate::spatial::skew(&c);
-        i.i_o + sc * sc * i.mass
+        self.inertias[0].i_com()
     }
     /// CoM of the base body in the base frame (m); zero for the delivered URDF.
     pub fn base_com(&self) -> Vector3<f64> {

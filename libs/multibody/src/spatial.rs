@@ -215,6 +215,11 @@ impl Inertia {
             i_o: i_c - sc * sc * mass,
         }
     }
+    /// Rotational inertia about the CoM (the inverse of [`Self::from_com`]'s shift).
+    pub fn i_com(&self) -> Matrix3<f64> {
+        let sc = skew(&self.com());
+        self.i_o + sc * sc * self.mass
+    }
     /// Centre of mass in this frame (origin if massless).
     pub fn com(&self) -> Vector3<f64> {
         if self.mass > 0.0 {
