@@ -217,7 +217,6 @@ fn phase_names(scenario: &sc_scenario::Scenario) -> Vec<String> {
         .collect()
 }
 
-/// Writes `summary` as `path` (pretty JSON).
 /// `navigation.csv` — the realised navigation errors and every barrier on knowledge —
 /// when the run had knowledge apart from the truth (a declared uncertainty).
 fn write_knowledge(path: &Path, records: &[StepRecord]) -> anyhow::Result<()> {
@@ -233,6 +232,7 @@ fn write_knowledge(path: &Path, records: &[StepRecord]) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Writes `summary` as `path` (pretty JSON).
 fn write_summary(path: &Path, summary: &sc_mission::Summary) -> anyhow::Result<()> {
     std::fs::write(path, serde_json::to_string_pretty(summary)? + "\n")
         .with_context(|| format!("cannot write {}", path.display()))
