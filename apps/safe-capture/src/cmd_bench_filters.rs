@@ -53,6 +53,10 @@ pub struct Args {
     /// Write the report as JSON to FILE as well.
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
+    /// Every mission under a declared uncertainty (its realisation from the seed): what
+    /// the margins for the declared errors cost.
+    #[command(flatten)]
+    uncertainty: crate::uncertainty_arg::UncertaintyArg,
 }
 
 fn pct(sorted: &[f64], p: f64) -> f64 {
@@ -247,19 +251,28 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         .map(sc_redteam::Case::parse)
         .transpose()
         .map_err(|e| anyhow::anyhow!("--redteam: {e}"))?;
-    let setups = a
+    a.uncertainty.refuse_truth("bench filters")?;
+    let mut setups = a
         .scenario
         .iter()
         .map(|p| Setup::load(p))
         .collect::<Result<Vec<_>, _>>()?;
+    for s in &mut setups {
+        a.uncertainty.apply(&mut s.scenario)?;
+    }
     let load_start = HostSample::now();
     let mut samples = run_missions(&a, &setups, case)?;
     let missions = samples.mission_wall.len();
     outln!(
-        "safety-layer solve time per control step [us] ({missions} missions{}, {})",
+        "safety-layer solve time per control step [us] ({missions} missions{}{}, {})",
         a.redteam
             .as_deref()
             .map(|c| format!(" under red-team case {c}"))
+            .unwrap_or_default(),
+        a.uncertainty
+            .uncertainty
+            .as_deref()
+            .map(|u| format!(", uncertainty {u}"))
             .unwrap_or_default(),
         if a.solve_all {
             "every QP solved"
@@ -282,6 +295,10 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     );
     report.insert("host_load".into(), serde_json::to_value(load)?);
     report.insert("solve_all".into(), serde_json::json!(a.solve_all));
+    report.insert(
+        "uncertainty".into(),
+        serde_json::json!(a.uncertainty.uncertainty.as_deref().unwrap_or("exact")),
+    );
     report.insert("mission_wall_s".into(), serde_json::json!(mission_wall));
     if let Some(p) = a.json {
         std::fs::write(&p, serde_json::to_string_pretty(&report)?)?;

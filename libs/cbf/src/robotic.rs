@@ -182,6 +182,47 @@ pub struct RoboticParams {
     pub sphere_jerk_bound: Vector7,
     /// The contract with the attitude filter, `|(Q τ_M)_i| ≤ β_i` [rad/s²].
     pub arm_reaction_budget: Vector3<f64>,
+    /// The declared bound on what the joint motors deliver beyond the command
+    /// ([`TorqueError`]); zero for the `exact` profile, where the rows are the nominal
+    /// ones bit for bit.
+    pub joint_torque_error: TorqueError,
+}
+
+/// The declared bound on the joint motors' torque error, from the scenario's
+/// `[uncertainty.actuators]`: a motor delivers `τ (1 + s)(1 + r) + b` with `|s|`, `|r|`,
+/// `|b|` within their bounds, so `|Δτ_k| ≤ rel |τ_k| + bias_k` with `rel = s + r + s r`
+/// (docs/SAFETY.md, "Margins for the declared errors").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TorqueError {
+    /// `rel` [-].
+    pub rel: f64,
+    /// `bias_k` [N m].
+    pub bias: Vector7,
+}
+
+impl TorqueError {
+    pub fn from_scenario(s: &sc_scenario::Scenario) -> Self {
+        Self::from_actuators(&s.uncertainty_bounds().actuators)
+    }
+
+    /// From the declared actuator bounds.
+    pub fn from_actuators(a: &sc_scenario::uncertainty::ActuatorBounds) -> Self {
+        let (sc, r) = (a.joint_torque_scale_rel, a.joint_torque_ripple_rel);
+        Self {
+            rel: sc + r + sc * r,
+            bias: Vector7::repeat(a.joint_torque_bias_nm),
+        }
+    }
+
+    /// No error declared.
+    pub fn is_zero(&self) -> bool {
+        self.rel == 0.0 && self.bias.iter().all(|b| *b == 0.0)
+    }
+
+    /// `e_k = rel τ̄_k + bias_k` [N m] for torques `|τ_k| ≤ τ̄_k`.
+    pub fn at(&self, torque_cap: &Vector7) -> Vector7 {
+        torque_cap.abs() * self.rel + self.bias
+    }
 }
 
 impl RoboticParams {
@@ -207,6 +248,7 @@ impl RoboticParams {
             joint_jerk_bound: Vector7::from(r.joint_jerk_bound_rad_s3),
             sphere_jerk_bound: Vector7::from(r.link_sphere_jerk_bound_m_s3),
             arm_reaction_budget: Vector3::from(s.safety.attitude.arm_reaction_budget_rad_s2),
+            joint_torque_error: TorqueError::from_scenario(s),
         }
     }
 }
@@ -372,6 +414,12 @@ pub const CERTIFY_ROUNDS: usize = 2;
 pub const MAX_VERIFY_ROUNDS: usize = 4;
 /// A row whose verified shortfall is `s` gets the margin `VERIFY_GAIN · s` on the next round.
 pub const VERIFY_GAIN: f64 = 1.5;
+/// On the verification path, the factor on the first-order effect of the declared torque
+/// error on the joint state and the sphere centres (the sum over the joints of each
+/// error's own effect, [`RoboticFilter::verify`]) that covers its higher orders [-]: the
+/// remainder measured over the envelope is below 2 %, kept with a factor ≥ 1.5 (test
+/// `the_verification_margin_bounds_the_torque_errors_effect`).
+pub const VERIFY_SECOND_ORDER: f64 = 1.1;
 /// Upper bound on the distance of any sphere centre from any joint axis [m] (the arm's
 /// reach plus its sphere offsets): the lever of the joints' motion in the link-base bounds.
 pub const LEVER_BOUND_M: f64 = 2.0;
@@ -380,10 +428,52 @@ pub const LEVER_BOUND_M: f64 = 2.0;
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Level {
     /// Bounds valid for every command whose joint accelerations at the sample are at most
-    /// the given ones (the a-posteriori certificate).
-    Certified(Vector7),
-    /// No in-sample bounds (the sample's own prediction); the verification adds margins.
-    Local,
+    /// the given ones and whose torques are at most the given ones (the a-posteriori
+    /// certificate; the torques bound the declared torque error).
+    Certified(Caps),
+    /// No in-sample bounds (the sample's own prediction), the declared torque error taken
+    /// for torques up to the given ones; the verification adds margins.
+    Local(Vector7),
+}
+
+/// What a certified row's bounds hold for: joint accelerations at the sample
+/// `|θ̈_i| ≤ accel_i` [rad/s²] and torques `|τ_k| ≤ torque_k` [N m].
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Caps {
+    accel: Vector7,
+    torque: Vector7,
+}
+
+impl Caps {
+    /// The caps of a command with joint accelerations `qdd` and torques `tau`.
+    fn of(qdd: &Vector7, tau: &Vector7) -> Self {
+        Self {
+            accel: qdd.abs(),
+            torque: tau.abs(),
+        }
+    }
+
+    /// Both caps, the larger of each.
+    fn sup(&self, o: &Self) -> Self {
+        Self {
+            accel: self.accel.sup(&o.accel),
+            torque: self.torque.sup(&o.torque),
+        }
+    }
+
+    /// Twice as large (the next candidate's guess).
+    fn grown(&self) -> Self {
+        Self {
+            accel: self.accel * 2.0,
+            torque: self.torque * 2.0,
+        }
+    }
+
+    /// `o` is within these caps (its torques only if they `matter`).
+    fn covers(&self, o: &Self, torque_matters: bool) -> bool {
+        let within = |a: &Vector7, g: &Vector7| a.iter().zip(g.iter()).all(|(a, g)| a <= g);
+        within(&o.accel, &self.accel) && (!torque_matters || within(&o.torque, &self.torque))
+    }
 }
 
 /// The outcome of verifying one command over one sample.
@@ -403,6 +493,41 @@ impl Verdict {
         self.ok = false;
         self.shortfall[j] = self.shortfall[j].max(short);
     }
+}
+
+/// What the declared joint-torque error `|Δτ_k| ≤ e_k` ([`RoboticParams::joint_torque_error`])
+/// can do at the sample: the plant moves like the model under the held torque `τ + Δτ`, so
+/// each row's `ḧ` (or `ḣ`), affine in the torque with normal `a_j`, is off by at most
+/// `Σ_k |a_jk| e_k` — the exact worst case over the box (docs/SAFETY.md, "Margins for the
+/// declared errors").
+#[derive(Debug, Clone, Copy)]
+struct Disturbance {
+    /// `δ_i = Σ_k |A_ik| e_k` [rad/s²]: the joint accelerations' share.
+    joint: Vector7,
+    /// Per row [row units / s² or / s], [`NAMES`] order.
+    rows: [f64; N],
+}
+
+impl Disturbance {
+    /// The `exact` profile: no error.
+    fn none() -> Self {
+        Self {
+            joint: Vector7::zeros(),
+            rows: [0.0; N],
+        }
+    }
+}
+
+/// The arm at one physics step of the verification: joint state and the link spheres'
+/// centres and velocities (F_B).
+#[derive(Debug, Clone, Copy)]
+struct ArmSnapshot {
+    theta: Vector7,
+    theta_dot: Vector7,
+    centers: [Vector3<f64>; NS],
+    velocities: [Vector3<f64>; NS],
+    /// The spheres' radii [m]; `None` where the sphere's state could not be evaluated.
+    radii: [Option<f64>; NS],
 }
 
 /// The robotic CBF-QP safety filter (paper eq. "robotic_qp").
@@ -538,46 +663,67 @@ impl RoboticFilter {
     /// The in-sample bounds of every row for a command whose joint accelerations at the
     /// sample are `qdd` (docs/SAFETY.md, "The arm at 10 Hz"): with the configured jerk
     /// bounds `J_i` (joints) and `J_k` (sphere centres), the accelerations inside the sample
-    /// stay within `ā_i = |θ̈_i| + J_i T`, the rates within `v̄_i = |θ̇_i| + ā_i T`; then
+    /// stay within `ā_i = |θ̈_i| + δ_i + J_i T` (`δ_i` the declared torque error's share,
+    /// [`Disturbance`]), the rates within `v̄_i = |θ̇_i| + ā_i T`; then
     /// * joint angle (`ḧ = kθ̈ − 2θ̇²`): `M₃ = |k|_max J_i + 6 v̄_i ā_i`;
     /// * joint rate: `J = J_i`;
     /// * link sphere (`ḧ = 2‖ṗ‖² + 2dᵀp̈`): `M₃ = 6 V A + 2 D J_k` with the centre's
-    ///   acceleration `A = ‖p̈‖ + J_k T`, speed `V = ‖ṗ‖ + A T`, distance `D = ‖d‖ + V T`.
+    ///   acceleration `A = ‖p̈‖ + ‖J‖_F ‖δ‖ + J_k T`, speed `V = ‖ṗ‖ + A T`, distance
+    ///   `D = ‖d‖ + V T`;
+    ///
+    /// and every row's `M₂` (or `D`) is its share of the torque error at the sample.
     fn certified_bounds(
         &self,
         x: &RoboticInput,
         qdd: &Vector7,
+        dist: &Disturbance,
     ) -> ([SampleBounds; NJ], [RateBounds; NJ], [SampleBounds; NS]) {
         let p = &self.params;
         let t = p.period;
-        let acc = Vector7::from_fn(|i, _| qdd[i].abs() + p.joint_jerk_bound[i] * t);
+        let acc = Vector7::from_fn(|i, _| qdd[i].abs() + dist.joint[i] + p.joint_jerk_bound[i] * t);
         let vel = Vector7::from_fn(|i, _| x.theta_dot[i].abs() + acc[i] * t);
         let theta = std::array::from_fn(|i| {
             let k = (p.theta_max[i] + p.theta_min[i] - 2.0 * x.theta[i]).abs() + 2.0 * vel[i] * t;
             SampleBounds {
                 period: t,
-                m2: 0.0,
+                m2: dist.rows[i],
                 m3: k * p.joint_jerk_bound[i] + 6.0 * vel[i] * acc[i],
             }
         });
         let rate = std::array::from_fn(|i| RateBounds {
             period: t,
-            d: 0.0,
+            d: dist.rows[NJ + i].max(dist.rows[2 * NJ + i]),
             j: p.joint_jerk_bound[i],
         });
+        let joint_norm = dist.joint.norm();
         let lb = std::array::from_fn(|k| {
             let s = &x.spheres[k];
             let jk = p.sphere_jerk_bound[k / 3];
-            let a = (s.jacobian * qdd + s.jdot_qdot).norm() + jk * t;
+            let a =
+                (s.jacobian * qdd + s.jdot_qdot).norm() + s.jacobian.norm() * joint_norm + jk * t;
             let v = (s.jacobian * x.theta_dot).norm() + a * t;
             let d = (s.center - x.base_center).norm() + v * t;
             SampleBounds {
                 period: t,
-                m2: 0.0,
+                m2: dist.rows[3 * NJ + k],
                 m3: 6.0 * v * a + 2.0 * d * jk,
             }
         });
         (theta, rate, lb)
+    }
+
+    /// What the declared joint-torque error can do at the sample ([`Disturbance`]) for
+    /// torques `|τ_k| ≤ torque_cap_k`; zero without one.
+    fn disturbance(&self, x: &RoboticInput, t: &RoboticTerms, torque_cap: &Vector7) -> Disturbance {
+        let te = &self.params.joint_torque_error;
+        if te.is_zero() {
+            return Disturbance::none();
+        }
+        let e = te.at(torque_cap);
+        Disturbance {
+            joint: x.a.abs() * e,
+            rows: std::array::from_fn(|j| t.normal(j).abs().dot(&e)),
+        }
     }
 
     /// The 42 barrier rows at `level`, each tightened by `margin[j]` [row units].
@@ -629,20 +775,28 @@ impl RoboticFilter {
     /// The sampled-data rows' offsets `ḧ_drift − φ_req` and `ḣ_drift − ḣ_req` at `level`.
     fn sampled_offsets(&self, x: &RoboticInput, t: &RoboticTerms, level: Level) -> [f64; N] {
         let p = &self.params;
+        let dist = match level {
+            Level::Certified(caps) => self.disturbance(x, t, &caps.torque),
+            Level::Local(torque) => self.disturbance(x, t, &torque),
+        };
         let (bt, br, blb) = match level {
-            Level::Certified(qdd) => self.certified_bounds(x, &qdd),
-            Level::Local => {
-                let z = SampleBounds {
+            Level::Certified(caps) => self.certified_bounds(x, &caps.accel, &dist),
+            Level::Local(_) => {
+                let z = |m2| SampleBounds {
                     period: p.period,
-                    m2: 0.0,
+                    m2,
                     m3: 0.0,
                 };
-                let zr = RateBounds {
+                let zr = |i: usize| RateBounds {
                     period: p.period,
-                    d: 0.0,
+                    d: dist.rows[NJ + i].max(dist.rows[2 * NJ + i]),
                     j: 0.0,
                 };
-                ([z; NJ], [zr; NJ], [z; NS])
+                (
+                    std::array::from_fn(|i| z(dist.rows[i])),
+                    std::array::from_fn(zr),
+                    std::array::from_fn(|k| z(dist.rows[3 * NJ + k])),
+                )
             }
         };
         // the decays of (C2) and of the rate rows, evaluated once for all rows
@@ -671,8 +825,16 @@ impl RoboticFilter {
     fn hard_rows(&self, x: &RoboticInput) -> [Row<NJ>; 2 * NJ + 6] {
         let p = &self.params;
         let lim = p.torque_max * (1.0 - BOX_MARGIN);
-        let hold = -(x.m_eff * (x.drift + x.xi));
+        let hold = hold_torque(x);
         let q_hold = x.reaction * hold;
+        // the motors' declared error (for any torque in the box) moves the reaction by up
+        // to `|Q| e`: kept inside β
+        let te = &p.joint_torque_error;
+        let q_err = if te.is_zero() {
+            Vector3::zeros()
+        } else {
+            x.reaction.abs() * te.at(&Vector7::repeat(p.torque_max))
+        };
         std::array::from_fn(|k| {
             if k < 2 * NJ {
                 let mut a = Vector7::zeros();
@@ -683,7 +845,7 @@ impl RoboticFilter {
                 let sign = if k % 2 == 0 { -1.0 } else { 1.0 };
                 Row {
                     a: x.reaction.row(i).transpose() * sign,
-                    c: p.arm_reaction_budget[i] - sign * q_hold[i],
+                    c: p.arm_reaction_budget[i] - sign * q_hold[i] - q_err[i],
                 }
             }
         })
@@ -732,7 +894,7 @@ impl RoboticFilter {
         local: &[Row<NJ>; N],
         s: &mut RowsBehind,
     ) -> Certificate {
-        let accel = |u: &Vector7| x.a * u + x.drift + x.xi;
+        let caps_of = |u: &Vector7| Caps::of(&(x.a * u + x.drift + x.xi), u);
         let res = self.engine.solve(u_nom, local, &p.weights, &p.hard);
         let mut c = Certificate {
             res,
@@ -741,12 +903,14 @@ impl RoboticFilter {
         if !matches!(res.kind, Kind::Skipped | Kind::Solved) {
             return c;
         }
-        // the accelerations the rows `c.res` was solved with were built for (None: the
-        // sample's own prediction, the loosest rows); the bounds grow with them joint by
-        // joint, so rows built for the larger of both are tighter than those
-        let mut solved_cap: Option<Vector7> = None;
+        // the torques matter only for a declared torque error
+        let torque_matters = !self.params.joint_torque_error.is_zero();
+        // the caps the rows `c.res` was solved with were built for (None: the sample's own
+        // prediction, the loosest rows); the bounds grow with them joint by joint, so rows
+        // built for the larger of both are tighter than those
+        let mut solved_cap: Option<Caps> = None;
         for _ in 0..CERTIFY_ROUNDS {
-            let own = accel(&c.res.u).abs();
+            let own = caps_of(&c.res.u);
             let cap = solved_cap.map_or(own, |s| s.sup(&own));
             // the certifying rows' offsets with the normals every level shares: `phi`
             // of the certifying rows, bit for bit, without building them
@@ -765,7 +929,7 @@ impl RoboticFilter {
                 break;
             }
             // the next candidate may accelerate more; bound it by twice as much
-            let grown = cap * 2.0;
+            let grown = cap.grown();
             let rows = self.barrier_rows(x, &p.terms, Level::Certified(grown), &[0.0; N]);
             let next = self.engine.solve(u_nom, &rows, &p.weights, &p.hard);
             c.iterations += next.iterations;
@@ -775,13 +939,8 @@ impl RoboticFilter {
             c.res = next;
             s.solved = Some(rows);
             solved_cap = Some(grown);
-            if accel(&c.res.u)
-                .abs()
-                .iter()
-                .zip(grown.iter())
-                .all(|(a, g)| a <= g)
-            {
-                // the rows' bounds cover the new command's accelerations
+            if grown.covers(&caps_of(&c.res.u), torque_matters) {
+                // the rows' bounds cover the new command's accelerations (and torques)
                 s.certifying = Some(rows);
                 break;
             }
@@ -859,13 +1018,17 @@ impl RoboticFilter {
         let robot = self.robot.clone()?;
         let mut margin = [0.0; N];
         let mut best: Option<(f64, Verified)> = None;
+        // the torques the rows take the declared torque error for: the holding torque's
+        // (a safe command near the limits is close to it), then every candidate's as well
+        let mut torque = hold_torque(x).abs();
         for _ in 0..MAX_VERIFY_ROUNDS {
-            let rows = self.barrier_rows(x, &p.terms, Level::Local, &margin);
+            let rows = self.barrier_rows(x, &p.terms, Level::Local(torque), &margin);
             let res = self.engine.solve(u_nom, &rows, &p.weights, &p.hard);
             *iterations += res.iterations;
             if res.kind == Kind::Failed {
                 break;
             }
+            torque = torque.sup(&res.u.abs());
             let v = self.verify(&robot, x, &p.terms, &res.u, &p.weights);
             *iterations += 1;
             let candidate = Verified {
@@ -906,7 +1069,11 @@ impl RoboticFilter {
 
     /// Integrates one sample under `tau` with the servicer model exactly as the simulator
     /// does (RK4 at the physics step; base force and torque held in the body frame) and
-    /// checks every row's conditions on the true trajectory.
+    /// checks every row's conditions on the true trajectory. With a declared torque error
+    /// `|Δτ_k| ≤ e_k` the sample is also integrated under `τ + e_k 1_k` for every joint
+    /// `k`, and every barrier and rate is lowered by `VERIFY_SECOND_ORDER · Σ_k |change|`:
+    /// the worst case over the box of the errors to first order, the coupling of the
+    /// joints inside the sample included.
     fn verify(
         &self,
         robot: &Robot,
@@ -921,42 +1088,61 @@ impl RoboticFilter {
             shortfall: [0.0; N],
             worst: f64::INFINITY,
         };
-        let mut u = Vector13::zeros();
-        u.fixed_rows_mut::<3>(0).copy_from(&x.force_b);
-        u.fixed_rows_mut::<3>(3).copy_from(&x.torque_b);
-        u.fixed_rows_mut::<NJ>(6).copy_from(tau);
+        let te = &p.joint_torque_error;
+        let e = te.at(tau);
+        let perturbed = if te.is_zero() { 0 } else { NJ };
+        // input 0 the command, input k the command with joint k − 1's error
+        let inputs: [Vector13; NJ + 1] = std::array::from_fn(|k| {
+            let mut u = Vector13::zeros();
+            u.fixed_rows_mut::<3>(0).copy_from(&x.force_b);
+            u.fixed_rows_mut::<3>(3).copy_from(&x.torque_b);
+            u.fixed_rows_mut::<NJ>(6).copy_from(tau);
+            if k > 0 {
+                u[6 + k - 1] += e[k - 1];
+            }
+            u
+        });
+        let mut states = [(x.theta, x.theta_dot, x.omega_b); NJ + 1];
         let h = p.physics_step;
         let steps = ((p.period / h).round() as usize).max(1);
-        let (mut th, mut thd, mut w) = (x.theta, x.theta_dot, x.omega_b);
         let Some(base) = robot.base_sphere() else {
             verdict.ok = false;
             verdict.worst = f64::NEG_INFINITY;
             return verdict;
         };
         for step in 1..=steps {
-            let Some((th1, thd1, w1)) = rk4_internal(robot, &th, &thd, &w, &u, h) else {
-                verdict.ok = false;
-                verdict.worst = f64::NEG_INFINITY;
-                return verdict;
+            for (st, u) in states.iter_mut().zip(&inputs).take(perturbed + 1) {
+                let Some(next) = rk4_internal(robot, &st.0, &st.1, &st.2, u, h) else {
+                    verdict.ok = false;
+                    verdict.worst = f64::NEG_INFINITY;
+                    return verdict;
+                };
+                *st = next;
+            }
+            let snap = |k: usize| self.snapshot(robot, &states[k].0, &states[k].1);
+            let nominal = snap(0);
+            let (hv, hd) = self.barriers_along(base, &nominal);
+            let (dh, dhd) = if perturbed == 0 {
+                ([0.0; N], [0.0; N])
+            } else {
+                let others: [ArmSnapshot; NJ] = std::array::from_fn(|k| snap(k + 1));
+                self.error_effect(base, &nominal, &others)
             };
-            th = th1;
-            thd = thd1;
-            w = w1;
             let s = step as f64 * h;
-            let (hv, hd) = self.barriers_along(robot, base, &th, &thd);
             for j in 0..N {
-                verdict.worst = verdict.worst.min(hv[j] / weights[j]);
-                if hv[j] < 0.0 {
+                let hj = hv[j] - dh[j];
+                verdict.worst = verdict.worst.min(hj / weights[j]);
+                if hj < 0.0 {
                     // C1: the barrier inside the sample
                     let short = if is_rel_deg_two(j) {
-                        2.0 * -hv[j] / (s * s)
+                        2.0 * -hj / (s * s)
                     } else {
-                        -hv[j] / s
+                        -hj / s
                     };
                     verdict.fail(j, short);
                 }
                 if step == steps
-                    && let Some(short) = self.next_sample_shortfall(j, t0, hv[j], hd[j], s)
+                    && let Some(short) = self.next_sample_shortfall(j, t0, hj, hd[j] - dhd[j], s)
                 {
                     verdict.fail(j, short);
                 }
@@ -965,17 +1151,72 @@ impl RoboticFilter {
         verdict
     }
 
-    /// Every barrier `h` and the rates `ḣ` of the relative-degree-two ones (joint angles,
-    /// link spheres) at the joint state `(θ, θ̇)` of the verification, [`NAMES`] order.
-    fn barriers_along(
+    /// How far the declared torque error may lower every barrier and rate ([`NAMES`]
+    /// order) at `nominal`, from the snapshots `perturbed` under each joint's error alone. With `r = VERIFY_SECOND_ORDER`, the joints' angles and rates deviate
+    /// by at most `Δθ_i = r Σ_k |θ_i,k − θ_i|`, `Δθ̇_i` likewise, the spheres' centres and
+    /// velocities by `Δc = r Σ_k ‖c_k − c‖`, `Δv` likewise; then
+    /// * joint rate: `Δh = Δθ̇_i`;
+    /// * joint angle (`h = (θ − θ_min)(θ_max − θ)`, `ḣ = k θ̇`): `Δh = |k| Δθ + Δθ²`,
+    ///   `Δḣ = |k| Δθ̇ + 2|θ̇| Δθ + 2 Δθ Δθ̇`;
+    /// * link sphere (`h = ‖d‖² − (ρ + R)²`, `ḣ = 2 dᵀv`): `Δh = 2‖d‖ Δc + Δc²`,
+    ///   `Δḣ = 2 (Δc ‖v‖ + ‖d‖ Δv + Δc Δv)`.
+    fn error_effect(
         &self,
-        robot: &Robot,
         base: &CollisionSphere,
-        th: &Vector7,
-        thd: &Vector7,
+        nominal: &ArmSnapshot,
+        perturbed: &[ArmSnapshot],
     ) -> ([f64; N], [f64; N]) {
+        let (mut dh, mut dhd) = ([0.0; N], [0.0; N]);
+        let r = VERIFY_SECOND_ORDER;
+        let sum = |f: &dyn Fn(&ArmSnapshot) -> f64| r * perturbed.iter().map(f).sum::<f64>();
         let p = &self.params;
+        let n = nominal;
+        for i in 0..NJ {
+            let dq = sum(&|o| (o.theta[i] - n.theta[i]).abs());
+            let dv = sum(&|o| (o.theta_dot[i] - n.theta_dot[i]).abs());
+            let k = (p.theta_max[i] + p.theta_min[i] - 2.0 * n.theta[i]).abs();
+            dh[i] = k * dq + dq * dq;
+            dhd[i] = k * dv + 2.0 * n.theta_dot[i].abs() * dq + 2.0 * dq * dv;
+            dh[NJ + i] = dv;
+            dh[2 * NJ + i] = dv;
+        }
+        for s in 0..NS {
+            let dc = sum(&|o| (o.centers[s] - n.centers[s]).norm());
+            let dvel = sum(&|o| (o.velocities[s] - n.velocities[s]).norm());
+            let d = (n.centers[s] - base.center).norm();
+            let v = n.velocities[s].norm();
+            dh[3 * NJ + s] = 2.0 * d * dc + dc * dc;
+            dhd[3 * NJ + s] = 2.0 * (dc * v + d * dvel + dc * dvel);
+        }
+        (dh, dhd)
+    }
+
+    /// The joint state `(θ, θ̇)` of the verification with every arm sphere's centre and
+    /// velocity in the base frame (a sphere whose state cannot be evaluated: zero).
+    fn snapshot(&self, robot: &Robot, th: &Vector7, thd: &Vector7) -> ArmSnapshot {
         let kin = robot.kinematics_vel(th, thd);
+        let mut snap = ArmSnapshot {
+            theta: *th,
+            theta_dot: *thd,
+            centers: [Vector3::zeros(); NS],
+            velocities: [Vector3::zeros(); NS],
+            radii: [None; NS],
+        };
+        for (k, (idx, _)) in robot.arm_spheres().take(NS).enumerate() {
+            if let Some(sp) = robot.sphere_state(&kin, idx) {
+                snap.centers[k] = sp.center;
+                snap.velocities[k] = sp.jacobian * thd;
+                snap.radii[k] = Some(sp.radius);
+            }
+        }
+        snap
+    }
+
+    /// Every barrier `h` and the rates `ḣ` of the relative-degree-two ones (joint angles,
+    /// link spheres) at a snapshot of the verification, [`NAMES`] order.
+    fn barriers_along(&self, base: &CollisionSphere, a: &ArmSnapshot) -> ([f64; N], [f64; N]) {
+        let p = &self.params;
+        let (th, thd) = (&a.theta, &a.theta_dot);
         let mut hv = [0.0; N];
         let mut hd = [0.0; N];
         for i in 0..NJ {
@@ -985,12 +1226,12 @@ impl RoboticFilter {
             hv[NJ + i] = p.theta_dot_max[i] - thd[i];
             hv[2 * NJ + i] = thd[i] + p.theta_dot_max[i];
         }
-        for (k, (idx, _)) in robot.arm_spheres().take(NS).enumerate() {
-            if let Some(sp) = robot.sphere_state(&kin, idx) {
-                let d = sp.center - base.center;
-                let rr = sp.radius + base.radius;
+        for k in 0..NS {
+            if let Some(radius) = a.radii[k] {
+                let d = a.centers[k] - base.center;
+                let rr = radius + base.radius;
                 hv[3 * NJ + k] = d.dot(&d) - rr * rr;
-                hd[3 * NJ + k] = 2.0 * d.dot(&(sp.jacobian * thd));
+                hd[3 * NJ + k] = 2.0 * d.dot(&a.velocities[k]);
             }
         }
         (hv, hd)
@@ -1043,7 +1284,8 @@ impl RoboticFilter {
     /// (input bounds, then the contract) at `x` — for verification and inspection.
     pub fn rows(&self, x: &RoboticInput) -> Option<(Vec<Row<NJ>>, Vec<f64>, Vec<Row<NJ>>)> {
         let t = self.terms(x).ok()?;
-        let rows = self.barrier_rows(x, &t, Level::Certified(Vector7::zeros()), &[0.0; N]);
+        let caps = Caps::of(&Vector7::zeros(), &hold_torque(x));
+        let rows = self.barrier_rows(x, &t, Level::Certified(caps), &[0.0; N]);
         Some((
             rows.to_vec(),
             self.weights().to_vec(),
@@ -1055,6 +1297,11 @@ impl RoboticFilter {
     pub fn dump_qp(&self) -> crate::QpDump {
         self.last.dump()
     }
+}
+
+/// `τ_hold = c_eff = −M_eff (b + ξ)`: the torque that holds the joint rates (`θ̈ = 0`).
+fn hold_torque(x: &RoboticInput) -> Vector7 {
+    -(x.m_eff * (x.drift + x.xi))
 }
 
 /// One RK4 step of the servicer's internal state `(θ, θ̇, ω_B)` under the held input `u`,
@@ -1213,7 +1460,7 @@ impl FilterStep<NJ, N> for RoboticFilter {
         u_nom: &Vector7,
         report: &mut FilterReport<N>,
     ) -> Actuated<NJ> {
-        let local = self.barrier_rows(x, &p.terms, Level::Local, &[0.0; N]);
+        let local = self.barrier_rows(x, &p.terms, Level::Local(hold_torque(x).abs()), &[0.0; N]);
         let mut behind = RowsBehind {
             solved: None,
             certifying: None,
@@ -1364,14 +1611,14 @@ mod tests {
         );
         let x = robotic_input_from_model(&robot, &theta, &theta_dot, &w, &fb, &tb).unwrap();
         let t = f.terms(&x).ok().unwrap();
-        let local = f.barrier_rows(&x, &t, Level::Local, &[0.0; N]);
+        let local = f.barrier_rows(&x, &t, Level::Local(Vector7::zeros()), &[0.0; N]);
         // the rows as the sampled-data formulation defines them, row by row through
         // `RelDeg2::row_at` / `RelDeg1::row_at` (the reference the offsets must equal)
         let reference = |level: Level| -> [Row<NJ>; N] {
             let p = &f.params;
             let (bt, br, blb) = match level {
-                Level::Certified(qdd) => f.certified_bounds(&x, &qdd),
-                Level::Local => (
+                Level::Certified(c) => f.certified_bounds(&x, &c.accel, &Disturbance::none()),
+                Level::Local(_) => (
                     [SampleBounds {
                         period: p.period,
                         m2: 0.0,
@@ -1412,7 +1659,8 @@ mod tests {
             Vector7::repeat(3.0),
             Vector7::from_fn(|i, _| i as f64),
         ] {
-            for level in [Level::Local, Level::Certified(qdd)] {
+            let caps = Caps::of(&qdd, &Vector7::zeros());
+            for level in [Level::Local(Vector7::zeros()), Level::Certified(caps)] {
                 let rows = reference(level);
                 let built = f.barrier_rows(&x, &t, level, &[0.0; N]);
                 for (a, b) in rows.iter().zip(&built) {

@@ -418,9 +418,26 @@ struct RoboticRun {
 /// singular band and the bus, then across the whole range. `filtered = false`: the
 /// nominal alone (saturated).
 fn robotic_run(filtered: bool) -> RoboticRun {
+    robotic_run_with(filtered, None)
+}
+
+/// Joint motors that deliver `τ_k s_k (1 ± r) + b_k` (the ripple's sign alternating from
+/// sample to sample), and whether the filter is told the bounds they lie in.
+struct MotorErrors {
+    scale: Vector7,
+    ripple: f64,
+    bias: Vector7,
+    declared: Option<sc_cbf::robotic::TorqueError>,
+}
+
+/// [`robotic_run`] with the motors' torque errors of `motors`.
+fn robotic_run_with(filtered: bool, motors: Option<&MotorErrors>) -> RoboticRun {
     let s = scenario();
     let robot = robot();
     let mut f = RoboticFilter::from_scenario(&s, robot.clone());
+    if let Some(e) = motors.and_then(|m| m.declared) {
+        f.params.joint_torque_error = e;
+    }
     let p = f.params.clone();
     assert!((p.period - TS).abs() < 1e-12, "the paper's 10 Hz");
     let base = robot.base_sphere().unwrap().clone();
@@ -494,6 +511,13 @@ fn robotic_run(filtered: bool) -> RoboticRun {
         } else {
             tau_nom.map(|c| c.clamp(-p.torque_max, p.torque_max))
         };
+        let tau = match motors {
+            Some(m) => {
+                let ripple = if k % 2 == 0 { m.ripple } else { -m.ripple };
+                tau.component_mul(&m.scale) * (1.0 + ripple) + m.bias
+            }
+            None => tau,
+        };
         let mut u = Vector13::zeros();
         u.fixed_rows_mut::<7>(6).copy_from(&tau);
         for _ in 0..SUB {
@@ -530,5 +554,55 @@ fn robotic_limits_and_link_base_invariant_at_10_hz_under_adversarial_nominal() {
         run.interventions > 300,
         "the nominal must actually be unsafe ({})",
         run.interventions
+    );
+}
+
+/// The joint motors' errors of the `realistic` profile at the corners of their bounds
+/// (scale, bias and ripple all at their bound, signs per joint from `signs`).
+fn realistic_motor_corner(signs: [f64; 7], declared: bool) -> MotorErrors {
+    let a = sc_scenario::Uncertainty::profile("realistic", std::path::Path::new("."))
+        .unwrap()
+        .actuators;
+    let sg = Vector7::from(signs);
+    MotorErrors {
+        scale: Vector7::repeat(1.0) + sg * a.joint_torque_scale_rel,
+        ripple: a.joint_torque_ripple_rel,
+        bias: sg * a.joint_torque_bias_nm,
+        declared: declared.then(|| sc_cbf::robotic::TorqueError::from_actuators(&a)),
+    }
+}
+
+/// The adversarial arm run with the `realistic` motors at the corners of their declared
+/// bounds: with the bounds declared, every barrier of the plant stays ≥ 0 at every physics
+/// step; with the same motors and nothing declared, some corner drives one below zero (so
+/// the margin is what keeps the first runs safe).
+#[test]
+fn robotic_invariant_under_the_declared_joint_torque_errors() {
+    let corners = [
+        [1.0; 7],
+        [-1.0; 7],
+        [1.0, -1.0, 1.0, -1.0, 1.0, -1.0, 1.0],
+        [-1.0, 1.0, -1.0, 1.0, -1.0, 1.0, -1.0],
+    ];
+    let mut undeclared_min = f64::INFINITY;
+    for signs in corners {
+        let run = robotic_run_with(true, Some(&realistic_motor_corner(signs, true)));
+        println!("declared, signs {signs:?}: {run:?}");
+        assert!(
+            run.min_h >= 0.0,
+            "{signs:?}: {}: {:e}",
+            run.worst,
+            run.min_h
+        );
+        let blind = robotic_run_with(true, Some(&realistic_motor_corner(signs, false)));
+        println!(
+            "undeclared, signs {signs:?}: min h {:e} ({})",
+            blind.min_h, blind.worst
+        );
+        undeclared_min = undeclared_min.min(blind.min_h);
+    }
+    assert!(
+        undeclared_min < 0.0,
+        "the errors must matter: without the margin some corner is unsafe ({undeclared_min:e})"
     );
 }
