@@ -28,7 +28,7 @@ use std::process::ExitCode;
 /// --json FILE writes {"total"|"translational"|"attitude"|"robotic": {"n", "geomean_us",
 /// "p50_us", "p90_us", "p99_us", "p999_us", "max_us", "cpu": {same keys}, "qp": {same
 /// keys}, "solved_steps", "iterations": {"mean", "max"}, "active_rows": {"mean", "max"}},
-/// "host_load": {"start"|"end": {"load_avg_1min", "cpus"}}, "solve_all", "mission_wall_s"}.
+/// "host_load": {"start"|"end": {"load_avg_1min", "cpus"}}, "solve_all", "uncertainty", "mission_wall_s"}.
 ///
 /// Wall-clock tails depend on what else runs: the host's 1-minute load average at the
 /// start and the end is printed (and in the JSON); with a load above the CPU count the
