@@ -1152,9 +1152,10 @@ impl RoboticFilter {
     }
 
     /// How far the declared torque error may lower every barrier and rate ([`NAMES`]
-    /// order) at `nominal`, from the snapshots `perturbed` under each joint's error alone. With `r = VERIFY_SECOND_ORDER`, the joints' angles and rates deviate
-    /// by at most `Δθ_i = r Σ_k |θ_i,k − θ_i|`, `Δθ̇_i` likewise, the spheres' centres and
-    /// velocities by `Δc = r Σ_k ‖c_k − c‖`, `Δv` likewise; then
+    /// order) at `nominal`, from the snapshots `perturbed` under each joint's error alone.
+    /// With `r = VERIFY_SECOND_ORDER`, the joints' angles and rates deviate by at most
+    /// `Δθ_i = r Σ_k |θ_i,k − θ_i|`, `Δθ̇_i` likewise, the spheres' centres and velocities
+    /// by `Δc = r Σ_k ‖c_k − c‖`, `Δv` likewise; then
     /// * joint rate: `Δh = Δθ̇_i`;
     /// * joint angle (`h = (θ − θ_min)(θ_max − θ)`, `ḣ = k θ̇`): `Δh = |k| Δθ + Δθ²`,
     ///   `Δḣ = |k| Δθ̇ + 2|θ̇| Δθ + 2 Δθ Δθ̇`;
@@ -1192,7 +1193,8 @@ impl RoboticFilter {
     }
 
     /// The joint state `(θ, θ̇)` of the verification with every arm sphere's centre and
-    /// velocity in the base frame (a sphere whose state cannot be evaluated: zero).
+    /// velocity in the base frame (a sphere whose state cannot be evaluated has no radius:
+    /// its barrier reads 0, as before).
     fn snapshot(&self, robot: &Robot, th: &Vector7, thd: &Vector7) -> ArmSnapshot {
         let kin = robot.kinematics_vel(th, thd);
         let mut snap = ArmSnapshot {
