@@ -192,26 +192,44 @@ pub struct RoboticParams {
 /// `[uncertainty.actuators]`: a motor delivers `τ (1 + s)(1 + r) + b` with `|s|`, `|r|`,
 /// `|b|` within their bounds, so `|Δτ_k| ≤ rel |τ_k| + bias_k` with `rel = s + r + s r`
 /// (docs/SAFETY.md, "Margins for the declared errors").
+///
+/// Built only from bounds that are finite and non-negative (anything else is refused as
+/// no bound at all would be: [`TorqueError::new`] returns `None`), so the rows never see
+/// a NaN or a negative margin.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TorqueError {
     /// `rel` [-].
-    pub rel: f64,
+    rel: f64,
     /// `bias_k` [N m].
-    pub bias: Vector7,
+    bias: Vector7,
 }
 
 impl TorqueError {
+    /// `rel` [-] and `bias` [N m], each finite and ≥ 0; `None` otherwise.
+    pub fn new(rel: f64, bias: Vector7) -> Option<Self> {
+        let ok = |v: f64| v.is_finite() && v >= 0.0;
+        (ok(rel) && bias.iter().all(|b| ok(*b))).then_some(Self { rel, bias })
+    }
+
+    /// No error.
+    pub fn none() -> Self {
+        Self {
+            rel: 0.0,
+            bias: Vector7::zeros(),
+        }
+    }
+
+    /// From the scenario's declared bounds (validated by the scenario: finite, ≥ 0).
     pub fn from_scenario(s: &sc_scenario::Scenario) -> Self {
         Self::from_actuators(&s.uncertainty_bounds().actuators)
     }
 
-    /// From the declared actuator bounds.
+    /// From the declared actuator bounds; [`TorqueError::none`] if they are not finite
+    /// and non-negative (the scenario's validation refuses such bounds before).
     pub fn from_actuators(a: &sc_scenario::uncertainty::ActuatorBounds) -> Self {
         let (sc, r) = (a.joint_torque_scale_rel, a.joint_torque_ripple_rel);
-        Self {
-            rel: sc + r + sc * r,
-            bias: Vector7::repeat(a.joint_torque_bias_nm),
-        }
+        Self::new(sc + r + sc * r, Vector7::repeat(a.joint_torque_bias_nm))
+            .unwrap_or_else(Self::none)
     }
 
     /// No error declared.
@@ -820,11 +838,25 @@ impl RoboticFilter {
         })
     }
 
-    /// Input bounds and the contract rows `β_i ∓ (Q (τ_M − τ_hold))_i ≥ 0`, with
-    /// `τ_hold = c_eff = −M_eff (b + ξ)` the torque that holds the joint rates.
-    fn hard_rows(&self, x: &RoboticInput) -> [Row<NJ>; 2 * NJ + 6] {
+    /// The commanded torque's bound per joint [N m]: `T_M (1 − BOX_MARGIN)`, or with a
+    /// declared torque error the command whose delivered torque `τ(1 + rel) + bias` stays
+    /// within that — the plant's torques stay in the box the envelope's bounds hold for.
+    fn command_limit(&self) -> Vector7 {
         let p = &self.params;
         let lim = p.torque_max * (1.0 - BOX_MARGIN);
+        let te = &p.joint_torque_error;
+        if te.is_zero() {
+            return Vector7::repeat(lim);
+        }
+        te.bias.map(|b| ((lim - b) / (1.0 + te.rel)).max(0.0))
+    }
+
+    /// Input bounds and the contract rows `β_i ∓ (Q (τ_M − τ_hold))_i − (|Q| e)_i ≥ 0`,
+    /// with `τ_hold = c_eff = −M_eff (b + ξ)` the torque that holds the joint rates and
+    /// `e` the declared torque error for any command in the box ([`Self::command_limit`]).
+    fn hard_rows(&self, x: &RoboticInput) -> [Row<NJ>; 2 * NJ + 6] {
+        let p = &self.params;
+        let lim = self.command_limit();
         let hold = hold_torque(x);
         let q_hold = x.reaction * hold;
         // the motors' declared error (for any torque in the box) moves the reaction by up
@@ -833,13 +865,13 @@ impl RoboticFilter {
         let q_err = if te.is_zero() {
             Vector3::zeros()
         } else {
-            x.reaction.abs() * te.at(&Vector7::repeat(p.torque_max))
+            x.reaction.abs() * te.at(&lim)
         };
         std::array::from_fn(|k| {
             if k < 2 * NJ {
                 let mut a = Vector7::zeros();
                 a[k / 2] = if k % 2 == 0 { -1.0 } else { 1.0 };
-                Row { a, c: lim }
+                Row { a, c: lim[k / 2] }
             } else {
                 let i = (k - 2 * NJ) / 2;
                 let sign = if k % 2 == 0 { -1.0 } else { 1.0 };
@@ -1685,5 +1717,100 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// With a declared torque error, the sample's own rows (`Local`) are the sampled-data
+    /// rows of their definition with `M₂` (rates: `D`) = the row's worst case over the box,
+    /// `Σ_k |a_jk| e_k`, `e = rel |τ̄| + bias` written out here from the profile's numbers;
+    /// the certified rows are tighter than without the error, row by row; and the torque
+    /// box keeps the delivered torque `τ (1 + rel) + bias` within `T_M`.
+    #[test]
+    fn a_declared_torque_error_lowers_every_row_by_its_worst_case() {
+        let s = sc_scenario::Scenario::load(std::path::Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../config/scenario.toml"
+        )))
+        .unwrap();
+        let robot = Robot::from_urdf_file(&s.urdf_path()).unwrap();
+        let exact = RoboticFilter::new(RoboticParams::from_scenario(&s));
+        let a = sc_scenario::Uncertainty::profile("realistic", std::path::Path::new("."))
+            .unwrap()
+            .actuators;
+        let mut params = RoboticParams::from_scenario(&s);
+        params.joint_torque_error = TorqueError::from_actuators(&a);
+        let f = RoboticFilter::new(params);
+        let theta = Vector7::from(s.safety.robotic.theta_max_rad) * 0.8;
+        let theta_dot = Vector7::from_fn(|i, _| 0.05 * (i as f64 - 3.0));
+        let (w, fb, tb) = (
+            Vector3::new(0.01, -0.02, 0.03),
+            Vector3::new(1.0, -2.0, 0.5),
+            Vector3::new(0.3, 0.1, -0.2),
+        );
+        let x = robotic_input_from_model(&robot, &theta, &theta_dot, &w, &fb, &tb).unwrap();
+        let t = f.terms(&x).ok().unwrap();
+        let tau = Vector7::from_fn(|i, _| 0.3 * (i as f64 - 2.5));
+        let (sc, r) = (a.joint_torque_scale_rel, a.joint_torque_ripple_rel);
+        let e = tau.abs() * (sc + r + sc * r) + Vector7::repeat(a.joint_torque_bias_nm);
+        let p = &f.params;
+        let decay = Decay::linear(p.gamma).at(p.period);
+        let rate = RateDecay::new(p.gamma_theta_dot, p.eps_theta_dot, p.period);
+        let rel2 = |r: &RelDegTwo<NJ>, mu: f64| {
+            let b = SampleBounds {
+                period: p.period,
+                m2: r.hddot_u.abs().dot(&e),
+                m3: 0.0,
+            };
+            RelDeg2::from(*r).row_at(&b, mu, &decay)
+        };
+        let rel1 = |r: &RelDegOne<NJ>| {
+            let b = RateBounds {
+                period: p.period,
+                d: r.hdot_u.abs().dot(&e),
+                j: 0.0,
+            };
+            RelDeg1::from(*r).row_at(&b, &rate)
+        };
+        let want: [Row<NJ>; N] = std::array::from_fn(|j| {
+            if j < NJ {
+                rel2(&t.theta[j], p.u_max_theta)
+            } else if j < 2 * NJ {
+                rel1(&t.theta_dot_max[j - NJ])
+            } else if j < 3 * NJ {
+                rel1(&t.theta_dot_min[j - 2 * NJ])
+            } else {
+                rel2(&t.link_base[j - 3 * NJ], p.u_max_lb)
+            }
+        });
+        let got = f.barrier_rows(&x, &t, Level::Local(tau.abs()), &[0.0; N]);
+        for (j, (a, b)) in want.iter().zip(&got).enumerate() {
+            assert!(
+                (a.c - b.c).abs() <= 1e-12 * (1.0 + a.c.abs()),
+                "{}",
+                NAMES[j]
+            );
+        }
+        let plain = exact.barrier_rows(&x, &t, Level::Local(tau.abs()), &[0.0; N]);
+        // tighter wherever the torque moves the row (link 1's spheres lie on joint 1's axis)
+        let moved = |j: usize| t.normal(j).amax() > 0.0;
+        for j in 0..N {
+            assert!(got[j].c <= plain[j].c, "{}", NAMES[j]);
+            assert!(!moved(j) || got[j].c < plain[j].c, "{}", NAMES[j]);
+        }
+        let caps = Caps::of(&(x.a * tau + x.drift + x.xi), &tau);
+        let cert = f.barrier_offsets(&x, &t, Level::Certified(caps));
+        let cert_plain = exact.barrier_offsets(&x, &t, Level::Certified(caps));
+        for j in 0..N {
+            assert!(cert[j] <= cert_plain[j], "{}", NAMES[j]);
+            assert!(!moved(j) || cert[j] < cert_plain[j], "{}", NAMES[j]);
+        }
+        // the box: the delivered torque of a command on the bound is T_M (1 − BOX_MARGIN)
+        let lim = f.command_limit();
+        let delivered = lim * (1.0 + sc + r + sc * r) + Vector7::repeat(a.joint_torque_bias_nm);
+        let box_max = p.torque_max * (1.0 - BOX_MARGIN);
+        assert!(
+            delivered.iter().all(|d| (d - box_max).abs() <= 1e-12),
+            "{delivered}"
+        );
+        assert!(exact.command_limit().iter().all(|l| *l == box_max));
     }
 }

@@ -575,7 +575,9 @@ fn realistic_motor_corner(signs: [f64; 7], declared: bool) -> MotorErrors {
 /// The adversarial arm run with the `realistic` motors at the corners of their declared
 /// bounds: with the bounds declared, every barrier of the plant stays ≥ 0 at every physics
 /// step; with the same motors and nothing declared, some corner drives one below zero (so
-/// the margin is what keeps the first runs safe).
+/// the margin is what keeps the first runs safe). Not every declared step is certified:
+/// the relaxed problem runs on 42–301 of the 900 steps (printed; docs/SAFETY.md says why),
+/// and the run is safe on those by measurement.
 #[test]
 fn robotic_invariant_under_the_declared_joint_torque_errors() {
     let corners = [
