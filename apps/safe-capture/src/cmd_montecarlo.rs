@@ -395,6 +395,12 @@ fn report(s: &CampaignSummary, out: &std::path::Path) -> ExitCode {
         .filter_map(|(n, w)| w.min_h.map(|h| (n, h, w.run)))
         .min_by(|a, b| a.1.total_cmp(&b.1));
     let t = s.solve_time_us.get("total").copied().unwrap_or_default();
+    if !s.not_covered.is_empty() {
+        outln!(
+            "montecarlo: the filters' margins do not cover the declared [{}]: outside the promise, the truth's margins below are measured (docs/SAFETY.md)",
+            s.not_covered.join(", ")
+        );
+    }
     outln!(
         "montecarlo: {} runs{} (seed {}{}): {} safe, {} captured, {} failed; worst margin {}; total solve time geomean {:.1} us, max {:.1} us; wall {:.1} s -> {}",
         s.runs,

@@ -260,12 +260,25 @@ fn how_with_uncertainty(a: &Args, scenario: &sc_scenario::Scenario) -> String {
     match &scenario.uncertainty {
         None => how(a).to_string(),
         Some(u) => format!(
-            "{} Every case ran under the declared uncertainty profile `{}` (seed {}, docs/UNCERTAINTY.md): the simulator propagates a plant, actuators and navigation errors drawn from it while the controllers and filters act on the declared model and the navigation's estimate; \"safe\" is on the simulated truth.",
+            "{} Every case ran under the declared uncertainty profile `{}` (seed {}, docs/UNCERTAINTY.md): the simulator propagates a plant, actuators and navigation errors drawn from it while the controllers and filters act on the declared model and the navigation's estimate; \"safe\" is on the simulated truth.{}",
             how(a),
             u.profile,
-            u.seed
+            u.seed,
+            not_covered_sentence(scenario)
         ),
     }
+}
+
+/// The declared error sources no filter margin covers, as a sentence (nothing if none).
+fn not_covered_sentence(scenario: &sc_scenario::Scenario) -> String {
+    let open = sc_cbf::coverage::not_covered(&scenario.uncertainty_bounds());
+    if open.is_empty() {
+        return String::new();
+    }
+    format!(
+        " The filters' margins do not cover the declared {}: for those the promise does not hold (docs/SAFETY.md, \"Margins for the declared errors\").",
+        open.join(", ")
+    )
 }
 
 /// `" (<items>)"`-like text of a list, or nothing when it is empty.
@@ -366,6 +379,10 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         if let Err(e) = r {
             errln!("redteam: {}: {e}", c.name());
         }
+    }
+    let open = not_covered_sentence(&setup.scenario);
+    if !open.is_empty() {
+        outln!("redteam:{open}");
     }
     verdict_line(&a, &s, wall, &under(&setup.scenario));
     Ok(

@@ -64,6 +64,13 @@ fn a_realisation_is_reproducible_from_its_seed_and_said_within_bounds() {
         out.contains("uncertainty: profile realistic (seed 3): realised plant, actuator and navigation errors within the declared bounds"),
         "{out}"
     );
+    // within the bounds is not covered by the margins: the run names what is not
+    assert!(
+        out.contains("the filters' margins do not cover the declared [model.servicer_mass_rel,")
+            && out.contains("navigation.relative_position_m")
+            && !out.contains("actuators.joint_torque_bias_nm"),
+        "{out}"
+    );
     assert_eq!(b.status.code(), a.status.code(), "{}", text(&b));
     assert_ne!(c.status.code(), Some(2), "{}", text(&c));
     assert!(
@@ -242,9 +249,15 @@ fn a_campaign_under_a_profile_says_so() {
         "{}",
         text(&o)
     );
+    assert!(
+        text(&o).contains("montecarlo: the filters' margins do not cover the declared [model."),
+        "{}",
+        text(&o)
+    );
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(
-        report.contains("Declared uncertainty: profile `realistic`"),
+        report.contains("Declared uncertainty: profile `realistic`")
+            && report.contains("The filters' margins do not cover the declared model."),
         "{report}"
     );
     let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
@@ -280,13 +293,15 @@ fn a_red_team_under_a_profile_says_so() {
     );
     assert_ne!(o.status.code(), Some(2), "{}", text(&o));
     assert!(
-        text(&o).contains("redteam (uncertainty realistic, seed 1): "),
+        text(&o).contains("redteam (uncertainty realistic, seed 1): ")
+            && text(&o).contains("redteam: The filters' margins do not cover the declared model."),
         "{}",
         text(&o)
     );
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(
-        report.contains("declared uncertainty profile `realistic` (seed 1"),
+        report.contains("declared uncertainty profile `realistic` (seed 1")
+            && report.contains("The filters' margins do not cover the declared model."),
         "{report}"
     );
 }

@@ -29,6 +29,7 @@ pub mod attitude;
 pub mod barrier;
 pub mod chain;
 pub mod common;
+pub mod coverage;
 pub mod engine;
 pub mod envelope;
 pub mod filter;

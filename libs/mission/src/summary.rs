@@ -134,6 +134,10 @@ pub struct UncertaintySummary {
     /// declared bound (empty: within). A simulation knows the truth; a flight system
     /// checks only what it can measure.
     pub outside_bounds: Vec<String>,
+    /// The declared error sources no filter margin covers (`sc_cbf::coverage`): outside
+    /// the promise even within their bounds.
+    #[serde(default)]
+    pub not_covered: Vec<String>,
 }
 
 impl UncertaintySummary {
@@ -190,6 +194,7 @@ impl UncertaintySummary {
             navigation_max: named(&max),
             navigation_bound: named(&bounds),
             outside_bounds,
+            not_covered: sc_cbf::coverage::not_covered(&declared),
         })
     }
 
@@ -203,8 +208,16 @@ impl UncertaintySummary {
                 self.outside_bounds.join(", ")
             )
         };
+        let covered = if self.not_covered.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; the filters' margins do not cover the declared [{}]: outside the promise (docs/SAFETY.md)",
+                self.not_covered.join(", ")
+            )
+        };
         format!(
-            "uncertainty: profile {} (seed {}): {within}",
+            "uncertainty: profile {} (seed {}): {within}{covered}",
             self.profile, self.seed
         )
     }

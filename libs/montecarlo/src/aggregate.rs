@@ -132,6 +132,9 @@ pub struct CampaignSummary {
     /// on the simulated truth, with the plant and the estimate drawn from it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub uncertainty: Option<String>,
+    /// The declared error sources no filter margin covers: outside the promise.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub not_covered: Vec<String>,
 }
 
 /// What a summary records beside the runs: the wall time and host load of the sessions
@@ -398,6 +401,7 @@ fn empty_summary(info: &CampaignInfo, sessions: &Sessions, runs: usize) -> Campa
             planned_runs: planned,
         }),
         uncertainty: info.uncertainty.clone(),
+        not_covered: info.not_covered.clone(),
     }
 }
 

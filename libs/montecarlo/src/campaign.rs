@@ -102,6 +102,10 @@ pub struct CampaignInfo {
     /// (docs/UNCERTAINTY.md; absent: `exact`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub uncertainty: Option<String>,
+    /// The declared error sources no filter margin covers (`sc_cbf::coverage`): outside
+    /// the promise even within their bounds.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub not_covered: Vec<String>,
 }
 
 /// How a campaign is run.
@@ -322,6 +326,7 @@ fn info_of(opts: &CampaignOptions, setup: &Setup, executor: &dyn Executor) -> Ca
             .uncertainty
             .as_ref()
             .map(|u| u.profile.clone()),
+        not_covered: sc_cbf::coverage::not_covered(&setup.scenario.uncertainty_bounds()),
     }
 }
 

@@ -76,6 +76,13 @@ fn header(o: &mut String, s: &CampaignSummary, execution: sc_mission::Execution)
             o,
             "Declared uncertainty: profile `{u}` (docs/UNCERTAINTY.md). Each run's plant, actuators and navigation errors were drawn from its run seed; \"safe\" is every barrier ≥ 0 on the simulated truth.\n"
         );
+        if !s.not_covered.is_empty() {
+            let _ = writeln!(
+                o,
+                "The filters' margins do not cover the declared {}: for those the promise does not hold, a safe run is measured, not guaranteed (docs/SAFETY.md, \"Margins for the declared errors\").\n",
+                s.not_covered.join(", ")
+            );
+        }
     }
     if let Some(i) = &s.interrupted {
         let _ = writeln!(

@@ -158,6 +158,52 @@ impl NavigationBounds {
 }
 
 impl Uncertainty {
+    /// Every scalar bound with its key (`model.*`, `actuators.*`,
+    /// `navigation.measurement_age_s`); the navigation's bias-plus-noise errors are
+    /// [`NavigationBounds::errors`].
+    pub fn scalar_bounds(&self) -> [(&'static str, f64); 13] {
+        let (m, a, n) = (&self.model, &self.actuators, &self.navigation);
+        [
+            ("model.servicer_mass_rel", m.servicer_mass_rel),
+            ("model.servicer_inertia_rel", m.servicer_inertia_rel),
+            ("model.servicer_com_m", m.servicer_com_m),
+            ("model.link_mass_rel", m.link_mass_rel),
+            ("model.link_inertia_rel", m.link_inertia_rel),
+            ("model.target_inertia_rel", m.target_inertia_rel),
+            (
+                "actuators.thruster_force_scale_rel",
+                a.thruster_force_scale_rel,
+            ),
+            (
+                "actuators.thruster_misalignment_rad",
+                a.thruster_misalignment_rad,
+            ),
+            ("actuators.body_torque_scale_rel", a.body_torque_scale_rel),
+            ("actuators.joint_torque_scale_rel", a.joint_torque_scale_rel),
+            ("actuators.joint_torque_bias_nm", a.joint_torque_bias_nm),
+            (
+                "actuators.joint_torque_ripple_rel",
+                a.joint_torque_ripple_rel,
+            ),
+            ("navigation.measurement_age_s", n.measurement_age_s),
+        ]
+    }
+
+    /// The keys of every error declared non-zero (navigation errors as
+    /// `navigation.<kind>`).
+    pub fn declared_sources(&self) -> Vec<String> {
+        let scalars = self.scalar_bounds().into_iter().filter(|(_, v)| *v != 0.0);
+        let nav = self
+            .navigation
+            .errors()
+            .into_iter()
+            .filter(|(_, b)| b.bound() != 0.0);
+        scalars
+            .map(|(k, _)| k.to_string())
+            .chain(nav.map(|(k, _)| format!("navigation.{k}")))
+            .collect()
+    }
+
     /// True if no error of any kind is declared.
     pub fn is_exact(&self) -> bool {
         *self == Uncertainty::default()

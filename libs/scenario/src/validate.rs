@@ -623,55 +623,33 @@ impl crate::Uncertainty {
     /// [`MAX_RELATIVE_MASS_ERROR`], scale errors and ripple below 1, misalignment below
     /// [`MAX_MISALIGNMENT_RAD`]. `prefix` names the section in errors.
     pub fn validate(&self, prefix: &str) -> Result<(), ScenarioError> {
-        let (m, a, n) = (&self.model, &self.actuators, &self.navigation);
         let rel = MAX_RELATIVE_MASS_ERROR;
-        let checks: [(&str, f64, f64); 13] = [
-            ("model.servicer_mass_rel", m.servicer_mass_rel, rel),
-            ("model.servicer_inertia_rel", m.servicer_inertia_rel, rel),
-            ("model.servicer_com_m", m.servicer_com_m, f64::INFINITY),
-            ("model.link_mass_rel", m.link_mass_rel, rel),
-            ("model.link_inertia_rel", m.link_inertia_rel, rel),
-            ("model.target_inertia_rel", m.target_inertia_rel, rel),
-            (
-                "actuators.thruster_force_scale_rel",
-                a.thruster_force_scale_rel,
-                1.0,
-            ),
-            (
-                "actuators.thruster_misalignment_rad",
-                a.thruster_misalignment_rad,
-                MAX_MISALIGNMENT_RAD,
-            ),
-            (
-                "actuators.body_torque_scale_rel",
-                a.body_torque_scale_rel,
-                1.0,
-            ),
-            (
-                "actuators.joint_torque_scale_rel",
-                a.joint_torque_scale_rel,
-                1.0,
-            ),
-            (
-                "actuators.joint_torque_bias_nm",
-                a.joint_torque_bias_nm,
-                f64::INFINITY,
-            ),
-            (
-                "actuators.joint_torque_ripple_rel",
-                a.joint_torque_ripple_rel,
-                1.0,
-            ),
-            (
-                "navigation.measurement_age_s",
-                n.measurement_age_s,
-                f64::INFINITY,
-            ),
+        let inf = f64::INFINITY;
+        // the upper limit of each of `scalar_bounds`, in its order
+        let below = [
+            rel,
+            rel,
+            inf,
+            rel,
+            rel,
+            rel,
+            1.0,
+            MAX_MISALIGNMENT_RAD,
+            1.0,
+            1.0,
+            inf,
+            1.0,
+            inf,
         ];
+        let checks = self
+            .scalar_bounds()
+            .into_iter()
+            .zip(below)
+            .map(|((key, v), b)| (key, v, b));
         for (key, v, below) in checks {
             bounded(&format!("{prefix}.{key}"), v, below)?;
         }
-        for (key, b) in n.errors() {
+        for (key, b) in self.navigation.errors() {
             bounded(
                 &format!("{prefix}.navigation.{key}.bias"),
                 b.bias,
