@@ -271,7 +271,7 @@ fn how_with_uncertainty(a: &Args, scenario: &sc_scenario::Scenario) -> String {
 
 /// The declared error sources no filter margin covers, as a sentence (nothing if none).
 fn not_covered_sentence(scenario: &sc_scenario::Scenario) -> String {
-    let open = sc_cbf::coverage::not_covered(&scenario.uncertainty_bounds());
+    let open = sc_cbf::coverage::not_covered_in(scenario, true);
     if open.is_empty() {
         return String::new();
     }

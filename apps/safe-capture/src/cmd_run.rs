@@ -294,7 +294,8 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     })?;
     write_knowledge(&out.join("navigation.csv"), &records)?;
     let mut summary = summarize(&records, &end, &phase_names(&scenario), !a.no_filter);
-    summary.uncertainty = sc_mission::UncertaintySummary::of(&records, &scenario, &robot);
+    summary.uncertainty =
+        sc_mission::UncertaintySummary::of(&records, &scenario, &robot, !a.no_filter);
     write_summary(&out.join("summary.json"), &summary)?;
     if !a.no_figures {
         let alone = a.no_filter || a.no_compare || a.basilisk;

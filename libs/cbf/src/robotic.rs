@@ -890,7 +890,8 @@ impl RoboticFilter {
             return Vector7::zeros();
         }
         let t = -(x.m_eff * x.theta_dot) / self.params.brake_time;
-        common::sat_inf(&t, self.params.torque_max * (1.0 - BOX_MARGIN))
+        // within the command box: with a declared torque error the delivered torque too
+        common::sat_inf(&t, self.command_limit().min())
     }
 
     /// The filter's command when its nominal is missing: the safety QP on the substitute.
@@ -1812,5 +1813,29 @@ mod tests {
             "{delivered}"
         );
         assert!(exact.command_limit().iter().all(|l| *l == box_max));
+        // the hard rows: the box at the command limit, the contract less |Q| e(limit)
+        let hard = f.hard_rows(&x);
+        let q_err =
+            x.reaction.abs() * (lim * (sc + r + sc * r) + Vector7::repeat(a.joint_torque_bias_nm));
+        let q_hold = x.reaction * hold_torque(&x);
+        for (k, row) in hard.iter().enumerate() {
+            let want = if k < 2 * NJ {
+                lim[k / 2]
+            } else {
+                let i = (k - 2 * NJ) / 2;
+                let sign = if k % 2 == 0 { -1.0 } else { 1.0 };
+                p.arm_reaction_budget[i] - sign * q_hold[i] - q_err[i]
+            };
+            assert!(
+                (row.c - want).abs() <= 1e-15 * (1.0 + want.abs()),
+                "hard row {k}"
+            );
+        }
+        // and the braking law stays inside the command box
+        let fast = RoboticInput {
+            theta_dot: Vector7::repeat(10.0),
+            ..x
+        };
+        assert!(f.brake(&fast).amax() <= lim.min());
     }
 }

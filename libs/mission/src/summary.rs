@@ -136,19 +136,20 @@ pub struct UncertaintySummary {
     pub outside_bounds: Vec<String>,
     /// The declared error sources no filter margin covers (`sc_cbf::coverage`): outside
     /// the promise even within their bounds.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub not_covered: Vec<String>,
 }
 
 impl UncertaintySummary {
-    /// The summary of `records` under the scenario's declared uncertainty; `None` when
-    /// it declares none. The run's realisation is drawn again from its seed (it is a
+    /// The summary of `records` under the scenario's declared uncertainty (`filtered`: the
+    /// filters were on); `None` when it declares none. The run's realisation is drawn again from its seed (it is a
     /// function of the scenario, the robot and the seed) to compare the realised plant
     /// and actuator errors with the declared bounds.
     pub fn of(
         records: &[StepRecord],
         scenario: &sc_scenario::Scenario,
         robot: &sc_multibody::Robot,
+        filtered: bool,
     ) -> Option<Self> {
         let spec = scenario.uncertainty.as_ref()?;
         let declared = scenario.uncertainty_bounds();
@@ -194,7 +195,7 @@ impl UncertaintySummary {
             navigation_max: named(&max),
             navigation_bound: named(&bounds),
             outside_bounds,
-            not_covered: sc_cbf::coverage::not_covered(&declared),
+            not_covered: sc_cbf::coverage::not_covered_in(scenario, filtered),
         })
     }
 

@@ -326,7 +326,7 @@ fn info_of(opts: &CampaignOptions, setup: &Setup, executor: &dyn Executor) -> Ca
             .uncertainty
             .as_ref()
             .map(|u| u.profile.clone()),
-        not_covered: sc_cbf::coverage::not_covered(&setup.scenario.uncertainty_bounds()),
+        not_covered: sc_cbf::coverage::not_covered_in(&setup.scenario, true),
     }
 }
 

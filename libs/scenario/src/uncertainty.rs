@@ -157,11 +157,14 @@ impl NavigationBounds {
     }
 }
 
+/// The number of scalar bounds ([`Uncertainty::scalar_bounds`]).
+pub const SCALAR_BOUNDS: usize = 13;
+
 impl Uncertainty {
     /// Every scalar bound with its key (`model.*`, `actuators.*`,
     /// `navigation.measurement_age_s`); the navigation's bias-plus-noise errors are
     /// [`NavigationBounds::errors`].
-    pub fn scalar_bounds(&self) -> [(&'static str, f64); 13] {
+    pub fn scalar_bounds(&self) -> [(&'static str, f64); SCALAR_BOUNDS] {
         let (m, a, n) = (&self.model, &self.actuators, &self.navigation);
         [
             ("model.servicer_mass_rel", m.servicer_mass_rel),

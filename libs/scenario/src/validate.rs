@@ -183,6 +183,17 @@ impl Scenario {
         }
         let u = self.uncertainty_bounds();
         u.validate("uncertainty")?;
+        let bias = u.actuators.joint_torque_bias_nm;
+        if bias >= self.limits.joint_torque_max_nm {
+            return Err(invalid(
+                "uncertainty.actuators.joint_torque_bias_nm",
+                bias,
+                format!(
+                    "below the joint torque limit (limits.joint_torque_max_nm = {}): a bias as large leaves the filters no command that keeps the delivered torque in the box",
+                    self.limits.joint_torque_max_nm
+                ),
+            ));
+        }
         let age = u.navigation.measurement_age_s;
         if age > self.mission.control_period_s {
             return Err(invalid(
@@ -625,8 +636,8 @@ impl crate::Uncertainty {
     pub fn validate(&self, prefix: &str) -> Result<(), ScenarioError> {
         let rel = MAX_RELATIVE_MASS_ERROR;
         let inf = f64::INFINITY;
-        // the upper limit of each of `scalar_bounds`, in its order
-        let below = [
+        // one limit per scalar bound, in its order (a bound without one does not compile)
+        let below: [f64; crate::uncertainty::SCALAR_BOUNDS] = [
             rel,
             rel,
             inf,

@@ -188,3 +188,22 @@ fn zero_gravity_is_allowed_negative_gravity_is_not() {
     let msg = reject(&with("orbit", "earth_mu_m3_s2", "nan"));
     assert!(msg.contains("orbit.earth_mu_m3_s2"), "{msg}");
 }
+
+/// A joint-torque bias as large as the joint torque limit is refused: no command keeps the
+/// delivered torque in the box.
+#[test]
+fn a_joint_torque_bias_at_the_torque_limit_is_refused() {
+    let text = format!(
+        "{}\n[uncertainty]\nprofile = \"exact\"\n[uncertainty.model]\nservicer_mass_rel = 0.0\nservicer_inertia_rel = 0.0\nservicer_com_m = 0.0\nlink_mass_rel = 0.0\nlink_inertia_rel = 0.0\ntarget_inertia_rel = 0.0\n[uncertainty.actuators]\nthruster_force_scale_rel = 0.0\nthruster_misalignment_rad = 0.0\nbody_torque_scale_rel = 0.0\njoint_torque_scale_rel = 0.0\njoint_torque_bias_nm = 2.0\njoint_torque_ripple_rel = 0.0\n",
+        default_text()
+    );
+    let msg = reject(&text);
+    assert!(
+        msg.contains("uncertainty.actuators.joint_torque_bias_nm")
+            && msg.contains("joint_torque_max_nm"),
+        "{msg}"
+    );
+    // just below the limit is a bound like any other
+    let ok = text.replace("joint_torque_bias_nm = 2.0", "joint_torque_bias_nm = 1.9");
+    Scenario::from_toml_str(&ok, &config_dir()).expect("a bias below the limit");
+}
