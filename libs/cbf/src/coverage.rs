@@ -52,6 +52,15 @@ mod tests {
         let all = realistic.declared_sources();
         assert_eq!(not_covered(&realistic, false), all);
         assert_eq!(all.len(), open.len() + COVERED.len());
+        // the measurement age, when declared, is named last (after the navigation errors)
+        let mut aged = realistic;
+        aged.navigation.measurement_age_s = 0.05;
+        let named = not_covered(&aged, true);
+        assert_eq!(
+            named.last().map(String::as_str),
+            Some("navigation.measurement_age_s")
+        );
+        assert_eq!(named.len(), open.len() + 1);
     }
 
     /// Every covered key is a key the scenario declares (a typo would cover nothing), and

@@ -1623,20 +1623,15 @@ mod tests {
         }
     }
 
-    /// The rows built from offsets and normals are the sampled-data rows of their
-    /// definition (`RelDeg2::row_at`, `RelDeg1::row_at`), and the certificate's offsets with
-    /// the shared normals are the rows of that level, bit for bit, at every level (what
-    /// lets the filter check a command without building them).
-    #[test]
-    fn offsets_and_normals_are_the_rows_of_every_level() {
+    /// The default scenario and a moving arm near its limits, the base turning and
+    /// pushed: every term of the robotic input non-zero.
+    fn moving_arm() -> (sc_scenario::Scenario, RoboticInput) {
         let s = sc_scenario::Scenario::load(std::path::Path::new(concat!(
             env!("CARGO_MANIFEST_DIR"),
             "/../../config/scenario.toml"
         )))
         .unwrap();
         let robot = Robot::from_urdf_file(&s.urdf_path()).unwrap();
-        let f = RoboticFilter::new(RoboticParams::from_scenario(&s));
-        // a moving arm near its limits, the base turning and pushed: every term non-zero
         let theta = Vector7::from(s.safety.robotic.theta_max_rad) * 0.8;
         let theta_dot = Vector7::from_fn(|i, _| 0.05 * (i as f64 - 3.0));
         let (w, fb, tb) = (
@@ -1645,6 +1640,17 @@ mod tests {
             Vector3::new(0.3, 0.1, -0.2),
         );
         let x = robotic_input_from_model(&robot, &theta, &theta_dot, &w, &fb, &tb).unwrap();
+        (s, x)
+    }
+
+    /// The rows built from offsets and normals are the sampled-data rows of their
+    /// definition (`RelDeg2::row_at`, `RelDeg1::row_at`), and the certificate's offsets with
+    /// the shared normals are the rows of that level, bit for bit, at every level (what
+    /// lets the filter check a command without building them).
+    #[test]
+    fn offsets_and_normals_are_the_rows_of_every_level() {
+        let (s, x) = moving_arm();
+        let f = RoboticFilter::new(RoboticParams::from_scenario(&s));
         let t = f.terms(&x).ok().unwrap();
         let local = f.barrier_rows(&x, &t, Level::Local(Vector7::zeros()), &[0.0; N]);
         // the rows as the sampled-data formulation defines them, row by row through
@@ -1727,12 +1733,7 @@ mod tests {
     /// box keeps the delivered torque `τ (1 + rel) + bias` within `T_M`.
     #[test]
     fn a_declared_torque_error_lowers_every_row_by_its_worst_case() {
-        let s = sc_scenario::Scenario::load(std::path::Path::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../config/scenario.toml"
-        )))
-        .unwrap();
-        let robot = Robot::from_urdf_file(&s.urdf_path()).unwrap();
+        let (s, x) = moving_arm();
         let exact = RoboticFilter::new(RoboticParams::from_scenario(&s));
         let a = sc_scenario::Uncertainty::profile("realistic", std::path::Path::new("."))
             .unwrap()
@@ -1740,14 +1741,6 @@ mod tests {
         let mut params = RoboticParams::from_scenario(&s);
         params.joint_torque_error = TorqueError::from_actuators(&a);
         let f = RoboticFilter::new(params);
-        let theta = Vector7::from(s.safety.robotic.theta_max_rad) * 0.8;
-        let theta_dot = Vector7::from_fn(|i, _| 0.05 * (i as f64 - 3.0));
-        let (w, fb, tb) = (
-            Vector3::new(0.01, -0.02, 0.03),
-            Vector3::new(1.0, -2.0, 0.5),
-            Vector3::new(0.3, 0.1, -0.2),
-        );
-        let x = robotic_input_from_model(&robot, &theta, &theta_dot, &w, &fb, &tb).unwrap();
         let t = f.terms(&x).ok().unwrap();
         let tau = Vector7::from_fn(|i, _| 0.3 * (i as f64 - 2.5));
         let (sc, r) = (a.joint_torque_scale_rel, a.joint_torque_ripple_rel);

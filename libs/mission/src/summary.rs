@@ -141,10 +141,10 @@ pub struct UncertaintySummary {
 }
 
 impl UncertaintySummary {
-    /// The summary of `records` under the scenario's declared uncertainty (`filtered`: the
-    /// filters were on); `None` when it declares none. The run's realisation is drawn again from its seed (it is a
-    /// function of the scenario, the robot and the seed) to compare the realised plant
-    /// and actuator errors with the declared bounds.
+    /// The summary of `records` under the scenario's declared uncertainty (`filtered`:
+    /// the filters were on); `None` when it declares none. The run's realisation is drawn
+    /// again from its seed (it is a function of the scenario, the robot and the seed) to
+    /// compare the realised plant and actuator errors with the declared bounds.
     pub fn of(
         records: &[StepRecord],
         scenario: &sc_scenario::Scenario,

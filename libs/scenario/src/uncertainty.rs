@@ -192,18 +192,24 @@ impl Uncertainty {
         ]
     }
 
-    /// The keys of every error declared non-zero (navigation errors as
-    /// `navigation.<kind>`).
+    /// The keys of every error declared non-zero, in the order of the sections (model,
+    /// actuators, navigation; the navigation's errors as `navigation.<kind>`, its
+    /// measurement age last).
     pub fn declared_sources(&self) -> Vec<String> {
+        let age = "navigation.measurement_age_s";
         let scalars = self.scalar_bounds().into_iter().filter(|(_, v)| *v != 0.0);
+        let (ages, others): (Vec<_>, Vec<_>) = scalars.partition(|(k, _)| *k == age);
         let nav = self
             .navigation
             .errors()
             .into_iter()
-            .filter(|(_, b)| b.bound() != 0.0);
-        scalars
+            .filter(|(_, b)| b.bound() != 0.0)
+            .map(|(k, _)| format!("navigation.{k}"));
+        others
+            .into_iter()
             .map(|(k, _)| k.to_string())
-            .chain(nav.map(|(k, _)| format!("navigation.{k}")))
+            .chain(nav)
+            .chain(ages.into_iter().map(|(k, _)| k.to_string()))
             .collect()
     }
 
