@@ -174,6 +174,15 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         .collect();
     let summary = read_json(&out.join("summary.json"));
     staged.commit()?;
+    // a declared uncertainty: the realised errors against the declared bounds, and what
+    // the margins do not cover (as `run` says it)
+    let uncertainty = summary
+        .as_ref()
+        .and_then(|s| serde_json::from_value::<sc_mission::Summary>(s.clone()).ok())
+        .and_then(|s| s.uncertainty);
+    if let Some(u) = uncertainty {
+        outln!("{}", u.line());
+    }
     outln!(
         "partition: {}; {} processes, failed: [{}]; shm leftovers: {}; wall {:.2} s -> {}",
         outcome(summary.as_ref(), scheduler.as_ref()),

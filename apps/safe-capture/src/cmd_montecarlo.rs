@@ -293,25 +293,6 @@ fn partition_executor(
     Ok((executor, note))
 }
 
-/// `--mode partition` with a declared uncertainty is refused before any run starts (the
-/// partition has no navigation role yet: every run would fail at its preflight).
-fn refuse_uncertainty_in_partition(a: &RunArgs, scenario: &Path) -> anyhow::Result<()> {
-    // a scenario that cannot be loaded is the campaign's to report
-    let Ok(mut s) = sc_scenario::Scenario::load(scenario) else {
-        return Ok(());
-    };
-    if let Some(spec) = a.uncertainty.spec_per_run()? {
-        s.set_uncertainty(spec)
-            .map_err(|e| anyhow::anyhow!("--uncertainty: {e}"))?;
-    }
-    if s.uncertainty.is_some() {
-        anyhow::bail!(
-            "--mode partition: the partition runs only the `exact` uncertainty profile so far (no navigation role yet); run the campaign in process (the default --mode)"
-        );
-    }
-    Ok(())
-}
-
 fn campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
     a.figures.check()?;
     let p = params(&a)?;
@@ -346,7 +327,6 @@ fn campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
             Box::new(StopOnSignal(InProcess))
         }
         Mode::Partition => {
-            refuse_uncertainty_in_partition(&a, &p.scenario)?;
             let config = a
                 .partition_config
                 .clone()

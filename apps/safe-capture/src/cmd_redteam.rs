@@ -322,11 +322,6 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let mut setup = Setup::load(&a.scenario)?;
     a.uncertainty.refuse_truth("redteam")?;
     a.uncertainty.apply(&mut setup.scenario)?;
-    if a.partition && setup.scenario.uncertainty.is_some() {
-        anyhow::bail!(
-            "--partition: the partition runs only the `exact` uncertainty profile (no navigation role yet); drop --partition to run the cases in process"
-        );
-    }
     let cases = selected(&a, run_ticks(&a, &setup))?;
     if a.list {
         for c in &cases {

@@ -217,21 +217,6 @@ fn phase_names(scenario: &sc_scenario::Scenario) -> Vec<String> {
         .collect()
 }
 
-/// `navigation.csv` — the realised navigation errors and every barrier on knowledge —
-/// when the run had knowledge apart from the truth (a declared uncertainty).
-fn write_knowledge(path: &Path, records: &[StepRecord]) -> anyhow::Result<()> {
-    if records.iter().all(|r| r.navigation_error.is_none()) {
-        return Ok(());
-    }
-    let mut f = create(path)?;
-    writeln!(f, "{}", sc_mission::knowledge_columns().join(","))?;
-    for line in records.iter().filter_map(sc_mission::knowledge_line) {
-        writeln!(f, "{line}")?;
-    }
-    f.flush()?;
-    Ok(())
-}
-
 /// Writes `summary` as `path` (pretty JSON).
 fn write_summary(path: &Path, summary: &sc_mission::Summary) -> anyhow::Result<()> {
     std::fs::write(path, serde_json::to_string_pretty(summary)? + "\n")
@@ -292,7 +277,9 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         dump_qp: a.dump_qp.as_deref(),
         quiet: a.quiet,
     })?;
-    write_knowledge(&out.join("navigation.csv"), &records)?;
+    let knowledge = out.join("navigation.csv");
+    sc_mission::record::write_knowledge(&knowledge, &records)
+        .with_context(|| format!("cannot write {}", knowledge.display()))?;
     let mut summary = summarize(&records, &end, &phase_names(&scenario), !a.no_filter);
     summary.uncertainty =
         sc_mission::UncertaintySummary::of(&records, &scenario, &robot, !a.no_filter);

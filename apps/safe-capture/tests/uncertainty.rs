@@ -1,7 +1,7 @@
 //! The declared uncertainty as a user meets it (docs/UNCERTAINTY.md): `exact` changes
 //! nothing, a realisation is reproducible from its seed, a truth drawn outside the
-//! declared bounds is said and fails the run, and the partition refuses what it cannot
-//! run yet.
+//! declared bounds is said and fails the run, the partition runs a profile as `run`
+//! does and refuses what it cannot run yet.
 
 use std::path::Path;
 use std::process::Output;
@@ -124,56 +124,105 @@ fn a_campaign_refuses_one_seed_for_all_its_runs() {
     assert!(text(&o).contains("--uncertainty-seed"), "{}", text(&o));
 }
 
+/// A partition config running `scenario` (the default config otherwise).
+fn partition_config(dir: &Path, scenario: &Path, extra: &str) -> std::path::PathBuf {
+    let cfg = std::fs::read_to_string(root().join("config/partition.toml")).unwrap();
+    let cfg = cfg.replacen(
+        "scenario = \"scenario.toml\"",
+        &format!("scenario = {:?}", scenario.display().to_string()),
+        1,
+    );
+    assert!(
+        cfg.contains(&scenario.display().to_string()),
+        "no scenario line"
+    );
+    let p = dir.join("partition.toml");
+    std::fs::write(&p, cfg + extra).unwrap();
+    p
+}
+
+fn launch(config: &Path, out: &Path) -> Output {
+    let (c, o) = (config.to_str().unwrap(), out.to_str().unwrap());
+    cli(&["launch", "--config", c, "--out", o], &[])
+}
+
+/// "In one process, the same": under a declared profile the partition's simulator
+/// propagates the same realised plant and actuators and publishes the same estimate as
+/// `run` — telemetry.csv (the truth) and navigation.csv (the errors, the barriers on
+/// knowledge) are byte-identical in lock-step, and `launch` says the same about them.
 #[test]
-fn the_partition_refuses_a_profile_it_cannot_run_yet() {
+fn a_lock_step_partition_under_a_profile_is_the_run_in_one_process() {
     let d = tmp("unc-partition");
+    let s = short_scenario(&d.0, DURATION_S);
+    let mut text_s = std::fs::read_to_string(&s).unwrap();
+    text_s.push_str("\n[uncertainty]\nprofile = \"realistic\"\nseed = 5\n");
+    std::fs::write(&s, text_s).unwrap();
+    let one = run(&s, &d.0.join("run"), &[]);
+    let p = partition_config(&d.0, &s, "");
+    let part = launch(&p, &d.0.join("launch"));
+    // an unfinished short mission exits 1 in both
+    assert_eq!(one.status.code(), part.status.code(), "{}", text(&part));
+    for f in ["telemetry.csv", "navigation.csv"] {
+        let a = std::fs::read(d.0.join("run").join(f)).unwrap();
+        let b = std::fs::read(d.0.join("launch").join(f)).unwrap();
+        assert!(a == b, "{f} differs between run and launch");
+    }
+    let line = |o: &Output| {
+        String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .find(|l| l.starts_with("uncertainty: "))
+            .map(str::to_string)
+    };
+    assert!(line(&one).is_some(), "{}", text(&one));
+    assert_eq!(line(&one), line(&part), "{}", text(&part));
+}
+
+/// A plant process propagates the declared model: with a declared profile the
+/// partition refuses it before anything starts instead of running the model as truth.
+#[test]
+fn the_partition_refuses_a_profile_with_a_plant_process() {
+    let d = tmp("unc-partition-plant");
     let s = short_scenario(&d.0, DURATION_S);
     let mut text_s = std::fs::read_to_string(&s).unwrap();
     text_s.push_str("\n[uncertainty]\nprofile = \"realistic\"\n");
     std::fs::write(&s, text_s).unwrap();
-    let cfg = std::fs::read_to_string(root().join("config/partition.toml")).unwrap();
-    let cfg = cfg.replacen(
-        "scenario = \"scenario.toml\"",
-        &format!("scenario = {:?}", s.display().to_string()),
-        1,
-    );
-    assert!(cfg.contains(&s.display().to_string()), "no scenario line");
-    let p = d.0.join("partition.toml");
-    std::fs::write(&p, cfg).unwrap();
-    let o = cli(
-        &[
-            "launch",
-            "--config",
-            p.to_str().unwrap(),
-            "--out",
-            d.0.join("o").to_str().unwrap(),
-        ],
-        &[],
-    );
+    let p = partition_config(&d.0, &s, "\n[simulator]\nplant = [\"/bin/true\"]\n");
+    let o = launch(&p, &d.0.join("o"));
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
-    assert!(text(&o).contains("`[uncertainty]`"), "{}", text(&o));
+    assert!(text(&o).contains("`[simulator] plant`"), "{}", text(&o));
+    assert!(!d.0.join("o").exists(), "a run was started");
 }
 
+/// `montecarlo --mode partition` under a profile: every run draws the realisation of its
+/// run seed in the partition's simulator, and the campaign's runs.csv is the in-process
+/// campaign's, byte for byte.
 #[test]
-fn a_partition_campaign_with_a_profile_is_refused_before_any_run() {
+fn a_partition_campaign_under_a_profile_is_the_campaign_in_process() {
     let d = tmp("unc-mc-partition");
-    let o = cli(
-        &[
+    let campaign = |mode: &str, out: &str| {
+        let o = d.0.join(out);
+        let args = [
             "montecarlo",
             "--runs",
             "2",
             "--mode",
-            "partition",
+            mode,
             "--uncertainty",
             "realistic",
             "--out",
-            d.0.join("o").to_str().unwrap(),
-        ],
-        &[],
+            o.to_str().unwrap(),
+        ];
+        let r = cli(&args, &[]);
+        assert_eq!(r.status.code(), Some(0), "{}", text(&r));
+        std::fs::read(o.join("runs.csv")).unwrap()
+    };
+    let in_process = campaign("in-process", "ip");
+    let partition = campaign("partition", "p");
+    assert!(in_process == partition, "runs.csv differs");
+    assert!(
+        d.0.join("p/runs/0/partition/navigation.csv").exists(),
+        "the partition ran without the profile"
     );
-    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
-    assert!(text(&o).contains("--mode partition"), "{}", text(&o));
-    assert!(!d.0.join("o").exists(), "a run was started");
 }
 
 /// Both sides: the truth's barriers in telemetry.csv, knowledge's and the realised

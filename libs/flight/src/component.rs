@@ -10,8 +10,8 @@
 
 use sc_icd::services::ServiceName;
 use sc_icd::{
-    Health, NominalAttitude, NominalRobotic, NominalTranslational, SafeAttitude, SafeRobotic,
-    SafeTranslational, SimState, StepResult, Tick,
+    Health, NavigationError, NominalAttitude, NominalRobotic, NominalTranslational, SafeAttitude,
+    SafeRobotic, SafeTranslational, SimState, StepResult, Tick,
 };
 
 /// One message of the ICD as a role receives or publishes it, tagged with its service.
@@ -25,6 +25,10 @@ pub enum Message {
     State(SimState),
     /// `safe_capture/partner/state` (the nominal controllers' copy).
     PartnerState(SimState),
+    /// `safe_capture/sim/truth` (the recorder; with a declared uncertainty only).
+    Truth(SimState),
+    /// `safe_capture/sim/navigation_error` (the recorder; with a declared uncertainty).
+    NavigationError(NavigationError),
     NominalTranslational(NominalTranslational),
     NominalAttitude(NominalAttitude),
     NominalRobotic(NominalRobotic),
@@ -44,6 +48,8 @@ impl Message {
             Message::Control(_) => CONTROL,
             Message::State(_) => SIM_STATE,
             Message::PartnerState(_) => PARTNER_STATE,
+            Message::Truth(_) => TRUTH,
+            Message::NavigationError(_) => NAVIGATION_ERROR,
             Message::NominalTranslational(_) => NOMINAL_TRANSLATIONAL,
             Message::NominalAttitude(_) => NOMINAL_ATTITUDE,
             Message::NominalRobotic(_) => NOMINAL_ROBOTIC,
@@ -60,7 +66,8 @@ impl Message {
     pub fn stamp_publish(&mut self, ns: u64) {
         match self {
             Message::Tick(m) | Message::Control(m) => m.send_ns = ns,
-            Message::State(m) | Message::PartnerState(m) => m.publish_ns = ns,
+            Message::State(m) | Message::PartnerState(m) | Message::Truth(m) => m.publish_ns = ns,
+            Message::NavigationError(_) => {}
             Message::NominalTranslational(m) => m.publish_ns = ns,
             Message::NominalAttitude(m) => m.publish_ns = ns,
             Message::NominalRobotic(m) => m.publish_ns = ns,

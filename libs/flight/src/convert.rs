@@ -257,3 +257,41 @@ pub fn arr3(v: &Vector3<f64>) -> [f64; 3] {
 pub fn arr7(v: &Vector7) -> [f64; 7] {
     a7(v)
 }
+
+/// The message of the realised navigation errors `e` of tick `tick` at time `t`.
+pub fn navigation_error(
+    tick: u64,
+    t: f64,
+    e: &sc_sim::uncertainty::NavigationError,
+) -> sc_icd::NavigationError {
+    sc_icd::NavigationError {
+        tick,
+        t,
+        relative_position_m: e.relative_position_m,
+        relative_velocity_m_s: e.relative_velocity_m_s,
+        servicer_attitude_rad: e.servicer_attitude_rad,
+        servicer_rate_rad_s: e.servicer_rate_rad_s,
+        target_attitude_rad: e.target_attitude_rad,
+        target_rate_rad_s: e.target_rate_rad_s,
+        grasp_point_m: e.grasp_point_m,
+        joint_angle_rad: e.joint_angle_rad,
+        joint_rate_rad_s: e.joint_rate_rad_s,
+        measurement_age_s: e.measurement_age_s,
+    }
+}
+
+/// The realised navigation errors a message carries ([`navigation_error`]'s inverse).
+pub fn navigation_error_of(m: &sc_icd::NavigationError) -> sc_sim::uncertainty::NavigationError {
+    sc_sim::uncertainty::NavigationError {
+        relative_position_m: m.relative_position_m,
+        relative_velocity_m_s: m.relative_velocity_m_s,
+        servicer_attitude_rad: m.servicer_attitude_rad,
+        servicer_rate_rad_s: m.servicer_rate_rad_s,
+        target_attitude_rad: m.target_attitude_rad,
+        target_rate_rad_s: m.target_rate_rad_s,
+        grasp_point_m: m.grasp_point_m,
+        joint_angle_rad: m.joint_angle_rad,
+        joint_rate_rad_s: m.joint_rate_rad_s,
+        measurement_age_s: m.measurement_age_s,
+    }
+}

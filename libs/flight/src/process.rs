@@ -62,12 +62,6 @@ impl Proc {
         let cfg = PartitionConfig::load(&config)?;
         let schedule = cfg.schedule()?;
         let setup = Setup::load(&cfg.scenario_path())?;
-        if setup.scenario.uncertainty.is_some() {
-            // as the launcher's preflight: no silent truth-as-knowledge run
-            return Err(FlightError::Usage(
-                "the scenario declares an `[uncertainty]` profile; the partition runs only the `exact` profile so far".into(),
-            ));
-        }
         let run = RunScope::from_env().ok_or_else(|| {
             FlightError::Usage(
                 "SC_RUN_ID is not set (processes are started by the launcher)".into(),

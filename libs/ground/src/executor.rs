@@ -411,15 +411,21 @@ pub fn read_run(out: &Path, may_miss: &[&str]) -> Result<Executed, PartitionErro
     if missing > 0 {
         return Err(PartitionError::SamplesMissed { missing, report });
     }
-    let records = parse_telemetry(
+    let file_error = |e: sc_mission::record::TelemetryError| PartitionError::File {
+        path: out.to_path_buf(),
+        message: e.to_string(),
+    };
+    let mut records = parse_telemetry(
         &read(&out.join("telemetry.csv"))?,
         &read(&out.join("timing.csv"))?,
         true,
     )
-    .map_err(|e| PartitionError::File {
-        path: out.to_path_buf(),
-        message: e.to_string(),
-    })?;
+    .map_err(file_error)?;
+    // a declared uncertainty: the navigation errors and the barriers on knowledge
+    let knowledge = out.join("navigation.csv");
+    if knowledge.exists() {
+        sc_mission::record::read_knowledge(&read(&knowledge)?, &mut records).map_err(file_error)?;
+    }
     if records.len() as u64 != rec.steps {
         return Err(PartitionError::StepCount {
             rows: records.len(),

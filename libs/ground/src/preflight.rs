@@ -48,10 +48,10 @@ pub fn preflight(
 pub fn check_scenario(cfg: &PartitionConfig) -> Result<PathBuf, ConfigError> {
     let path = cfg.scenario_path();
     match sc_scenario::Scenario::load(&path) {
-        // refused, not ignored: the partition has no navigation role yet, so its
-        // controllers and filters would act on the truth and its plant would be the model
-        Ok(s) if s.uncertainty.is_some() => err(format!(
-            "scenario = {:?} declares an `[uncertainty]` profile: the partition runs only the `exact` profile so far (the navigation role is issue #25); run it in one process with `safe-capture run`, or remove the section",
+        // refused, not ignored: a plant process propagates the declared model, so the
+        // realised plant of the uncertainty would silently not be the truth
+        Ok(s) if s.uncertainty.is_some() && !cfg.simulator.plant.is_empty() => err(format!(
+            "scenario = {:?} declares an `[uncertainty]` profile, but `[simulator] plant` propagates the declared model only; drop the plant (the built-in simulator propagates the realised plant) or the section",
             cfg.scenario
         )),
         Ok(_) => Ok(path),

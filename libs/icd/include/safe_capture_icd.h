@@ -35,6 +35,8 @@ extern "C" {
 #define SC_SERVICE_CONTROL "safe_capture/scheduler/control" /* Tick, QoS flight */
 #define SC_SERVICE_SIM_STATE "safe_capture/sim/state" /* SimState, QoS flight */
 #define SC_SERVICE_PARTNER_STATE "safe_capture/partner/state" /* SimState, QoS partner */
+#define SC_SERVICE_TRUTH "safe_capture/sim/truth" /* SimState, QoS flight */
+#define SC_SERVICE_NAVIGATION_ERROR "safe_capture/sim/navigation_error" /* NavigationError, QoS flight */
 #define SC_SERVICE_NOMINAL_TRANSLATIONAL "safe_capture/nominal/translational" /* NominalTranslational, QoS partner */
 #define SC_SERVICE_NOMINAL_ATTITUDE "safe_capture/nominal/attitude" /* NominalAttitude, QoS partner */
 #define SC_SERVICE_NOMINAL_ROBOTIC "safe_capture/nominal/robotic" /* NominalRobotic, QoS partner */
@@ -59,6 +61,7 @@ extern "C" {
 #define SC_TYPE_NAME_SAFE_ATTITUDE "safe_capture::v2::SafeAttitude"
 #define SC_TYPE_NAME_SAFE_ROBOTIC "safe_capture::v2::SafeRobotic"
 #define SC_TYPE_NAME_STEP_RESULT "safe_capture::v1::StepResult"
+#define SC_TYPE_NAME_NAVIGATION_ERROR "safe_capture::v1::NavigationError"
 #define SC_TYPE_NAME_HEALTH "safe_capture::v1::Health"
 
 /* Event ids of the partition's event services (`sc_bus::pubsub`, `sc_bus::handshake`; `libs/bus/tests/icd_constants.rs` checks them against sc-bus). */
@@ -460,6 +463,40 @@ SC_ICD_STATIC_ASSERT(offsetof(ScStepResult, publish_ns) == 40, "ScStepResult.pub
 SC_ICD_STATIC_ASSERT(offsetof(ScStepResult, force_b) == 48, "ScStepResult.force_b: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScStepResult, torque_b) == 72, "ScStepResult.torque_b: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScStepResult, tau) == 96, "ScStepResult.tau: offset");
+
+/* NavigationError -- safe_capture::v1::NavigationError, 96 B. Simulator → recorder, with a declared `[uncertainty]` only: the realised navigation errors of the tick's estimate (the state on `SIM_STATE`) against the measured truth (on `TRUTH`), each as in `navigation.csv` (vectors: Euclidean norm; joints: the largest of the seven). */
+typedef struct ScNavigationError {
+    uint64_t tick; /* Tick index [-] */
+    double t; /* Simulation time of the estimate [s] */
+    double relative_position_m; /* Relative position error of the servicer base to the target CoM [m] */
+    double relative_velocity_m_s; /* Relative velocity error [m/s] */
+    double servicer_attitude_rad; /* Servicer attitude error (rotation angle) [rad] */
+    double servicer_rate_rad_s; /* Servicer body rate error [rad/s] */
+    double target_attitude_rad; /* Target attitude error (rotation angle) [rad] */
+    double target_rate_rad_s; /* Target body rate error [rad/s] */
+    double grasp_point_m; /* Grasping point error in the target frame [m] */
+    double joint_angle_rad; /* Largest joint angle error [rad] */
+    double joint_rate_rad_s; /* Largest joint rate error [rad/s] */
+    double measurement_age_s; /* Age of the measurement the estimate rests on [s] */
+#if defined(__cplusplus) && __cplusplus >= 201703L
+    /* the name iceoryx2's C++ API matches the payload type by */
+    static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v1::NavigationError";
+#endif
+} ScNavigationError;
+SC_ICD_STATIC_ASSERT(sizeof(ScNavigationError) == 96, "ScNavigationError: size");
+SC_ICD_STATIC_ASSERT(SC_ICD_ALIGNOF(ScNavigationError) == 8, "ScNavigationError: alignment");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavigationError, tick) == 0, "ScNavigationError.tick: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavigationError, t) == 8, "ScNavigationError.t: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavigationError, relative_position_m) == 16, "ScNavigationError.relative_position_m: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavigationError, relative_velocity_m_s) == 24, "ScNavigationError.relative_velocity_m_s: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavigationError, servicer_attitude_rad) == 32, "ScNavigationError.servicer_attitude_rad: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavigationError, servicer_rate_rad_s) == 40, "ScNavigationError.servicer_rate_rad_s: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavigationError, target_attitude_rad) == 48, "ScNavigationError.target_attitude_rad: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavigationError, target_rate_rad_s) == 56, "ScNavigationError.target_rate_rad_s: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavigationError, grasp_point_m) == 64, "ScNavigationError.grasp_point_m: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavigationError, joint_angle_rad) == 72, "ScNavigationError.joint_angle_rad: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavigationError, joint_rate_rad_s) == 80, "ScNavigationError.joint_rate_rad_s: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavigationError, measurement_age_s) == 88, "ScNavigationError.measurement_age_s: offset");
 
 /* Health -- safe_capture::v1::Health, 56 B. Recorder → scheduler: the recorder's progress (lock-step flow control); the fields are those of a health report any process could publish. */
 typedef struct ScHealth {

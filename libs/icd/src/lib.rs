@@ -486,6 +486,40 @@ icd_message! {
 }
 
 icd_message! {
+    /// Simulator → recorder, with a declared `[uncertainty]` only: the realised
+    /// navigation errors of the tick's estimate (the state on `SIM_STATE`) against the
+    /// measured truth (on `TRUTH`), each as in `navigation.csv` (vectors: Euclidean norm;
+    /// joints: the largest of the seven).
+    #[type_name("safe_capture::v1::NavigationError")]
+    pub struct NavigationError {
+        /// Tick index
+        pub tick: u64 = ["-"],
+        /// Simulation time of the estimate
+        pub t: f64 = ["s"],
+        /// Relative position error of the servicer base to the target CoM
+        pub relative_position_m: f64 = ["m"],
+        /// Relative velocity error
+        pub relative_velocity_m_s: f64 = ["m/s"],
+        /// Servicer attitude error (rotation angle)
+        pub servicer_attitude_rad: f64 = ["rad"],
+        /// Servicer body rate error
+        pub servicer_rate_rad_s: f64 = ["rad/s"],
+        /// Target attitude error (rotation angle)
+        pub target_attitude_rad: f64 = ["rad"],
+        /// Target body rate error
+        pub target_rate_rad_s: f64 = ["rad/s"],
+        /// Grasping point error in the target frame
+        pub grasp_point_m: f64 = ["m"],
+        /// Largest joint angle error
+        pub joint_angle_rad: f64 = ["rad"],
+        /// Largest joint rate error
+        pub joint_rate_rad_s: f64 = ["rad/s"],
+        /// Age of the measurement the estimate rests on
+        pub measurement_age_s: f64 = ["s"],
+    }
+}
+
+icd_message! {
     /// Recorder → scheduler: the recorder's progress (lock-step flow control); the
     /// fields are those of a health report any process could publish.
     #[type_name("safe_capture::v1::Health")]
@@ -512,7 +546,7 @@ icd_message! {
 }
 
 /// Every message of the ICD, in the order of the C header and docs/ICD.md.
-pub const MESSAGES: [&spec::MessageSpec; 10] = [
+pub const MESSAGES: [&spec::MessageSpec; 11] = [
     &Tick::SPEC,
     &SimState::SPEC,
     &NominalTranslational::SPEC,
@@ -522,6 +556,7 @@ pub const MESSAGES: [&spec::MessageSpec; 10] = [
     &SafeAttitude::SPEC,
     &SafeRobotic::SPEC,
     &StepResult::SPEC,
+    &NavigationError::SPEC,
     &Health::SPEC,
 ];
 
@@ -543,6 +578,7 @@ const _: () = assert!(core::mem::size_of::<SafeTranslational>() == 160);
 const _: () = assert!(core::mem::size_of::<SafeAttitude>() == 240);
 const _: () = assert!(core::mem::size_of::<SafeRobotic>() == 864);
 const _: () = assert!(core::mem::size_of::<StepResult>() == 152);
+const _: () = assert!(core::mem::size_of::<NavigationError>() == 96);
 const _: () = assert!(core::mem::size_of::<Health>() == 56);
 const _: () = assert!(core::mem::align_of::<SimState>() == 8);
 const _: () = assert!(core::mem::align_of::<Health>() == 8);
@@ -587,6 +623,7 @@ mod tests {
         check::<SafeAttitude>();
         check::<SafeRobotic>();
         check::<StepResult>();
+        check::<NavigationError>();
         check::<Health>();
     }
 

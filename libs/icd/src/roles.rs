@@ -93,9 +93,9 @@ impl Role {
 }
 
 use services::{
-    CONTROL, HANDSHAKE, HEALTH, NOMINAL_ATTITUDE, NOMINAL_ROBOTIC, NOMINAL_TRANSLATIONAL,
-    PARTNER_STATE, PREPARE, SAFE_ATTITUDE, SAFE_ROBOTIC, SAFE_TRANSLATIONAL, SIM_STATE,
-    STAGE_DEADLINE, STEP_RESULT, TICK,
+    CONTROL, HANDSHAKE, HEALTH, NAVIGATION_ERROR, NOMINAL_ATTITUDE, NOMINAL_ROBOTIC,
+    NOMINAL_TRANSLATIONAL, PARTNER_STATE, PREPARE, SAFE_ATTITUDE, SAFE_ROBOTIC, SAFE_TRANSLATIONAL,
+    SIM_STATE, STAGE_DEADLINE, STEP_RESULT, TICK, TRUTH,
 };
 
 /// Every role of the partition, in start order (the scheduler, the handshake's
@@ -116,7 +116,13 @@ pub const ROLES: [Role; 9] = [
         name: "simulator",
         kind: RoleKind::Simulator,
         exec: "sc-simulator",
-        publishes: &[SIM_STATE, PARTNER_STATE, STEP_RESULT],
+        publishes: &[
+            TRUTH,
+            NAVIGATION_ERROR,
+            SIM_STATE,
+            PARTNER_STATE,
+            STEP_RESULT,
+        ],
         subscribes: &[
             TICK,
             PREPARE,
@@ -193,6 +199,8 @@ pub const ROLES: [Role; 9] = [
         publishes: &[HEALTH],
         subscribes: &[
             TICK,
+            TRUTH,
+            NAVIGATION_ERROR,
             SIM_STATE,
             NOMINAL_TRANSLATIONAL,
             NOMINAL_ATTITUDE,

@@ -31,7 +31,9 @@ icd_services! {
         /// tick is delivered to the two processes that need it, not to all eight: each
         /// subscriber costs the scheduler's send, on the critical path.
         CONTROL = "safe_capture/scheduler/control", Tick, Flight;
-        /// The state at the start of each step, for the flight side (lossless).
+        /// The state at the start of each step, for the flight side (lossless); with a
+        /// declared `[uncertainty]` the navigation's estimate (what the controllers and
+        /// filters know), its `barriers` those on knowledge.
         SIM_STATE = "safe_capture/sim/state", SimState, Flight;
         /// The same state for the nominal controllers — the processes partners replace,
         /// woken by it — on a newest-wins service: a partner that stops reading loses
@@ -39,6 +41,14 @@ icd_services! {
         /// after `SIM_STATE`, so the filters always have the state before any command
         /// answering it.
         PARTNER_STATE = "safe_capture/partner/state", SimState, Partner;
+        /// The true state at the start of each step, for the recorder, with a declared
+        /// `[uncertainty]` only: `SIM_STATE` then carries the navigation's estimate (what
+        /// the controllers and filters know), this one the truth with the monitored
+        /// barriers. Published before `SIM_STATE`.
+        TRUTH = "safe_capture/sim/truth", SimState, Flight;
+        /// The realised navigation errors of each step's estimate, for the recorder, with a
+        /// declared `[uncertainty]` only. Published with `TRUTH`.
+        NAVIGATION_ERROR = "safe_capture/sim/navigation_error", NavigationError, Flight;
         /// The nominal translational command; the translational safety filter wakes on it.
         NOMINAL_TRANSLATIONAL = "safe_capture/nominal/translational", NominalTranslational, Partner;
         /// The nominal attitude command; the attitude safety filter wakes on it.

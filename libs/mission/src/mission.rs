@@ -292,13 +292,7 @@ impl Mission {
 /// The realisation of the scenario's declared uncertainty (`None` when it declares
 /// none), drawn from its seed.
 fn draw_realisation(setup: &Setup) -> Result<Option<Realisation>, SetupError> {
-    let bounds = setup.scenario.uncertainty_truth_bounds();
-    if setup.scenario.uncertainty.is_none() {
-        return Ok(None);
-    }
-    let seed = setup.scenario.uncertainty.as_ref().map_or(0, |u| u.seed);
-    Realisation::draw(&bounds, seed, &setup.scenario, &setup.robot)
-        .map(Some)
+    Realisation::declared(&setup.scenario, &setup.robot)
         .map_err(|e| SetupError::Other(format!("uncertainty: {e}")))
 }
 

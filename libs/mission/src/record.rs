@@ -185,6 +185,63 @@ pub fn knowledge_line(r: &StepRecord) -> Option<String> {
     Some(v.join(","))
 }
 
+/// Writes `navigation.csv` at `path` when the records have knowledge apart from the
+/// truth (a declared uncertainty); nothing otherwise. `safe-capture run` and the
+/// partition's recorder write it with this one function.
+pub fn write_knowledge(path: &std::path::Path, records: &[StepRecord]) -> std::io::Result<()> {
+    use std::io::Write;
+    if records.iter().all(|r| r.navigation_error.is_none()) {
+        return Ok(());
+    }
+    let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
+    writeln!(f, "{}", knowledge_columns().join(","))?;
+    for line in records.iter().filter_map(knowledge_line) {
+        writeln!(f, "{line}")?;
+    }
+    f.flush()
+}
+
+/// Reads `navigation.csv` (written by [`write_knowledge`]) back into `records`, the
+/// steps of the same run's telemetry: each line's navigation errors and barriers on
+/// knowledge go to the record of its step, bit for bit.
+pub fn read_knowledge(text: &str, records: &mut [StepRecord]) -> Result<(), TelemetryError> {
+    const FILE: &str = "navigation.csv";
+    let names = knowledge_columns();
+    let mut lines = text.lines();
+    if lines.next() != Some(names.join(",").as_str()) {
+        return Err(TelemetryError::Header { file: FILE });
+    }
+    let mut rows = 0;
+    for (i, line) in lines.enumerate() {
+        let n = i + 2;
+        let mut c = Fields::new(FILE, n, line, &names)?;
+        let step: u64 = c.parse("a step")?;
+        let t: f64 = c.parse("a time")?;
+        let r = records
+            .get_mut(i)
+            .filter(|r| r.step == step && same_bits(r.t, t))
+            .ok_or(TelemetryError::KnowledgeStep { line: n, step })?;
+        let mut e = [0.0; 10];
+        for x in &mut e {
+            *x = c.parse("a number")?;
+        }
+        let mut h = [0.0; sc_cbf::monitor::N_ALL];
+        for x in &mut h {
+            *x = c.parse("a number")?;
+        }
+        r.navigation_error = Some(sc_sim::uncertainty::NavigationError::from_values(&e));
+        r.knowledge_barriers = Some(h);
+        rows += 1;
+    }
+    if rows != records.len() {
+        return Err(TelemetryError::KnowledgeRows {
+            rows,
+            steps: records.len(),
+        });
+    }
+    Ok(())
+}
+
 /// Formats one record as a `telemetry.csv` line (without newline).
 pub fn telemetry_line(r: &StepRecord) -> String {
     let o = &r.obs;
@@ -349,6 +406,10 @@ pub enum TelemetryError {
     },
     #[error("timing.csv: more rows than the {rows} of telemetry.csv")]
     TimingLonger { rows: usize },
+    #[error("navigation.csv line {line}: step {step} is not the step of telemetry.csv's row")]
+    KnowledgeStep { line: usize, step: u64 },
+    #[error("navigation.csv: {rows} rows for the {steps} steps of telemetry.csv")]
+    KnowledgeRows { rows: usize, steps: usize },
 }
 
 /// Bit-for-bit equality of two floats (NaN equals NaN).

@@ -295,3 +295,56 @@ fn thread_cpu_time_lies_within_the_wall_time() {
         records.len()
     );
 }
+
+/// `read_knowledge` gives back what `write_knowledge` wrote under a declared profile:
+/// every navigation error and barrier on knowledge with the same bits; a navigation.csv
+/// of another run (its steps not the telemetry's) or cut short is refused.
+#[test]
+fn knowledge_round_trips_bit_for_bit() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/scenario.toml");
+    let mut setup = Setup::load(&path).unwrap();
+    setup.scenario.mission.duration_s = 3.0;
+    let spec = sc_scenario::UncertaintySpec {
+        profile: "realistic".into(),
+        seed: 2,
+        model: None,
+        actuators: None,
+        navigation: None,
+        truth: None,
+    };
+    setup.scenario.set_uncertainty(spec).unwrap();
+    let mut records = Vec::new();
+    Mission::new(setup, RunOptions { no_filter: false })
+        .unwrap()
+        .run(|_, r| records.push(*r));
+    let dir = std::env::temp_dir().join(format!("sc-knowledge-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("navigation.csv");
+    sc_mission::record::write_knowledge(&file, &records).unwrap();
+    let text = std::fs::read_to_string(&file).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    let mut back: Vec<StepRecord> = records
+        .iter()
+        .map(|r| StepRecord {
+            navigation_error: None,
+            knowledge_barriers: None,
+            ..*r
+        })
+        .collect();
+    sc_mission::record::read_knowledge(&text, &mut back).unwrap();
+    for (a, b) in records.iter().zip(&back) {
+        let (ea, eb) = (a.navigation_error.unwrap(), b.navigation_error.unwrap());
+        bits::<10>(&ea.values(), &eb.values(), "navigation_error", a.step);
+        bits::<{ sc_cbf::monitor::N_ALL }>(
+            &a.knowledge_barriers.unwrap(),
+            &b.knowledge_barriers.unwrap(),
+            "knowledge_barriers",
+            a.step,
+        );
+    }
+    let err = sc_mission::record::read_knowledge(&text, &mut back[1..]).unwrap_err();
+    assert!(err.to_string().contains("is not the step"), "{err}");
+    let short: String = text.lines().take(3).map(|l| format!("{l}\n")).collect();
+    let err = sc_mission::record::read_knowledge(&short, &mut back).unwrap_err();
+    assert!(err.to_string().contains("rows for the"), "{err}");
+}

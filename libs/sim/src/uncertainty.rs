@@ -340,6 +340,22 @@ impl NavigationError {
         ]
     }
 
+    /// From values in [`NAVIGATION_ERROR_NAMES`]' order ([`Self::values`]' inverse).
+    pub fn from_values(v: &[f64; 10]) -> Self {
+        Self {
+            relative_position_m: v[0],
+            relative_velocity_m_s: v[1],
+            servicer_attitude_rad: v[2],
+            servicer_rate_rad_s: v[3],
+            target_attitude_rad: v[4],
+            target_rate_rad_s: v[5],
+            grasp_point_m: v[6],
+            joint_angle_rad: v[7],
+            joint_rate_rad_s: v[8],
+            measurement_age_s: v[9],
+        }
+    }
+
     /// The declared bounds in the same order.
     pub fn bounds(b: &NavigationBounds) -> [f64; 10] {
         let e = b.errors().map(|(_, x): (&str, BiasNoise)| x.bound());
@@ -541,6 +557,23 @@ pub enum UncertaintyError {
 const MAX_PLANT_DRAWS: usize = 100;
 
 impl Realisation {
+    /// The realisation of `scenario`'s declared uncertainty, drawn from its seed and its
+    /// truth bounds (`uncertainty.truth`, else the declared ones); `None` when it declares
+    /// none (truth and knowledge are one). The mission in one process and the partition's
+    /// simulator draw the same realisation from the same scenario.
+    pub fn declared(scenario: &Scenario, robot: &Robot) -> Result<Option<Self>, UncertaintyError> {
+        let Some(spec) = scenario.uncertainty.as_ref() else {
+            return Ok(None);
+        };
+        Self::draw(
+            &scenario.uncertainty_truth_bounds(),
+            spec.seed,
+            scenario,
+            robot,
+        )
+        .map(Some)
+    }
+
     /// Draws the realisation of `bounds` with `seed` for the declared `scenario` and
     /// `robot`.
     pub fn draw(

@@ -22,6 +22,8 @@ SERVICE_TICK = "safe_capture/scheduler/tick"  # Tick, QoS flight
 SERVICE_CONTROL = "safe_capture/scheduler/control"  # Tick, QoS flight
 SERVICE_SIM_STATE = "safe_capture/sim/state"  # SimState, QoS flight
 SERVICE_PARTNER_STATE = "safe_capture/partner/state"  # SimState, QoS partner
+SERVICE_TRUTH = "safe_capture/sim/truth"  # SimState, QoS flight
+SERVICE_NAVIGATION_ERROR = "safe_capture/sim/navigation_error"  # NavigationError, QoS flight
 SERVICE_NOMINAL_TRANSLATIONAL = "safe_capture/nominal/translational"  # NominalTranslational, QoS partner
 SERVICE_NOMINAL_ATTITUDE = "safe_capture/nominal/attitude"  # NominalAttitude, QoS partner
 SERVICE_NOMINAL_ROBOTIC = "safe_capture/nominal/robotic"  # NominalRobotic, QoS partner
@@ -42,6 +44,8 @@ SERVICE_QOS = {
     SERVICE_CONTROL: "flight",
     SERVICE_SIM_STATE: "flight",
     SERVICE_PARTNER_STATE: "partner",
+    SERVICE_TRUTH: "flight",
+    SERVICE_NAVIGATION_ERROR: "flight",
     SERVICE_NOMINAL_TRANSLATIONAL: "partner",
     SERVICE_NOMINAL_ATTITUDE: "partner",
     SERVICE_NOMINAL_ROBOTIC: "partner",
@@ -352,6 +356,29 @@ class StepResult(ctypes.Structure):
         return "safe_capture::v1::StepResult"
 
 
+class NavigationError(ctypes.Structure):
+    """Simulator → recorder, with a declared `[uncertainty]` only: the realised navigation errors of the tick's estimate (the state on `SIM_STATE`) against the measured truth (on `TRUTH`), each as in `navigation.csv` (vectors: Euclidean norm; joints: the largest of the seven)."""
+
+    _fields_ = [
+        ("tick", ctypes.c_uint64),  # Tick index [-]
+        ("t", ctypes.c_double),  # Simulation time of the estimate [s]
+        ("relative_position_m", ctypes.c_double),  # Relative position error of the servicer base to the target CoM [m]
+        ("relative_velocity_m_s", ctypes.c_double),  # Relative velocity error [m/s]
+        ("servicer_attitude_rad", ctypes.c_double),  # Servicer attitude error (rotation angle) [rad]
+        ("servicer_rate_rad_s", ctypes.c_double),  # Servicer body rate error [rad/s]
+        ("target_attitude_rad", ctypes.c_double),  # Target attitude error (rotation angle) [rad]
+        ("target_rate_rad_s", ctypes.c_double),  # Target body rate error [rad/s]
+        ("grasp_point_m", ctypes.c_double),  # Grasping point error in the target frame [m]
+        ("joint_angle_rad", ctypes.c_double),  # Largest joint angle error [rad]
+        ("joint_rate_rad_s", ctypes.c_double),  # Largest joint rate error [rad/s]
+        ("measurement_age_s", ctypes.c_double),  # Age of the measurement the estimate rests on [s]
+    ]
+
+    @staticmethod
+    def type_name():
+        return "safe_capture::v1::NavigationError"
+
+
 class Health(ctypes.Structure):
     """Recorder → scheduler: the recorder's progress (lock-step flow control); the fields are those of a health report any process could publish."""
 
@@ -383,6 +410,7 @@ ALL_TYPES = [
     SafeAttitude,
     SafeRobotic,
     StepResult,
+    NavigationError,
     Health,
 ]
 
@@ -396,6 +424,8 @@ __all__ = [
     "SERVICE_CONTROL",
     "SERVICE_SIM_STATE",
     "SERVICE_PARTNER_STATE",
+    "SERVICE_TRUTH",
+    "SERVICE_NAVIGATION_ERROR",
     "SERVICE_NOMINAL_TRANSLATIONAL",
     "SERVICE_NOMINAL_ATTITUDE",
     "SERVICE_NOMINAL_ROBOTIC",
@@ -462,6 +492,7 @@ __all__ = [
     "SafeAttitude",
     "SafeRobotic",
     "StepResult",
+    "NavigationError",
     "Health",
     "ALL_TYPES",
 ]

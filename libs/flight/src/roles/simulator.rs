@@ -21,9 +21,9 @@ use sc_cbf::SafetyLayer;
 use sc_cbf::monitor::{Barriers, Monitor, N_ALL, min_into};
 use sc_core::{Command, Observation, PerSubsystem, Subsystem, SubsystemSet};
 use sc_icd::services::{self, ServiceName};
-use sc_icd::{StepResult, Tick, end, fault, tick_command};
+use sc_icd::{SimState, StepResult, Tick, end, fault, tick_command};
 use sc_scenario::Scenario;
-use sc_sim::{Plant, Simulator};
+use sc_sim::{Plant, Realisation, Simulator};
 use std::collections::VecDeque;
 
 /// A safe command as the simulator judges it, whatever its subsystem.
@@ -75,7 +75,11 @@ impl Received {
 /// The tick in progress: its state and deadline.
 struct InTick {
     tick: Tick,
+    /// The true state (capture, monitor).
     o: Observation,
+    /// What the controllers and filters know: the navigation's estimate (the truth for
+    /// the `exact` profile); the backups are computed on it, as the filters would.
+    known: Observation,
     barriers: Barriers,
     barriers_between: Barriers,
     until_ns: u64,
@@ -109,10 +113,16 @@ const WAKE: &[WakeSet] = &[
 
 /// The simulator role.
 pub struct SimulatorRole {
+    /// Propagates the truth (the realisation's plant with a declared uncertainty).
     sim: Simulator,
     plant: Option<Box<dyn Plant + Send>>,
+    /// The layer on the declared model (the backups).
     layer: SafetyLayer,
+    /// Every barrier on the truth.
     monitor: Monitor,
+    /// With a declared `[uncertainty]`: the realisation (plant, actuators, navigation)
+    /// and the barriers on knowledge (the declared model on the estimate).
+    realisation: Option<(Realisation, Monitor)>,
     scenario: Scenario,
     deadline_ns: u64,
     /// With `max_ticks` (benchmarks, soak runs) the physics goes on after the mission's
@@ -147,6 +157,7 @@ impl SimulatorRole {
             plant,
             layer: SafetyLayer::from_scenario(&scenario, robot.clone()),
             monitor: Monitor::from_scenario(&scenario, robot),
+            realisation: None,
             scenario,
             deadline_ns,
             keep_going,
@@ -164,18 +175,44 @@ impl SimulatorRole {
         }
     }
 
-    /// From the process's config: the simulator at the base period, the plant process of
-    /// `[simulator] plant` (started now, before the handshake), the simulator's deadline.
+    /// The role propagating the truth of `realisation` (drawn for `scenario`, the
+    /// declared one): the simulator and its monitor on the realised plant, the actuators'
+    /// errors on every applied command, the navigation's estimate published as the state.
+    pub fn with_realisation(mut self, realisation: Realisation) -> Result<Self, FlightError> {
+        let robot = std::sync::Arc::new(realisation.true_robot.clone());
+        let truth = &realisation.true_scenario;
+        self.sim = Simulator::new(truth, robot.clone())
+            .map_err(|e| FlightError::Simulator(e.to_string()))?;
+        let known = std::mem::replace(&mut self.monitor, Monitor::from_scenario(truth, robot));
+        self.realisation = Some((realisation, known));
+        Ok(self)
+    }
+
+    /// From the process's config: the simulator at the base period (on the realised plant
+    /// of a declared `[uncertainty]`), the plant process of `[simulator] plant` (started
+    /// now, before the handshake), the simulator's deadline.
     pub fn from_process(p: &Proc) -> Result<Self, FlightError> {
         let scenario = p.scenario_with_period(p.schedule.base_period_s);
         let robot = p.setup.robot.clone();
+        let realisation = Realisation::declared(&scenario, &robot)
+            .map_err(|e| FlightError::Simulator(format!("uncertainty: {e}")))?;
         let sim = Simulator::new(&scenario, robot.clone())
             .map_err(|e| FlightError::Simulator(e.to_string()))?;
-        let plant = start_plant(p, &sim)?;
         let deadline = p.deadline(p.cfg.deadlines.simulator_ms);
         let ns = deadline.as_nanos().min(u128::from(u64::MAX)) as u64;
         let keep_going = p.cfg.max_ticks > 0;
-        Ok(Self::new(sim, plant, scenario, robot, ns, keep_going))
+        let mut role = Self::new(sim, None, scenario, robot, ns, keep_going);
+        if let Some(r) = realisation {
+            if !p.cfg.simulator.plant.is_empty() {
+                // as the preflight: the plant process would propagate the model
+                return Err(FlightError::Usage(
+                    "a declared [uncertainty] needs the built-in simulator: `[simulator] plant` propagates the declared model only".into(),
+                ));
+            }
+            role = role.with_realisation(r)?;
+        }
+        role.plant = start_plant(p, &role.sim)?;
+        Ok(role)
     }
 
     /// Takes the inputs of one wake-up (in the role's read order).
@@ -214,21 +251,39 @@ impl SimulatorRole {
     /// answers), awaits the safe commands.
     fn start_tick(&mut self, t: Tick, now_ns: u64, out: &mut Outbox) {
         let o = self.sim.observe();
-        let mut msg = convert::sim_state(&o);
         let barriers = self.monitor.evaluate(&o.barrier_state());
-        msg.barriers = barriers;
-        msg.barriers_between = self.between.unwrap_or(barriers);
-        msg.tick = t.tick;
-        msg.due_mask = t.due_mask;
-        msg.tick_send_ns = t.send_ns;
-        msg.recv_ns = now_ns;
+        let barriers_between = self.between.unwrap_or(barriers);
+        let stamp = |mut msg: SimState, b: Barriers, between: Barriers| {
+            msg.barriers = b;
+            msg.barriers_between = between;
+            msg.tick = t.tick;
+            msg.due_mask = t.due_mask;
+            msg.tick_send_ns = t.send_ns;
+            msg.recv_ns = now_ns;
+            msg
+        };
+        let truth = stamp(convert::sim_state(&o), barriers, barriers_between);
+        let (known, msg) = match self.realisation.as_mut() {
+            Some((r, knowledge)) => {
+                // the truth for the recorder first, then what the controllers know
+                let (estimate, error) = r.navigation.estimate(&self.sim);
+                out.send(Message::Truth(truth));
+                out.send(Message::NavigationError(convert::navigation_error(
+                    t.tick, o.t, &error,
+                )));
+                let kb = knowledge.evaluate(&estimate.barrier_state());
+                (estimate, stamp(convert::sim_state(&estimate), kb, kb))
+            }
+            None => (o, truth),
+        };
         out.send(Message::State(msg));
         out.send(Message::PartnerState(msg));
         self.pending = Some(InTick {
             tick: t,
             o,
+            known,
             barriers,
-            barriers_between: msg.barriers_between,
+            barriers_between,
             until_ns: now_ns.saturating_add(self.deadline_ns),
             safe_recv_ns: 0,
         });
@@ -302,7 +357,7 @@ impl SimulatorRole {
     /// advances the physics (the barriers monitored at every physics step) and
     /// publishes the step result.
     fn finish_tick(&mut self, p: InTick, out: &mut Outbox) {
-        let (k, o) = (p.tick.tick, p.o);
+        let (k, o, known) = (p.tick.tick, p.o, p.known);
         let due = SubsystemSet::from_bits(p.tick.due_mask);
         let mut res = StepResult {
             tick: k,
@@ -311,7 +366,7 @@ impl SimulatorRole {
             ..Default::default()
         };
         for s in Subsystem::ALL {
-            self.apply(s, &o, k, due, &mut res, out);
+            self.apply(s, &known, k, due, &mut res, out);
         }
         convert::set_applied(&mut res, &self.held);
         // the phase is the mission's own schedule, never a partner's report
@@ -340,11 +395,16 @@ impl SimulatorRole {
         let mut min: Barriers = [f64::INFINITY; N_ALL];
         let monitor = &self.monitor;
         let at_physics_step = |b: &sc_sim::BarrierState| min_into(&mut min, &monitor.evaluate(b));
+        // what the actuators deliver of the applied command
+        let delivered = match self.realisation.as_mut() {
+            Some((r, _)) => r.actuators.deliver(&self.held),
+            None => self.held,
+        };
         let stepped = match self.plant.as_mut() {
             Some(pl) => self
                 .sim
-                .step_with_plant(pl.as_mut(), &self.held, at_physics_step),
-            None => self.sim.step_with(&self.held, at_physics_step),
+                .step_with_plant(pl.as_mut(), &delivered, at_physics_step),
+            None => self.sim.step_with(&delivered, at_physics_step),
         };
         self.between = Some(min);
         if let Err(e) = stepped {
@@ -542,6 +602,65 @@ mod tests {
             Some(r) => r,
             None => panic!("no step result in {:?}", out.send),
         }
+    }
+
+    /// The role on a realisation of the `realistic` profile (seed 3).
+    fn realistic_role() -> SimulatorRole {
+        let mut su = setup();
+        let spec = sc_scenario::UncertaintySpec {
+            profile: "realistic".into(),
+            seed: 3,
+            model: None,
+            actuators: None,
+            navigation: None,
+            truth: None,
+        };
+        su.scenario.set_uncertainty(spec).unwrap();
+        let real = Realisation::declared(&su.scenario, &su.robot)
+            .unwrap()
+            .expect("a declared profile");
+        role().with_realisation(real).unwrap()
+    }
+
+    /// With a declared uncertainty the truth (with the monitor's barriers) and the
+    /// realised errors go first, then the estimate on both state services with the
+    /// barriers on knowledge; the backups are computed on the estimate, the capture and
+    /// the monitor on the truth.
+    #[test]
+    fn a_realisation_publishes_the_truth_apart_from_the_estimate() {
+        let mut r = realistic_role();
+        let out = handle(&mut r, 100, Woke::Event, &[tick(0, SubsystemSet::ALL)]);
+        let [
+            Message::Truth(truth),
+            Message::NavigationError(nav),
+            Message::State(known),
+            Message::PartnerState(partner),
+        ] = out.send[..]
+        else {
+            panic!("truth, errors, then the estimate: {:?}", out.send);
+        };
+        assert_eq!(
+            sc_icd::Message::as_bytes(&known),
+            sc_icd::Message::as_bytes(&partner)
+        );
+        assert_ne!(truth.r_r, known.r_r, "the estimate is not the truth");
+        assert_eq!((truth.tick, nav.tick, known.tick), (0, 0, 0));
+        assert!(nav.relative_position_m > 0.0 && nav.relative_position_m <= 0.02);
+        let p = r.pending.as_ref().unwrap();
+        assert_eq!(p.barriers, truth.barriers, "the monitor on the truth");
+        assert_eq!(convert::sim_state(&p.known).r_r, known.r_r);
+        assert_ne!(known.barriers, truth.barriers, "barriers on knowledge");
+        // no safe command by the deadline: the backups, on what the filters knew
+        let out = handle(&mut r, 100 + DEADLINE_NS, Woke::Timeout, &[]);
+        let res = result(&out);
+        assert_eq!(res.fallback_mask, SubsystemSet::ALL.bits());
+        let mut layer = SafetyLayer::from_scenario(&r.scenario, setup().robot);
+        let o = convert::observation(&known);
+        assert_eq!(
+            convert::arr3(&layer.backup_translational(&o).actuated),
+            res.force_b,
+            "the translational backup on the estimate"
+        );
     }
 
     #[test]

@@ -70,11 +70,16 @@ pub(super) fn judge(out: &Path, broken: bool, error: Option<String>) -> (i32, Op
 }
 
 /// The mission's verdict from a run's summary.json: captured with every barrier
-/// satisfied and no fault; `None` without a readable summary.
+/// satisfied, no fault and (with a declared uncertainty) the realised errors within the
+/// declared bounds, as `safe-capture run` judges; `None` without a readable summary.
 pub fn mission_verdict(summary: &Path) -> Option<bool> {
     let s: sc_mission::Summary =
         serde_json::from_str(&std::fs::read_to_string(summary).ok()?).ok()?;
-    Some(s.captured && s.violated_constraints.is_empty() && s.fault_count == 0)
+    let within = s
+        .uncertainty
+        .as_ref()
+        .is_none_or(|u| u.outside_bounds.is_empty());
+    Some(s.captured && s.violated_constraints.is_empty() && s.fault_count == 0 && within)
 }
 
 /// The flight-side services (everything but the partners' `safe_capture/nominal/*`) of

@@ -166,6 +166,7 @@ mod tests {
             sc_icd::SafeAttitude::json_schema(),
             sc_icd::SafeRobotic::json_schema(),
             sc_icd::StepResult::json_schema(),
+            sc_icd::NavigationError::json_schema(),
             FrameTransform::json_schema(),
             SceneUpdate::json_schema(),
         ]

@@ -71,6 +71,8 @@ pub struct RecorderRole<S: RecordSink> {
     sink: S,
     layer: SafetyLayer,
     scenario: sc_scenario::Scenario,
+    /// The declared model (the uncertainty summary draws the realisation from it).
+    robot: std::sync::Arc<sc_multibody::Robot>,
     /// Mission time of a tick: tick × base period [ns].
     period_ns: u64,
     pid: u32,
@@ -100,6 +102,7 @@ impl<S: RecordSink> RecorderRole<S> {
             sink,
             layer: SafetyLayer::from_scenario(&setup.scenario, setup.robot.clone()),
             scenario: setup.scenario.clone(),
+            robot: setup.robot.clone(),
             period_ns: (base_period_s * 1e9).round() as u64,
             pid,
             rep: RecorderReport::default(),
@@ -161,7 +164,7 @@ impl<S: RecordSink> RecorderRole<S> {
             let complete = self
                 .pending
                 .get(&r.tick)
-                .is_some_and(|set| set.complete(&r));
+                .is_some_and(|set| set.complete(&r, self.scenario.uncertainty.is_some()));
             let waited = self
                 .queued_since_ns
                 .is_some_and(|t| now_ns.saturating_sub(t) > INCOMPLETE_WAIT_NS);
@@ -198,6 +201,15 @@ impl<S: RecordSink> RecorderRole<S> {
             (services::SAFE_ATTITUDE, Some(Attitude), set.sa.is_some()),
             (services::SAFE_ROBOTIC, Some(Robotic), set.sr.is_some()),
         ];
+        // with a declared uncertainty the truth and the navigation errors too
+        let knowledge = [
+            (services::TRUTH, None, set.truth.is_some()),
+            (services::NAVIGATION_ERROR, None, set.navigation.is_some()),
+        ];
+        let declared = self.scenario.uncertainty.is_some();
+        let required = required
+            .into_iter()
+            .chain(knowledge.into_iter().filter(|_| declared));
         for (svc, s, present) in required {
             if s.is_none_or(|s| state.due_mask & s.bit() != 0) {
                 *self.rep.expected.entry(svc.as_str().into()).or_default() += 1;
@@ -282,7 +294,8 @@ fn end_of(r: &StepResult) -> Option<MissionEnd> {
 /// The tick a message of a tick answers.
 fn tick_of(m: &Message) -> Option<u64> {
     Some(match m {
-        Message::State(x) => x.tick,
+        Message::State(x) | Message::Truth(x) => x.tick,
+        Message::NavigationError(x) => x.tick,
         Message::NominalTranslational(x) => x.tick,
         Message::NominalAttitude(x) => x.tick,
         Message::NominalRobotic(x) => x.tick,
@@ -297,6 +310,8 @@ fn tick_of(m: &Message) -> Option<u64> {
 fn file(set: &mut Tickset, m: &Message) {
     match *m {
         Message::State(x) => set.state = Some(x),
+        Message::Truth(x) => set.truth = Some(x),
+        Message::NavigationError(x) => set.navigation = Some(x),
         Message::NominalTranslational(x) => set.nt = Some(x),
         Message::NominalAttitude(x) => set.na = Some(x),
         Message::NominalRobotic(x) => set.nr = Some(x),
@@ -329,6 +344,8 @@ impl<S: RecordSink> Component for RecorderRole<S> {
         // step results first: everything of their tick was sent before them
         &[
             services::STEP_RESULT,
+            services::TRUTH,
+            services::NAVIGATION_ERROR,
             services::SIM_STATE,
             services::NOMINAL_TRANSLATIONAL,
             services::NOMINAL_ATTITUDE,
@@ -390,9 +407,11 @@ impl<S: RecordSink> Component for RecorderRole<S> {
             .iter()
             .map(|x| x.name.clone())
             .collect();
-        let summary = summarize(&self.records, &end, &phase_names, true);
+        let mut summary = summarize(&self.records, &end, &phase_names, true);
+        summary.uncertainty =
+            sc_mission::UncertaintySummary::of(&self.records, &self.scenario, &self.robot, true);
         self.rep.end = summary.end.clone();
-        let r = self.sink.finish(&summary, &self.rep);
+        let r = self.sink.finish(&self.records, &summary, &self.rep);
         self.keep(r);
         if let Some(e) = &self.error {
             out.log(format!("error: recorder: {e}"));
@@ -448,7 +467,12 @@ mod tests {
             self.steps.push(latency.to_string());
             Ok(())
         }
-        fn finish(&mut self, s: &sc_mission::Summary, r: &RecorderReport) -> Result<(), SinkError> {
+        fn finish(
+            &mut self,
+            _: &[StepRecord],
+            s: &sc_mission::Summary,
+            r: &RecorderReport,
+        ) -> Result<(), SinkError> {
             self.finished = Some((s.end.clone(), r.clone()));
             Ok(())
         }

@@ -31,8 +31,14 @@ pub trait RecordSink {
     fn message(&mut self, log_ns: u64, m: &Message) -> Result<(), SinkError>;
     /// One step: its telemetry row and its line of `latency.csv`.
     fn step(&mut self, rec: &StepRecord, latency_line: &str) -> Result<(), SinkError>;
-    /// The end: the summary and the recorder's report; everything flushed and closed.
-    fn finish(&mut self, summary: &Summary, report: &RecorderReport) -> Result<(), SinkError>;
+    /// The end: `navigation.csv` from the records (with a declared uncertainty), the
+    /// summary and the recorder's report; everything flushed and closed.
+    fn finish(
+        &mut self,
+        records: &[StepRecord],
+        summary: &Summary,
+        report: &RecorderReport,
+    ) -> Result<(), SinkError>;
 }
 
 /// The files of a partition run's output folder.
@@ -109,10 +115,15 @@ impl RecordSink for FileSink {
         let topic = m.service().as_str();
         match m {
             Message::Tick(x) | Message::Control(x) => mcap.write(topic, log_ns, x.send_ns, x),
-            Message::State(x) | Message::PartnerState(x) => mcap
+            // the 3D panel's frames (and scene) from the truth: the state itself, or with
+            // a declared uncertainty (the state is then the estimate) the truth's message
+            Message::State(x) | Message::PartnerState(x) if self.scenario.uncertainty.is_some() => {
+                mcap.write(topic, log_ns, x.publish_ns, x)
+            }
+            Message::State(x) | Message::PartnerState(x) | Message::Truth(x) => mcap
                 .write(topic, log_ns, x.publish_ns, x)
-                // the 3D panel's frames (and scene), from each state
                 .and_then(|_| mcap.write_3d(log_ns, x.publish_ns, x)),
+            Message::NavigationError(x) => mcap.write(topic, log_ns, 0, x),
             Message::NominalTranslational(x) => mcap.write(topic, log_ns, x.publish_ns, x),
             Message::NominalAttitude(x) => mcap.write(topic, log_ns, x.publish_ns, x),
             Message::NominalRobotic(x) => mcap.write(topic, log_ns, x.publish_ns, x),
@@ -132,8 +143,15 @@ impl RecordSink for FileSink {
         writeln!(self.latency, "{latency_line}").map_err(&e)
     }
 
-    fn finish(&mut self, summary: &Summary, report: &RecorderReport) -> Result<(), SinkError> {
+    fn finish(
+        &mut self,
+        records: &[StepRecord],
+        summary: &Summary,
+        report: &RecorderReport,
+    ) -> Result<(), SinkError> {
         let e = io(&self.out);
+        let knowledge = self.out.join("navigation.csv");
+        sc_mission::record::write_knowledge(&knowledge, records).map_err(io(&knowledge))?;
         self.telemetry.flush().map_err(&e)?;
         self.latency.flush().map_err(&e)?;
         if let Some(m) = self.mcap.as_mut() {

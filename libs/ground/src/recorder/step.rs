@@ -14,7 +14,12 @@ use sc_mission::StepRecord;
 /// The messages of one tick (or the ones held for slower rate groups).
 #[derive(Debug, Default, Clone, Copy)]
 pub struct Tickset {
+    /// The state the controllers and filters got (the estimate with a declared
+    /// uncertainty).
     pub state: Option<SimState>,
+    /// With a declared uncertainty: the truth and the realised navigation errors.
+    pub truth: Option<SimState>,
+    pub navigation: Option<sc_icd::NavigationError>,
     pub nt: Option<NominalTranslational>,
     pub na: Option<NominalAttitude>,
     pub nr: Option<NominalRobotic>,
@@ -26,9 +31,13 @@ pub struct Tickset {
 impl Tickset {
     /// The tick's due subsystem `s` has what its step needs: its safe command (unless the
     /// simulator used the backup) and its nominal command (unless the filter flagged it
-    /// missing).
-    pub fn complete(&self, r: &StepResult) -> bool {
+    /// missing); with `knowledge` (a declared uncertainty) also the truth and the
+    /// navigation errors.
+    pub fn complete(&self, r: &StepResult, knowledge: bool) -> bool {
         let Some(st) = self.state else { return false };
+        if knowledge && (self.truth.is_none() || self.navigation.is_none()) {
+            return false;
+        }
         let missing_flag = faults::UPSTREAM_MISSING | faults::NOMINAL_MISSING;
         let need = |s: Subsystem, nom: bool, safe: Option<u32>| {
             st.due_mask & s.bit() == 0
@@ -89,7 +98,9 @@ fn nominal_seen<const D: usize>(
 }
 
 /// The record of step result `r` with the state and messages of its tick (`set`), the
-/// messages held from earlier ticks (`held`, updated) and the scenario's phases.
+/// messages held from earlier ticks (`held`, updated) and the scenario's phases. With a
+/// declared uncertainty `state` is what the filters knew (the backups are computed on it,
+/// its barriers are those on knowledge) and `set.truth` the truth the record holds.
 pub fn record(
     layer: &mut SafetyLayer,
     scenario: &sc_scenario::Scenario,
@@ -99,6 +110,7 @@ pub fn record(
     held: &mut Tickset,
 ) -> StepRecord {
     let o = convert::observation(state);
+    let truth = set.truth.as_ref().unwrap_or(state);
     held.nt = set.nt.or(held.nt);
     held.na = set.na.or(held.na);
     held.nr = set.nr.or(held.nr);
@@ -121,10 +133,9 @@ pub fn record(
         t: o.t,
         // the mission's own schedule, as the simulator decides it
         phase: scenario.phase_index(o.t),
-        obs: o,
-        // the partition refuses a scenario with uncertainty (sc_flight::admission)
-        navigation_error: None,
-        knowledge_barriers: None,
+        obs: convert::observation(truth),
+        navigation_error: set.navigation.as_ref().map(convert::navigation_error_of),
+        knowledge_barriers: set.truth.map(|_| state.barriers),
         // what the filter got: NaN where it ran on the substitute nominal (as in
         // process), never a message of another tick or one marked invalid
         f_h_nom: nominal_seen(held.nt.map(|m| convert::vec3(&m.f_h)), tr.report.faults),
@@ -134,8 +145,8 @@ pub fn record(
         attitude: at,
         robotic: rb,
         applied,
-        barriers: state.barriers,
-        barriers_between: state.barriers_between,
+        barriers: truth.barriers,
+        barriers_between: truth.barriers_between,
     }
 }
 
