@@ -321,7 +321,15 @@ fn verdict_line(a: &Args, s: &report::CampaignSummary, wall: f64, under: &str) {
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let mut setup = Setup::load(&a.scenario)?;
     a.uncertainty.refuse_truth("redteam")?;
+    let declared_in_file = setup.scenario.uncertainty.clone();
     a.uncertainty.apply(&mut setup.scenario)?;
+    if a.partition && setup.scenario.uncertainty != declared_in_file {
+        // the partition's processes read the scenario file: a profile given on the
+        // command line would be reported but not run
+        anyhow::bail!(
+            "--partition: the processes read the scenario file, so --uncertainty cannot change its profile; declare it in the scenario's [uncertainty] section (docs/UNCERTAINTY.md), or drop --partition to run the cases in process"
+        );
+    }
     let cases = selected(&a, run_ticks(&a, &setup))?;
     if a.list {
         for c in &cases {

@@ -201,7 +201,7 @@ fn a_partition_campaign_under_a_profile_is_the_campaign_in_process() {
     let d = tmp("unc-mc-partition");
     let campaign = |mode: &str, out: &str| {
         let o = d.0.join(out);
-        let args = [
+        let mut args = vec![
             "montecarlo",
             "--runs",
             "2",
@@ -212,6 +212,10 @@ fn a_partition_campaign_under_a_profile_is_the_campaign_in_process() {
             "--out",
             o.to_str().unwrap(),
         ];
+        if mode == "partition" {
+            // navigation.csv is kept with the recordings only
+            args.push("--keep-recordings");
+        }
         let r = cli(&args, &[]);
         assert_eq!(r.status.code(), Some(0), "{}", text(&r));
         std::fs::read(o.join("runs.csv")).unwrap()
@@ -434,4 +438,25 @@ fn campaigns_and_basilisk_refuse_what_they_cannot_check() {
     let o = cli(&["run", "--basilisk", "--uncertainty", "realistic"], &[]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(text(&o).contains("--basilisk"), "{}", text(&o));
+}
+
+/// The partition's processes read the scenario file: `redteam --partition` refuses a
+/// command-line profile the file does not declare (it would be reported, not run).
+#[test]
+fn a_partition_red_team_refuses_a_profile_the_file_does_not_declare() {
+    let d = tmp("unc-rt-partition");
+    let o = cli(
+        &[
+            "redteam",
+            "--partition",
+            "--uncertainty",
+            "realistic",
+            "--out",
+            d.0.join("o").to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("--partition"), "{}", text(&o));
+    assert!(!d.0.join("o").exists(), "a case was started");
 }

@@ -25,8 +25,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The recorder's large outputs, removed from a run's folder once it is read back unless
 /// kept ([`Partition::keep_recordings`]).
-pub const RECORDINGS: [&str; 4] = [
+pub const RECORDINGS: [&str; 5] = [
     "telemetry.csv",
+    "navigation.csv",
     "timing.csv",
     "recording.mcap",
     "latency.csv",

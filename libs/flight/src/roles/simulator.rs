@@ -485,7 +485,12 @@ impl Component for SimulatorRole {
     }
 
     fn warm(&self) -> &'static [ServiceName] {
-        &[services::PARTNER_STATE, services::SIM_STATE]
+        &[
+            services::PARTNER_STATE,
+            services::SIM_STATE,
+            services::TRUTH,
+            services::NAVIGATION_ERROR,
+        ]
     }
 
     fn next(&mut self, _: u64) -> Next {

@@ -72,10 +72,11 @@ pub(super) fn reap_bounded(run: &RunScope) -> Option<sc_bus::Result<sc_bus::Node
 }
 
 /// What a partition run writes into its output directory (besides `logs/`).
-pub const RUN_OUTPUTS: [&str; 18] = [
+pub const RUN_OUTPUTS: [&str; 19] = [
     ALL_READY,
     "summary.json",
     "telemetry.csv",
+    "navigation.csv",
     "timing.csv",
     "recording.mcap",
     "launch.json",

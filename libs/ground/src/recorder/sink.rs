@@ -150,15 +150,15 @@ impl RecordSink for FileSink {
         report: &RecorderReport,
     ) -> Result<(), SinkError> {
         let e = io(&self.out);
-        let knowledge = self.out.join("navigation.csv");
-        sc_mission::record::write_knowledge(&knowledge, records).map_err(io(&knowledge))?;
         self.telemetry.flush().map_err(&e)?;
         self.latency.flush().map_err(&e)?;
         if let Some(m) = self.mcap.as_mut() {
             m.finish().map_err(mcap_err)?;
         }
         self.write_json("summary.json", summary)?;
-        self.write_json("recorder.json", report)
+        self.write_json("recorder.json", report)?;
+        let knowledge = self.out.join("navigation.csv");
+        sc_mission::record::write_knowledge(&knowledge, records).map_err(io(&knowledge))
     }
 }
 

@@ -111,6 +111,14 @@ pub fn record(
 ) -> StepRecord {
     let o = convert::observation(state);
     let truth = set.truth.as_ref().unwrap_or(state);
+    // a declared uncertainty whose truth never came: the estimate is no truth — its
+    // barriers are recorded as not evaluated (NaN counts as violated), never as the truth's
+    let unknown = [f64::NAN; sc_icd::N_BARRIERS];
+    let (barriers, between) = if scenario.uncertainty.is_some() && set.truth.is_none() {
+        (unknown, unknown)
+    } else {
+        (truth.barriers, truth.barriers_between)
+    };
     held.nt = set.nt.or(held.nt);
     held.na = set.na.or(held.na);
     held.nr = set.nr.or(held.nr);
@@ -145,8 +153,8 @@ pub fn record(
         attitude: at,
         robotic: rb,
         applied,
-        barriers: truth.barriers,
-        barriers_between: truth.barriers_between,
+        barriers,
+        barriers_between: between,
     }
 }
 
