@@ -182,8 +182,8 @@ typedef struct ScSimState {
     double com_v_h[3]; /* Derivative of com_h in the rotating Hill frame, frame F_H [m/s] */
     double com_r[3]; /* Servicer system centre of mass relative to the target CoM, frame F_R [m] */
     double com_v_r[3]; /* Inertial velocity of the servicer system centre of mass, frame F_R [m/s] */
-    double barriers[51]; /* Every barrier h at this state, from the simulator's own state (the safety monitor), in telemetry order; NaN (null in the MCAP) = not evaluated [unit per constraint] */
-    double barriers_between[51]; /* The smallest value of every barrier over the physics steps since the previous state message (this state included) [unit per constraint] */
+    double barriers[51]; /* Every barrier h at this state, from the simulator's own state (the safety monitor), in telemetry order; NaN (null in the MCAP) = not evaluated. With a declared `[uncertainty]` the state is the estimate and these the barriers on knowledge (the declared model on it) [unit per constraint] */
+    double barriers_between[51]; /* The smallest value of every barrier over the physics steps since the previous state message (this state included); with a declared `[uncertainty]` equal to `barriers` (knowledge exists at the ticks only) [unit per constraint] */
 #if defined(__cplusplus) && __cplusplus >= 201703L
     /* the name iceoryx2's C++ API matches the payload type by */
     static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v3::SimState";
@@ -464,7 +464,7 @@ SC_ICD_STATIC_ASSERT(offsetof(ScStepResult, force_b) == 48, "ScStepResult.force_
 SC_ICD_STATIC_ASSERT(offsetof(ScStepResult, torque_b) == 72, "ScStepResult.torque_b: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScStepResult, tau) == 96, "ScStepResult.tau: offset");
 
-/* NavigationError -- safe_capture::v1::NavigationError, 96 B. Simulator → recorder, with a declared `[uncertainty]` only: the realised navigation errors of the tick's estimate (the state on `SIM_STATE`) against the measured truth (on `TRUTH`), each as in `navigation.csv` (vectors: Euclidean norm; joints: the largest of the seven). */
+/* NavigationError -- safe_capture::v1::NavigationError, 96 B. Simulator → recorder, with a declared `[uncertainty]` only: the realised navigation errors of the tick's estimate (the state on `SIM_STATE`) against the truth measured `measurement_age_s` before it (with an age of 0 the truth on `TRUTH`), each as in `navigation.csv` (vectors: Euclidean norm; joints: the largest of the seven). */
 typedef struct ScNavigationError {
     uint64_t tick; /* Tick index [-] */
     double t; /* Simulation time of the estimate [s] */

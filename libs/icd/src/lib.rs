@@ -308,10 +308,13 @@ icd_message! {
         /// Inertial velocity of the servicer system centre of mass
         pub com_v_r: [f64; 3] = ["m/s", Reference, Xyz],
         /// Every barrier h at this state, from the simulator's own state (the safety
-        /// monitor), in telemetry order; NaN (null in the MCAP) = not evaluated
+        /// monitor), in telemetry order; NaN (null in the MCAP) = not evaluated. With a
+        /// declared `[uncertainty]` the state is the estimate and these the barriers on
+        /// knowledge (the declared model on it)
         pub barriers: [f64; N_BARRIERS] = ["unit per constraint", None, Barriers],
         /// The smallest value of every barrier over the physics steps since the
-        /// previous state message (this state included)
+        /// previous state message (this state included); with a declared
+        /// `[uncertainty]` equal to `barriers` (knowledge exists at the ticks only)
         pub barriers_between: [f64; N_BARRIERS] = ["unit per constraint", None, Barriers],
     }
 }
@@ -488,8 +491,9 @@ icd_message! {
 icd_message! {
     /// Simulator → recorder, with a declared `[uncertainty]` only: the realised
     /// navigation errors of the tick's estimate (the state on `SIM_STATE`) against the
-    /// measured truth (on `TRUTH`), each as in `navigation.csv` (vectors: Euclidean norm;
-    /// joints: the largest of the seven).
+    /// truth measured `measurement_age_s` before it (with an age of 0 the truth on
+    /// `TRUTH`), each as in `navigation.csv` (vectors: Euclidean norm; joints: the
+    /// largest of the seven).
     #[type_name("safe_capture::v1::NavigationError")]
     pub struct NavigationError {
         /// Tick index

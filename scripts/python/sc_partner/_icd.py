@@ -187,8 +187,8 @@ class SimState(ctypes.Structure):
         ("com_v_h", ctypes.c_double * 3),  # Derivative of com_h in the rotating Hill frame, frame F_H [m/s]
         ("com_r", ctypes.c_double * 3),  # Servicer system centre of mass relative to the target CoM, frame F_R [m]
         ("com_v_r", ctypes.c_double * 3),  # Inertial velocity of the servicer system centre of mass, frame F_R [m/s]
-        ("barriers", ctypes.c_double * 51),  # Every barrier h at this state, from the simulator's own state (the safety monitor), in telemetry order; NaN (null in the MCAP) = not evaluated [unit per constraint]
-        ("barriers_between", ctypes.c_double * 51),  # The smallest value of every barrier over the physics steps since the previous state message (this state included) [unit per constraint]
+        ("barriers", ctypes.c_double * 51),  # Every barrier h at this state, from the simulator's own state (the safety monitor), in telemetry order; NaN (null in the MCAP) = not evaluated. With a declared `[uncertainty]` the state is the estimate and these the barriers on knowledge (the declared model on it) [unit per constraint]
+        ("barriers_between", ctypes.c_double * 51),  # The smallest value of every barrier over the physics steps since the previous state message (this state included); with a declared `[uncertainty]` equal to `barriers` (knowledge exists at the ticks only) [unit per constraint]
     ]
 
     @staticmethod
@@ -357,7 +357,7 @@ class StepResult(ctypes.Structure):
 
 
 class NavigationError(ctypes.Structure):
-    """Simulator → recorder, with a declared `[uncertainty]` only: the realised navigation errors of the tick's estimate (the state on `SIM_STATE`) against the measured truth (on `TRUTH`), each as in `navigation.csv` (vectors: Euclidean norm; joints: the largest of the seven)."""
+    """Simulator → recorder, with a declared `[uncertainty]` only: the realised navigation errors of the tick's estimate (the state on `SIM_STATE`) against the truth measured `measurement_age_s` before it (with an age of 0 the truth on `TRUTH`), each as in `navigation.csv` (vectors: Euclidean norm; joints: the largest of the seven)."""
 
     _fields_ = [
         ("tick", ctypes.c_uint64),  # Tick index [-]
