@@ -290,11 +290,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         a.figures.export_dir(&out.join("figures"))?;
     }
     staged.commit()?;
-    let within = summary
-        .uncertainty
-        .as_ref()
-        .is_none_or(|u| u.outside_bounds.is_empty());
-    let safe = summary.violated_constraints.is_empty() && summary.fault_count == 0 && within;
+    let safe = summary.safe();
     if let Some(u) = &summary.uncertainty {
         outln!("{}", u.line());
     }

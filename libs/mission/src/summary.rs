@@ -122,6 +122,18 @@ pub struct Summary {
     pub uncertainty: Option<UncertaintySummary>,
 }
 
+impl Summary {
+    /// Safe as `run` and `launch` judge a run: every barrier held, no fault, and (with a
+    /// declared uncertainty) the realised errors within the declared bounds.
+    pub fn safe(&self) -> bool {
+        let within = self
+            .uncertainty
+            .as_ref()
+            .is_none_or(|u| u.outside_bounds.is_empty());
+        self.violated_constraints.is_empty() && self.fault_count == 0 && within
+    }
+}
+
 /// The declared uncertainty of a run and whether the realised errors stayed inside it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct UncertaintySummary {

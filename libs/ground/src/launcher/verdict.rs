@@ -75,11 +75,7 @@ pub(super) fn judge(out: &Path, broken: bool, error: Option<String>) -> (i32, Op
 pub fn mission_verdict(summary: &Path) -> Option<bool> {
     let s: sc_mission::Summary =
         serde_json::from_str(&std::fs::read_to_string(summary).ok()?).ok()?;
-    let within = s
-        .uncertainty
-        .as_ref()
-        .is_none_or(|u| u.outside_bounds.is_empty());
-    Some(s.captured && s.violated_constraints.is_empty() && s.fault_count == 0 && within)
+    Some(s.captured && s.safe())
 }
 
 /// The flight-side services (everything but the partners' `safe_capture/nominal/*`) of
