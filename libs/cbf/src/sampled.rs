@@ -245,6 +245,76 @@ pub fn phi_required_of(h: f64, hd: f64, bounds: &SampleBounds, mu: f64, decay: &
     c1.max(c2)
 }
 
+/// What a filter does not know of a barrier's state at the sample: the true `h` and `ḣ`
+/// lie within `h` and `hdot` of the estimate's (the navigation's and the model's errors
+/// through the barrier's gradients; docs/SAFETY.md, "Measurement-robust rows").
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StateUncertainty {
+    /// `δh` [unit of h].
+    pub h: f64,
+    /// `δḣ` [unit of h / s].
+    pub hdot: f64,
+}
+
+impl StateUncertainty {
+    /// Nothing unknown: the rows are the estimate's own, bit for bit.
+    pub fn is_zero(&self) -> bool {
+        self.h == 0.0 && self.hdot == 0.0
+    }
+}
+
+/// [`phi_required_of`] for **every** true state consistent with the estimate `(h, ḣ)`:
+/// the true `(h_t, ḣ_t)` lies in the box `|h_t − h| ≤ δh`, `|ḣ_t − ḣ| ≤ δḣ` and (by the
+/// induction the rows keep) in the braking-safe set `S = {h ≥ 0, H ≥ 0}`.
+///
+/// * The braking requirement `β = μ + M₂ + M₃T` meets (C1) and (C2) from every state of
+///   `S` ([`braking_requirement`]), so it bounds the requirement of every consistent state.
+/// * If the low corner `(h − δh, ḣ − δḣ)` is in `S`, the whole box is: (C1)'s requirement
+///   falls with `h` and `ḣ`, (C2)'s margin `G = H(p(T), v(T)) − κ(H(h, ḣ))` rises with `h`
+///   (`∂H/∂p = 1 ≥ κ'`) and falls with `ḣ` by at most
+///   `(|ḣ| − |v(T)|)/μ − T ≤ (T|ψ| + ½M₃T²)/μ − T` per unit (`ψ = φ − M₂`, `|ψ| ≤ ψ_max`),
+///   so the low corner's requirement with `κ` raised by that deficit over `2δḣ` covers
+///   the box.
+///
+/// The result is the smaller of the two; with nothing unknown it is
+/// [`phi_required_of`] itself.
+pub fn phi_required_known(
+    h: f64,
+    hd: f64,
+    unknown: &StateUncertainty,
+    bounds: &SampleBounds,
+    mu: f64,
+    decay: &DecayAt,
+    psi_max: f64,
+) -> f64 {
+    if unknown.is_zero() {
+        return phi_required_of(h, hd, bounds, mu, decay);
+    }
+    let beta = braking_requirement(bounds, mu);
+    let (h_lo, hd_lo) = (h - unknown.h, hd - unknown.hdot);
+    if !(h_lo >= 0.0 && braking_barrier(h_lo, hd_lo, mu) >= 0.0) {
+        return beta;
+    }
+    let t = bounds.period;
+    let per_unit = ((t * psi_max.abs() + 0.5 * bounds.m3 * t * t) / mu - t).max(0.0);
+    let deficit = 2.0 * unknown.hdot * per_unit;
+    let c1 = bounds.m2 + bounds.m3 * t / 3.0 + c1_requirement(h_lo, hd_lo, t);
+    let kappa = decay.target(braking_barrier(h_lo, hd_lo, mu)) + deficit;
+    let p0 = h_lo + hd_lo * t - bounds.m3 * t * t * t / 6.0;
+    let v0 = hd_lo - 0.5 * bounds.m3 * t * t;
+    let c2 = bounds.m2 + c2_requirement(p0, v0, t, mu, kappa);
+    c1.max(c2).min(beta)
+}
+
+/// [`hdot_required_of`] for every true `h_t` with `|h_t − h| ≤ δh`, `h_t ≥ 0`: the
+/// requirement falls with `h`, so it is the lowest consistent value's.
+pub fn hdot_required_known(h: f64, delta_h: f64, bounds: &RateBounds, decay: &RateDecay) -> f64 {
+    if delta_h == 0.0 {
+        return hdot_required_of(h, bounds, decay);
+    }
+    hdot_required_of((h - delta_h).max(0.0), bounds, decay)
+}
+
 /// [`RelDeg1::hdot_required_at`] from the barrier's value `h` alone.
 pub fn hdot_required_of(h: f64, bounds: &RateBounds, decay: &RateDecay) -> f64 {
     let t = bounds.period;
@@ -422,6 +492,65 @@ mod tests {
             }
             // the worst case still keeps h ≥ 0 inside the sample and H(T) ≥ κ(H) ≥ 0
             assert_worst_case_holds(&x, &b, mu, phi, kappa);
+        }
+    }
+
+    /// Measurement-robust rows: every true state in the estimate's box and in the set
+    /// keeps (C1) and (C2) under the worst case of a command that meets the estimate's
+    /// robust row — at the requirement itself (or the least command the subsystem can
+    /// produce, `ψ = −ψ_max`) and at the largest, `ψ = ψ_max`.
+    #[test]
+    fn a_robust_row_holds_for_every_true_state_consistent_with_the_estimate() {
+        let mut seed = 11;
+        let mut boxed = 0;
+        for _ in 0..4000 {
+            let (mu, b, truth) = random_state(&mut seed);
+            let mut r = || lcg(&mut seed);
+            let unknown = StateUncertainty {
+                h: 0.3 * r() * r(),
+                hdot: 0.3 * r() * r(),
+            };
+            // an estimate whose box holds the truth
+            let est_h = truth.h + unknown.h * (2.0 * r() - 1.0);
+            let est_hd = truth.hdot + unknown.hdot * (2.0 * r() - 1.0);
+            let gamma = 2.0 * r();
+            let decay = Decay::linear(gamma);
+            let psi_max = braking_requirement(&b, mu) + 2.0 * r();
+            let phi = phi_required_known(
+                est_h,
+                est_hd,
+                &unknown,
+                &b,
+                mu,
+                &decay.at(b.period),
+                psi_max,
+            );
+            assert!(phi.is_finite());
+            assert!(phi <= braking_requirement(&b, mu) + 1e-12);
+            if braking_barrier(est_h - unknown.h, est_hd - unknown.hdot, mu) >= 0.0 {
+                boxed += 1;
+            }
+            let kappa = decay.target(braking_barrier(truth.h, truth.hdot, mu), b.period);
+            // the commands a subsystem can produce: |φ − M₂| ≤ ψ_max
+            for phi_u in [phi.max(b.m2 - psi_max), (psi_max + b.m2).max(phi)] {
+                assert_worst_case_holds(&truth, &b, mu, phi_u, kappa);
+            }
+        }
+        // both branches were exercised
+        assert!(boxed > 400 && boxed < 3600, "{boxed}");
+    }
+
+    #[test]
+    fn nothing_unknown_is_the_estimates_own_row() {
+        let mut seed = 5;
+        for _ in 0..1000 {
+            let (mu, b, x) = random_state(&mut seed);
+            let d = Decay::linear(1.0).at(b.period);
+            assert_eq!(
+                phi_required_known(x.h, x.hdot, &StateUncertainty::default(), &b, mu, &d, 1.0)
+                    .to_bits(),
+                phi_required_of(x.h, x.hdot, &b, mu, &d).to_bits()
+            );
         }
     }
 
