@@ -33,6 +33,7 @@ pub mod coverage;
 pub mod engine;
 pub mod envelope;
 pub mod filter;
+pub mod knowledge;
 pub mod monitor;
 pub mod qp;
 pub mod robotic;
