@@ -84,10 +84,11 @@ fn check_file(path: &Path, kind: Option<Kind>, mc_scenario: &Path) -> Result<Str
         Kind::Scenario => {
             let s = Scenario::load(path).map_err(|e| scenario_problem(&e))?;
             Ok(format!(
-                "scenario: {} phases, {} s at most, control period {} s",
+                "scenario: {} phases, {} s at most, control period {} s{}",
                 s.mission.phases.len(),
                 s.mission.duration_s,
-                s.mission.control_period_s
+                s.mission.control_period_s,
+                uncertified_note(&s)?
             ))
         }
         Kind::Partition => {
@@ -124,6 +125,27 @@ fn check_file(path: &Path, kind: Option<Kind>, mc_scenario: &Path) -> Result<Str
             ))
         }
     }
+}
+
+/// What the declared uncertainty leaves without a certified command, said before
+/// anything runs (docs/SAFETY.md, "Translational: what the declared errors cost"); empty
+/// when everything is certifiable or nothing is declared.
+fn uncertified_note(s: &Scenario) -> Result<String, Problem> {
+    if s.uncertainty.is_none() {
+        return Ok(String::new());
+    }
+    let robot = sc_multibody::Robot::from_urdf_file(&s.urdf_path())
+        .map_err(|e| format!("servicer.urdf: {e}"))?;
+    Ok(
+        match sc_cbf::translational_margins::wall_uncertifiable_below(s, &robot) {
+            Some(r) => format!(
+                "; NOTE: under the declared uncertainty the translational rows cannot certify \
+                 a state on the approach corridor's wall at ranges up to {r:.2} m (there the \
+                 filter acts on the relaxed problem, flagged; docs/SAFETY.md)"
+            ),
+            None => String::new(),
+        },
+    )
 }
 
 /// A scenario error without the file's name (the line starts with it).

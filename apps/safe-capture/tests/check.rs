@@ -84,6 +84,29 @@ fn the_shipped_configs_are_valid() {
     assert!(o.stderr.is_empty(), "{}", text(&o));
 }
 
+/// A scenario whose declared uncertainty leaves the corridor's wall without a certified
+/// command is valid, but `check` says so before anything runs (docs/SAFETY.md,
+/// "Translational: what the declared errors cost").
+#[test]
+fn a_declared_uncertainty_the_rows_cannot_certify_is_named_before_the_run() {
+    let d = tmp("check-uncertified");
+    let s = shipped_with(
+        &d,
+        "scenario.toml",
+        "[mission]",
+        "[uncertainty]\nprofile = \"realistic\"\n\n[mission]",
+    );
+    let o = check(&[s.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("NOTE: under the declared uncertainty the translational rows cannot certify")
+            && out.contains("corridor's wall at ranges up to 9.00 m"),
+        "{}",
+        text(&o)
+    );
+}
+
 #[test]
 fn a_scenario_with_a_bad_value_names_the_key_and_the_rule() {
     let d = tmp("check-bad-value");

@@ -11,6 +11,7 @@
 
 use crate::common::{FilterOutput, faults};
 use crate::filter::{Coupling, SafetyFilter};
+use crate::translational::TranslationalParams;
 use crate::{
     AttitudeFilter, AttitudeOutput, RoboticFilter, RoboticOutput, TranslationalFilter,
     TranslationalOutput,
@@ -88,7 +89,7 @@ impl SafetyLayer {
     pub fn from_scenario(s: &sc_scenario::Scenario, robot: Arc<Robot>) -> Self {
         let mass = robot.total_mass();
         Self {
-            translational: TranslationalFilter::from_scenario(s, mass),
+            translational: TranslationalFilter::new(TranslationalParams::from_model(s, &robot)),
             attitude: AttitudeFilter::from_scenario(s, mass),
             robotic: RoboticFilter::from_scenario(s, robot.clone()),
             model: robot,

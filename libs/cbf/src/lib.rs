@@ -40,6 +40,7 @@ pub mod robotic;
 pub mod sampled;
 mod step;
 pub mod translational;
+pub mod translational_margins;
 pub mod verify;
 
 pub use attitude::{AttitudeFilter, AttitudeInput, AttitudeParams};

@@ -21,10 +21,12 @@ use crate::barrier::{RelDegOne, RelDegTwo, Row};
 use crate::common::{
     self, BOX_MARGIN, FilterOutput, FilterReport, clamp_box, in_range3, unit_quat,
 };
+use crate::engine::Kind;
 use crate::engine::{Engine, LastProblem, SolverTally};
 use crate::filter::{Coupling, SafetyFilter};
-use crate::sampled::{RateBounds, RelDeg1, RelDeg2, SampleBounds};
+use crate::sampled::{self, RateBounds, RelDeg1, RelDeg2, SampleBounds};
 use crate::step::{self, Actuated, FilterStep, Invalid, Solved};
+use crate::translational_margins::{ForceError, InertialMotion, TranslationalErrors, Unknowns};
 use crate::{Formulation, qp::SolverParams};
 use nalgebra::{Matrix3, Vector3};
 use sc_core::{Observation, Subsystem};
@@ -79,6 +81,9 @@ pub struct TranslationalParams {
     pub omega_bound: f64,
     /// Radius of the target's circular orbit [m] (bounds the CW linearisation error).
     pub orbit_radius: f64,
+    /// The declared errors the rows budget for (docs/SAFETY.md, "Margins for the declared
+    /// errors"); `None`: none declared (the `exact` profile), the rows are the nominal ones.
+    pub errors: Option<TranslationalErrors>,
 }
 
 impl TranslationalParams {
@@ -108,6 +113,19 @@ impl TranslationalParams {
                 .sup(&Vector3::from(s.safety.attitude.omega_min_rad_s).abs())
                 .norm(),
             orbit_radius: a,
+            errors: None,
+        }
+    }
+
+    /// [`Self::from_scenario`] with the scenario's declared errors for the model `robot`
+    /// (its mass the filter's `m`), in the sampled-data formulation (the paper's rows
+    /// have no margins).
+    pub fn from_model(s: &sc_scenario::Scenario, robot: &Robot) -> Self {
+        let errors = TranslationalErrors::new(&s.uncertainty_bounds(), robot);
+        Self {
+            errors: (s.safety.formulation == Formulation::SampledData && !errors.is_zero())
+                .then_some(errors),
+            ..Self::from_scenario(s, robot.total_mass())
         }
     }
 }
@@ -129,6 +147,9 @@ pub struct TranslationalInput {
     pub q_rb: Quat,
     /// Base body rate ω_B [rad/s, F_B]: how fast the body-fixed force turns.
     pub omega_b: Vector3<f64>,
+    /// Bounds on the error of `r_H` [m] and `v_H` [m/s] against the plant's true CoM
+    /// ([`crate::knowledge::ComKnowledge::com_error`]); zero when nothing is declared.
+    pub com_error: (f64, f64),
 }
 
 impl TranslationalInput {
@@ -142,6 +163,7 @@ impl TranslationalInput {
             omega_dot_h: Vector3::zeros(),
             q_rb,
             omega_b: Vector3::zeros(),
+            com_error: (0.0, 0.0),
         }
     }
 }
@@ -266,11 +288,31 @@ pub fn tangential_speed(
 pub(crate) struct Prepared {
     r_bh: Matrix3<f64>,
     terms: [RelDegTwo<3>; N],
-    /// The barrier rows ([`NAMES`] order) and the tangential-speed row.
+    /// The barrier rows ([`NAMES`] order) and the tangential-speed row — with declared
+    /// errors, those for every command in the force box.
     rows: [Row<3>; N + 1],
     weights: [f64; N + 1],
     bounds: [Row<3>; 6],
+    /// With declared errors: what the rows for a smaller force are built from.
+    known: Option<KnownInputs>,
 }
+
+/// The terms the rows for declared errors are rebuilt from for another force bound
+/// ([`TranslationalFilter::known_rows`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct KnownInputs {
+    axis: CorridorAxis,
+    tangential: RelDegOne<3>,
+    /// The CoM's position and velocity and the tide in the inertially fixed F_R.
+    r_r: Vector3<f64>,
+    v_r: Vector3<f64>,
+    tide: Vector3<f64>,
+}
+
+/// Rounds of [`TranslationalFilter::solve_known`] before the rows for the whole force box.
+pub const FORCE_CAP_ROUNDS: usize = 4;
+/// Growth of the force bound between two rounds [-].
+pub const FORCE_CAP_GROWTH: f64 = 1.25;
 
 /// The translational CBF-QP safety filter (paper eq. "translation_qp").
 pub struct TranslationalFilter {
@@ -318,11 +360,28 @@ impl TranslationalFilter {
         omega_b: &Vector3<f64>,
         axis: &CorridorAxis,
     ) -> ([SampleBounds; N], RateBounds) {
+        self.sample_bounds_known(r, v, omega_b, axis, (0.0, 0.0), 1.0)
+    }
+
+    /// [`Self::sample_bounds`] for every true state within `(ē_r, ē_v)` of the estimate
+    /// `(r, v)` and a force scaled by at most `k_hi`: the ranges start from `‖r‖ ± ē_r`,
+    /// `‖v‖ + ē_v`, the force's acceleration is `k_hi √3F/m` and the corridor's gradient
+    /// may be `cos ψ · chord` longer.
+    pub fn sample_bounds_known(
+        &self,
+        r: &Vector3<f64>,
+        v: &Vector3<f64>,
+        omega_b: &Vector3<f64>,
+        axis: &CorridorAxis,
+        err: (f64, f64),
+        k_hi: f64,
+    ) -> ([SampleBounds; N], RateBounds) {
         let p = &self.params;
         let t = p.period;
         let n = p.mean_motion;
-        let f_acc = 3f64.sqrt() * p.force_max / p.mass;
-        let (rn, vn) = (r.norm(), v.norm());
+        let f_acc = 3f64.sqrt() * p.force_max / p.mass * k_hi;
+        let (rn_est, vn) = (r.norm(), v.norm() + err.1 + n * err.0);
+        let rn = rn_est + err.0;
         // fixed point of A(R, V), V(A), R(A): n is tiny, two passes are plenty
         let mut a = f_acc + 3.0 * n * n * rn + 2.0 * n * vn;
         let (mut vv, mut rr) = (vn, rn);
@@ -331,12 +390,13 @@ impl TranslationalFilter {
             rr = rn + vn * t + 0.5 * a * t * t;
             a = f_acc + 3.0 * n * n * rr + 2.0 * n * vv;
         }
-        let r_min = (rn - vn * t - 0.5 * a * t * t).max(1e-3);
+        let r_min = (rn_est - err.0 - vn * t - 0.5 * a * t * t).max(1e-3);
         let omega = omega_b.norm().max(p.omega_bound) + n;
         let jerk = 3.0 * n * n * vv + 2.0 * n * a + f_acc * omega;
         let grav = 3.0 * n * n * rr * rr / p.orbit_radius;
-        let rhat = r / rn.max(1e-12);
-        let g_now = (axis.d - rhat * p.cos_psi).norm();
+        let rhat = r / rn_est.max(1e-12);
+        let g_now = (axis.d - rhat * p.cos_psi).norm()
+            + p.cos_psi * crate::translational_margins::direction_chord(err.0, rn_est);
         let g_max = (1.0 + p.cos_psi).min(g_now + t * (n + vv / r_min));
         let m3_ac = n * n * n * rr
             + 3.0 * n * n * vv
@@ -383,7 +443,7 @@ impl TranslationalFilter {
         r_hr: &Matrix3<f64>,
         axis: &CorridorAxis,
         terms: &[RelDegTwo<3>; N],
-    ) -> ([Row<3>; N + 1], [f64; N + 1]) {
+    ) -> ([Row<3>; N + 1], [f64; N + 1], Option<KnownInputs>) {
         let p = &self.params;
         let mu = [p.u_max_ac, p.u_max_caz];
         let c_t = tangential_coefficient(p);
@@ -394,8 +454,18 @@ impl TranslationalFilter {
         let radial = r_rh * Vector3::x();
         let tidal = (radial * (3.0 * radial.dot(&r_r)) - r_r) * (p.mean_motion * p.mean_motion);
         let tangential = tangential_speed(&r_r, &v_r, &tidal, r_hr, p.mass, c_t);
-        let rows: [Row<3>; N + 1] = match p.formulation {
-            Formulation::SampledData => {
+        let known = p.errors.as_ref().map(|_| KnownInputs {
+            axis: *axis,
+            tangential,
+            r_r,
+            v_r,
+            tide: tidal,
+        });
+        let rows: [Row<3>; N + 1] = match (p.formulation, &p.errors, &known) {
+            (Formulation::SampledData, Some(errors), Some(k)) => {
+                self.known_rows(x, terms, k, errors.force, self.full_force())
+            }
+            (Formulation::SampledData, _, _) => {
                 let (b, bt) = self.sample_bounds(&x.r_h, &x.v_h, &x.omega_b, axis);
                 [
                     RelDeg2::from(terms[0]).row(&b[0], mu[0], p.gamma),
@@ -403,7 +473,7 @@ impl TranslationalFilter {
                     RelDeg1::from(tangential).row(&bt, p.gamma, 0.0),
                 ]
             }
-            Formulation::Paper => [
+            (Formulation::Paper, _, _) => [
                 terms[0].row(p.gamma, p.eps_ac, p.u_max_ac),
                 terms[1].row(p.gamma, p.eps_caz, p.u_max_caz),
                 // the paper has no tangential limit: a row that never binds
@@ -418,7 +488,137 @@ impl TranslationalFilter {
             p.u_max_caz,
             2.0 * (c_t.max(0.0) * p.r_caz).sqrt() * p.force_max / p.mass,
         ];
-        (rows, weights)
+        (rows, weights, known)
+    }
+
+    /// The QP with declared errors: the rows for a force bound `c` certify a command of
+    /// `‖f‖ ≤ c` only. Starting from the nominal's norm (a feasible nominal is certified
+    /// by its own rows), a solution larger than its bound is solved again with the bound
+    /// raised to it (× [`FORCE_CAP_GROWTH`]), at most [`FORCE_CAP_ROUNDS`] times; then the
+    /// prepared rows, which hold for every command in the box.
+    fn solve_known(
+        &mut self,
+        x: &TranslationalInput,
+        p: &Prepared,
+        k: &KnownInputs,
+        force: ForceError,
+        u_nom: &Vector3<f64>,
+        report: &mut FilterReport<N>,
+    ) -> Actuated<3> {
+        let full = self.full_force();
+        let mut cap = u_nom.norm().min(full);
+        for _ in 0..FORCE_CAP_ROUNDS {
+            let rows = self.known_rows(x, &p.terms, k, force, cap);
+            let outcome = self.engine.solve(u_nom, &rows, &p.weights, &p.bounds);
+            let size = outcome.u.norm();
+            if size <= cap && outcome.kind != Kind::Failed {
+                return self.conclude_solved(x, p, u_nom, &outcome, &rows, report);
+            }
+            if cap >= full {
+                break;
+            }
+            cap = (size.max(cap) * FORCE_CAP_GROWTH).min(full);
+        }
+        let outcome = self.engine.solve(u_nom, &p.rows, &p.weights, &p.bounds);
+        self.conclude_solved(x, p, u_nom, &outcome, &p.rows, report)
+    }
+
+    /// [`step::conclude`] for a solve on `rows` (the barrier rows first).
+    fn conclude_solved(
+        &mut self,
+        x: &TranslationalInput,
+        p: &Prepared,
+        u_nom: &Vector3<f64>,
+        outcome: &crate::engine::Outcome<3>,
+        rows: &[Row<3>; N + 1],
+        report: &mut FilterReport<N>,
+    ) -> Actuated<3> {
+        let solved = Solved {
+            outcome,
+            rows,
+            weights: &p.weights,
+            hard: &p.bounds,
+            certifying: &rows[..N],
+        };
+        step::conclude(self, x, p, u_nom, solved, report)
+    }
+
+    /// `√3 F` [N]: the largest force the box `‖f_B‖∞ ≤ F` admits.
+    fn full_force(&self) -> f64 {
+        3f64.sqrt() * self.params.force_max
+    }
+
+    /// The sampled-data rows for every true state and force the declared errors admit
+    /// ([`crate::translational_margins`]): each barrier's `δh`, `δḣ` make its requirement
+    /// the measurement-robust one ([`sampled::phi_required_known`]), its `δφ` adds to `M₂`,
+    /// and the offset holds for every scale of the delivered force.
+    ///
+    /// `force_cap` [N] bounds `‖f_H‖` of the commands the rows are for (the gradients'
+    /// turn and the force's misalignment act on it); `√3F` covers every command in the
+    /// box. The in-sample bounds and `ψ_max` are always the whole box's.
+    fn known_rows(
+        &self,
+        x: &TranslationalInput,
+        terms: &[RelDegTwo<3>; N],
+        k: &KnownInputs,
+        force: ForceError,
+        force_cap: f64,
+    ) -> [Row<3>; N + 1] {
+        let p = &self.params;
+        let (axis, tangential) = (&k.axis, &k.tangential);
+        let err = x.com_error;
+        let (b, bt) = self.sample_bounds_known(&x.r_h, &x.v_h, &x.omega_b, axis, err, force.k_hi);
+        let a0 = cw_drift(p.mean_motion, &x.r_h, &x.v_h);
+        let f_acc = force_cap / p.mass;
+        let u = Unknowns::new(&x.r_h, &x.v_h, err, &a0, p.mean_motion, f_acc, force);
+        let rhat = x.r_h / u.rn;
+        let v_along = rhat.dot(&x.v_h);
+        let v_perp = (x.v_h - rhat * v_along).norm();
+        let g = (axis.d - rhat * p.cos_psi).norm();
+        let rates = (axis.d_dot.norm(), axis.d_ddot.norm());
+        let unknown = [u.corridor(g, p.cos_psi, rates, v_along, v_perp), u.zone()];
+        let decay = sampled::Decay::linear(p.gamma).at(p.period);
+        let mu = [p.u_max_ac, p.u_max_caz];
+        let rows: [Row<3>; N] = std::array::from_fn(|i| {
+            let t = terms[i];
+            let (state, dphi) = unknown[i];
+            let bounds = SampleBounds {
+                m2: b[i].m2 + dphi,
+                ..b[i]
+            };
+            let reach = t.hddot_u.norm() * 3f64.sqrt() * p.force_max * force.k_hi;
+            let psi_max = t.hddot_drift.abs() + reach + bounds.m2;
+            let req =
+                sampled::phi_required_known(t.h, t.hdot, &state, &bounds, mu[i], &decay, psi_max);
+            Row {
+                a: t.hddot_u,
+                c: force.scaled_offset(t.hddot_drift - req),
+            }
+        });
+        let (r_r, v_r, tide) = (&k.r_r, &k.v_r, &k.tide);
+        let rr_hat = r_r / r_r.norm();
+        let along = rr_hat.dot(v_r);
+        let vt_perp = (v_r - rr_hat * along).norm();
+        let c_t = tangential_coefficient(p);
+        let motion = InertialMotion {
+            frame_rate: x.omega_h.norm(),
+            speed: v_r.norm(),
+            along,
+            v_perp: vt_perp,
+            tide: tide.norm(),
+        };
+        let (dh_t, dd_t) = u.tangential(c_t, p.mean_motion, &motion);
+        let rate = RateBounds {
+            d: bt.d + dd_t,
+            ..bt
+        };
+        let rate_decay = sampled::RateDecay::new(p.gamma, 0.0, p.period);
+        let req_t = sampled::hdot_required_known(tangential.h, dh_t, &rate, &rate_decay);
+        let row_t = Row {
+            a: tangential.hdot_u,
+            c: force.scaled_offset(tangential.hdot_drift - req_t),
+        };
+        [rows[0], rows[1], row_t]
     }
 
     /// `‖f_B‖∞ ≤ F` on the body-frame force `f_B = R_BH f_H`: the six rows
@@ -520,6 +720,9 @@ impl FilterStep<3, N> for TranslationalFilter {
             || !in_range3(&x.omega_h, MAX_FRAME_RATE)
             || !in_range3(&x.omega_dot_h, MAX_FRAME_RATE)
             || !common::finite(&x.omega_b)
+            || ![x.com_error.0, x.com_error.1]
+                .iter()
+                .all(|e| e.is_finite() && *e >= 0.0)
         {
             return Err(Invalid::State);
         }
@@ -533,7 +736,7 @@ impl FilterStep<3, N> for TranslationalFilter {
             approach_corridor(&x.r_h, &x.v_h, &axis, &a0, p.mass, p.cos_psi),
             collision_avoidance_zone(&x.r_h, &x.v_h, &a0, p.mass, p.r_caz),
         ];
-        let (rows, weights) = self.barrier_rows(x, &r_hr, &axis, &terms);
+        let (rows, weights, known) = self.barrier_rows(x, &r_hr, &axis, &terms);
         let bounds = self.force_box(&r_bh);
         if rows.iter().chain(&bounds).all(Row::is_finite) && common::finite(&r_bh) {
             Ok(Prepared {
@@ -542,6 +745,7 @@ impl FilterStep<3, N> for TranslationalFilter {
                 rows,
                 weights,
                 bounds,
+                known,
             })
         } else {
             Err(Invalid::State)
@@ -568,6 +772,10 @@ impl FilterStep<3, N> for TranslationalFilter {
         u_nom: &Vector3<f64>,
         report: &mut FilterReport<N>,
     ) -> Actuated<3> {
+        if let (Some(errors), Some(k)) = (&self.params.errors, &p.known) {
+            let force = errors.force;
+            return self.solve_known(x, p, k, force, u_nom, report);
+        }
         let outcome = self.engine.solve(u_nom, &p.rows, &p.weights, &p.bounds);
         let solved = Solved {
             outcome: &outcome,
@@ -604,7 +812,7 @@ impl SafetyFilter<3, N> for TranslationalFilter {
 
     /// The servicer's system centre of mass relative to the target's, in the Hill frame
     /// (ξ_tr = 0: first in the causal order; no model needed).
-    fn input(&self, _: &Robot, o: &Observation, _: &Coupling) -> Option<TranslationalInput> {
+    fn input(&self, robot: &Robot, o: &Observation, _: &Coupling) -> Option<TranslationalInput> {
         Some(TranslationalInput {
             r_h: o.com_h,
             v_h: o.com_v_h,
@@ -613,6 +821,10 @@ impl SafetyFilter<3, N> for TranslationalFilter {
             omega_dot_h: o.omega_dot_h,
             q_rb: o.q_rb,
             omega_b: o.omega_b,
+            com_error: match &self.params.errors {
+                Some(e) => e.com.com_error(robot, &o.theta, &o.theta_dot, &o.omega_b),
+                None => (0.0, 0.0),
+            },
         })
     }
 

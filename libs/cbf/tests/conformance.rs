@@ -206,6 +206,7 @@ impl Conformance<3, 2> for TranslationalFilter {
                     omega_dot_h: wd,
                     q_rb: qrb,
                     omega_b: wb,
+                    com_error: (0.0, 0.0),
                 },
                 realistic: false,
             })
@@ -221,12 +222,16 @@ impl Conformance<3, 2> for TranslationalFilter {
             omega_dot_h: v3,
             q_rb: [v; 4],
             omega_b: v3,
+            com_error: (v, v),
         }
     }
     fn state_finite(x: &TranslationalInput) -> bool {
         [x.r_h, x.v_h, x.omega_h, x.omega_dot_h, x.omega_b]
             .iter()
             .all(finite)
+            && [x.com_error.0, x.com_error.1]
+                .iter()
+                .all(|e| e.is_finite() && *e >= 0.0)
             && x.q_hr.iter().chain(x.q_rb.iter()).all(|c| c.is_finite())
     }
     /// A refused state gets no force; an accepted one `‖R_BH f_H‖∞ ≤ F` with `f_B = R_BH f_H`
