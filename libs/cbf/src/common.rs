@@ -106,7 +106,9 @@ pub struct FilterReport<const N: usize> {
     /// [`faults`] bitset.
     pub faults: u32,
     /// Least violation `t*` of the relaxed problem (0 otherwise), as a fraction of each
-    /// barrier's braking authority (docs/SAFETY.md).
+    /// barrier's braking authority (docs/SAFETY.md) — except for a translational step
+    /// degraded under declared errors: `1 − λ`, the share of the declared margins given
+    /// up (`TranslationalFilter::solve_degraded`).
     pub violation: f64,
 }
 

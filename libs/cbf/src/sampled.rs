@@ -276,7 +276,12 @@ impl StateUncertainty {
 ///   so the low corner's requirement with `κ` raised by that deficit over `2δḣ` covers
 ///   the box.
 ///
-/// The result is the smaller of the two; with nothing unknown it is
+/// With the low corner in `S` the result is the smaller of the two. Otherwise the truth
+/// may be on `S`'s boundary: `β`, but never less than the estimate's own requirement.
+/// When even the high corner is outside `S`, no consistent state is in it and the row asks
+/// for the worst one's recovery: the low corner's requirement, at least `β` and the
+/// estimate's own. So the robust row is never looser than the estimate's row (test
+/// `a_robust_row_is_never_looser_than_the_estimates`). With nothing unknown it is
 /// [`phi_required_of`] itself.
 pub fn phi_required_known(
     h: f64,
@@ -292,9 +297,33 @@ pub fn phi_required_known(
     }
     let beta = braking_requirement(bounds, mu);
     let (h_lo, hd_lo) = (h - unknown.h, hd - unknown.hdot);
-    if !(h_lo >= 0.0 && braking_barrier(h_lo, hd_lo, mu) >= 0.0) {
-        return beta;
+    let in_set = |h: f64, hd: f64| h >= 0.0 && braking_barrier(h, hd, mu) >= 0.0;
+    let own = || phi_required_of(h, hd, bounds, mu, decay);
+    if in_set(h_lo, hd_lo) {
+        return low_corner_requirement(h_lo, hd_lo, unknown, bounds, mu, decay, psi_max).min(beta);
     }
+    if in_set(h + unknown.h, hd + unknown.hdot) {
+        // the truth may be anywhere in S: β; never less than the estimate's own row
+        return beta.max(own());
+    }
+    // no consistent state is in S: recover the worst one (and never ask less than β or
+    // the estimate's own row)
+    low_corner_requirement(h_lo, hd_lo, unknown, bounds, mu, decay, psi_max)
+        .max(beta)
+        .max(own())
+}
+
+/// The low corner's requirement with (C2)'s target raised by the rate's deficit over
+/// `2δḣ` ([`phi_required_known`]).
+fn low_corner_requirement(
+    h_lo: f64,
+    hd_lo: f64,
+    unknown: &StateUncertainty,
+    bounds: &SampleBounds,
+    mu: f64,
+    decay: &DecayAt,
+    psi_max: f64,
+) -> f64 {
     let t = bounds.period;
     let per_unit = ((t * psi_max.abs() + 0.5 * bounds.m3 * t * t) / mu - t).max(0.0);
     let deficit = 2.0 * unknown.hdot * per_unit;
@@ -303,16 +332,22 @@ pub fn phi_required_known(
     let p0 = h_lo + hd_lo * t - bounds.m3 * t * t * t / 6.0;
     let v0 = hd_lo - 0.5 * bounds.m3 * t * t;
     let c2 = bounds.m2 + c2_requirement(p0, v0, t, mu, kappa);
-    c1.max(c2).min(beta)
+    c1.max(c2)
 }
 
 /// [`hdot_required_of`] for every true `h_t` with `|h_t − h| ≤ δh`, `h_t ≥ 0`: the
-/// requirement falls with `h`, so it is the lowest consistent value's.
+/// requirement falls with `h`, so it is the lowest consistent value's — never above the
+/// estimate's own, and unclamped when no consistent value is `≥ 0`.
 pub fn hdot_required_known(h: f64, delta_h: f64, bounds: &RateBounds, decay: &RateDecay) -> f64 {
     if delta_h == 0.0 {
         return hdot_required_of(h, bounds, decay);
     }
-    hdot_required_of((h - delta_h).max(0.0), bounds, decay)
+    let lowest = if h + delta_h < 0.0 {
+        h - delta_h
+    } else {
+        (h - delta_h).max(0.0).min(h)
+    };
+    hdot_required_of(lowest, bounds, decay)
 }
 
 /// [`RelDeg1::hdot_required_at`] from the barrier's value `h` alone.
@@ -526,7 +561,10 @@ mod tests {
                 psi_max,
             );
             assert!(phi.is_finite());
-            assert!(phi <= braking_requirement(&b, mu) + 1e-12);
+            // an estimate in S asks no more than braking (outside it, its own recovery)
+            if braking_barrier(est_h, est_hd, mu) >= 0.0 && est_h >= 0.0 {
+                assert!(phi <= braking_requirement(&b, mu) + 1e-12);
+            }
             if braking_barrier(est_h - unknown.h, est_hd - unknown.hdot, mu) >= 0.0 {
                 boxed += 1;
             }
@@ -538,6 +576,42 @@ mod tests {
         }
         // both branches were exercised
         assert!(boxed > 400 && boxed < 3600, "{boxed}");
+    }
+
+    /// Wherever the estimate is — inside `S`, near its boundary, far outside — the robust
+    /// requirement is at least the estimate's own, and so is the rate row's.
+    #[test]
+    fn a_robust_row_is_never_looser_than_the_estimates() {
+        let mut seed = 13;
+        for _ in 0..20000 {
+            let (mu, b, x) = random_state(&mut seed);
+            let mut r = || lcg(&mut seed);
+            // anywhere: shifted by up to ±1 in h and ±1 in ḣ from a state of S
+            let (h, hd) = (x.h + 2.0 * r() - 1.0, x.hdot + 2.0 * r() - 1.0);
+            let unknown = StateUncertainty {
+                h: 0.3 * r(),
+                hdot: 0.3 * r(),
+            };
+            let d = Decay::linear(2.0 * r()).at(b.period);
+            let psi_max = braking_requirement(&b, mu) + r();
+            let robust = phi_required_known(h, hd, &unknown, &b, mu, &d, psi_max);
+            let own = phi_required_of(h, hd, &b, mu, &d);
+            // (below the least `φ` a command can produce, `M₂ − ψ_max`, no row binds)
+            let floor = b.m2 - psi_max;
+            assert!(
+                robust.max(floor) >= own.max(floor) - 1e-12,
+                "h {h} hd {hd} {unknown:?}: {robust} < {own}"
+            );
+            let rate = RateBounds {
+                period: b.period,
+                d: 0.1 * r(),
+                j: r(),
+            };
+            let rd = RateDecay::new(2.0 * r(), 0.0, b.period);
+            assert!(
+                hdot_required_known(h, unknown.h, &rate, &rd) >= hdot_required_of(h, &rate, &rd)
+            );
+        }
     }
 
     #[test]

@@ -313,6 +313,9 @@ pub(crate) struct KnownInputs {
 pub const FORCE_CAP_ROUNDS: usize = 4;
 /// Growth of the force bound between two rounds [-].
 pub const FORCE_CAP_GROWTH: f64 = 1.25;
+/// Halvings of the share of the declared errors when no command is certified
+/// ([`TranslationalFilter::solve_degraded`]): the share to 1/64.
+pub const DEGRADE_ROUNDS: usize = 6;
 
 /// The translational CBF-QP safety filter (paper eq. "translation_qp").
 pub struct TranslationalFilter {
@@ -360,20 +363,21 @@ impl TranslationalFilter {
         omega_b: &Vector3<f64>,
         axis: &CorridorAxis,
     ) -> ([SampleBounds; N], RateBounds) {
-        self.sample_bounds_known(r, v, omega_b, axis, (0.0, 0.0), 1.0)
+        self.sample_bounds_known(r, v, omega_b, axis, (0.0, 0.0, 0.0), 1.0)
     }
 
-    /// [`Self::sample_bounds`] for every true state within `(ē_r, ē_v)` of the estimate
-    /// `(r, v)` and a force scaled by at most `k_hi`: the ranges start from `‖r‖ ± ē_r`,
-    /// `‖v‖ + ē_v`, the force's acceleration is `k_hi √3F/m` and the corridor's gradient
-    /// may be `cos ψ · chord` longer.
+    /// [`Self::sample_bounds`] for every true state within `(ē_r, ē_v, ē_ω)` of the
+    /// estimate `(r, v, ω_B)` (`ē_v` in F_H) and a force scaled by at most `k_hi`: the
+    /// ranges start from `‖r‖ ± ē_r`, `‖v‖ + ē_v + nē_r`, `‖ω_B‖ + ē_ω`, the force's
+    /// acceleration is `k_hi √3F/m` and the corridor's gradient may be `cos ψ · chord`
+    /// longer.
     pub fn sample_bounds_known(
         &self,
         r: &Vector3<f64>,
         v: &Vector3<f64>,
         omega_b: &Vector3<f64>,
         axis: &CorridorAxis,
-        err: (f64, f64),
+        err: (f64, f64, f64),
         k_hi: f64,
     ) -> ([SampleBounds; N], RateBounds) {
         let p = &self.params;
@@ -391,7 +395,7 @@ impl TranslationalFilter {
             a = f_acc + 3.0 * n * n * rr + 2.0 * n * vv;
         }
         let r_min = (rn_est - err.0 - vn * t - 0.5 * a * t * t).max(1e-3);
-        let omega = omega_b.norm().max(p.omega_bound) + n;
+        let omega = (omega_b.norm() + err.2).max(p.omega_bound) + n;
         let jerk = 3.0 * n * n * vv + 2.0 * n * a + f_acc * omega;
         let grav = 3.0 * n * n * rr * rr / p.orbit_radius;
         let rhat = r / rn_est.max(1e-12);
@@ -463,7 +467,7 @@ impl TranslationalFilter {
         });
         let rows: [Row<3>; N + 1] = match (p.formulation, &p.errors, &known) {
             (Formulation::SampledData, Some(errors), Some(k)) => {
-                self.known_rows(x, terms, k, errors.force, self.full_force())
+                self.known_rows(x, terms, k, errors.force, self.full_force(), 1.0)
             }
             (Formulation::SampledData, _, _) => {
                 let (b, bt) = self.sample_bounds(&x.r_h, &x.v_h, &x.omega_b, axis);
@@ -492,10 +496,11 @@ impl TranslationalFilter {
     }
 
     /// The QP with declared errors: the rows for a force bound `c` certify a command of
-    /// `‖f‖ ≤ c` only. Starting from the nominal's norm (a feasible nominal is certified
-    /// by its own rows), a solution larger than its bound is solved again with the bound
-    /// raised to it (× [`FORCE_CAP_GROWTH`]), at most [`FORCE_CAP_ROUNDS`] times; then the
-    /// prepared rows, which hold for every command in the box.
+    /// `‖f‖ ≤ c` only ([`Self::rising_cap`]). First from the nominal's norm (a feasible
+    /// nominal is certified by its own rows); when that finds nothing, from zero (the rows
+    /// get stricter as `c` grows, so a large nominal must not hide a certified smaller
+    /// command); then the rows for every command in the box. Nothing certified: the
+    /// largest feasible share of the margins ([`Self::solve_degraded`]).
     fn solve_known(
         &mut self,
         x: &TranslationalInput,
@@ -506,21 +511,97 @@ impl TranslationalFilter {
         report: &mut FilterReport<N>,
     ) -> Actuated<3> {
         let full = self.full_force();
-        let mut cap = u_nom.norm().min(full);
-        for _ in 0..FORCE_CAP_ROUNDS {
-            let rows = self.known_rows(x, &p.terms, k, force, cap);
-            let outcome = self.engine.solve(u_nom, &rows, &p.weights, &p.bounds);
-            let size = outcome.u.norm();
-            if size <= cap && outcome.kind != Kind::Failed {
+        let from_nominal = u_nom.norm().min(full);
+        let starts = [from_nominal, 0.0];
+        let tries = if from_nominal > 0.0 {
+            &starts[..]
+        } else {
+            &starts[1..]
+        };
+        for &start in tries {
+            if let Some((outcome, rows)) = self.rising_cap(x, p, k, force, u_nom, start) {
                 return self.conclude_solved(x, p, u_nom, &outcome, &rows, report);
             }
+        }
+        let outcome = self.engine.solve(u_nom, &p.rows, &p.weights, &p.bounds);
+        if matches!(outcome.kind, Kind::Solved | Kind::Skipped) {
+            return self.conclude_solved(x, p, u_nom, &outcome, &p.rows, report);
+        }
+        self.solve_degraded(x, p, k, force, u_nom, report)
+    }
+
+    /// Solves with the rows for the force bound `c` from `start`: a solution of
+    /// `‖f‖ ≤ c` is certified; a larger one raises `c` to its norm × [`FORCE_CAP_GROWTH`]
+    /// (at most [`FORCE_CAP_ROUNDS`] solves, `c ≤ √3F`). `None` when the rows become
+    /// infeasible or the rounds run out.
+    fn rising_cap(
+        &mut self,
+        x: &TranslationalInput,
+        p: &Prepared,
+        k: &KnownInputs,
+        force: ForceError,
+        u_nom: &Vector3<f64>,
+        start: f64,
+    ) -> Option<(crate::engine::Outcome<3>, [Row<3>; N + 1])> {
+        let full = self.full_force();
+        let mut cap = start;
+        for _ in 0..FORCE_CAP_ROUNDS {
+            let rows = self.known_rows(x, &p.terms, k, force, cap, 1.0);
+            let outcome = self.engine.solve(u_nom, &rows, &p.weights, &p.bounds);
+            if !matches!(outcome.kind, Kind::Solved | Kind::Skipped) {
+                return None;
+            }
+            let size = outcome.u.norm();
+            if size <= cap {
+                return Some((outcome, rows));
+            }
             if cap >= full {
-                break;
+                return None;
             }
             cap = (size.max(cap) * FORCE_CAP_GROWTH).min(full);
         }
-        let outcome = self.engine.solve(u_nom, &p.rows, &p.weights, &p.bounds);
-        self.conclude_solved(x, p, u_nom, &outcome, &p.rows, report)
+        None
+    }
+
+    /// No command is certified for the declared errors: the command of the rows with the
+    /// largest share `λ` of the declared errors that are still feasible (for every command
+    /// in the box; bisection, [`DEGRADE_ROUNDS`] halvings), reported as relaxed with the
+    /// violation `1 − λ` (the share of the margins given up). `λ = 0` is the nominal
+    /// model's rows; when even they are infeasible, their relaxed problem as without
+    /// declared errors. Never the relaxed problem of infeasible margins, which can give up
+    /// the zone for the corridor (docs/SAFETY.md).
+    fn solve_degraded(
+        &mut self,
+        x: &TranslationalInput,
+        p: &Prepared,
+        k: &KnownInputs,
+        force: ForceError,
+        u_nom: &Vector3<f64>,
+        report: &mut FilterReport<N>,
+    ) -> Actuated<3> {
+        let full = self.full_force();
+        let nominal_rows = self.known_rows(x, &p.terms, k, force, full, 0.0);
+        let first = self
+            .engine
+            .solve(u_nom, &nominal_rows, &p.weights, &p.bounds);
+        if !matches!(first.kind, Kind::Solved | Kind::Skipped) {
+            return self.conclude_solved(x, p, u_nom, &first, &nominal_rows, report);
+        }
+        let (mut best, mut best_rows, mut share) = (first, nominal_rows, 0.0);
+        let (mut lo, mut hi) = (0.0, 1.0);
+        for _ in 0..DEGRADE_ROUNDS {
+            let mid = 0.5 * (lo + hi);
+            let rows = self.known_rows(x, &p.terms, k, force, full, mid);
+            let outcome = self.engine.solve(u_nom, &rows, &p.weights, &p.bounds);
+            if matches!(outcome.kind, Kind::Solved | Kind::Skipped) {
+                (best, best_rows, share, lo) = (outcome, rows, mid, mid);
+            } else {
+                hi = mid;
+            }
+        }
+        best.kind = Kind::Relaxed;
+        best.violation = 1.0 - share;
+        self.conclude_solved(x, p, u_nom, &best, &best_rows, report)
     }
 
     /// [`step::conclude`] for a solve on `rows` (the barrier rows first).
@@ -563,11 +644,32 @@ impl TranslationalFilter {
         k: &KnownInputs,
         force: ForceError,
         force_cap: f64,
+        share: f64,
     ) -> [Row<3>; N + 1] {
         let p = &self.params;
         let (axis, tangential) = (&k.axis, &k.tangential);
-        let err = x.com_error;
-        let (b, bt) = self.sample_bounds_known(&x.r_h, &x.v_h, &x.omega_b, axis, err, force.k_hi);
+        let force = force.share(share);
+        let (e_r, e_v) = if share == 1.0 {
+            x.com_error
+        } else {
+            (x.com_error.0 * share, x.com_error.1 * share)
+        };
+        // the CoM's velocity error is inertial; in the rotating F_H it gains ‖ω_H‖ē_r
+        let err = (e_r, e_v + x.omega_h.norm() * e_r);
+        let rate_err = share
+            * self
+                .params
+                .errors
+                .as_ref()
+                .map_or(0.0, |e| e.com.rate_rad_s);
+        let (b, bt) = self.sample_bounds_known(
+            &x.r_h,
+            &x.v_h,
+            &x.omega_b,
+            axis,
+            (err.0, err.1, rate_err),
+            force.k_hi,
+        );
         let a0 = cw_drift(p.mean_motion, &x.r_h, &x.v_h);
         let f_acc = force_cap / p.mass;
         let u = Unknowns::new(&x.r_h, &x.v_h, err, &a0, p.mean_motion, f_acc, force);
@@ -601,13 +703,12 @@ impl TranslationalFilter {
         let vt_perp = (v_r - rr_hat * along).norm();
         let c_t = tangential_coefficient(p);
         let motion = InertialMotion {
-            frame_rate: x.omega_h.norm(),
             speed: v_r.norm(),
             along,
             v_perp: vt_perp,
             tide: tide.norm(),
         };
-        let (dh_t, dd_t) = u.tangential(c_t, p.mean_motion, &motion);
+        let (dh_t, dd_t) = u.tangential(c_t.max(0.0), p.mean_motion, &motion);
         let rate = RateBounds {
             d: bt.d + dd_t,
             ..bt

@@ -69,6 +69,21 @@ impl ForceError {
         *self == Self::NONE
     }
 
+    /// The share `λ ∈ [0, 1]` of these errors (`1`: themselves, `0`: [`Self::NONE`]).
+    pub fn share(&self, share: f64) -> Self {
+        if share == 1.0 {
+            return *self;
+        }
+        if share == 0.0 {
+            return Self::NONE;
+        }
+        Self {
+            k_lo: 1.0 - share * (1.0 - self.k_lo),
+            k_hi: 1.0 + share * (self.k_hi - 1.0),
+            turn_rad: share * self.turn_rad,
+        }
+    }
+
     /// The offset of a row `b·f + c ≥ 0` that holds for every scale in `[k_lo, k_hi]`:
     /// `c/k_lo` when the row needs force (`c < 0`), else `c/k_hi`.
     pub fn scaled_offset(&self, c: f64) -> f64 {
@@ -103,7 +118,7 @@ impl TranslationalErrors {
 }
 
 /// Chord between the unit vectors of `r` and `r + e`, `‖e‖ ≤ ē`, `‖r‖ = rn`:
-/// `√(2(1 − √(1 − (ē/rn)²)))` (the angle's sine is at most `ē/rn`); 2 when `ē ≥ rn`.
+/// `√(2(1 − √(1 − u²)))`, `u = ē/rn` (the angle's sine is at most `u`); 2 when `ē ≥ rn`.
 pub fn direction_chord(e: f64, rn: f64) -> f64 {
     if e == 0.0 {
         return 0.0;
@@ -112,7 +127,8 @@ pub fn direction_chord(e: f64, rn: f64) -> f64 {
     if u.is_nan() || u >= 1.0 {
         return 2.0;
     }
-    (2.0 * (1.0 - (1.0 - u * u).sqrt())).max(0.0).sqrt()
+    // √(2(1 − √(1 − u²))) written without the cancellation
+    u * (2.0 / (1.0 + (1.0 - u * u).sqrt())).sqrt()
 }
 
 /// The estimate's CoM state and what is unknown of it, with the magnitudes the bounds
@@ -220,17 +236,17 @@ impl Unknowns {
         (unknown, phi)
     }
 
-    /// Tangential speed `h_t = c_t‖r‖ − ‖v_⊥‖²` (in F_R, where the velocity's error is
-    /// `ē_vR = ē_v + ‖ω_H‖ē_r`), `ḣ_t = c_t s + 2sq/‖r‖ − 2v_⊥ᵀa` (`s = r̂ᵀv`,
+    /// Tangential speed `h_t = c_t‖r‖ − ‖v_⊥‖²` (in the inertially fixed F_R, whose
+    /// velocity error — the CoM's inertial one — is at most the F_H bound `ē_v` these
+    /// unknowns carry), `ḣ_t = c_t s + 2sq/‖r‖ − 2v_⊥ᵀa` (`s = r̂ᵀv`,
     /// `q = ‖v_⊥‖²`, `a` = tide + force): `(δh_t, δḣ_t)` from the errors of `s`, `q`,
     /// `1/‖r‖` and `v_⊥` term by term (`|Δ(xy)| ≤ |Δx||y| + |x||Δy| + |Δx||Δy|`).
     pub fn tangential(&self, c_t: f64, n: f64, m: &InertialMotion) -> (f64, f64) {
-        let (frame_rate, speed, along, v_perp, tide) =
-            (m.frame_rate, m.speed, m.along, m.v_perp, m.tide);
+        let (speed, along, v_perp, tide) = (m.speed, m.along, m.v_perp, m.tide);
         if self.rho.is_nan() || self.rho <= 0.0 {
             return (f64::INFINITY, f64::INFINITY);
         }
-        let e_v = self.e_v + frame_rate * self.e_r;
+        let e_v = self.e_v;
         let d_perp = e_v + 2.0 * self.chord * (speed + e_v);
         let d_q = 2.0 * v_perp * d_perp + d_perp * d_perp;
         let d_s = self.chord * (speed + e_v) + e_v;
@@ -252,8 +268,6 @@ impl Unknowns {
 /// it.
 #[derive(Debug, Clone, Copy)]
 pub struct InertialMotion {
-    /// `‖ω_H‖` [rad/s]: how F_H turns (the velocity's error in F_R gains `‖ω_H‖ē_r`).
-    pub frame_rate: f64,
     /// `‖v‖`, `r̂ᵀv`, `‖v_⊥‖` [m/s].
     pub speed: f64,
     pub along: f64,
@@ -276,13 +290,15 @@ fn unbounded() -> (StateUncertainty, f64) {
 
 /// Step of the range grid of [`wall_uncertifiable_below`] [m].
 pub const WALL_RANGE_STEP_M: f64 = 0.05;
+/// Most grid points [`wall_uncertifiable_below`] evaluates (200 m at 0.05 m).
+pub const WALL_RANGE_MAX_STEPS: usize = 4000;
 
 /// Where the declared errors leave the translational rows without a certified command:
 /// the largest range [m] on a grid of [`WALL_RANGE_STEP_M`] from `R_CAZ` to the servicer's
-/// initial distance at which the filter's own rows are infeasible for a servicer on the
+/// initial distance (at most [`WALL_RANGE_MAX_STEPS`] points) at which the filter's own rows are infeasible for a servicer on the
 /// corridor's wall, at rest towards it (`ḣ = 0`) and moving across the line of sight at
 /// the tangential-speed limit, with the CoM's error bound of the initial arm
-/// configuration — there only the relaxed problem acts (docs/SAFETY.md,
+/// configuration — there the filter keeps only a share of the margins (docs/SAFETY.md,
 /// "Translational: what the declared errors cost"). `None`: certified at every range of
 /// the grid, or nothing declared.
 pub fn wall_uncertifiable_below(s: &sc_scenario::Scenario, robot: &Robot) -> Option<f64> {
@@ -302,7 +318,7 @@ pub fn wall_uncertifiable_below(s: &sc_scenario::Scenario, robot: &Robot) -> Opt
     let across = d
         .cross(&Vector3::z())
         .try_normalize(1e-9)
-        .unwrap_or(d.cross(&Vector3::x()).normalize());
+        .unwrap_or_else(|| d.cross(&Vector3::x()).normalize());
     let sin_psi = (1.0 - cos_psi * cos_psi).max(0.0).sqrt();
     let wall = d * cos_psi + across * sin_psi;
     let sideways = d.cross(&across).normalize();
@@ -311,7 +327,8 @@ pub fn wall_uncertifiable_below(s: &sc_scenario::Scenario, robot: &Robot) -> Opt
     let far = Vector3::from(s.servicer.initial_position_m)
         .norm()
         .max(params.r_caz);
-    let steps = ((far - params.r_caz) / WALL_RANGE_STEP_M).floor() as usize;
+    let steps =
+        (((far - params.r_caz) / WALL_RANGE_STEP_M).floor() as usize).min(WALL_RANGE_MAX_STEPS);
     (0..=steps)
         .map(|i| params.r_caz + i as f64 * WALL_RANGE_STEP_M)
         .filter(|&range| {
@@ -327,7 +344,11 @@ pub fn wall_uncertifiable_below(s: &sc_scenario::Scenario, robot: &Robot) -> Opt
                 sc_models::quat::IDENTITY,
             );
             x.com_error = com_error;
-            filter.backup(&x).report.status == crate::common::FilterStatus::Relaxed
+            // relaxed, refused or braked without a solver: not certified
+            !matches!(
+                filter.backup(&x).report.status,
+                crate::common::FilterStatus::Solved | crate::common::FilterStatus::Skipped
+            )
         })
         .last()
 }
@@ -433,8 +454,7 @@ mod tests {
             let r = ball(seed, 1.0).normalize() * rn;
             let v = ball(seed, 0.2);
             let err = (0.1 * lcg(seed), 0.01 * lcg(seed));
-            let frame_rate = n;
-            let (er, ev) = (ball(seed, err.0), ball(seed, err.1 + frame_rate * err.0));
+            let (er, ev) = (ball(seed, err.0), ball(seed, err.1));
             let (rt, vt) = (r + er, v + ev);
             let f = Vector3::from_fn(|_, _| f_max * (2.0 * lcg(seed) - 1.0));
             let k = force.k_lo + (force.k_hi - force.k_lo) * lcg(seed);
@@ -449,7 +469,6 @@ mod tests {
             let along = rhat.dot(&v);
             let v_perp = (v - rhat * along).norm();
             let motion = InertialMotion {
-                frame_rate,
                 speed: v.norm(),
                 along,
                 v_perp,

@@ -46,8 +46,41 @@ fn translational_run(
     nominal: &mut ForceNominal,
 ) -> (Run, f64) {
     let s = scenario();
+    let world = World {
+        filter: TranslationalFilter::from_scenario(&s, mass()),
+        scale: 1.0,
+        turn: nalgebra::Matrix3::identity(),
+        estimate_error: Box::new(|_| (Vector3::zeros(), Vector3::zeros())),
+        com_error: (0.0, 0.0),
+    };
+    translational_run_in(world, omega_b, steps, filtered, nominal)
+}
+
+/// The estimate's error `(e_r, e_v)` at control step `k` (F_H).
+type EstimateError = dyn Fn(usize) -> (Vector3<f64>, Vector3<f64>);
+
+/// What the filter does not know: the plant's CoM accelerates by `scale · turn · f/m`,
+/// and the filter sees the state off by `estimate_error(step)` (F_H) with the declared
+/// bound `com_error`.
+struct World {
+    filter: TranslationalFilter,
+    scale: f64,
+    turn: nalgebra::Matrix3<f64>,
+    estimate_error: Box<EstimateError>,
+    com_error: (f64, f64),
+}
+
+/// [`translational_run`] in `world`; the barriers are those of the true state.
+fn translational_run_in(
+    world: World,
+    omega_b: Vector3<f64>,
+    steps: usize,
+    filtered: bool,
+    nominal: &mut ForceNominal,
+) -> (Run, f64) {
+    let s = scenario();
     let n = mean_motion(&s);
-    let mut f = TranslationalFilter::from_scenario(&s, mass());
+    let mut f = world.filter;
     let p = f.params.clone();
     let q_hr0 = s.reference_frame.attitude_in_hill;
     let r_r0 = Vector3::from(s.servicer.initial_position_m);
@@ -71,9 +104,12 @@ fn translational_run(
     assert!(b0[0] > 0.0 && b0[1] > 0.0, "the run starts safe: {b0:?}");
     for k in 0..steps {
         let t = k as f64 * TS;
-        let mut x = TranslationalInput::circular(r, v, q_hr_at(&s, n, t), n, q_rb);
+        let (e_r, e_v) = (world.estimate_error)(k);
+        let (r_est, v_est) = (r + e_r, v + e_v);
+        let mut x = TranslationalInput::circular(r_est, v_est, q_hr_at(&s, n, t), n, q_rb);
         x.omega_b = omega_b;
-        let f_nom = nominal(t, &r, &v);
+        x.com_error = world.com_error;
+        let f_nom = nominal(t, &r_est, &v_est);
         run.steps += 1;
         let f_b = if filtered {
             let out = f.filter(&x, &f_nom);
@@ -98,7 +134,11 @@ fn translational_run(
         };
         // RK4 with the body-fixed force turning with the body and the frame
         let force_h = |tt: f64, q: &quat::Quat| {
-            quat::to_matrix(&q_hr_at(&s, n, tt)) * quat::to_matrix(q) * f_b
+            quat::to_matrix(&q_hr_at(&s, n, tt))
+                * quat::to_matrix(q)
+                * world.turn
+                * f_b
+                * world.scale
         };
         for j in 0..SUB {
             let t0 = t + j as f64 * h;
@@ -170,6 +210,84 @@ fn translational_corridor_and_caz_invariant_under_a_nominal_pushing_into_the_cor
         dist < 2.0,
         "the servicer was pushed to the CAZ boundary ({dist} m)"
     );
+}
+
+/// The corner-pushing nominal against a plant and a navigation at the `realistic` bounds:
+/// the force scaled by each end of `[k_lo, k_hi]` and turned by `θ̄`, the estimate off by
+/// 95 % of the CoM's error bound in a direction that turns with every step. With the
+/// errors declared every barrier of the true state stays ≥ 0 at every physics step; the
+/// same plant and estimate with nothing declared leave the corridor and enter the zone.
+/// Most steps have no certified command (the corridor's wall is not certifiable under
+/// `realistic`, docs/SAFETY.md): there the filter keeps the largest share of the margins
+/// that is feasible (flagged relaxed) — the relaxed problem of the full margins instead
+/// took the servicer 1 m into the zone (min h_CAZ −2.28 m²).
+#[test]
+fn translational_invariant_on_the_truth_under_the_declared_realistic_errors() {
+    let mut s = scenario();
+    let realistic =
+        sc_scenario::Uncertainty::profile("realistic", std::path::Path::new(".")).expect("profile");
+    s.set_uncertainty(sc_scenario::UncertaintySpec {
+        profile: "exact".into(),
+        seed: 0,
+        model: Some(realistic.model),
+        actuators: Some(realistic.actuators),
+        navigation: Some(realistic.navigation),
+        truth: None,
+    })
+    .expect("declared");
+    let n = mean_motion(&s);
+    let declared = sc_cbf::translational::TranslationalParams::from_model(&s, &robot());
+    let errors = declared.errors.clone().expect("realistic declares errors");
+    let theta = Vector7::from(s.servicer.initial_theta_rad);
+    let com_error = errors
+        .com
+        .com_error(&robot(), &theta, &Vector7::zeros(), &Vector3::zeros());
+    let turn =
+        nalgebra::Rotation3::new(Vector3::new(0.6, -0.8, 0.0) * errors.force.turn_rad).into_inner();
+    let estimate_error = move |k: usize| {
+        let a = 0.7 * k as f64;
+        let dir = Vector3::new(a.cos(), a.sin() * 0.8, 0.6 * a.sin()).normalize();
+        (dir * 0.95 * com_error.0, -dir * 0.95 * com_error.1)
+    };
+    let w = Vector3::new(0.02, -0.03, 0.05);
+    for scale in [errors.force.k_lo, errors.force.k_hi] {
+        let world = |filter| World {
+            filter,
+            scale,
+            turn,
+            estimate_error: Box::new(estimate_error),
+            com_error,
+        };
+        let mut nominal = |t: f64, _: &Vector3<f64>, _: &Vector3<f64>| {
+            let f_r = Vector3::new(1.0, 0.1 * (0.05 * t).sin(), 0.1 * (0.031 * t).cos())
+                .normalize()
+                * 9.0;
+            quat::rotate(&q_hr_at(&s, n, t), &f_r)
+        };
+        let known = TranslationalFilter::new(declared.clone());
+        let (run, dist) = translational_run_in(world(known), w, 4000, true, &mut nominal);
+        let blind = TranslationalFilter::from_scenario(&s, mass());
+        let (open, _) = translational_run_in(world(blind), w, 4000, true, &mut nominal);
+        println!(
+            "k = {scale}: declared {run:?}, final |r| = {dist}; undeclared {:?}",
+            open.min
+        );
+        assert!(
+            run.min.iter().all(|m| *m >= 0.0),
+            "k = {scale}: a true barrier below zero with the errors declared: {run:?}"
+        );
+        assert!(
+            open.min.iter().any(|m| *m < 0.0),
+            "k = {scale}: the errors must matter: undeclared {open:?}"
+        );
+        assert!(
+            run.interventions > 1000,
+            "the nominal must be unsafe: {run:?}"
+        );
+        // the wall is not certifiable under `realistic` (docs/SAFETY.md): the degraded
+        // path acted; if this fails, a change made it certifiable — update the docs
+        assert!(run.relaxed > 0, "no degraded step: {run:?}");
+    }
 }
 
 /// A random saturating nominal: a new direction (biased towards the target) every 3 s at

@@ -314,7 +314,7 @@ typedef struct ScSafeTranslational {
     uint32_t n_constraints; /* Number of constraints in `h` and `phi` [-] */
     uint32_t phase; /* Mission phase of the nominal command filtered (0-based) [-] */
     uint32_t solve_cpu_ns; /* CPU time of the filter call on its thread, saturating at u32::MAX [ns] */
-    double slack; /* Slack of the relaxed QP (0 otherwise), normalised rows [-] */
+    double slack; /* Slack of the relaxed QP (0 otherwise), normalised rows; for a translational step degraded under a declared uncertainty, the share of the declared margins given up (docs/SAFETY.md) [-] */
     double h[2]; /* Barrier values h_i the filter evaluated; NaN (null in the MCAP) = not evaluated [unit per constraint] */
     double phi[2]; /* CBF conditions Φ_i at the safe command [unit per constraint / s] */
     double u[3]; /* Safe force f_H, frame F_H [N] */
@@ -358,7 +358,7 @@ typedef struct ScSafeAttitude {
     uint32_t n_constraints; /* Number of constraints in `h` and `phi` [-] */
     uint32_t phase; /* Mission phase of the nominal command filtered (0-based) [-] */
     uint32_t solve_cpu_ns; /* CPU time of the filter call on its thread, saturating at u32::MAX [ns] */
-    double slack; /* Slack of the relaxed QP (0 otherwise), normalised rows [-] */
+    double slack; /* Slack of the relaxed QP (0 otherwise), normalised rows; for a translational step degraded under a declared uncertainty, the share of the declared margins given up (docs/SAFETY.md) [-] */
     double h[7]; /* Barrier values h_i the filter evaluated; NaN (null in the MCAP) = not evaluated [unit per constraint] */
     double phi[7]; /* CBF conditions Φ_i at the safe command [unit per constraint / s] */
     double u[3]; /* Safe torque τ_B, frame F_B [N·m] */
@@ -402,7 +402,7 @@ typedef struct ScSafeRobotic {
     uint32_t n_constraints; /* Number of constraints in `h` and `phi` [-] */
     uint32_t phase; /* Mission phase of the nominal command filtered (0-based) [-] */
     uint32_t solve_cpu_ns; /* CPU time of the filter call on its thread, saturating at u32::MAX [ns] */
-    double slack; /* Slack of the relaxed QP (0 otherwise), normalised rows [-] */
+    double slack; /* Slack of the relaxed QP (0 otherwise), normalised rows; for a translational step degraded under a declared uncertainty, the share of the declared margins given up (docs/SAFETY.md) [-] */
     double h[42]; /* Barrier values h_i the filter evaluated; NaN (null in the MCAP) = not evaluated [unit per constraint] */
     double phi[42]; /* CBF conditions Φ_i at the safe command [unit per constraint / s] */
     double u[7]; /* Safe joint torques τ_M, frame M [N·m] */

@@ -409,7 +409,9 @@ macro_rules! safe_msg {
                 pub phase: u32 = ["-"],
                 /// CPU time of the filter call on its thread, saturating at u32::MAX
                 pub solve_cpu_ns: u32 = ["ns"],
-                /// Slack of the relaxed QP (0 otherwise), normalised rows
+                /// Slack of the relaxed QP (0 otherwise), normalised rows; for a
+                /// translational step degraded under a declared uncertainty, the share
+                /// of the declared margins given up (docs/SAFETY.md)
                 pub slack: f64 = ["-"],
                 /// Barrier values h_i the filter evaluated; NaN (null in the MCAP) = not
                 /// evaluated
