@@ -60,6 +60,9 @@ pub struct TranslationalParams {
     pub r_caz: f64,
     /// γ_h [1/s].
     pub gamma: f64,
+    /// Share of the corridor's braking authority at the wall the cone's curvature may take
+    /// [-] ([`tangential_coefficient`]).
+    pub curvature_share: f64,
     /// ε_AC [m/s], ε_CAZ [m²/s].
     pub eps_ac: f64,
     pub eps_caz: f64,
@@ -99,6 +102,7 @@ impl TranslationalParams {
             cos_psi: t.corridor_half_angle_deg.to_radians().cos(),
             r_caz: t.caz_radius_m,
             gamma: s.safety.gamma_per_s,
+            curvature_share: t.curvature_share(),
             eps_ac: t.eps_ac,
             eps_caz: t.eps_caz,
             u_max_ac: t.u_max_ac_m_s2,
@@ -245,18 +249,14 @@ pub fn collision_avoidance_zone(
     }
 }
 
-/// Share of the corridor's braking authority at the wall (`sin ψ F/m − μ_AC`) that the
-/// cone's curvature may take; the rest stays for the sampled-data margins.
-pub const CURVATURE_SHARE: f64 = 0.5;
-
 /// The tangential-speed coefficient `c_t` [m/s²] of [`tangential_speed`]: the servicer's
 /// speed across the line to the target may not exceed `√(c_t ‖r‖)`, so that the cone's
-/// curvature `cos ψ ‖v_⊥‖²/‖r‖` never takes more than [`CURVATURE_SHARE`] of the braking
+/// curvature `cos ψ ‖v_⊥‖²/‖r‖` never takes more than `curvature_share` of the braking
 /// authority `sin ψ F/m − μ_AC` that keeps it inside the corridor. Non-positive when
 /// `μ_AC` exceeds the authority (a configuration error).
 pub fn tangential_coefficient(p: &TranslationalParams) -> f64 {
     let sin_psi = (1.0 - p.cos_psi * p.cos_psi).max(0.0).sqrt();
-    CURVATURE_SHARE * (sin_psi * p.force_max / p.mass - p.u_max_ac) / p.cos_psi
+    p.curvature_share * (sin_psi * p.force_max / p.mass - p.u_max_ac) / p.cos_psi
 }
 
 /// Tangential-speed limit, a constraint of the certified set (not one of the paper's

@@ -237,6 +237,22 @@ pub struct SafetyTranslational {
     pub u_max_ac_m_s2: f64,
     /// u_max of the CAZ's auxiliary barrier [m²/s²].
     pub u_max_caz_m2_s2: f64,
+    /// Share of the corridor's braking authority at the wall (`sin ψ F/m − u_max_ac`) the
+    /// cone's curvature may take [-], in (0, 1]; absent: [`DEFAULT_CURVATURE_SHARE`]
+    /// (docs/SAFETY.md, "The corridor's curvature").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub curvature_share: Option<f64>,
+}
+
+/// The curvature's share of the corridor's braking authority when a scenario does not set
+/// `safety.translational.curvature_share` [-].
+pub const DEFAULT_CURVATURE_SHARE: f64 = 0.5;
+
+impl SafetyTranslational {
+    /// `curvature_share`, or [`DEFAULT_CURVATURE_SHARE`].
+    pub fn curvature_share(&self) -> f64 {
+        self.curvature_share.unwrap_or(DEFAULT_CURVATURE_SHARE)
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -360,6 +360,14 @@ impl Scenario {
         non_negative("safety.translational.eps_ac", tr.eps_ac)?;
         non_negative("safety.translational.eps_caz", tr.eps_caz)?;
         positive("safety.translational.u_max_ac_m_s2", tr.u_max_ac_m_s2)?;
+        let share = tr.curvature_share();
+        if share.is_nan() || share <= 0.0 || share > 1.0 {
+            return Err(invalid(
+                "safety.translational.curvature_share",
+                share,
+                "must be in (0, 1]",
+            ));
+        }
         positive("safety.translational.u_max_caz_m2_s2", tr.u_max_caz_m2_s2)
     }
 

@@ -207,3 +207,32 @@ fn a_joint_torque_bias_at_the_torque_limit_is_refused() {
     let ok = text.replace("joint_torque_bias_nm = 2.0", "joint_torque_bias_nm = 1.9");
     Scenario::from_toml_str(&ok, &config_dir()).expect("a bias below the limit");
 }
+
+/// The corridor's curvature share is optional (absent: the default, and not written back),
+/// and outside (0, 1] it is refused with its key.
+#[test]
+fn the_curvature_share_is_optional_and_checked() {
+    let s = Scenario::load(&config_dir().join("scenario.toml")).unwrap();
+    assert_eq!(s.safety.translational.curvature_share, None);
+    assert_eq!(
+        s.safety.translational.curvature_share(),
+        sc_scenario::DEFAULT_CURVATURE_SHARE
+    );
+    assert!(!s.to_toml_string().contains("curvature_share"));
+    let set = |v: &str| {
+        with(
+            "safety.translational",
+            "u_max_caz_m2_s2",
+            &format!("0.06\ncurvature_share = {v}"),
+        )
+    };
+    let tuned = Scenario::from_toml_str(&set("0.25"), &config_dir()).unwrap();
+    assert_eq!(tuned.safety.translational.curvature_share(), 0.25);
+    for bad in ["0.0", "1.5", "-0.1", "nan"] {
+        let msg = reject(&set(bad));
+        assert!(
+            msg.contains("safety.translational.curvature_share"),
+            "{bad}: {msg}"
+        );
+    }
+}
