@@ -39,6 +39,8 @@ pub mod qp;
 pub mod robotic;
 pub mod sampled;
 mod step;
+#[cfg(test)]
+mod test_draws;
 pub mod translational;
 pub mod translational_margins;
 pub mod verify;

@@ -426,14 +426,8 @@ impl<const M: usize> RelDeg1<M> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_draws::lcg;
     use nalgebra::Vector1;
-
-    fn lcg(s: &mut u64) -> f64 {
-        *s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (*s >> 11) as f64 / (1u64 << 53) as f64
-    }
 
     /// The worst case the row guards against: ḧ(s) = φ − M₂ − M₃ s, integrated exactly.
     fn worst(x: &RelDeg2<1>, b: &SampleBounds, phi: f64, s: f64) -> (f64, f64) {

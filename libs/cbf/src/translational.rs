@@ -500,7 +500,7 @@ impl TranslationalFilter {
     /// nominal is certified by its own rows); when that finds nothing, from zero (the rows
     /// get stricter as `c` grows, so a large nominal must not hide a certified smaller
     /// command); then the rows for every command in the box. Nothing certified: the
-    /// largest feasible share of the margins ([`Self::solve_degraded`]).
+    /// a feasible share of the margins ([`Self::solve_degraded`]).
     fn solve_known(
         &mut self,
         x: &TranslationalInput,
@@ -564,7 +564,8 @@ impl TranslationalFilter {
     }
 
     /// No command is certified for the declared errors: the command of the rows with the
-    /// largest share `λ` of the declared errors that are still feasible (for every command
+    /// share `λ` of the declared errors that are still feasible, found by bisection — the
+    /// largest when feasibility falls with `λ`, not proven in general (for every command
     /// in the box; bisection, [`DEGRADE_ROUNDS`] halvings), reported as relaxed with the
     /// violation `1 − λ` (the share of the margins given up). `λ = 0` is the nominal
     /// model's rows; when even they are infeasible, their relaxed problem as without
@@ -647,7 +648,7 @@ impl TranslationalFilter {
         share: f64,
     ) -> [Row<3>; N + 1] {
         let p = &self.params;
-        let (axis, tangential) = (&k.axis, &k.tangential);
+        let axis = &k.axis;
         let force = force.share(share);
         let (e_r, e_v) = if share == 1.0 {
             x.com_error
@@ -697,29 +698,45 @@ impl TranslationalFilter {
                 c: force.scaled_offset(t.hddot_drift - req),
             }
         });
-        let (r_r, v_r, tide) = (&k.r_r, &k.v_r, &k.tide);
-        let rr_hat = r_r / r_r.norm();
-        let along = rr_hat.dot(v_r);
-        let vt_perp = (v_r - rr_hat * along).norm();
-        let c_t = tangential_coefficient(p);
+        [
+            rows[0],
+            rows[1],
+            self.tangential_known_row(k, &u, &bt, force),
+        ]
+    }
+
+    /// The tangential-speed row of [`Self::known_rows`] (relative degree one, in F_R): the
+    /// lowest consistent `h_t` and `D + δḣ_t`, its offset for every force scale.
+    fn tangential_known_row(
+        &self,
+        k: &KnownInputs,
+        u: &Unknowns,
+        bt: &RateBounds,
+        force: ForceError,
+    ) -> Row<3> {
+        let p = &self.params;
+        let tangential = &k.tangential;
+        let rr_hat = k.r_r / k.r_r.norm();
+        let along = rr_hat.dot(&k.v_r);
         let motion = InertialMotion {
-            speed: v_r.norm(),
+            speed: k.v_r.norm(),
             along,
-            v_perp: vt_perp,
-            tide: tide.norm(),
+            v_perp: (k.v_r - rr_hat * along).norm(),
+            tide: k.tide.norm(),
         };
-        let (dh_t, dd_t) = u.tangential(c_t.max(0.0), p.mean_motion, &motion);
+        // |c_t|: the term's error bound holds for either sign
+        let c_t = tangential_coefficient(p).abs();
+        let (dh_t, dd_t) = u.tangential(c_t, p.mean_motion, &motion);
         let rate = RateBounds {
             d: bt.d + dd_t,
-            ..bt
+            ..*bt
         };
         let rate_decay = sampled::RateDecay::new(p.gamma, 0.0, p.period);
         let req_t = sampled::hdot_required_known(tangential.h, dh_t, &rate, &rate_decay);
-        let row_t = Row {
+        Row {
             a: tangential.hdot_u,
             c: force.scaled_offset(tangential.hdot_drift - req_t),
-        };
-        [rows[0], rows[1], row_t]
+        }
     }
 
     /// `‖f_B‖∞ ≤ F` on the body-frame force `f_B = R_BH f_H`: the six rows

@@ -356,25 +356,29 @@ pub fn wall_uncertifiable_below(s: &sc_scenario::Scenario, robot: &Robot) -> Opt
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_draws::{ball, lcg};
     use crate::translational::{
         approach_corridor, collision_avoidance_zone, corridor_axis, cw_drift,
     };
     use nalgebra::Matrix3;
 
-    fn lcg(s: &mut u64) -> f64 {
-        *s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (*s >> 11) as f64 / (1u64 << 53) as f64
-    }
+    /// Servicer mass [kg], mean motion [rad/s] and force bound [N] of the draws, and a
+    /// force error of about `realistic`'s size.
+    const MASS: f64 = 269.0;
+    const N_ORBIT: f64 = 1.1e-3;
+    const F_MAX: f64 = 7.0;
+    const FORCE: ForceError = ForceError {
+        k_lo: 0.88,
+        k_hi: 1.14,
+        turn_rad: 0.0052,
+    };
 
-    fn ball(seed: &mut u64, radius: f64) -> Vector3<f64> {
-        loop {
-            let v = Vector3::from_fn(|_, _| 2.0 * lcg(seed) - 1.0);
-            if v.norm() <= 1.0 && v.norm() > 1e-3 {
-                return v * radius;
-            }
-        }
+    /// A command in the box, a scale in `[k_lo, k_hi]` and the force the plant receives.
+    fn delivered(seed: &mut u64) -> (Vector3<f64>, f64, Vector3<f64>) {
+        let f = Vector3::from_fn(|_, _| F_MAX * (2.0 * lcg(seed) - 1.0));
+        let k = FORCE.k_lo + (FORCE.k_hi - FORCE.k_lo) * lcg(seed);
+        let f_true = nalgebra::Rotation3::new(ball(seed, FORCE.turn_rad)) * f * k;
+        (f, k, f_true)
     }
 
     /// The corridor's and the zone's true `h`, `ḣ`, `ḧ` (true state, scaled and turned
@@ -382,13 +386,8 @@ mod tests {
     #[test]
     fn true_barrier_terms_stay_within_the_unknowns() {
         let seed = &mut 9u64;
-        let (mass, n, cos_psi, f_max) = (269.0, 1.1e-3, 5f64.to_radians().cos(), 7.0);
-        let force = ForceError {
-            k_lo: 0.88,
-            k_hi: 1.14,
-            turn_rad: 0.0052,
-        };
-        let f_acc = 3f64.sqrt() * f_max / mass;
+        let (mass, n, cos_psi, force) = (MASS, N_ORBIT, 5f64.to_radians().cos(), FORCE);
+        let f_acc = 3f64.sqrt() * F_MAX / mass;
         let axis = corridor_axis(
             &Matrix3::identity(),
             &Vector3::new(-1.0, 0.0, 0.0),
@@ -402,10 +401,7 @@ mod tests {
             let err = (0.1 * lcg(seed), 0.01 * lcg(seed));
             let (er, ev) = (ball(seed, err.0), ball(seed, err.1));
             let (rt, vt) = (r + er, v + ev);
-            let f = Vector3::from_fn(|_, _| f_max * (2.0 * lcg(seed) - 1.0));
-            let k = force.k_lo + (force.k_hi - force.k_lo) * lcg(seed);
-            let turn = nalgebra::Rotation3::new(ball(seed, force.turn_rad));
-            let f_true = turn * f * k;
+            let (f, k, f_true) = delivered(seed);
             let a0 = cw_drift(n, &r, &v);
             let at = cw_drift(n, &rt, &vt);
             let u = Unknowns::new(&r, &v, err, &a0, n, f_acc, force);
@@ -440,13 +436,8 @@ mod tests {
     #[test]
     fn true_tangential_terms_stay_within_the_unknowns() {
         let seed = &mut 21u64;
-        let (mass, n, f_max, c_t) = (269.0, 1.1e-3, 7.0, 6.4e-4);
-        let force = ForceError {
-            k_lo: 0.88,
-            k_hi: 1.14,
-            turn_rad: 0.0052,
-        };
-        let f_acc = 3f64.sqrt() * f_max / mass;
+        let (mass, n, c_t, force) = (MASS, N_ORBIT, 6.4e-4, FORCE);
+        let f_acc = 3f64.sqrt() * F_MAX / mass;
         let radial = Vector3::new(0.3, -0.2, 0.9).normalize();
         let tide_of = |r: &Vector3<f64>| (radial * (3.0 * radial.dot(r)) - r) * (n * n);
         for _ in 0..20000 {
@@ -456,9 +447,7 @@ mod tests {
             let err = (0.1 * lcg(seed), 0.01 * lcg(seed));
             let (er, ev) = (ball(seed, err.0), ball(seed, err.1));
             let (rt, vt) = (r + er, v + ev);
-            let f = Vector3::from_fn(|_, _| f_max * (2.0 * lcg(seed) - 1.0));
-            let k = force.k_lo + (force.k_hi - force.k_lo) * lcg(seed);
-            let f_true = nalgebra::Rotation3::new(ball(seed, force.turn_rad)) * f * k;
+            let (f, k, f_true) = delivered(seed);
             let (tide, tide_t) = (tide_of(&r), tide_of(&rt));
             let eye = Matrix3::identity();
             let e = crate::translational::tangential_speed(&r, &v, &tide, &eye, mass, c_t);

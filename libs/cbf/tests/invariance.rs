@@ -220,7 +220,7 @@ fn translational_corridor_and_caz_invariant_under_a_nominal_pushing_into_the_cor
 /// Most steps have no certified command (the corridor's wall is not certifiable under
 /// `realistic`, docs/SAFETY.md): there the filter keeps the largest share of the margins
 /// that is feasible (flagged relaxed) — the relaxed problem of the full margins instead
-/// took the servicer 1 m into the zone (min h_CAZ −2.28 m²).
+/// took the servicer 1 m into the zone (min h_CAZ −2.28 m², with 509bb72's rows).
 #[test]
 fn translational_invariant_on_the_truth_under_the_declared_realistic_errors() {
     let mut s = scenario();
