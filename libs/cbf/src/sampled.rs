@@ -276,13 +276,16 @@ impl StateUncertainty {
 ///   so the low corner's requirement with `κ` raised by that deficit over `2δḣ` covers
 ///   the box.
 ///
-/// With the low corner in `S` the result is the smaller of the two. Otherwise the truth
-/// may be on `S`'s boundary: `β`, but never less than the estimate's own requirement.
-/// When even the high corner is outside `S`, no consistent state is in it and the row asks
-/// for the worst one's recovery: the low corner's requirement, at least `β` and the
-/// estimate's own. So the robust row is never looser than the estimate's row (test
-/// `a_robust_row_is_never_looser_than_the_estimates`). With nothing unknown it is
-/// [`phi_required_of`] itself.
+/// With the low corner in `S` the result is the smaller of the two. Otherwise, while the
+/// high corner is in `S`, the truth may be on `S`'s boundary: `β`, which brakes every
+/// state of `S` and so every consistent one — also when the estimate itself is outside
+/// `S`, where its own requirement (a recovery `S`'s states do not need) may exceed `β`
+/// (test `in_the_middle_case_beta_holds_for_every_consistent_truth`). When even the high
+/// corner is outside `S`, no consistent state is in it and the row asks for the worst
+/// one's recovery: the low corner's requirement, at least `β` and the estimate's own. So
+/// the robust row is never looser than the estimate's row wherever the estimate is in `S`
+/// or no consistent state is (test `a_robust_row_is_never_looser_than_the_estimates`).
+/// With nothing unknown it is [`phi_required_of`] itself.
 pub fn phi_required_known(
     h: f64,
     hd: f64,
@@ -298,19 +301,19 @@ pub fn phi_required_known(
     let beta = braking_requirement(bounds, mu);
     let (h_lo, hd_lo) = (h - unknown.h, hd - unknown.hdot);
     let in_set = |h: f64, hd: f64| h >= 0.0 && braking_barrier(h, hd, mu) >= 0.0;
-    let own = || phi_required_of(h, hd, bounds, mu, decay);
     if in_set(h_lo, hd_lo) {
         return low_corner_requirement(h_lo, hd_lo, unknown, bounds, mu, decay, psi_max).min(beta);
     }
     if in_set(h + unknown.h, hd + unknown.hdot) {
-        // the truth may be anywhere in S: β; never less than the estimate's own row
-        return beta.max(own());
+        // the truth may be anywhere in S: β brakes every state of S (an estimate outside
+        // S may ask more for its own recovery, which no consistent truth needs)
+        return beta;
     }
     // no consistent state is in S: recover the worst one (and never ask less than β or
     // the estimate's own row)
     low_corner_requirement(h_lo, hd_lo, unknown, bounds, mu, decay, psi_max)
         .max(beta)
-        .max(own())
+        .max(phi_required_of(h, hd, bounds, mu, decay))
 }
 
 /// The low corner's requirement with (C2)'s target raised by the rate's deficit over
@@ -572,11 +575,16 @@ mod tests {
         assert!(boxed > 400 && boxed < 3600, "{boxed}");
     }
 
-    /// Wherever the estimate is — inside `S`, near its boundary, far outside — the robust
-    /// requirement is at least the estimate's own, and so is the rate row's.
+    /// Wherever the estimate is in `S`, or no state of its box is (far outside), the robust
+    /// requirement is at least the estimate's own; in between (the estimate outside `S`,
+    /// its box's high corner in it) it is `β`, which may be less than the estimate's own
+    /// recovery and is sound there (`in_the_middle_case_beta_holds_for_every_consistent_truth`).
+    /// The rate row's is at least the estimate's own everywhere.
     #[test]
     fn a_robust_row_is_never_looser_than_the_estimates() {
         let mut seed = 13;
+        let in_set = |h: f64, hd: f64, mu: f64| h >= 0.0 && braking_barrier(h, hd, mu) >= 0.0;
+        let (mut inside, mut between, mut beyond) = (0, 0, 0);
         for _ in 0..20000 {
             let (mu, b, x) = random_state(&mut seed);
             let mut r = || lcg(&mut seed);
@@ -590,12 +598,26 @@ mod tests {
             let psi_max = braking_requirement(&b, mu) + r();
             let robust = phi_required_known(h, hd, &unknown, &b, mu, &d, psi_max);
             let own = phi_required_of(h, hd, &b, mu, &d);
-            // (below the least `φ` a command can produce, `M₂ − ψ_max`, no row binds)
-            let floor = b.m2 - psi_max;
-            assert!(
-                robust.max(floor) >= own.max(floor) - 1e-12,
-                "h {h} hd {hd} {unknown:?}: {robust} < {own}"
-            );
+            if in_set(h, hd, mu) || !in_set(h + unknown.h, hd + unknown.hdot, mu) {
+                if in_set(h, hd, mu) {
+                    inside += 1;
+                } else {
+                    beyond += 1;
+                }
+                // (below the least `φ` a command can produce, `M₂ − ψ_max`, no row binds)
+                let floor = b.m2 - psi_max;
+                assert!(
+                    robust.max(floor) >= own.max(floor) - 1e-12,
+                    "h {h} hd {hd} {unknown:?}: {robust} < {own}"
+                );
+            } else {
+                between += 1;
+                assert_eq!(
+                    robust,
+                    braking_requirement(&b, mu),
+                    "h {h} hd {hd} {unknown:?}"
+                );
+            }
             let rate = RateBounds {
                 period: b.period,
                 d: 0.1 * r(),
@@ -606,6 +628,88 @@ mod tests {
                 hdot_required_known(h, unknown.h, &rate, &rd) >= hdot_required_of(h, &rate, &rd)
             );
         }
+        eprintln!("estimate in S {inside}, between {between}, no consistent state in S {beyond}");
+        // every part of the domain was exercised
+        assert!(
+            inside > 1000 && between > 1000 && beyond > 1000,
+            "{inside} {between} {beyond}"
+        );
+    }
+
+    /// The middle case of [`phi_required_known`]: the estimate outside `S`, its box's high
+    /// corner in it. The row asks `β` — less than the estimate's own recovery on many of
+    /// these draws — and every true state of the box that is in `S` (on `S`'s boundary
+    /// and inside it) keeps (C1) and (C2) under the worst case of every command that
+    /// meets it, at the requirement and at the largest, `ψ = ψ_max`.
+    #[test]
+    fn in_the_middle_case_beta_holds_for_every_consistent_truth() {
+        let mut seed = 17;
+        let in_set = |h: f64, hd: f64, mu: f64| h >= 0.0 && braking_barrier(h, hd, mu) >= 0.0;
+        let (mut cases, mut looser, mut truths) = (0, 0, 0);
+        while cases < 2000 {
+            let (mu, b, x) = random_state(&mut seed);
+            let mut r = || lcg(&mut seed);
+            let unknown = StateUncertainty {
+                h: 0.3 * r(),
+                hdot: 0.3 * r(),
+            };
+            // an estimate below a state of S, within the box of it: the high corner is in S
+            let (est_h, est_hd) = (x.h - unknown.h * r(), x.hdot - unknown.hdot * r());
+            if in_set(est_h, est_hd, mu) || in_set(est_h - unknown.h, est_hd - unknown.hdot, mu) {
+                continue;
+            }
+            cases += 1;
+            let gamma = 2.0 * r();
+            let decay = Decay::linear(gamma);
+            let d = decay.at(b.period);
+            let beta = braking_requirement(&b, mu);
+            let psi_max = beta + 2.0 * r();
+            let phi = phi_required_known(est_h, est_hd, &unknown, &b, mu, &d, psi_max);
+            assert_eq!(phi, beta);
+            if phi_required_of(est_h, est_hd, &b, mu, &d) > beta {
+                looser += 1;
+            }
+            // the truths: x itself, then states of the box on S's boundary (k < 4) and
+            // inside it
+            for k in 0..20 {
+                let (h_t, hd_t) = if k == 0 {
+                    (x.h, x.hdot)
+                } else {
+                    let hd_t = est_hd + unknown.hdot * (2.0 * r() - 1.0);
+                    // the least h of S at this rate, within the box
+                    let h_min = if hd_t < 0.0 {
+                        hd_t * hd_t / (2.0 * mu)
+                    } else {
+                        0.0
+                    };
+                    let lo = h_min.max(est_h - unknown.h);
+                    let hi = est_h + unknown.h;
+                    if lo > hi {
+                        continue;
+                    }
+                    let at = if k < 4 { 0.0 } else { r() };
+                    (lo + (hi - lo) * at, hd_t)
+                };
+                assert!(in_set(h_t, hd_t, mu), "{h_t} {hd_t}");
+                truths += 1;
+                let truth = RelDeg2 {
+                    h: h_t,
+                    hdot: hd_t,
+                    a: 0.0,
+                    b: Vector1::new(1.0),
+                };
+                let kappa = decay.target(braking_barrier(h_t, hd_t, mu), b.period);
+                for phi_u in [phi.max(b.m2 - psi_max), (psi_max + b.m2).max(phi)] {
+                    assert_worst_case_holds(&truth, &b, mu, phi_u, kappa);
+                }
+            }
+        }
+        eprintln!(
+            "{cases} estimates, {looser} with their own requirement above β, {truths} truths"
+        );
+        // the case the fix is for: the estimate's own requirement above β
+        assert!(looser > 200, "{looser} of {cases}");
+        assert!(truths > 20000, "{truths}");
     }
 
     #[test]
