@@ -367,10 +367,11 @@ impl TranslationalFilter {
     }
 
     /// [`Self::sample_bounds`] for every true state within `(ē_r, ē_v, ē_ω)` of the
-    /// estimate `(r, v, ω_B)` (`ē_v` in F_H) and a force scaled by at most `k_hi`: the
-    /// ranges start from `‖r‖ ± ē_r`, `‖v‖ + ē_v + nē_r`, `‖ω_B‖ + ē_ω`, the force's
-    /// acceleration is `k_hi √3F/m` and the corridor's gradient may be `cos ψ · chord`
-    /// longer.
+    /// estimate `(r, v, ω_B)` and a force scaled by at most `k_hi`: the ranges start from
+    /// `‖r‖ ± ē_r`, `‖v‖ + ē_v`, `‖ω_B‖ + ē_ω`, the force's acceleration is `k_hi √3F/m`
+    /// and the corridor's gradient may be `cos ψ · chord` longer. `ē_v` bounds the error
+    /// of `v` itself, in F_H: the CoM's inertial velocity error plus `‖ω_H‖ē_r` (the
+    /// frame's rotation acting on the position's error), as `known_rows` passes it.
     pub fn sample_bounds_known(
         &self,
         r: &Vector3<f64>,
@@ -384,7 +385,7 @@ impl TranslationalFilter {
         let t = p.period;
         let n = p.mean_motion;
         let f_acc = 3f64.sqrt() * p.force_max / p.mass * k_hi;
-        let (rn_est, vn) = (r.norm(), v.norm() + err.1 + n * err.0);
+        let (rn_est, vn) = (r.norm(), v.norm() + err.1);
         let rn = rn_est + err.0;
         // fixed point of A(R, V), V(A), R(A): n is tiny, two passes are plenty
         let mut a = f_acc + 3.0 * n * n * rn + 2.0 * n * vn;
