@@ -657,7 +657,7 @@ impl TranslationalFilter {
             (x.com_error.0 * share, x.com_error.1 * share)
         };
         // the CoM's velocity error is inertial; in the rotating F_H it gains ‖ω_H‖ē_r
-        let err = (e_r, e_v + x.omega_h.norm() * e_r);
+        let err = crate::knowledge::in_hill((e_r, e_v), &x.omega_h);
         let rate_err = share
             * self
                 .params
