@@ -43,6 +43,7 @@ impl Setup {
             path: urdf.display().to_string(),
             message: e.to_string(),
         })?;
+        scenario.validate_with_servicer_mass(robot.total_mass())?;
         let rb = &scenario.safety.robotic;
         let (lower, upper, velocity, effort) = robot.joint_limit_arrays();
         for i in 0..sc_multibody::NJ {
@@ -84,5 +85,27 @@ impl Setup {
     /// Total servicer mass [kg] (base + arm), the `m` of the CW model.
     pub fn mass(&self) -> f64 {
         self.robot.total_mass()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rules that need the servicer's mass are checked when its model is loaded: a
+    /// corridor budget above the braking authority at the wall (tangential coefficient
+    /// `c_t ≤ 0`) is refused, on one line naming the key.
+    #[test]
+    fn a_corridor_budget_above_the_walls_authority_is_refused_with_the_model() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/scenario.toml");
+        let setup = Setup::load(&path).expect("the default loads");
+        let mut s = setup.scenario;
+        s.safety.translational.u_max_ac_m_s2 = 0.01;
+        let msg = Setup::from_scenario(s).expect_err("refused").to_string();
+        assert!(!msg.contains('\n'), "{msg}");
+        assert!(
+            msg.starts_with("`safety.translational.u_max_ac_m_s2` = 0.01: ") && msg.contains("c_t"),
+            "{msg}"
+        );
     }
 }

@@ -371,6 +371,32 @@ impl Scenario {
         positive("safety.translational.u_max_caz_m2_s2", tr.u_max_caz_m2_s2)
     }
 
+    /// The rules that need the servicer's total mass `m` [kg], which the scenario does not
+    /// hold (its URDF does; `sc_mission::Setup` checks them when it loads the model): the
+    /// tangential-speed coefficient `c_t = curvature_share (sin ψ_AC F/m − u_max_ac)/cos ψ_AC`
+    /// of the translational filter must be positive. With `c_t ≤ 0` the corridor's budget
+    /// `u_max_ac_m_s2` takes all of its braking authority at the wall, `sin ψ_AC F/m`, and
+    /// the tangential-speed limit `‖v_⊥‖² ≤ c_t ‖r‖` allows no motion across the line of
+    /// sight at all.
+    pub fn validate_with_servicer_mass(&self, mass_kg: f64) -> Result<(), ScenarioError> {
+        let tr = &self.safety.translational;
+        // as the filter computes it (`sc_cbf::translational::tangential_coefficient`)
+        let cos_psi = tr.corridor_half_angle_deg.to_radians().cos();
+        let sin_psi = (1.0 - cos_psi * cos_psi).max(0.0).sqrt();
+        let authority = sin_psi * self.limits.force_max_n / mass_kg;
+        let c_t = tr.curvature_share() * (authority - tr.u_max_ac_m_s2) / cos_psi;
+        if c_t > 0.0 {
+            return Ok(());
+        }
+        Err(invalid(
+            "safety.translational.u_max_ac_m_s2",
+            tr.u_max_ac_m_s2,
+            format!(
+                "must be below the corridor's braking authority at its wall, sin(corridor_half_angle_deg) limits.force_max_n / m = {authority:.6} m/s² with the servicer's mass m = {mass_kg} kg (its URDF): otherwise the tangential-speed coefficient c_t = {c_t:.3e} m/s² is not > 0 and no motion across the line of sight is allowed"
+            ),
+        ))
+    }
+
     fn validate_safety_attitude(&self) -> Result<(), ScenarioError> {
         let at = &self.safety.attitude;
         angle_deg("safety.attitude.los_half_angle_deg", at.los_half_angle_deg)?;

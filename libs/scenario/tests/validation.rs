@@ -236,3 +236,48 @@ fn the_curvature_share_is_optional_and_checked() {
         );
     }
 }
+
+/// The tangential-speed coefficient `c_t` needs the servicer's mass (its URDF's, given by
+/// the caller): the default's is positive; a corridor budget at or above the braking
+/// authority at the wall (`sin 5° · 7 N / 269 kg = 0.00227 m/s²`), or a servicer heavy
+/// enough to bring the authority below the budget, makes `c_t ≤ 0` and is refused, on one
+/// line naming the key, its value and the rule.
+#[test]
+fn a_tangential_coefficient_at_or_below_zero_is_refused() {
+    let mass = 269.0;
+    let s = Scenario::load(&config_dir().join("scenario.toml")).unwrap();
+    s.validate_with_servicer_mass(mass).unwrap();
+    let refused = |s: &Scenario, mass: f64| {
+        let msg = s
+            .validate_with_servicer_mass(mass)
+            .expect_err("c_t <= 0 was accepted")
+            .to_string();
+        assert!(!msg.contains('\n'), "error must be one line: {msg}");
+        assert!(
+            msg.contains("`safety.translational.u_max_ac_m_s2`")
+                && msg.contains("braking authority")
+                && msg.contains("c_t"),
+            "{msg}"
+        );
+        msg
+    };
+    for budget in ["0.003", "0.01"] {
+        let text = with("safety.translational", "u_max_ac_m_s2", budget);
+        // valid on its own: the rule needs the mass
+        let s = Scenario::from_toml_str(&text, &config_dir()).unwrap();
+        let msg = refused(&s, mass);
+        assert!(msg.contains(budget), "{msg}");
+    }
+    // the budget exactly at the authority: c_t = 0
+    let mut at = s.clone();
+    let cos = at
+        .safety
+        .translational
+        .corridor_half_angle_deg
+        .to_radians()
+        .cos();
+    at.safety.translational.u_max_ac_m_s2 = (1.0 - cos * cos).sqrt() * at.limits.force_max_n / mass;
+    refused(&at, mass);
+    // the default budget with a servicer four times as heavy
+    refused(&s, 4.0 * mass);
+}
