@@ -211,7 +211,7 @@ fn hostile_partner_processes_through_the_partition_are_safe() {
         // the simulator applied only its filters' commands
         let sim = std::fs::read_to_string(dir.join("logs/simulator.log")).unwrap();
         assert!(
-            sim.contains("safe commands rejected (translational, attitude, robotic) [0, 0, 0], samples from a second publisher dropped [0, 0, 0]"),
+            sim.contains("safe commands rejected (translational, attitude, robotic) [0, 0, 0], navigation estimates missing or rejected 0, samples from a second publisher dropped [0, 0, 0]"),
             "{case}: {sim}"
         );
     }

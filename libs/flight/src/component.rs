@@ -10,8 +10,8 @@
 
 use sc_icd::services::ServiceName;
 use sc_icd::{
-    Health, NavigationError, NominalAttitude, NominalRobotic, NominalTranslational, SafeAttitude,
-    SafeRobotic, SafeTranslational, SimState, StepResult, Tick,
+    Health, NavState, NavigationError, NominalAttitude, NominalRobotic, NominalTranslational,
+    SafeAttitude, SafeRobotic, SafeTranslational, SimState, StepResult, Tick,
 };
 
 /// One message of the ICD as a role receives or publishes it, tagged with its service.
@@ -29,6 +29,10 @@ pub enum Message {
     Truth(SimState),
     /// `safe_capture/sim/navigation_error` (the recorder; with a declared uncertainty).
     NavigationError(NavigationError),
+    /// `safe_capture/sim/measurement` (the navigation).
+    Measurement(NavState),
+    /// `safe_capture/navigation/estimate` (the simulator).
+    Estimate(NavState),
     NominalTranslational(NominalTranslational),
     NominalAttitude(NominalAttitude),
     NominalRobotic(NominalRobotic),
@@ -50,6 +54,8 @@ impl Message {
             Message::PartnerState(_) => PARTNER_STATE,
             Message::Truth(_) => TRUTH,
             Message::NavigationError(_) => NAVIGATION_ERROR,
+            Message::Measurement(_) => MEASUREMENT,
+            Message::Estimate(_) => ESTIMATE,
             Message::NominalTranslational(_) => NOMINAL_TRANSLATIONAL,
             Message::NominalAttitude(_) => NOMINAL_ATTITUDE,
             Message::NominalRobotic(_) => NOMINAL_ROBOTIC,
@@ -68,6 +74,7 @@ impl Message {
             Message::Tick(m) | Message::Control(m) => m.send_ns = ns,
             Message::State(m) | Message::PartnerState(m) | Message::Truth(m) => m.publish_ns = ns,
             Message::NavigationError(_) => {}
+            Message::Measurement(m) | Message::Estimate(m) => m.publish_ns = ns,
             Message::NominalTranslational(m) => m.publish_ns = ns,
             Message::NominalAttitude(m) => m.publish_ns = ns,
             Message::NominalRobotic(m) => m.publish_ns = ns,

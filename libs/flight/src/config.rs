@@ -63,6 +63,10 @@ pub struct RoleExec {
 #[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Deadlines {
+    /// The simulator substitutes its own navigation for an estimate missing this long
+    /// after it published the measurement (optional: [`DEFAULT_NAVIGATION_MS`]).
+    #[serde(default = "default_navigation_ms")]
+    pub navigation_ms: f64,
     pub safety_translational_ms: f64,
     pub safety_attitude_ms: f64,
     pub safety_robotic_ms: f64,
@@ -177,6 +181,15 @@ impl Schedule {
     }
 }
 
+/// The navigation deadline of a config that names none [ms]: an estimator answers
+/// within a few hundred µs here (docs/PARTITION.md); 10 ms leaves the filters 30 of the
+/// translational stage's 40.
+pub const DEFAULT_NAVIGATION_MS: f64 = 10.0;
+
+fn default_navigation_ms() -> f64 {
+    DEFAULT_NAVIGATION_MS
+}
+
 impl Deadlines {
     /// The stage deadline of the filter of `s` [ms].
     pub fn filter_ms(&self, s: Subsystem) -> f64 {
@@ -187,9 +200,11 @@ impl Deadlines {
         }
     }
 
-    /// Every stage deadline with its key, in causal order, the simulator's last.
-    fn keyed(&self) -> [(&'static str, f64); 4] {
+    /// Every stage deadline with its key, in causal order (the navigation first), the
+    /// simulator's last.
+    fn keyed(&self) -> [(&'static str, f64); 5] {
         [
+            ("deadlines.navigation_ms", self.navigation_ms),
             (
                 "deadlines.safety_translational_ms",
                 self.safety_translational_ms,

@@ -295,3 +295,47 @@ pub fn navigation_error_of(m: &sc_icd::NavigationError) -> sc_sim::uncertainty::
         measurement_age_s: m.measurement_age_s,
     }
 }
+
+/// The message of a navigation state (publish stamp left for the runner).
+pub fn nav_state(n: &sc_sim::NavSample) -> sc_icd::NavState {
+    let s = &n.state;
+    sc_icd::NavState {
+        tick: n.tick,
+        t: s.t,
+        measured_t: n.measured_t,
+        publish_ns: 0,
+        target_r: a3(&s.r_t),
+        target_v: a3(&s.v_t),
+        q_it: s.q_it,
+        omega_t: a3(&s.w_t),
+        r_i: a3(&s.dr),
+        v_i: a3(&s.dv),
+        q_ib: s.q_ib,
+        omega_b: a3(&s.w_b),
+        theta: a7(&s.theta),
+        theta_dot: a7(&s.theta_dot),
+        grasp_t: a3(&n.grasp_t),
+    }
+}
+
+/// The navigation state of a message ([`nav_state`]'s inverse).
+pub fn nav_sample(m: &sc_icd::NavState) -> sc_sim::NavSample {
+    sc_sim::NavSample {
+        tick: m.tick,
+        measured_t: m.measured_t,
+        state: sc_sim::SimState {
+            t: m.t,
+            r_t: v3(&m.target_r),
+            v_t: v3(&m.target_v),
+            q_it: m.q_it,
+            w_t: v3(&m.omega_t),
+            dr: v3(&m.r_i),
+            dv: v3(&m.v_i),
+            q_ib: m.q_ib,
+            w_b: v3(&m.omega_b),
+            theta: v7(&m.theta),
+            theta_dot: v7(&m.theta_dot),
+        },
+        grasp_t: v3(&m.grasp_t),
+    }
+}

@@ -89,6 +89,7 @@ fn kind(k: RoleKind) -> String {
     match k {
         RoleKind::Scheduler => "scheduler".into(),
         RoleKind::Simulator => "simulator".into(),
+        RoleKind::Navigation => "navigation".into(),
         RoleKind::Nominal(s) => format!("nominal controller ({s})"),
         RoleKind::Filter(s) => format!("safety filter ({s})"),
         RoleKind::Recorder => "recorder".into(),

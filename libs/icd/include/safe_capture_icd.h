@@ -33,6 +33,8 @@ extern "C" {
 /* Service names (relative: a run's iceoryx2 global.prefix is "sc_<SC_RUN_ID>_"). Each pub/sub service has an event service of the same name. */
 #define SC_SERVICE_TICK "safe_capture/scheduler/tick" /* Tick, QoS flight */
 #define SC_SERVICE_CONTROL "safe_capture/scheduler/control" /* Tick, QoS flight */
+#define SC_SERVICE_MEASUREMENT "safe_capture/sim/measurement" /* NavState, QoS partner */
+#define SC_SERVICE_ESTIMATE "safe_capture/navigation/estimate" /* NavState, QoS partner */
 #define SC_SERVICE_SIM_STATE "safe_capture/sim/state" /* SimState, QoS flight */
 #define SC_SERVICE_PARTNER_STATE "safe_capture/partner/state" /* SimState, QoS partner */
 #define SC_SERVICE_TRUTH "safe_capture/sim/truth" /* SimState, QoS flight */
@@ -62,6 +64,7 @@ extern "C" {
 #define SC_TYPE_NAME_SAFE_ROBOTIC "safe_capture::v2::SafeRobotic"
 #define SC_TYPE_NAME_STEP_RESULT "safe_capture::v1::StepResult"
 #define SC_TYPE_NAME_NAVIGATION_ERROR "safe_capture::v1::NavigationError"
+#define SC_TYPE_NAME_NAV_STATE "safe_capture::v1::NavState"
 #define SC_TYPE_NAME_HEALTH "safe_capture::v1::Health"
 
 /* Event ids of the partition's event services (`sc_bus::pubsub`, `sc_bus::handshake`; `libs/bus/tests/icd_constants.rs` checks them against sc-bus). */
@@ -103,6 +106,7 @@ extern "C" {
 #define SC_FAULT_DEADLINE_MISS 64u /* Deadline missed. */
 #define SC_FAULT_PEER_DEAD 128u /* A peer process was detected dead. */
 #define SC_FAULT_REJECTED_COMMAND 256u /* The simulator rejected a safe command (not finite or beyond the input bounds, `sc_flight::admission`) and applied the filter's backup instead. */
+#define SC_FAULT_NAVIGATION_REJECTED 512u /* The navigation's estimate was missing at the navigation deadline or rejected (not finite, not current, a quaternion off the unit sphere, or farther from the measurement than the declared navigation bounds, `sc_sim::navigation`); the simulator's own navigation (the declared error model) was substituted. */
 
 /* Values of `Health.state`. */
 #define SC_HEALTH_STARTING 0u /* Process started, ports being created. */
@@ -113,7 +117,7 @@ extern "C" {
 
 /* Role ids, from the role table (sc_icd::ROLES, start order): Health.role; the handshake id is SC_EVENT_HANDSHAKE_ID_OFFSET + role */
 #define SC_ROLE_SCHEDULER 0u /* scheduler: rate groups, ticks (lock-step or real time), the end of the run, liveness of the peers */
-#define SC_ROLE_SIMULATOR 1u /* simulator: the plant: applies the re-validated safe commands (the backup when one is missing or rejected), publishes the state with the monitored barriers */
+#define SC_ROLE_SIMULATOR 1u /* simulator: the plant: measures the state, admits the navigation's estimate (its own navigation when that is missing or rejected) and publishes the knowledge derived from it, applies the re-validated safe commands (the backup when one is missing or rejected) */
 #define SC_ROLE_NOMINAL_TRANSLATIONAL 2u /* nominal_translational: the nominal translational controller (MPC), replaceable by a partner's */
 #define SC_ROLE_NOMINAL_ATTITUDE 3u /* nominal_attitude: the nominal attitude controller (MPC), replaceable by a partner's */
 #define SC_ROLE_NOMINAL_ROBOTIC 4u /* nominal_robotic: the nominal robotic controller (joint-space PD), replaceable by a partner's */
@@ -121,6 +125,7 @@ extern "C" {
 #define SC_ROLE_SAFETY_ATTITUDE 6u /* safety_attitude: the attitude safety filter (line of sight, body-rate limits), ξ = the translational safe force */
 #define SC_ROLE_SAFETY_ROBOTIC 7u /* safety_robotic: the robotic safety filter (joint angles and rates, link–base spheres), ξ = the translational and attitude safe commands */
 #define SC_ROLE_RECORDER 8u /* recorder: telemetry: the same telemetry.csv, timing.csv and summary.json as `safe-capture run`, plus recording.mcap and latency.csv */
+#define SC_ROLE_NAVIGATION 9u /* navigation: the navigation: the estimate of each tick's state from the measurements (the declared error model), replaceable by a partner's estimator */
 
 /* Tick -- safe_capture::v2::Tick, 40 B. Scheduler → simulator, every other process (stop), recorder: start one control step. */
 typedef struct ScTick {
@@ -439,7 +444,7 @@ typedef struct ScStepResult {
     uint32_t end; /* How the step ended, one of `end` (0 running, 1 captured, 2 timeout, 3 simulator failed) [-] */
     uint32_t fallback_mask; /* Subsystems (bits of `due`) whose command is the filter fallback computed by the simulator because the safe command was missing at the deadline (1 translational, 2 attitude, 4 robotic, 7 all) [-] */
     uint32_t held_mask; /* Subsystems (bits of `due`) whose command was held from an earlier tick (slower rate group) (1 translational, 2 attitude, 4 robotic, 7 all) [-] */
-    uint32_t fault_flags; /* Partition fault flags, bits of `fault` (1 stale input, 2 non finite input, 4 solver failed, 8 infeasible, 16 saturated, 32 nominal missing, 64 deadline miss, 128 peer dead, 256 rejected command) [-] */
+    uint32_t fault_flags; /* Partition fault flags, bits of `fault` (1 stale input, 2 non finite input, 4 solver failed, 8 infeasible, 16 saturated, 32 nominal missing, 64 deadline miss, 128 peer dead, 256 rejected command, 512 navigation rejected) [-] */
     uint64_t safe_recv_ns; /* Stamp at which the robotic safe command (the tick's last) was delivered, host CLOCK_MONOTONIC [ns] */
     uint64_t publish_ns; /* Publish stamp, host CLOCK_MONOTONIC [ns] */
     double force_b[3]; /* Applied base force f_B, frame F_B [N] */
@@ -498,12 +503,52 @@ SC_ICD_STATIC_ASSERT(offsetof(ScNavigationError, joint_angle_rad) == 72, "ScNavi
 SC_ICD_STATIC_ASSERT(offsetof(ScNavigationError, joint_rate_rad_s) == 80, "ScNavigationError.joint_rate_rad_s: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScNavigationError, measurement_age_s) == 88, "ScNavigationError.measurement_age_s: offset");
 
+/* NavState -- safe_capture::v1::NavState, 376 B. A navigation state in the inertial frame the simulator propagates in: on `MEASUREMENT` what the simulator's sensors measured (simulator → navigation), on `ESTIMATE` what the navigation estimates (navigation → simulator). The simulator admits an estimate (`sc_sim::navigation`), then derives every quantity of the `SIM_STATE` the controllers and filters get from it with the declared model. */
+typedef struct ScNavState {
+    uint64_t tick; /* Tick index this state answers [-] */
+    double t; /* Simulation time of the tick: the time an estimate is of [s] */
+    double measured_t; /* Simulation time of the measurement the values rest on (≤ `t`: the sensors' age); an estimate carries its measurement's [s] */
+    uint64_t publish_ns; /* Publish stamp, host CLOCK_MONOTONIC [ns] */
+    double target_r[3]; /* Target CoM position from the Earth's centre, frame F_I [m] */
+    double target_v[3]; /* Target CoM inertial velocity, frame F_I [m/s] */
+    double q_it[4]; /* Target attitude q_IT: rotates F_T vectors into F_I, frame F_T → F_I [-] */
+    double omega_t[3]; /* Target body rate ω_T w.r.t. inertial, frame F_T [rad/s] */
+    double r_i[3]; /* Servicer base origin relative to the target CoM, frame F_I [m] */
+    double v_i[3]; /* Inertial derivative of `r_i`, frame F_I [m/s] */
+    double q_ib[4]; /* Servicer attitude q_IB: rotates F_B vectors into F_I, frame F_B → F_I [-] */
+    double omega_b[3]; /* Servicer body rate ω_B w.r.t. inertial, frame F_B [rad/s] */
+    double theta[7]; /* Joint angles θ, frame M [rad] */
+    double theta_dot[7]; /* Joint rates θ̇, frame M [rad/s] */
+    double grasp_t[3]; /* Grasping point relative to the target CoM, frame F_T [m] */
+#if defined(__cplusplus) && __cplusplus >= 201703L
+    /* the name iceoryx2's C++ API matches the payload type by */
+    static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v1::NavState";
+#endif
+} ScNavState;
+SC_ICD_STATIC_ASSERT(sizeof(ScNavState) == 376, "ScNavState: size");
+SC_ICD_STATIC_ASSERT(SC_ICD_ALIGNOF(ScNavState) == 8, "ScNavState: alignment");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavState, tick) == 0, "ScNavState.tick: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavState, t) == 8, "ScNavState.t: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavState, measured_t) == 16, "ScNavState.measured_t: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavState, publish_ns) == 24, "ScNavState.publish_ns: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavState, target_r) == 32, "ScNavState.target_r: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavState, target_v) == 56, "ScNavState.target_v: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavState, q_it) == 80, "ScNavState.q_it: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavState, omega_t) == 112, "ScNavState.omega_t: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavState, r_i) == 136, "ScNavState.r_i: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavState, v_i) == 160, "ScNavState.v_i: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavState, q_ib) == 184, "ScNavState.q_ib: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavState, omega_b) == 216, "ScNavState.omega_b: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavState, theta) == 240, "ScNavState.theta: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavState, theta_dot) == 296, "ScNavState.theta_dot: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScNavState, grasp_t) == 352, "ScNavState.grasp_t: offset");
+
 /* Health -- safe_capture::v1::Health, 56 B. Recorder → scheduler: the recorder's progress (lock-step flow control); the fields are those of a health report any process could publish. */
 typedef struct ScHealth {
     uint32_t role; /* Role id: the role's position in the role table `ROLES` [-] */
     uint32_t pid; /* Operating-system process id [-] */
     uint32_t state; /* State, one of `health_state` (0 starting, 1 ready, 2 running, 3 faulted, 4 stopping) [-] */
-    uint32_t last_fault_flags; /* Last fault flags, bits of `fault` (1 stale input, 2 non finite input, 4 solver failed, 8 infeasible, 16 saturated, 32 nominal missing, 64 deadline miss, 128 peer dead, 256 rejected command) [-] */
+    uint32_t last_fault_flags; /* Last fault flags, bits of `fault` (1 stale input, 2 non finite input, 4 solver failed, 8 infeasible, 16 saturated, 32 nominal missing, 64 deadline miss, 128 peer dead, 256 rejected command, 512 navigation rejected) [-] */
     uint64_t ticks_handled; /* Ticks handled since start [-] */
     uint64_t deadline_misses; /* Deadline misses since start [-] */
     uint64_t cycle_slips; /* Cycle slips (a tick answered late or skipped) since start [-] */

@@ -24,7 +24,7 @@
 //! - times: `t` is simulation time [s]; `*_ns` are `CLOCK_MONOTONIC` stamps [ns]
 //!   of the machine (see [`monotonic_ns`]).
 //!
-//! Frames ([`spec::Frame`]): F_H Hill (LVLH) frame of the target orbit, F_R reference
+//! Frames ([`spec::Frame`]): F_I Earth-centred inertial frame, F_H Hill (LVLH) frame of the target orbit, F_R reference
 //! frame, F_B servicer base (body) frame, F_T target body frame, M manipulator joint
 //! space. Quaternions are scalar-first `[w, x, y, z]`; `q_XY` rotates F_Y vectors into F_X.
 //!
@@ -159,6 +159,11 @@ icd_constants! {
         /// The simulator rejected a safe command (not finite or beyond the input bounds,
         /// `sc_flight::admission`) and applied the filter's backup instead.
         REJECTED_COMMAND = 1 << 8,
+        /// The navigation's estimate was missing at the navigation deadline or rejected
+        /// (not finite, not current, a quaternion off the unit sphere, or farther from
+        /// the measurement than the declared navigation bounds, `sc_sim::navigation`);
+        /// the simulator's own navigation (the declared error model) was substituted.
+        NAVIGATION_REJECTED = 1 << 9,
     }
 }
 
@@ -526,6 +531,48 @@ icd_message! {
 }
 
 icd_message! {
+    /// A navigation state in the inertial frame the simulator propagates in: on
+    /// `MEASUREMENT` what the simulator's sensors measured (simulator → navigation), on
+    /// `ESTIMATE` what the navigation estimates (navigation → simulator). The simulator
+    /// admits an estimate (`sc_sim::navigation`), then derives every quantity of the
+    /// `SIM_STATE` the controllers and filters get from it with the declared model.
+    #[type_name("safe_capture::v1::NavState")]
+    pub struct NavState {
+        /// Tick index this state answers
+        pub tick: u64 = ["-"],
+        /// Simulation time of the tick: the time an estimate is of
+        pub t: f64 = ["s"],
+        /// Simulation time of the measurement the values rest on (≤ `t`: the sensors'
+        /// age); an estimate carries its measurement's
+        pub measured_t: f64 = ["s"],
+        /// Publish stamp, host CLOCK_MONOTONIC
+        pub publish_ns: u64 = ["ns"],
+        /// Target CoM position from the Earth's centre
+        pub target_r: [f64; 3] = ["m", Inertial, Xyz],
+        /// Target CoM inertial velocity
+        pub target_v: [f64; 3] = ["m/s", Inertial, Xyz],
+        /// Target attitude q_IT: rotates F_T vectors into F_I
+        pub q_it: [f64; 4] = ["-", InertialFromTarget, Wxyz],
+        /// Target body rate ω_T w.r.t. inertial
+        pub omega_t: [f64; 3] = ["rad/s", Target, Xyz],
+        /// Servicer base origin relative to the target CoM
+        pub r_i: [f64; 3] = ["m", Inertial, Xyz],
+        /// Inertial derivative of `r_i`
+        pub v_i: [f64; 3] = ["m/s", Inertial, Xyz],
+        /// Servicer attitude q_IB: rotates F_B vectors into F_I
+        pub q_ib: [f64; 4] = ["-", InertialFromBase, Wxyz],
+        /// Servicer body rate ω_B w.r.t. inertial
+        pub omega_b: [f64; 3] = ["rad/s", Base, Xyz],
+        /// Joint angles θ
+        pub theta: [f64; N_JOINTS] = ["rad", Joints, Joints],
+        /// Joint rates θ̇
+        pub theta_dot: [f64; N_JOINTS] = ["rad/s", Joints, Joints],
+        /// Grasping point relative to the target CoM
+        pub grasp_t: [f64; 3] = ["m", Target, Xyz],
+    }
+}
+
+icd_message! {
     /// Recorder → scheduler: the recorder's progress (lock-step flow control); the
     /// fields are those of a health report any process could publish.
     #[type_name("safe_capture::v1::Health")]
@@ -552,7 +599,7 @@ icd_message! {
 }
 
 /// Every message of the ICD, in the order of the C header and docs/ICD.md.
-pub const MESSAGES: [&spec::MessageSpec; 11] = [
+pub const MESSAGES: [&spec::MessageSpec; 12] = [
     &Tick::SPEC,
     &SimState::SPEC,
     &NominalTranslational::SPEC,
@@ -563,6 +610,7 @@ pub const MESSAGES: [&spec::MessageSpec; 11] = [
     &SafeRobotic::SPEC,
     &StepResult::SPEC,
     &NavigationError::SPEC,
+    &NavState::SPEC,
     &Health::SPEC,
 ];
 
@@ -585,6 +633,7 @@ const _: () = assert!(core::mem::size_of::<SafeAttitude>() == 240);
 const _: () = assert!(core::mem::size_of::<SafeRobotic>() == 864);
 const _: () = assert!(core::mem::size_of::<StepResult>() == 152);
 const _: () = assert!(core::mem::size_of::<NavigationError>() == 96);
+const _: () = assert!(core::mem::size_of::<NavState>() == 376);
 const _: () = assert!(core::mem::size_of::<Health>() == 56);
 const _: () = assert!(core::mem::align_of::<SimState>() == 8);
 const _: () = assert!(core::mem::align_of::<Health>() == 8);

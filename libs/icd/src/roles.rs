@@ -13,8 +13,12 @@ use sc_core::Subsystem;
 pub enum RoleKind {
     /// Rate groups, the ticks, the handshake, the end of the run, the peers' liveness.
     Scheduler,
-    /// The plant in the loop: applies the safe commands, publishes the state.
+    /// The plant in the loop: applies the safe commands, measures the state, admits the
+    /// navigation's estimate and publishes the knowledge derived from it.
     Simulator,
+    /// The navigation: turns the measurements into the estimate the controllers and
+    /// filters act on; replaceable by a partner's estimator.
+    Navigation,
     /// A nominal controller; replaceable by a partner's process.
     Nominal(Subsystem),
     /// A safety filter.
@@ -93,14 +97,16 @@ impl Role {
 }
 
 use services::{
-    CONTROL, HANDSHAKE, HEALTH, NAVIGATION_ERROR, NOMINAL_ATTITUDE, NOMINAL_ROBOTIC,
-    NOMINAL_TRANSLATIONAL, PARTNER_STATE, PREPARE, SAFE_ATTITUDE, SAFE_ROBOTIC, SAFE_TRANSLATIONAL,
-    SIM_STATE, STAGE_DEADLINE, STEP_RESULT, TICK, TRUTH,
+    CONTROL, ESTIMATE, HANDSHAKE, HEALTH, MEASUREMENT, NAVIGATION_ERROR, NOMINAL_ATTITUDE,
+    NOMINAL_ROBOTIC, NOMINAL_TRANSLATIONAL, PARTNER_STATE, PREPARE, SAFE_ATTITUDE, SAFE_ROBOTIC,
+    SAFE_TRANSLATIONAL, SIM_STATE, STAGE_DEADLINE, STEP_RESULT, TICK, TRUTH,
 };
 
 /// Every role of the partition, in start order (the scheduler, the handshake's
 /// coordinator, first). A role's id is its position.
-pub const ROLES: [Role; 9] = [
+/// New roles are appended: the ids of the others stay those partners' processes were
+/// built with.
+pub const ROLES: [Role; 10] = [
     Role {
         name: "scheduler",
         kind: RoleKind::Scheduler,
@@ -118,6 +124,7 @@ pub const ROLES: [Role; 9] = [
         exec: "sc-simulator",
         publishes: &[
             TRUTH,
+            MEASUREMENT,
             NAVIGATION_ERROR,
             SIM_STATE,
             PARTNER_STATE,
@@ -126,6 +133,7 @@ pub const ROLES: [Role; 9] = [
         subscribes: &[
             TICK,
             PREPARE,
+            ESTIMATE,
             SAFE_TRANSLATIONAL,
             SAFE_ATTITUDE,
             SAFE_ROBOTIC,
@@ -133,7 +141,7 @@ pub const ROLES: [Role; 9] = [
         rate: Rate::Base,
         flight: true,
         partner: false,
-        doc: "the plant: applies the re-validated safe commands (the backup when one is missing or rejected), publishes the state with the monitored barriers",
+        doc: "the plant: measures the state, admits the navigation's estimate (its own navigation when that is missing or rejected) and publishes the knowledge derived from it, applies the re-validated safe commands (the backup when one is missing or rejected)",
     },
     nominal(Subsystem::Translational, "sc-nominal-translational"),
     nominal(Subsystem::Attitude, "sc-nominal-attitude"),
@@ -215,6 +223,17 @@ pub const ROLES: [Role; 9] = [
         partner: false,
         doc: "telemetry: the same telemetry.csv, timing.csv and summary.json as `safe-capture run`, plus recording.mcap and latency.csv",
     },
+    Role {
+        name: "navigation",
+        kind: RoleKind::Navigation,
+        exec: "sc-navigation",
+        publishes: &[ESTIMATE],
+        subscribes: &[CONTROL, MEASUREMENT, PREPARE],
+        rate: Rate::Base,
+        flight: true,
+        partner: true,
+        doc: "the navigation: the estimate of each tick's state from the measurements (the declared error model), replaceable by a partner's estimator",
+    },
 ];
 
 /// The row of a nominal controller (the processes partners replace).
@@ -261,7 +280,12 @@ mod tests {
 
     #[test]
     fn every_kind_has_one_row_and_ids_are_positions() {
-        let mut kinds = vec![RoleKind::Scheduler, RoleKind::Simulator, RoleKind::Recorder];
+        let mut kinds = vec![
+            RoleKind::Scheduler,
+            RoleKind::Simulator,
+            RoleKind::Navigation,
+            RoleKind::Recorder,
+        ];
         for s in Subsystem::ALL {
             kinds.push(RoleKind::Nominal(s));
             kinds.push(RoleKind::Filter(s));

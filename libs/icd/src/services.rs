@@ -31,9 +31,19 @@ icd_services! {
         /// tick is delivered to the two processes that need it, not to all eight: each
         /// subscriber costs the scheduler's send, on the critical path.
         CONTROL = "safe_capture/scheduler/control", Tick, Flight;
-        /// The state at the start of each step, for the flight side (lossless); with a
-        /// declared `[uncertainty]` the navigation's estimate (what the controllers and
-        /// filters know), its `barriers` those on knowledge.
+        /// What the sensors measured at the start of each step, for the navigation (the
+        /// process partners replace): the true state `uncertainty.navigation.measurement_age_s`
+        /// old, on a newest-wins service (a navigation that stops reading can never make
+        /// the simulator wait). Published before anything else of the tick.
+        MEASUREMENT = "safe_capture/sim/measurement", NavState, Partner;
+        /// The navigation's estimate of the tick's state; the simulator wakes on it,
+        /// admits it (or substitutes its own navigation, flagged) and publishes the
+        /// knowledge derived from it as `SIM_STATE` and `PARTNER_STATE`.
+        ESTIMATE = "safe_capture/navigation/estimate", NavState, Partner;
+        /// The state at the start of each step, for the flight side (lossless): the
+        /// admitted estimate seen through the declared model (what the controllers and
+        /// filters know; the truth for the `exact` profile), its `barriers` those on
+        /// knowledge.
         SIM_STATE = "safe_capture/sim/state", SimState, Flight;
         /// The same state for the nominal controllers — the processes partners replace,
         /// woken by it — on a newest-wins service: a partner that stops reading loses

@@ -66,7 +66,7 @@ macro_rules! scalar_field_type {
 scalar_field_type!(f64 => F64, u64 => U64, u32 => U32, i32 => I32);
 
 /// The frame a field's vector is expressed in (or the frames a quaternion relates).
-/// F_H Hill (LVLH) frame of the target orbit, F_R reference frame, F_B servicer base
+/// F_I Earth-centred inertial frame, F_H Hill (LVLH) frame of the target orbit, F_R reference frame, F_B servicer base
 /// (body) frame, F_T target body frame, M manipulator joint space. Quaternions are
 /// scalar-first `[w, x, y, z]`; `q_XY` rotates F_Y vectors into F_X.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -89,6 +89,12 @@ pub enum Frame {
     ReferenceFromBase,
     /// q_RT: rotates F_T vectors into F_R.
     ReferenceFromTarget,
+    /// F_I, the Earth-centred inertial frame the simulator propagates in.
+    Inertial,
+    /// q_IB: rotates F_B vectors into F_I.
+    InertialFromBase,
+    /// q_IT: rotates F_T vectors into F_I.
+    InertialFromTarget,
 }
 
 impl Frame {
@@ -104,6 +110,9 @@ impl Frame {
             Frame::HillFromReference => "F_R → F_H",
             Frame::ReferenceFromBase => "F_B → F_R",
             Frame::ReferenceFromTarget => "F_T → F_R",
+            Frame::Inertial => "F_I",
+            Frame::InertialFromBase => "F_B → F_I",
+            Frame::InertialFromTarget => "F_T → F_I",
         }
     }
 }

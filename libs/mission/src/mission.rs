@@ -7,7 +7,8 @@ use crate::stages;
 use sc_cbf::monitor::{Barriers, Monitor, min_into};
 use sc_cbf::{Actuation, ActuatorLimits, Nominals, QpDump, SafetyLayer};
 use sc_nominal::NominalControllers;
-use sc_sim::{Plant, Realisation, Simulator};
+use sc_sim::navigation::{default_navigation, substitute_navigation};
+use sc_sim::{Estimator, NavigationGate, Plant, Realisation, Simulator};
 use std::sync::Arc;
 
 /// Options of a run.
@@ -104,6 +105,11 @@ pub struct Mission {
     pub realisation: Option<Realisation>,
     /// The barriers on knowledge (the declared model), with a realisation only.
     knowledge_monitor: Option<Monitor>,
+    /// The navigation the controllers and filters see through (the partition's
+    /// navigation role runs the same), replaceable ([`Self::set_navigation`]).
+    navigation: Box<dyn Estimator + Send>,
+    /// The simulator's sensors and the gate every estimate passes.
+    gate: NavigationGate,
     end: Option<MissionEnd>,
 }
 
@@ -125,6 +131,10 @@ impl Mission {
         let knowledge_monitor = realisation
             .is_some()
             .then(|| Monitor::from_scenario(&setup.scenario, setup.robot.clone()));
+        let navigation = default_navigation(realisation.as_ref());
+        let substitute = substitute_navigation(realisation.as_ref());
+        let gate = NavigationGate::new(&setup.scenario, setup.robot.clone(), substitute)
+            .map_err(|e| SetupError::Other(e.to_string()))?;
         Ok(Self {
             setup,
             sim,
@@ -137,8 +147,15 @@ impl Mission {
             plant: None,
             realisation,
             knowledge_monitor,
+            navigation,
+            gate,
             end: None,
         })
+    }
+
+    /// Estimates with `navigation` from now on (a partner's estimator, a hostile one).
+    pub fn set_navigation(&mut self, navigation: Box<dyn Estimator + Send>) {
+        self.navigation = navigation;
     }
 
     /// Propagates with `plant` from now on (another simulator in the loop, e.g. Basilisk),
@@ -162,14 +179,12 @@ impl Mission {
     pub fn compute(&mut self) -> StepRecord {
         let truth = self.sim.observe();
         let barriers = self.monitor.evaluate(&truth.barrier_state());
-        // what the controllers and filters know: the navigation's estimate
-        let (o, navigation_error) = match self.realisation.as_mut() {
-            Some(r) => {
-                let (estimate, error) = r.navigation.estimate(&self.sim);
-                (estimate, Some(error))
-            }
-            None => (truth, None),
-        };
+        // what the controllers and filters know: the navigation's estimate, admitted
+        let m = self.gate.measure(&self.sim, self.sim.step_count());
+        let estimate = self.navigation.estimate(&m);
+        let (known, rejected) = self.gate.admit(Some(&estimate), &m, &self.sim, &truth);
+        let o = known.observation;
+        let navigation_error = self.realisation.is_some().then_some(known.error);
         let knowledge_barriers = self
             .knowledge_monitor
             .as_ref()
@@ -200,6 +215,7 @@ impl Mission {
             obs: truth,
             navigation_error,
             knowledge_barriers,
+            navigation_rejected: rejected.is_some(),
             // a missing nominal is recorded as NaN
             f_h_nom: nominals.translational.unwrap_or(nan3),
             tau_b_nom: nominals.attitude.unwrap_or(nan3),

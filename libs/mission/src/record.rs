@@ -28,6 +28,9 @@ pub struct StepRecord {
     /// what the filters act on — in [`crate::constraint_names`] order (`None`: the
     /// `exact` profile, where knowledge is the truth).
     pub knowledge_barriers: Option<Barriers>,
+    /// The navigation's estimate was missing or refused and the simulator's own
+    /// navigation substituted (`sc_sim::navigation`; `fault::NAVIGATION_REJECTED`).
+    pub navigation_rejected: bool,
     /// Nominal commands: force in F_H [N], torque in F_B [N m], joint torques [N m].
     pub f_h_nom: Vector3<f64>,
     pub tau_b_nom: Vector3<f64>,
@@ -652,6 +655,8 @@ fn read_record(c: &mut Fields, filtered: bool) -> Result<StepRecord, TelemetryEr
         obs,
         navigation_error: None,
         knowledge_barriers: None,
+        // not in the telemetry: the live summary and the simulator's log have it
+        navigation_rejected: false,
         f_h_nom,
         tau_b_nom,
         tau_m_nom,

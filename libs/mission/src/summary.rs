@@ -264,6 +264,10 @@ fn flag_names(bits: u32) -> Vec<String> {
 /// The filters' names in the order of the records' arrays.
 const FILTERS: [&str; 3] = ["translational", "attitude", "robotic"];
 
+/// Who a refused estimate's fault event names, and its flag (`fault::NAVIGATION_REJECTED`).
+const NAVIGATION: &str = "navigation";
+const NAVIGATION_REJECTED: &str = "NAVIGATION_REJECTED";
+
 /// Most fault events kept in the summary (every one is counted in `fault_count`).
 const MAX_FAULT_EVENTS: usize = 1000;
 
@@ -425,16 +429,24 @@ impl Tally {
         ];
         for (name, f) in FILTERS.into_iter().zip(reported) {
             if f != 0 {
-                self.fault_count += 1;
-                if self.fault_events.len() < MAX_FAULT_EVENTS {
-                    self.fault_events.push(FaultEvent {
-                        step: r.step,
-                        t_s: r.t,
-                        filter: name.into(),
-                        flags: flag_names(f),
-                    });
-                }
+                self.fault(r, name, flag_names(f));
             }
+        }
+        if r.navigation_rejected {
+            self.fault(r, NAVIGATION, vec![NAVIGATION_REJECTED.into()]);
+        }
+    }
+
+    /// Counts a fault of `by` and keeps its event while there is room.
+    fn fault(&mut self, r: &StepRecord, by: &str, flags: Vec<String>) {
+        self.fault_count += 1;
+        if self.fault_events.len() < MAX_FAULT_EVENTS {
+            self.fault_events.push(FaultEvent {
+                step: r.step,
+                t_s: r.t,
+                filter: by.into(),
+                flags,
+            });
         }
     }
 

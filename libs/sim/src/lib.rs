@@ -17,6 +17,7 @@
 //!
 //! [`Simulator::observe`] gives what each subsystem needs ([`Observation`]).
 
+pub mod navigation;
 mod observation;
 mod plant;
 pub mod plant_process;
@@ -25,6 +26,7 @@ mod report;
 mod state;
 pub mod uncertainty;
 
+pub use navigation::{Estimator, NavSample, NavigationGate, Rejection};
 pub use observation::{TRAJECTORY_COLUMNS, TrajectoryRow};
 pub use plant::{Plant, PlantError, SIM_STATE_LEN};
 pub use plant_process::ProcessPlant;

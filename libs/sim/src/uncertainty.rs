@@ -4,19 +4,19 @@
 //! * [`PlantErrors`] make the simulated plant differ from the model the filters and
 //!   nominals use (mass properties of the servicer, its arm and the target).
 //! * [`ActuatorErrors`] make what the actuators deliver differ from the applied command.
-//! * [`Navigation`] turns the true state into the estimate the controllers and filters
-//!   act on: bias and noise on every navigated quantity, an old measurement, the
-//!   declared (not the true) target inertia and grasping point.
+//! * [`DeclaredNavigation`] turns the measurement into the estimate the controllers and
+//!   filters act on: bias and noise on every navigated quantity
+//!   ([`crate::navigation`]: the measurement's age, the gate, the declared model).
 //!
 //! Every draw stays inside its bound (uniform inside the bound, noise truncated at it):
 //! the bounds are what the filters' margins may rest on. A realisation is a function of
 //! the bounds and the seed only.
 
-use crate::state::{SimState, Simulator};
+use crate::navigation::DeclaredNavigation;
+use crate::state::Simulator;
 use nalgebra::{Matrix3, Vector3};
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::{Rng, SeedableRng};
-use sc_core::Observation;
 use sc_models::quat;
 use sc_multibody::{NJ, Robot, Vector7};
 use sc_scenario::uncertainty::{ActuatorBounds, BiasNoise, ModelBounds, NavigationBounds};
@@ -26,6 +26,10 @@ use serde::Serialize;
 /// The random stream of the per-step draws (noise, ripple), separate from the draws made
 /// once per run so that adding a per-step source does not change a run's plant.
 const STEP_STREAM: u64 = 1;
+
+/// The random stream of the simulator's own navigation, substituted for a rejected
+/// estimate (apart from the navigation's so that the two never share their noise).
+pub(crate) const SUBSTITUTE_STREAM: u64 = STEP_STREAM + 2;
 
 /// A uniform draw in `[0, 1)` (53 bits).
 fn unit(rng: &mut ChaCha8Rng) -> f64 {
@@ -56,7 +60,7 @@ fn in_ball(rng: &mut ChaCha8Rng, b: f64) -> Vector3<f64> {
 
 /// Normal with σ = `bound`/3 per component, its norm truncated at `bound` (redrawn,
 /// then scaled onto the bound if the redraws run out).
-fn truncated(rng: &mut ChaCha8Rng, bound: f64) -> Vector3<f64> {
+pub(crate) fn truncated(rng: &mut ChaCha8Rng, bound: f64) -> Vector3<f64> {
     const REDRAWS: usize = 8;
     if bound == 0.0 {
         return Vector3::zeros();
@@ -74,7 +78,7 @@ fn truncated(rng: &mut ChaCha8Rng, bound: f64) -> Vector3<f64> {
 
 /// The scalar version of [`truncated`]: redrawn outside the bound (a clamp would put
 /// 0.27 % of the draws exactly on it), projected only after the last redraw.
-fn truncated1(rng: &mut ChaCha8Rng, bound: f64) -> f64 {
+pub(crate) fn truncated1(rng: &mut ChaCha8Rng, bound: f64) -> f64 {
     const REDRAWS: usize = 8;
     if bound == 0.0 {
         return 0.0;
@@ -90,7 +94,7 @@ fn truncated1(rng: &mut ChaCha8Rng, bound: f64) -> f64 {
 }
 
 /// The rotation by the small rotation vector `v` [rad] as a quaternion.
-fn rotation(v: &Vector3<f64>) -> quat::Quat {
+pub(crate) fn rotation(v: &Vector3<f64>) -> quat::Quat {
     let a = v.norm();
     if a == 0.0 {
         return [1.0, 0.0, 0.0, 0.0];
@@ -300,7 +304,7 @@ pub struct NavigationError {
 }
 
 /// Relative rounding allowed when a measurement age is turned into physics steps.
-const AGE_ROUNDING: f64 = 1e-9;
+pub(crate) const AGE_ROUNDING: f64 = 1e-9;
 
 /// How far a realised navigation error may exceed its bound before it counts as
 /// outside it, in the quantity's own unit: the error is recomputed as the difference of
@@ -412,131 +416,13 @@ impl NavigationBias {
     }
 }
 
-/// The default navigation: the truth with the declared errors, seen through the
-/// declared model.
-#[derive(Debug, Clone)]
-pub struct Navigation {
-    bounds: NavigationBounds,
-    pub bias: NavigationBias,
-    /// The declared scenario and robot: the estimate's observation is computed with them.
-    knower: Simulator,
-    declared_grasp_t: Vector3<f64>,
-    rng: ChaCha8Rng,
-}
-
-/// Adds a bias plus a truncated noise draw to a 3-vector.
-fn err3(rng: &mut ChaCha8Rng, bias: &[f64; 3], b: BiasNoise) -> Vector3<f64> {
-    Vector3::from(*bias) + truncated(rng, b.noise)
-}
-
-impl Navigation {
-    /// The navigation of one run; `knower` is a simulator of the declared scenario and robot.
-    fn new(
-        bounds: NavigationBounds,
-        bias: NavigationBias,
-        knower: Simulator,
-        rng: ChaCha8Rng,
-    ) -> Self {
-        let declared_grasp_t = knower.p.grasp_point_t;
-        Self {
-            bounds,
-            bias,
-            knower,
-            declared_grasp_t,
-            rng,
-        }
-    }
-
-    /// The measurement's age in whole physics steps of `truth` (at most one period).
-    /// (`0.03 / 0.01` is 2.9999999999999996 in floating point: the quotient is rounded
-    /// up by [`AGE_ROUNDING`] before it is floored.)
-    fn age_steps(&self, truth: &Simulator) -> usize {
-        let q = self.bounds.measurement_age_s / truth.p.physics_step;
-        let steps = (q * (1.0 + AGE_ROUNDING)).floor();
-        (steps as usize).min(truth.p.substeps)
-    }
-
-    /// The estimate of the current state, and its realised errors against the truth.
-    pub fn estimate(&mut self, truth: &Simulator) -> (Observation, NavigationError) {
-        let age = self.age_steps(truth);
-        let measured = truth.state_ago(age);
-        let (b, n) = (self.bias, self.bounds);
-        let rng = &mut self.rng;
-        let r_ir = quat::to_matrix(&truth.p.q_ir);
-        let mut est = measured;
-        est.dr += r_ir * err3(rng, &b.relative_position_m, n.relative_position_m);
-        est.dv += r_ir * err3(rng, &b.relative_velocity_m_s, n.relative_velocity_m_s);
-        let att_b = err3(rng, &b.servicer_attitude_rad, n.servicer_attitude_rad);
-        est.q_ib = rotated(&measured.q_ib, &att_b);
-        est.w_b += err3(rng, &b.servicer_rate_rad_s, n.servicer_rate_rad_s);
-        let att_t = err3(rng, &b.target_attitude_rad, n.target_attitude_rad);
-        est.q_it = rotated(&measured.q_it, &att_t);
-        est.w_t += err3(rng, &b.target_rate_rad_s, n.target_rate_rad_s);
-        let grasp = err3(rng, &b.grasp_point_m, n.grasp_point_m);
-        for k in 0..NJ {
-            est.theta[k] += b.joint_angle_rad[k] + truncated1(rng, n.joint_angle_rad.noise);
-            est.theta_dot[k] += b.joint_rate_rad_s[k] + truncated1(rng, n.joint_rate_rad_s.noise);
-        }
-        // the estimate is of the current time, from the (old) measurement
-        est.t = truth.state.t;
-        self.knower.p.grasp_point_t = self.declared_grasp_t + grasp;
-        self.knower.state = est;
-        self.knower.step = truth.step;
-        // the declared errors are those of the measurement at its time; its age is
-        // reported apart (the motion over the age is the margins' to cover)
-        // whole physics steps (a difference of two times would add its rounding)
-        let age_s = age as f64 * truth.p.physics_step;
-        let error = error_of(&est, &measured, &grasp, age_s);
-        (self.knower.observe(), error)
-    }
-}
-
-/// `q` turned by the small rotation `v` (unchanged, not re-rounded, when `v` is zero).
-fn rotated(q: &quat::Quat, v: &Vector3<f64>) -> quat::Quat {
-    if *v == Vector3::zeros() {
-        *q
-    } else {
-        quat::mul(q, &rotation(v))
-    }
-}
-
-/// The realised errors of `est` against the `measured` truth, `age_s` old.
-fn error_of(
-    est: &SimState,
-    measured: &SimState,
-    grasp: &Vector3<f64>,
-    age_s: f64,
-) -> NavigationError {
-    let truth = measured;
-    let angle = |a: &quat::Quat, b: &quat::Quat| {
-        // 2 atan2(‖v‖, |w|): exact near zero, where acos(|w|) is not
-        if a == b {
-            return 0.0;
-        }
-        let d = quat::mul(&quat::conj(a), b);
-        2.0 * Vector3::new(d[1], d[2], d[3]).norm().atan2(d[0].abs())
-    };
-    let max_abs = |a: &Vector7, b: &Vector7| (a - b).amax();
-    NavigationError {
-        relative_position_m: (est.dr - truth.dr).norm(),
-        relative_velocity_m_s: (est.dv - truth.dv).norm(),
-        servicer_attitude_rad: angle(&est.q_ib, &truth.q_ib),
-        servicer_rate_rad_s: (est.w_b - truth.w_b).norm(),
-        target_attitude_rad: angle(&est.q_it, &truth.q_it),
-        target_rate_rad_s: (est.w_t - truth.w_t).norm(),
-        grasp_point_m: grasp.norm(),
-        joint_angle_rad: max_abs(&est.theta, &truth.theta),
-        joint_rate_rad_s: max_abs(&est.theta_dot, &truth.theta_dot),
-        measurement_age_s: age_s,
-    }
-}
-
 /// One run's realisation: the plant, the actuators and the navigation.
 #[derive(Debug, Clone)]
 pub struct Realisation {
     pub plant: PlantErrors,
     pub actuators: ActuatorErrors,
-    pub navigation: Navigation,
+    /// The navigation's errors (the default navigation's estimator).
+    pub navigation: DeclaredNavigation,
     /// The plant's scenario and robot (the truth the simulator propagates).
     pub true_scenario: Scenario,
     pub true_robot: Robot,
@@ -599,7 +485,8 @@ impl Realisation {
         let knower = Simulator::new(scenario, std::sync::Arc::new(robot.clone()))
             .map_err(|e| UncertaintyError::Simulator(e.to_string()))?;
         step_rng.set_stream(STEP_STREAM + 1);
-        let navigation = Navigation::new(bounds.navigation, bias, knower, step_rng);
+        let r_ir = quat::to_matrix(&knower.p.q_ir);
+        let navigation = DeclaredNavigation::new(bounds.navigation, bias, r_ir, step_rng);
         Ok(Self {
             plant,
             actuators,

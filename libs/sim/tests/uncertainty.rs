@@ -4,8 +4,9 @@
 
 use sc_multibody::Robot;
 use sc_scenario::{Scenario, Uncertainty};
+use sc_sim::navigation::{Estimator, PassThrough, error_of};
 use sc_sim::uncertainty::NAVIGATION_ERROR_NAMES;
-use sc_sim::{Command, NavigationError, Realisation, Simulator};
+use sc_sim::{Command, NavigationError, NavigationGate, Realisation, Simulator};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -14,6 +15,12 @@ fn setup() -> (Scenario, Arc<Robot>) {
     let s = Scenario::load(&root.join("config/scenario.toml")).unwrap();
     let r = Arc::new(Robot::from_urdf_file(&s.urdf_path()).unwrap());
     (s, r)
+}
+
+/// The gate of `s` (its measurement age; the bounds do not matter here).
+fn gate(s: &Scenario) -> NavigationGate {
+    let (_, robot) = setup();
+    NavigationGate::new(s, robot, Box::new(PassThrough)).unwrap()
 }
 
 fn example() -> Uncertainty {
@@ -46,12 +53,14 @@ fn scaled(u: &Uncertainty, k: f64) -> Uncertainty {
 /// step.
 fn navigation_errors(r: &mut Realisation, steps: usize) -> Vec<NavigationError> {
     let mut sim = Simulator::new(&r.true_scenario, Arc::new(r.true_robot.clone())).unwrap();
+    let gate = gate(&r.true_scenario);
     let mut cmd = Command::zero();
     cmd.tau[1] = 0.5;
     cmd.force_b[0] = 2.0;
     (0..steps)
         .map(|_| {
-            let (_, e) = r.navigation.estimate(&sim);
+            let m = gate.measure(&sim, 0);
+            let e = error_of(&r.navigation.estimate(&m), &m, gate.measurement_age(&sim));
             let delivered = r.actuators.deliver(&cmd);
             sim.step(&delivered).unwrap();
             e
@@ -131,9 +140,13 @@ fn zero_bounds_give_the_truth_back() {
     // the same model, to the last bit (Robot has no PartialEq: its Debug form is complete)
     assert_eq!(format!("{:?}", r.true_robot), format!("{robot:?}"));
     let sim = Simulator::new(&s, robot.clone()).unwrap();
-    let (estimate, e) = r.navigation.estimate(&sim);
-    assert_eq!(estimate, sim.observe());
-    assert_eq!(e, NavigationError::default());
+    let mut gate = NavigationGate::new(&s, robot.clone(), Box::new(PassThrough)).unwrap();
+    let m = gate.measure(&sim, 0);
+    let estimate = r.navigation.estimate(&m);
+    assert_eq!(estimate, m);
+    let (k, rejected) = gate.admit(Some(&estimate), &m, &sim, &sim.observe());
+    assert_eq!((k.observation, rejected), (sim.observe(), None));
+    assert_eq!(k.error, NavigationError::default());
     let mut cmd = Command::zero();
     cmd.tau[3] = 1.0;
     assert_eq!(r.actuators.deliver(&cmd), cmd);

@@ -20,6 +20,8 @@ N_BARRIERS = 51  # Number of barriers of the whole safety layer (translational, 
 # Each pub/sub service has an event service of the same name.
 SERVICE_TICK = "safe_capture/scheduler/tick"  # Tick, QoS flight
 SERVICE_CONTROL = "safe_capture/scheduler/control"  # Tick, QoS flight
+SERVICE_MEASUREMENT = "safe_capture/sim/measurement"  # NavState, QoS partner
+SERVICE_ESTIMATE = "safe_capture/navigation/estimate"  # NavState, QoS partner
 SERVICE_SIM_STATE = "safe_capture/sim/state"  # SimState, QoS flight
 SERVICE_PARTNER_STATE = "safe_capture/partner/state"  # SimState, QoS partner
 SERVICE_TRUTH = "safe_capture/sim/truth"  # SimState, QoS flight
@@ -42,6 +44,8 @@ SERVICE_HANDSHAKE_GO = "safe_capture/handshake/go"
 SERVICE_QOS = {
     SERVICE_TICK: "flight",
     SERVICE_CONTROL: "flight",
+    SERVICE_MEASUREMENT: "partner",
+    SERVICE_ESTIMATE: "partner",
     SERVICE_SIM_STATE: "flight",
     SERVICE_PARTNER_STATE: "partner",
     SERVICE_TRUTH: "flight",
@@ -98,6 +102,7 @@ FAULT_NOMINAL_MISSING = 32  # Nominal command missing or invalid; filter used ze
 FAULT_DEADLINE_MISS = 64  # Deadline missed.
 FAULT_PEER_DEAD = 128  # A peer process was detected dead.
 FAULT_REJECTED_COMMAND = 256  # The simulator rejected a safe command (not finite or beyond the input bounds, `sc_flight::admission`) and applied the filter's backup instead.
+FAULT_NAVIGATION_REJECTED = 512  # The navigation's estimate was missing at the navigation deadline or rejected (not finite, not current, a quaternion off the unit sphere, or farther from the measurement than the declared navigation bounds, `sc_sim::navigation`); the simulator's own navigation (the declared error model) was substituted.
 
 # Values of `Health.state`.
 HEALTH_STARTING = 0  # Process started, ports being created.
@@ -109,7 +114,7 @@ HEALTH_STOPPING = 4  # Shutting down.
 # Role ids, from the role table (sc_icd::ROLES, start order): Health.role; a participant
 # announces EVENT_HANDSHAKE_ID_OFFSET + role in the handshake.
 ROLE_SCHEDULER = 0  # rate groups, ticks (lock-step or real time), the end of the run, liveness of the peers
-ROLE_SIMULATOR = 1  # the plant: applies the re-validated safe commands (the backup when one is missing or rejected), publishes the state with the monitored barriers
+ROLE_SIMULATOR = 1  # the plant: measures the state, admits the navigation's estimate (its own navigation when that is missing or rejected) and publishes the knowledge derived from it, applies the re-validated safe commands (the backup when one is missing or rejected)
 ROLE_NOMINAL_TRANSLATIONAL = 2  # the nominal translational controller (MPC), replaceable by a partner's
 ROLE_NOMINAL_ATTITUDE = 3  # the nominal attitude controller (MPC), replaceable by a partner's
 ROLE_NOMINAL_ROBOTIC = 4  # the nominal robotic controller (joint-space PD), replaceable by a partner's
@@ -117,6 +122,7 @@ ROLE_SAFETY_TRANSLATIONAL = 5  # the translational safety filter (approach corri
 ROLE_SAFETY_ATTITUDE = 6  # the attitude safety filter (line of sight, body-rate limits), ξ = the translational safe force
 ROLE_SAFETY_ROBOTIC = 7  # the robotic safety filter (joint angles and rates, link–base spheres), ξ = the translational and attitude safe commands
 ROLE_RECORDER = 8  # telemetry: the same telemetry.csv, timing.csv and summary.json as `safe-capture run`, plus recording.mcap and latency.csv
+ROLE_NAVIGATION = 9  # the navigation: the estimate of each tick's state from the measurements (the declared error model), replaceable by a partner's estimator
 # The role names (config keys, node names), indexed by role id.
 ROLE_NAMES = (
     "scheduler",
@@ -128,6 +134,7 @@ ROLE_NAMES = (
     "safety_attitude",
     "safety_robotic",
     "recorder",
+    "navigation",
 )
 
 
@@ -343,7 +350,7 @@ class StepResult(ctypes.Structure):
         ("end", ctypes.c_uint32),  # How the step ended, one of `end` (0 running, 1 captured, 2 timeout, 3 simulator failed) [-]
         ("fallback_mask", ctypes.c_uint32),  # Subsystems (bits of `due`) whose command is the filter fallback computed by the simulator because the safe command was missing at the deadline (1 translational, 2 attitude, 4 robotic, 7 all) [-]
         ("held_mask", ctypes.c_uint32),  # Subsystems (bits of `due`) whose command was held from an earlier tick (slower rate group) (1 translational, 2 attitude, 4 robotic, 7 all) [-]
-        ("fault_flags", ctypes.c_uint32),  # Partition fault flags, bits of `fault` (1 stale input, 2 non finite input, 4 solver failed, 8 infeasible, 16 saturated, 32 nominal missing, 64 deadline miss, 128 peer dead, 256 rejected command) [-]
+        ("fault_flags", ctypes.c_uint32),  # Partition fault flags, bits of `fault` (1 stale input, 2 non finite input, 4 solver failed, 8 infeasible, 16 saturated, 32 nominal missing, 64 deadline miss, 128 peer dead, 256 rejected command, 512 navigation rejected) [-]
         ("safe_recv_ns", ctypes.c_uint64),  # Stamp at which the robotic safe command (the tick's last) was delivered, host CLOCK_MONOTONIC [ns]
         ("publish_ns", ctypes.c_uint64),  # Publish stamp, host CLOCK_MONOTONIC [ns]
         ("force_b", ctypes.c_double * 3),  # Applied base force f_B, frame F_B [N]
@@ -379,6 +386,32 @@ class NavigationError(ctypes.Structure):
         return "safe_capture::v1::NavigationError"
 
 
+class NavState(ctypes.Structure):
+    """A navigation state in the inertial frame the simulator propagates in: on `MEASUREMENT` what the simulator's sensors measured (simulator → navigation), on `ESTIMATE` what the navigation estimates (navigation → simulator). The simulator admits an estimate (`sc_sim::navigation`), then derives every quantity of the `SIM_STATE` the controllers and filters get from it with the declared model."""
+
+    _fields_ = [
+        ("tick", ctypes.c_uint64),  # Tick index this state answers [-]
+        ("t", ctypes.c_double),  # Simulation time of the tick: the time an estimate is of [s]
+        ("measured_t", ctypes.c_double),  # Simulation time of the measurement the values rest on (≤ `t`: the sensors' age); an estimate carries its measurement's [s]
+        ("publish_ns", ctypes.c_uint64),  # Publish stamp, host CLOCK_MONOTONIC [ns]
+        ("target_r", ctypes.c_double * 3),  # Target CoM position from the Earth's centre, frame F_I [m]
+        ("target_v", ctypes.c_double * 3),  # Target CoM inertial velocity, frame F_I [m/s]
+        ("q_it", ctypes.c_double * 4),  # Target attitude q_IT: rotates F_T vectors into F_I, frame F_T → F_I [-]
+        ("omega_t", ctypes.c_double * 3),  # Target body rate ω_T w.r.t. inertial, frame F_T [rad/s]
+        ("r_i", ctypes.c_double * 3),  # Servicer base origin relative to the target CoM, frame F_I [m]
+        ("v_i", ctypes.c_double * 3),  # Inertial derivative of `r_i`, frame F_I [m/s]
+        ("q_ib", ctypes.c_double * 4),  # Servicer attitude q_IB: rotates F_B vectors into F_I, frame F_B → F_I [-]
+        ("omega_b", ctypes.c_double * 3),  # Servicer body rate ω_B w.r.t. inertial, frame F_B [rad/s]
+        ("theta", ctypes.c_double * 7),  # Joint angles θ, frame M [rad]
+        ("theta_dot", ctypes.c_double * 7),  # Joint rates θ̇, frame M [rad/s]
+        ("grasp_t", ctypes.c_double * 3),  # Grasping point relative to the target CoM, frame F_T [m]
+    ]
+
+    @staticmethod
+    def type_name():
+        return "safe_capture::v1::NavState"
+
+
 class Health(ctypes.Structure):
     """Recorder → scheduler: the recorder's progress (lock-step flow control); the fields are those of a health report any process could publish."""
 
@@ -386,7 +419,7 @@ class Health(ctypes.Structure):
         ("role", ctypes.c_uint32),  # Role id: the role's position in the role table `ROLES` [-]
         ("pid", ctypes.c_uint32),  # Operating-system process id [-]
         ("state", ctypes.c_uint32),  # State, one of `health_state` (0 starting, 1 ready, 2 running, 3 faulted, 4 stopping) [-]
-        ("last_fault_flags", ctypes.c_uint32),  # Last fault flags, bits of `fault` (1 stale input, 2 non finite input, 4 solver failed, 8 infeasible, 16 saturated, 32 nominal missing, 64 deadline miss, 128 peer dead, 256 rejected command) [-]
+        ("last_fault_flags", ctypes.c_uint32),  # Last fault flags, bits of `fault` (1 stale input, 2 non finite input, 4 solver failed, 8 infeasible, 16 saturated, 32 nominal missing, 64 deadline miss, 128 peer dead, 256 rejected command, 512 navigation rejected) [-]
         ("ticks_handled", ctypes.c_uint64),  # Ticks handled since start [-]
         ("deadline_misses", ctypes.c_uint64),  # Deadline misses since start [-]
         ("cycle_slips", ctypes.c_uint64),  # Cycle slips (a tick answered late or skipped) since start [-]
@@ -411,6 +444,7 @@ ALL_TYPES = [
     SafeRobotic,
     StepResult,
     NavigationError,
+    NavState,
     Health,
 ]
 
@@ -422,6 +456,8 @@ __all__ = [
     "N_BARRIERS",
     "SERVICE_TICK",
     "SERVICE_CONTROL",
+    "SERVICE_MEASUREMENT",
+    "SERVICE_ESTIMATE",
     "SERVICE_SIM_STATE",
     "SERVICE_PARTNER_STATE",
     "SERVICE_TRUTH",
@@ -468,6 +504,7 @@ __all__ = [
     "FAULT_DEADLINE_MISS",
     "FAULT_PEER_DEAD",
     "FAULT_REJECTED_COMMAND",
+    "FAULT_NAVIGATION_REJECTED",
     "HEALTH_STARTING",
     "HEALTH_READY",
     "HEALTH_RUNNING",
@@ -482,6 +519,7 @@ __all__ = [
     "ROLE_SAFETY_ATTITUDE",
     "ROLE_SAFETY_ROBOTIC",
     "ROLE_RECORDER",
+    "ROLE_NAVIGATION",
     "ROLE_NAMES",
     "Tick",
     "SimState",
@@ -493,6 +531,7 @@ __all__ = [
     "SafeRobotic",
     "StepResult",
     "NavigationError",
+    "NavState",
     "Health",
     "ALL_TYPES",
 ]

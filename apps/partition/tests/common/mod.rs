@@ -189,7 +189,7 @@ pub fn assert_clean(rep: &LaunchReport, out: &Path) {
     );
     let left: Vec<i32> = pids_of("sc-", out);
     assert!(left.is_empty(), "processes left behind: {left:?}");
-    assert_eq!(rep.exits.len(), 9, "{:?}", rep.exits);
+    assert_eq!(rep.exits.len(), sc_icd::ROLES.len(), "{:?}", rep.exits);
 }
 
 /// Telemetry steps are 0..n without gaps; returns n.

@@ -2,18 +2,22 @@
 //! file one role's decisions, driven by the one runner (`crate::runner`).
 //!
 //! * [`scheduler`] — rate groups, lock-step or real time, the end of the run, liveness;
-//! * [`simulator`] — the plant: applies the (re-validated) safe commands, publishes states;
+//! * [`simulator`] — the plant: measures, admits the estimate, publishes the knowledge,
+//!   applies the (re-validated) safe commands;
+//! * [`navigation`] — the estimate from the measurements, replaceable by a partner's process;
 //! * [`nominal`] — a nominal controller, replaceable by a partner's process;
 //! * [`filter`] — a safety filter.
 //!
 //! The recorder is a ground tool: `sc_ground::recorder`.
 
 pub mod filter;
+pub mod navigation;
 pub mod nominal;
 pub mod scheduler;
 pub mod simulator;
 
 pub use filter::FilterRole;
+pub use navigation::NavigationRole;
 pub use nominal::NominalRole;
 pub use scheduler::{SchedulerReport, SchedulerRole};
 pub use simulator::SimulatorRole;
@@ -99,14 +103,16 @@ mod tests {
             ),
             (
                 RoleKind::Simulator,
-                Box::new(SimulatorRole::new(
-                    sim,
-                    None,
-                    su.scenario.clone(),
-                    su.robot.clone(),
-                    1,
-                    false,
-                )),
+                Box::new(
+                    SimulatorRole::new(sim, None, su.scenario.clone(), su.robot.clone(), 1, false)
+                        .unwrap(),
+                ),
+            ),
+            (
+                RoleKind::Navigation,
+                Box::new(NavigationRole::new(Box::new(
+                    sc_sim::navigation::PassThrough,
+                ))),
             ),
         ];
         for s in Subsystem::ALL {

@@ -1,11 +1,13 @@
-//! The simulator: the plant in the loop. At each tick it publishes the state with the
-//! monitored barriers, waits up to its deadline for the safe commands of the subsystems
-//! due, applies them after re-validating them (`crate::admission`) — the filter's backup
+//! The simulator: the plant in the loop. At each tick it publishes the measurement,
+//! waits up to the navigation deadline for the navigation's estimate, admits it
+//! (`sc_sim::navigation`: its own navigation substituted, flagged, for one missing or
+//! refused) and publishes the knowledge derived from it as the state, waits up to its
+//! deadline for the safe commands of the subsystems due, applies them after re-validating them (`crate::admission`) — the filter's backup
 //! when one is missing or refused, the held command of a slower rate group — advances
 //! the physics and publishes the step result.
 //!
 //! Wake-ups (docs/PARTITION.md, "Who wakes whom"): between ticks on the tick only;
-//! within a tick on the robotic safe command, the last of the causal chain (the earlier
+//! within a tick first on the estimate, then on the robotic safe command, the last of the causal chain (the earlier
 //! ones were sent before it). While a filter is absent (dead or late: its command may
 //! never come), when the robotic group is not due, or when the robotic command of the
 //! tick is here without an earlier one, on every safe command — their listeners are
@@ -23,7 +25,8 @@ use sc_core::{Command, Observation, PerSubsystem, Subsystem, SubsystemSet};
 use sc_icd::services::{self, ServiceName};
 use sc_icd::{SimState, StepResult, Tick, end, fault, tick_command};
 use sc_scenario::Scenario;
-use sc_sim::{Plant, Realisation, Simulator};
+use sc_sim::navigation::{PassThrough, substitute_navigation};
+use sc_sim::{NavSample, NavigationGate, Plant, Realisation, Rejection, Simulator};
 use std::collections::VecDeque;
 
 /// A safe command as the simulator judges it, whatever its subsystem.
@@ -75,22 +78,32 @@ impl Received {
 /// The tick in progress: its state and deadline.
 struct InTick {
     tick: Tick,
+    /// When the tick was received [monotonic ns].
+    recv_ns: u64,
     /// The true state (capture, monitor).
     o: Observation,
-    /// What the controllers and filters know: the navigation's estimate (the truth for
-    /// the `exact` profile); the backups are computed on it, as the filters would.
-    known: Observation,
+    /// What the sensors measured.
+    measurement: NavSample,
+    /// What the controllers and filters know: the admitted estimate through the declared
+    /// model (the truth for the `exact` profile); the backups are computed on it, as the
+    /// filters would. `None` while the estimate is awaited.
+    known: Option<Observation>,
+    /// The estimate was missing or refused and the simulator's own navigation used.
+    navigation_rejected: bool,
     barriers: Barriers,
     barriers_between: Barriers,
+    /// The navigation deadline while the estimate is awaited, then the safe commands'.
     until_ns: u64,
     /// When the robotic safe command (the tick's last) was delivered [monotonic ns].
     safe_recv_ns: u64,
 }
 
-/// The wake sets: between ticks, within a tick, within a tick on every safe command.
+/// The wake sets: between ticks, within a tick, within a tick on every safe command,
+/// within a tick awaiting the estimate.
 const IDLE: usize = 0;
 const ROBOTIC: usize = 1;
 const ANY: usize = 2;
+const NAVIGATION: usize = 3;
 const WAKE: &[WakeSet] = &[
     WakeSet {
         on: &[services::TICK, services::PREPARE],
@@ -109,6 +122,10 @@ const WAKE: &[WakeSet] = &[
         ],
         lazy: true,
     },
+    WakeSet {
+        on: &[services::TICK, services::ESTIMATE],
+        lazy: false,
+    },
 ];
 
 /// The simulator role.
@@ -123,6 +140,14 @@ pub struct SimulatorRole {
     /// With a declared `[uncertainty]`: the realisation (plant, actuators, navigation)
     /// and the barriers on knowledge (the declared model on the estimate).
     realisation: Option<(Realisation, Monitor)>,
+    /// The sensors and the gate of the navigation's estimates.
+    gate: NavigationGate,
+    /// The newest estimate received (the awaited tick's, once it came).
+    estimate: Option<sc_icd::NavState>,
+    /// The navigation missed its deadline and has not answered since: not waited for.
+    navigation_absent: bool,
+    navigation_rejected: u64,
+    navigation_deadline_ns: u64,
     scenario: Scenario,
     deadline_ns: u64,
     /// With `max_ticks` (benchmarks, soak runs) the physics goes on after the mission's
@@ -143,7 +168,9 @@ pub struct SimulatorRole {
 
 impl SimulatorRole {
     /// The role with its simulator (and, optionally, another propagator behind it) on
-    /// `scenario` (whose control period is the base period).
+    /// `scenario` (whose control period is the base period); it waits `deadline_ns` for
+    /// the safe commands after it published the state, and as long for the estimate
+    /// unless [`Self::with_navigation_deadline`] says otherwise.
     pub fn new(
         sim: Simulator,
         plant: Option<Box<dyn Plant + Send>>,
@@ -151,13 +178,20 @@ impl SimulatorRole {
         robot: std::sync::Arc<sc_multibody::Robot>,
         deadline_ns: u64,
         keep_going: bool,
-    ) -> Self {
-        Self {
+    ) -> Result<Self, FlightError> {
+        let gate = NavigationGate::new(&scenario, robot.clone(), Box::new(PassThrough))
+            .map_err(|e| FlightError::Simulator(e.to_string()))?;
+        Ok(Self {
             sim,
             plant,
             layer: SafetyLayer::from_scenario(&scenario, robot.clone()),
             monitor: Monitor::from_scenario(&scenario, robot),
             realisation: None,
+            gate,
+            estimate: None,
+            navigation_absent: false,
+            navigation_rejected: 0,
+            navigation_deadline_ns: deadline_ns,
             scenario,
             deadline_ns,
             keep_going,
@@ -172,7 +206,13 @@ impl SimulatorRole {
             stop: false,
             rehearse: false,
             misses: 0,
-        }
+        })
+    }
+
+    /// Waits `ns` for the navigation's estimate after the measurement.
+    pub fn with_navigation_deadline(mut self, ns: u64) -> Self {
+        self.navigation_deadline_ns = ns;
+        self
     }
 
     /// The role propagating the truth of `realisation` (drawn for `scenario`, the
@@ -184,6 +224,8 @@ impl SimulatorRole {
         self.sim = Simulator::new(truth, robot.clone())
             .map_err(|e| FlightError::Simulator(e.to_string()))?;
         let known = std::mem::replace(&mut self.monitor, Monitor::from_scenario(truth, robot));
+        self.gate
+            .set_substitute(substitute_navigation(Some(&realisation)));
         self.realisation = Some((realisation, known));
         Ok(self)
     }
@@ -198,10 +240,11 @@ impl SimulatorRole {
             .map_err(|e| FlightError::Simulator(format!("uncertainty: {e}")))?;
         let sim = Simulator::new(&scenario, robot.clone())
             .map_err(|e| FlightError::Simulator(e.to_string()))?;
-        let deadline = p.deadline(p.cfg.deadlines.simulator_ms);
-        let ns = deadline.as_nanos().min(u128::from(u64::MAX)) as u64;
+        let ns = |ms| p.deadline(ms).as_nanos().min(u128::from(u64::MAX)) as u64;
         let keep_going = p.cfg.max_ticks > 0;
-        let mut role = Self::new(sim, None, scenario, robot, ns, keep_going);
+        let deadline = ns(p.cfg.deadlines.simulator_ms);
+        let mut role = Self::new(sim, None, scenario, robot, deadline, keep_going)?
+            .with_navigation_deadline(ns(p.cfg.deadlines.navigation_ms));
         if let Some(r) = realisation {
             if !p.cfg.simulator.plant.is_empty() {
                 // as the preflight: the plant process would propagate the model
@@ -222,6 +265,12 @@ impl SimulatorRole {
         for m in inputs {
             if let Message::Tick(t) = m {
                 self.ticks.push_back(*t);
+            } else if let Message::Estimate(e) = m {
+                let known = self.pending.as_ref().map(|p| p.measurement.tick);
+                // an estimate of the awaited tick or the one before brings it back
+                let came =
+                    super::keep_for_tick(vec![*e], &mut self.estimate, in_tick, known, |e| e.tick);
+                self.navigation_absent &= !came;
             } else if let Some((s, r)) = Received::of(m, &self.scenario.limits) {
                 if in_tick.is_some() {
                     // within a tick a command brings an absent filter back
@@ -246,47 +295,89 @@ impl SimulatorRole {
         })
     }
 
-    /// Starts tick `t` received at `now_ns`: observes, publishes the state (flight side
-    /// first: a nominal command can then never reach a filter before the state it
-    /// answers), awaits the safe commands.
+    /// Starts tick `t` received at `now_ns`: observes, publishes the truth (with a
+    /// declared uncertainty, for the recorder) and the measurement, awaits the estimate
+    /// (not while the navigation is absent).
     fn start_tick(&mut self, t: Tick, now_ns: u64, out: &mut Outbox) {
         let o = self.sim.observe();
         let barriers = self.monitor.evaluate(&o.barrier_state());
         let barriers_between = self.between.unwrap_or(barriers);
-        let stamp = |mut msg: SimState, b: Barriers, between: Barriers| {
-            msg.barriers = b;
-            msg.barriers_between = between;
-            msg.tick = t.tick;
-            msg.due_mask = t.due_mask;
-            msg.tick_send_ns = t.send_ns;
-            msg.recv_ns = now_ns;
-            msg
+        if self.realisation.is_some() {
+            let truth = stamp(convert::sim_state(&o), &t, now_ns);
+            out.send(Message::Truth(with_barriers(
+                truth,
+                barriers,
+                barriers_between,
+            )));
+        }
+        let measurement = self.gate.measure(&self.sim, t.tick);
+        out.send(Message::Measurement(convert::nav_state(&measurement)));
+        let wait = if self.navigation_absent {
+            0
+        } else {
+            self.navigation_deadline_ns
         };
-        let truth = stamp(convert::sim_state(&o), barriers, barriers_between);
-        let (known, msg) = match self.realisation.as_mut() {
-            Some((r, knowledge)) => {
-                // the truth for the recorder first, then what the controllers know
-                let (estimate, error) = r.navigation.estimate(&self.sim);
-                out.send(Message::Truth(truth));
-                out.send(Message::NavigationError(convert::navigation_error(
-                    t.tick, o.t, &error,
-                )));
-                let kb = knowledge.evaluate(&estimate.barrier_state());
-                (estimate, stamp(convert::sim_state(&estimate), kb, kb))
-            }
-            None => (o, truth),
-        };
-        out.send(Message::State(msg));
-        out.send(Message::PartnerState(msg));
         self.pending = Some(InTick {
             tick: t,
+            recv_ns: now_ns,
             o,
-            known,
+            measurement,
+            known: None,
+            navigation_rejected: false,
             barriers,
             barriers_between,
-            until_ns: now_ns.saturating_add(self.deadline_ns),
+            until_ns: now_ns.saturating_add(wait),
             safe_recv_ns: 0,
         });
+    }
+
+    /// Admits the tick's estimate (or substitutes the simulator's own navigation) and
+    /// publishes the knowledge: the realised errors (with a declared uncertainty), then
+    /// the state, flight side first (a nominal command can then never reach a filter
+    /// before the state it answers); the safe commands are awaited from `now_ns`.
+    fn publish_knowledge(&mut self, p: &mut InTick, now_ns: u64, out: &mut Outbox) {
+        let k = p.tick.tick;
+        let estimate = self.estimate.take().map(|e| convert::nav_sample(&e));
+        let came = estimate.is_some_and(|e| e.tick == k);
+        let (known, rejected) = self
+            .gate
+            .admit(estimate.as_ref(), &p.measurement, &self.sim, &p.o);
+        if let Some(why) = rejected {
+            self.refuse_estimate(k, &why, out);
+            p.navigation_rejected = true;
+        }
+        self.navigation_absent = !came;
+        let (b, between) = if known.truth {
+            (p.barriers, p.barriers_between)
+        } else {
+            let m = self.realisation.as_ref().map_or(&self.monitor, |(_, m)| m);
+            let kb = m.evaluate(&known.observation.barrier_state());
+            (kb, kb)
+        };
+        if self.realisation.is_some() {
+            out.send(Message::NavigationError(convert::navigation_error(
+                k,
+                p.o.t,
+                &known.error,
+            )));
+        }
+        let msg = with_barriers(
+            stamp(convert::sim_state(&known.observation), &p.tick, p.recv_ns),
+            b,
+            between,
+        );
+        out.send(Message::State(msg));
+        out.send(Message::PartnerState(msg));
+        p.known = Some(known.observation);
+        p.until_ns = now_ns.saturating_add(self.deadline_ns);
+    }
+
+    /// Logs and counts a refused or missing estimate (a missing one once per absence).
+    fn refuse_estimate(&mut self, k: u64, why: &Rejection, out: &mut Outbox) {
+        self.navigation_rejected += 1;
+        if *why != Rejection::Missing || !self.navigation_absent {
+            out.log(format!("simulator: FAULT tick {k}: navigation estimate {why}; the simulator's own navigation substituted"));
+        }
     }
 
     /// What acts for subsystem `s` over tick `k`: the fresh safe command if it passed
@@ -356,8 +447,8 @@ impl SimulatorRole {
     /// Ends the tick in progress: applies the commands, decides the mission's end,
     /// advances the physics (the barriers monitored at every physics step) and
     /// publishes the step result.
-    fn finish_tick(&mut self, p: InTick, out: &mut Outbox) {
-        let (k, o, known) = (p.tick.tick, p.o, p.known);
+    fn finish_tick(&mut self, p: InTick, known: Observation, out: &mut Outbox) {
+        let (k, o) = (p.tick.tick, p.o);
         let due = SubsystemSet::from_bits(p.tick.due_mask);
         let mut res = StepResult {
             tick: k,
@@ -365,6 +456,9 @@ impl SimulatorRole {
             safe_recv_ns: p.safe_recv_ns,
             ..Default::default()
         };
+        if p.navigation_rejected {
+            res.fault_flags |= fault::NAVIGATION_REJECTED;
+        }
         for s in Subsystem::ALL {
             self.apply(s, &known, k, due, &mut res, out);
         }
@@ -416,7 +510,20 @@ impl SimulatorRole {
     /// Works through the queued ticks until one awaits its commands.
     fn process(&mut self, now_ns: u64, out: &mut Outbox) {
         loop {
-            if let Some(p) = self.pending.take() {
+            if let Some(mut p) = self.pending.take() {
+                let known = match p.known {
+                    Some(known) => known,
+                    None => {
+                        let here = self.estimate.is_some_and(|e| e.tick == p.tick.tick);
+                        if !here && now_ns < p.until_ns {
+                            self.pending = Some(p);
+                            return;
+                        }
+                        self.publish_knowledge(&mut p, now_ns, out);
+                        self.pending = Some(p);
+                        continue;
+                    }
+                };
                 let complete = self.complete(&p.tick);
                 if !complete && now_ns < p.until_ns {
                     self.pending = Some(p);
@@ -425,7 +532,7 @@ impl SimulatorRole {
                 if !complete {
                     self.misses += 1;
                 }
-                self.finish_tick(p, out);
+                self.finish_tick(p, known, out);
                 continue;
             }
             let Some(t) = self.ticks.pop_front() else {
@@ -434,6 +541,7 @@ impl SimulatorRole {
             if t.command == tick_command::STOP {
                 // wake the consumers once so that they see the stop too
                 out.notify.extend_from_slice(&[
+                    services::MEASUREMENT,
                     services::PARTNER_STATE,
                     services::SIM_STATE,
                     services::STEP_RESULT,
@@ -446,6 +554,22 @@ impl SimulatorRole {
             }
         }
     }
+}
+
+/// `msg` stamped as the state of tick `t` received at `recv_ns`.
+fn stamp(mut msg: SimState, t: &Tick, recv_ns: u64) -> SimState {
+    msg.tick = t.tick;
+    msg.due_mask = t.due_mask;
+    msg.tick_send_ns = t.send_ns;
+    msg.recv_ns = recv_ns;
+    msg
+}
+
+/// `msg` with the barriers `b` and their minima since the last state `between`.
+fn with_barriers(mut msg: SimState, b: Barriers, between: Barriers) -> SimState {
+    msg.barriers = b;
+    msg.barriers_between = between;
+    msg
 }
 
 /// Starts the plant process of `[simulator] plant`, if any, at the simulator's state.
@@ -478,6 +602,7 @@ impl Component for SimulatorRole {
         &[
             services::PREPARE,
             services::TICK,
+            services::ESTIMATE,
             services::SAFE_ROBOTIC,
             services::SAFE_ATTITUDE,
             services::SAFE_TRANSLATIONAL,
@@ -486,6 +611,7 @@ impl Component for SimulatorRole {
 
     fn warm(&self) -> &'static [ServiceName] {
         &[
+            services::MEASUREMENT,
             services::PARTNER_STATE,
             services::SIM_STATE,
             services::TRUTH,
@@ -503,6 +629,12 @@ impl Component for SimulatorRole {
                 until_ns: None,
             };
         };
+        if p.known.is_none() {
+            return Next::Wait {
+                set: NAVIGATION,
+                until_ns: Some(p.until_ns),
+            };
+        }
         let due = SubsystemSet::from_bits(p.tick.due_mask);
         let robotic_here = self.got[Subsystem::Robotic].is_some_and(|m| m.tick == p.tick.tick);
         let any =
@@ -544,10 +676,11 @@ impl Component for SimulatorRole {
             dropped(services::SAFE_ROBOTIC),
         ];
         out.log(format!(
-            "simulator: done at step {}, {} deadline misses, safe commands rejected (translational, attitude, robotic) {:?}, samples from a second publisher dropped {impostors:?}",
+            "simulator: done at step {}, {} deadline misses, safe commands rejected (translational, attitude, robotic) {:?}, navigation estimates missing or rejected {}, samples from a second publisher dropped {impostors:?}",
             self.sim.step_count(),
             self.misses,
-            self.rejected.0
+            self.rejected.0,
+            self.navigation_rejected
         ));
         0
     }
@@ -565,7 +698,7 @@ mod tests {
     fn role() -> SimulatorRole {
         let su = setup();
         let sim = Simulator::new(&su.scenario, su.robot.clone()).unwrap();
-        SimulatorRole::new(sim, None, su.scenario, su.robot, DEADLINE_NS, false)
+        SimulatorRole::new(sim, None, su.scenario, su.robot, DEADLINE_NS, false).unwrap()
     }
 
     fn tick(k: u64, due: SubsystemSet) -> Message {
@@ -599,6 +732,23 @@ mod tests {
         out
     }
 
+    /// The tick's measurement in `out`, answered as the `exact` navigation would.
+    fn estimate_of(out: &Outbox) -> Message {
+        match out.send.iter().find_map(|m| match m {
+            Message::Measurement(x) => Some(*x),
+            _ => None,
+        }) {
+            Some(m) => Message::Estimate(m),
+            None => panic!("no measurement in {:?}", out.send),
+        }
+    }
+
+    /// Tick `k` started and its estimate answered: the outbox of the estimate's wake-up.
+    fn start(r: &mut SimulatorRole, now: u64, k: u64, due: SubsystemSet) -> Outbox {
+        let out = handle(r, now, Woke::Event, &[tick(k, due)]);
+        handle(r, now, Woke::Event, &[estimate_of(&out)])
+    }
+
     fn result(out: &Outbox) -> StepResult {
         match out.send.iter().find_map(|m| match m {
             Message::StepResult(r) => Some(*r),
@@ -610,7 +760,7 @@ mod tests {
     }
 
     /// The role on a realisation of the `realistic` profile (seed 3).
-    fn realistic_role() -> SimulatorRole {
+    fn realistic_role() -> (SimulatorRole, Realisation) {
         let mut su = setup();
         let spec = sc_scenario::UncertaintySpec {
             profile: "realistic".into(),
@@ -624,7 +774,111 @@ mod tests {
         let real = Realisation::declared(&su.scenario, &su.robot)
             .unwrap()
             .expect("a declared profile");
-        role().with_realisation(real).unwrap()
+        let sim = Simulator::new(&su.scenario, su.robot.clone()).unwrap();
+        let role = SimulatorRole::new(sim, None, su.scenario, su.robot, DEADLINE_NS, false)
+            .unwrap()
+            .with_realisation(real.clone())
+            .unwrap();
+        (role, real)
+    }
+
+    /// The estimate of the measurement in `out` by the declared navigation `nav`.
+    fn declared_estimate(nav: &mut dyn sc_sim::Estimator, out: &Outbox) -> Message {
+        let Message::Estimate(m) = estimate_of(out) else {
+            unreachable!()
+        };
+        let e = nav.estimate(&convert::nav_sample(&m));
+        Message::Estimate(convert::nav_state(&e))
+    }
+
+    /// An estimate that is not finite, not current or beyond its declared bound of the
+    /// measurement is refused: the simulator's own navigation is substituted, the step
+    /// flagged, the fault logged and counted; a missing one likewise at the deadline.
+    #[test]
+    fn a_refused_or_missing_estimate_is_replaced_and_flagged() {
+        let (mut r, real) = realistic_role();
+        let mut nav = real.navigation.clone();
+        type Spoil = fn(&mut sc_icd::NavState);
+        let bad: [(&str, Spoil); 4] = [
+            ("not finite", |e| e.r_i[0] = f64::NAN),
+            ("relative_position_m", |e| e.r_i[0] += 1.0),
+            ("off the unit sphere", |e| e.q_ib[0] *= 2.0),
+            // for another tick: still awaited, refused at the deadline
+            ("not current", |e| e.tick = e.tick.wrapping_sub(1)),
+        ];
+        for (k, (why, spoil)) in bad.into_iter().enumerate() {
+            let k = k as u64;
+            let out = handle(&mut r, 0, Woke::Event, &[tick(k, SubsystemSet::ALL)]);
+            let Message::Estimate(mut e) = declared_estimate(&mut nav, &out) else {
+                unreachable!()
+            };
+            spoil(&mut e);
+            let mut out = handle(&mut r, 1, Woke::Event, &[Message::Estimate(e)]);
+            if why == "not current" {
+                assert!(out.send.is_empty(), "the tick's estimate is still awaited");
+                out = handle(&mut r, DEADLINE_NS, Woke::Timeout, &[]);
+            }
+            assert!(
+                out.log.iter().any(
+                    |l| l.contains(&format!("FAULT tick {k}: navigation estimate"))
+                        && l.contains(why)
+                ),
+                "{why}: {:?}",
+                out.log
+            );
+            let Some(Message::State(known)) =
+                out.send.iter().find(|m| matches!(m, Message::State(_)))
+            else {
+                panic!("{why}: no state in {:?}", out.send)
+            };
+            assert!(
+                known.r_r.iter().all(|x| x.is_finite()),
+                "{why}: the substitute's"
+            );
+            let Some(Message::NavigationError(err)) = out
+                .send
+                .iter()
+                .find(|m| matches!(m, Message::NavigationError(_)))
+            else {
+                panic!("{why}: no errors")
+            };
+            assert!(
+                err.relative_position_m <= 0.02,
+                "{why}: within the declared bound"
+            );
+            let res = result(&handle(&mut r, 2, Woke::Event, &safe(k)));
+            assert_eq!(res.fault_flags, fault::NAVIGATION_REJECTED, "{why}");
+        }
+        // no estimate of the tick by the deadline: absent, the next tick is not waited for
+        let out = handle(
+            &mut r,
+            2 * DEADLINE_NS,
+            Woke::Event,
+            &[tick(4, SubsystemSet::ALL)],
+        );
+        assert!(
+            out.send.iter().any(|m| matches!(m, Message::State(_))),
+            "absent: no wait"
+        );
+        let mut fin = Outbox::default();
+        r.finish(Finish::Done, &[], &mut fin);
+        assert!(
+            fin.log[0].contains("navigation estimates missing or rejected 5"),
+            "{:?}",
+            fin.log
+        );
+        // a missing estimate is logged once, at the deadline
+        let (mut r, _) = realistic_role();
+        handle(&mut r, 10, Woke::Event, &[tick(0, SubsystemSet::ALL)]);
+        let out = handle(&mut r, 10 + DEADLINE_NS, Woke::Timeout, &[]);
+        assert!(
+            out.log.iter().any(|l| l
+                .contains("FAULT tick 0: navigation estimate missing at the navigation deadline")),
+            "{:?}",
+            out.log
+        );
+        let res = result(&handle(&mut r, 11 + DEADLINE_NS, Woke::Event, &safe(0)));
+        assert_eq!(res.fault_flags, fault::NAVIGATION_REJECTED);
     }
 
     /// With a declared uncertainty the truth (with the monitor's barriers) and the
@@ -633,10 +887,16 @@ mod tests {
     /// the monitor on the truth.
     #[test]
     fn a_realisation_publishes_the_truth_apart_from_the_estimate() {
-        let mut r = realistic_role();
+        let (mut r, real) = realistic_role();
         let out = handle(&mut r, 100, Woke::Event, &[tick(0, SubsystemSet::ALL)]);
+        let [Message::Truth(truth), Message::Measurement(_)] = out.send[..] else {
+            panic!("the truth, then the measurement: {:?}", out.send);
+        };
+        let mut navigation = real.navigation.clone();
+        let estimate = declared_estimate(&mut navigation, &out);
+        let out = handle(&mut r, 100, Woke::Event, &[estimate]);
+        assert!(out.log.is_empty(), "admitted: {:?}", out.log);
         let [
-            Message::Truth(truth),
             Message::NavigationError(nav),
             Message::State(known),
             Message::PartnerState(partner),
@@ -653,7 +913,7 @@ mod tests {
         assert!(nav.relative_position_m > 0.0 && nav.relative_position_m <= 0.02);
         let p = r.pending.as_ref().unwrap();
         assert_eq!(p.barriers, truth.barriers, "the monitor on the truth");
-        assert_eq!(convert::sim_state(&p.known).r_r, known.r_r);
+        assert_eq!(convert::sim_state(&p.known.unwrap()).r_r, known.r_r);
         assert_ne!(known.barriers, truth.barriers, "barriers on knowledge");
         // no safe command by the deadline: the backups, on what the filters knew
         let out = handle(&mut r, 100 + DEADLINE_NS, Woke::Timeout, &[]);
@@ -672,6 +932,18 @@ mod tests {
     fn a_tick_publishes_the_state_then_applies_the_safe_commands() {
         let mut r = role();
         let out = handle(&mut r, 100, Woke::Event, &[tick(0, SubsystemSet::ALL)]);
+        assert!(
+            matches!(out.send[..], [Message::Measurement(_)]),
+            "the measurement, then the estimate is awaited"
+        );
+        assert_eq!(
+            r.next(100),
+            Next::Wait {
+                set: NAVIGATION,
+                until_ns: Some(100 + DEADLINE_NS)
+            }
+        );
+        let out = handle(&mut r, 100, Woke::Event, &[estimate_of(&out)]);
         assert!(
             matches!(out.send[..], [Message::State(_), Message::PartnerState(_)]),
             "flight side first"
@@ -696,7 +968,7 @@ mod tests {
     #[test]
     fn at_the_deadline_the_missing_commands_are_the_filters_backups() {
         let mut r = role();
-        handle(&mut r, 0, Woke::Event, &[tick(0, SubsystemSet::ALL)]);
+        start(&mut r, 0, 0, SubsystemSet::ALL);
         // a command for another tick is not this tick's
         let late = Message::SafeTranslational(SafeTranslational {
             tick: 7,
@@ -724,7 +996,7 @@ mod tests {
     #[test]
     fn a_command_beyond_its_bounds_is_refused_and_counted() {
         let mut r = role();
-        handle(&mut r, 0, Woke::Event, &[tick(0, SubsystemSet::ALL)]);
+        start(&mut r, 0, 0, SubsystemSet::ALL);
         let mut cmds = safe(0);
         if let Message::SafeRobotic(m) = &mut cmds[0] {
             m.u[6] = f64::NAN;
@@ -745,7 +1017,7 @@ mod tests {
     fn a_slower_group_holds_its_command() {
         let mut r = role();
         let only_robotic = SubsystemSet::only(Subsystem::Robotic);
-        handle(&mut r, 0, Woke::Event, &[tick(0, only_robotic)]);
+        start(&mut r, 0, 0, only_robotic);
         let Next::Wait { set, .. } = r.next(0) else {
             panic!()
         };
@@ -770,6 +1042,7 @@ mod tests {
         assert_eq!(
             out.notify,
             vec![
+                services::MEASUREMENT,
                 services::PARTNER_STATE,
                 services::SIM_STATE,
                 services::STEP_RESULT

@@ -131,7 +131,8 @@ impl RecordSink for FileSink {
             Message::SafeAttitude(x) => mcap.write(topic, log_ns, x.publish_ns, x),
             Message::SafeRobotic(x) => mcap.write(topic, log_ns, x.publish_ns, x),
             Message::StepResult(x) => mcap.write(topic, log_ns, x.publish_ns, x),
-            Message::Health(_) => Ok(()),
+            // not recorded: their effect is the state (SIM_STATE) and its errors
+            Message::Health(_) | Message::Measurement(_) | Message::Estimate(_) => Ok(()),
         }
         .map_err(mcap_err)
     }

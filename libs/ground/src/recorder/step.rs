@@ -7,7 +7,7 @@ use sc_core::Subsystem;
 use sc_flight::convert::{self, SafeMsg};
 use sc_icd::{
     NominalAttitude, NominalRobotic, NominalTranslational, SafeAttitude, SafeRobotic,
-    SafeTranslational, SimState, StepResult,
+    SafeTranslational, SimState, StepResult, fault,
 };
 use sc_mission::StepRecord;
 
@@ -144,6 +144,7 @@ pub fn record(
         obs: convert::observation(truth),
         navigation_error: set.navigation.as_ref().map(convert::navigation_error_of),
         knowledge_barriers: set.truth.map(|_| state.barriers),
+        navigation_rejected: r.fault_flags & fault::NAVIGATION_REJECTED != 0,
         // what the filter got: NaN where it ran on the substitute nominal (as in
         // process), never a message of another tick or one marked invalid
         f_h_nom: nominal_seen(held.nt.map(|m| convert::vec3(&m.f_h)), tr.report.faults),
