@@ -208,6 +208,8 @@ pub const ROLES: [Role; 10] = [
         subscribes: &[
             TICK,
             TRUTH,
+            MEASUREMENT,
+            ESTIMATE,
             NAVIGATION_ERROR,
             SIM_STATE,
             NOMINAL_TRANSLATIONAL,

@@ -167,6 +167,7 @@ mod tests {
             sc_icd::SafeRobotic::json_schema(),
             sc_icd::StepResult::json_schema(),
             sc_icd::NavigationError::json_schema(),
+            sc_icd::NavState::json_schema(),
             FrameTransform::json_schema(),
             SceneUpdate::json_schema(),
         ]

@@ -296,6 +296,7 @@ fn tick_of(m: &Message) -> Option<u64> {
     Some(match m {
         Message::State(x) | Message::Truth(x) => x.tick,
         Message::NavigationError(x) => x.tick,
+        Message::Measurement(x) | Message::Estimate(x) => x.tick,
         Message::NominalTranslational(x) => x.tick,
         Message::NominalAttitude(x) => x.tick,
         Message::NominalRobotic(x) => x.tick,
@@ -345,6 +346,8 @@ impl<S: RecordSink> Component for RecorderRole<S> {
         &[
             services::STEP_RESULT,
             services::TRUTH,
+            services::MEASUREMENT,
+            services::ESTIMATE,
             services::NAVIGATION_ERROR,
             services::SIM_STATE,
             services::NOMINAL_TRANSLATIONAL,

@@ -124,6 +124,10 @@ impl RecordSink for FileSink {
                 .write(topic, log_ns, x.publish_ns, x)
                 .and_then(|_| mcap.write_3d(log_ns, x.publish_ns, x)),
             Message::NavigationError(x) => mcap.write(topic, log_ns, 0, x),
+            // what the navigation got and answered (the offline harness replays them)
+            Message::Measurement(x) | Message::Estimate(x) => {
+                mcap.write(topic, log_ns, x.publish_ns, x)
+            }
             Message::NominalTranslational(x) => mcap.write(topic, log_ns, x.publish_ns, x),
             Message::NominalAttitude(x) => mcap.write(topic, log_ns, x.publish_ns, x),
             Message::NominalRobotic(x) => mcap.write(topic, log_ns, x.publish_ns, x),
@@ -131,8 +135,8 @@ impl RecordSink for FileSink {
             Message::SafeAttitude(x) => mcap.write(topic, log_ns, x.publish_ns, x),
             Message::SafeRobotic(x) => mcap.write(topic, log_ns, x.publish_ns, x),
             Message::StepResult(x) => mcap.write(topic, log_ns, x.publish_ns, x),
-            // not recorded: their effect is the state (SIM_STATE) and its errors
-            Message::Health(_) | Message::Measurement(_) | Message::Estimate(_) => Ok(()),
+            // not recorded: the recorder's own progress
+            Message::Health(_) => Ok(()),
         }
         .map_err(mcap_err)
     }
