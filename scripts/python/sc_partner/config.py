@@ -41,15 +41,20 @@ def phase_index(scenario, t):
     return idx
 
 
+def base_period(partition):
+    """The partition's base period (the fastest rate group's, one tick) in s."""
+    groups = partition.get("rate_groups") or []
+    if not groups:
+        raise ValueError("the partition config has no [[rate_groups]]")
+    return min(float(g["period_s"]) for g in groups)
+
+
 def group_periods(partition, subsystem):
     """(period of `subsystem`'s rate group, base period = fastest group) in s."""
     if subsystem not in SUBSYSTEMS:
         raise ValueError(f"subsystem {subsystem!r}: one of {', '.join(SUBSYSTEMS)}")
-    groups = partition.get("rate_groups") or []
-    if not groups:
-        raise ValueError("the partition config has no [[rate_groups]]")
-    base = min(float(g["period_s"]) for g in groups)
-    for g in groups:
+    base = base_period(partition)
+    for g in partition["rate_groups"]:
         if subsystem in g["members"]:
             return float(g["period_s"]), base
     raise ValueError(f"no rate group has the member {subsystem!r}")

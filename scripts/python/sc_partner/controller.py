@@ -31,7 +31,6 @@ import argparse
 import ctypes
 import os
 import sys
-import time
 import traceback
 
 import numpy as np
@@ -68,8 +67,6 @@ _SUBSYSTEM = {
 }
 
 HANDSHAKE_TIMEOUT_S = 60.0
-# the longest sleep between two looks at the stop (only matters if the simulator died)
-WAIT_MS = 100
 
 
 class State:
@@ -181,9 +178,7 @@ def run_partition(controller, argv=None):
     """Runs `controller` as the partition's nominal controller of its subsystem until
     the stop. Returns the process exit code (0 stopped normally, 1 handshake timeout,
     2 usage)."""
-    import iceoryx2 as iox2
-
-    from . import bus
+    from . import bus, process
 
     label = controller.label
     parser = argparse.ArgumentParser(prog=label, description=f"nominal {controller.subsystem} controller")
@@ -202,65 +197,18 @@ def run_partition(controller, argv=None):
     period_s, _ = sc_config.group_periods(partition, controller.subsystem)
     controller.setup(scenario, period_s)
 
-    iox2.set_log_level_from_env_or(iox2.LogLevel.Warn)
-    node = (
-        iox2.NodeBuilder.new()
-        .name(iox2.NodeName.new(f"nominal_{controller.subsystem}"))
-        .config(bus.run_config(run_id))
-        .create(iox2.ServiceType.Ipc)
+    def answer(raw, recv_ns):
+        if not raw.due_mask & due_bit:
+            return None, None
+        return controller.message(State(raw, sc_config.phase_index(scenario, raw.t)), recv_ns)
+
+    return process.serve(
+        label,
+        f"nominal_{controller.subsystem}",
+        role,
+        run_id,
+        process.Port(icd.SERVICE_PARTNER_STATE, icd.SimState, bus.NOMINAL, "states"),
+        process.Port(service, msg_cls, bus.NOMINAL, "command"),
+        answer,
+        args.handshake_timeout_s,
     )
-    state_svc = bus.open_pubsub(node, icd.SERVICE_PARTNER_STATE, icd.SimState, bus.NOMINAL)
-    state_ev = bus.data_event(node, icd.SERVICE_PARTNER_STATE, bus.NOMINAL)
-    control_svc = bus.open_pubsub(node, icd.SERVICE_CONTROL, icd.Tick, bus.PARTITION)
-    cmd_svc = bus.open_pubsub(node, service, msg_cls, bus.NOMINAL)
-    cmd_ev = bus.data_event(node, service, bus.NOMINAL)
-    state_sub = state_svc.subscriber_builder().create()
-    state_listener = state_ev.listener_builder().create()
-    # the stop comes on the control service; no listener: it is read at every
-    # wake-up (the simulator notifies the state service once more when it stops)
-    control_sub = control_svc.subscriber_builder().create()
-    publisher = cmd_svc.publisher_builder().create()
-    notifier = cmd_ev.notifier_builder().default_event_id(iox2.EventId.new(icd.EVENT_SAMPLE)).create()
-    ports = [state_sub, state_listener, control_sub, publisher, notifier]
-    handled = invalid = 0
-    try:
-        if not bus.handshake(node, role, args.handshake_timeout_s):
-            print(f"{label}: handshake timed out", file=sys.stderr)
-            return 1
-        while True:
-            state_listener.timed_wait(iox2.Duration.from_millis(WAIT_MS))
-            while True:
-                sample = state_sub.receive()
-                if sample is None:
-                    break
-                raw = icd.SimState.from_buffer_copy(sample.payload().contents)
-                sample.delete()
-                if not raw.due_mask & due_bit:
-                    continue
-                recv_ns = time.monotonic_ns()
-                state = State(raw, sc_config.phase_index(scenario, raw.t))
-                msg, reason = controller.message(state, recv_ns)
-                if reason is not None:
-                    invalid += 1
-                    if invalid == 1:
-                        print(f"{label}: tick {raw.tick}: no valid command: {reason}", file=sys.stderr, flush=True)
-                msg.publish_ns = time.monotonic_ns()
-                publisher.loan_uninit().write_payload(msg).send()
-                notifier.notify()
-                handled += 1
-            stop = False
-            while True:
-                sample = control_sub.receive()
-                if sample is None:
-                    break
-                stop |= sample.payload().contents.command == icd.TICK_STOP
-                sample.delete()
-            if stop:
-                notifier.notify()  # wake the safety filter once so that it sees the stop too
-                print(f"{label}: handled {handled} states ({invalid} without a valid command)", file=sys.stderr)
-                return 0
-    finally:
-        for p in ports:
-            p.delete()
-        del state_svc, state_ev, control_svc, cmd_svc, cmd_ev
-        del node

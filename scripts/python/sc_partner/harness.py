@@ -14,6 +14,14 @@ without iceoryx2 processes::
     python -m sc_partner.harness my_pkg.my_module:MyController \\
         --mcap out/partition/recording.mcap --config config/partition.toml
 
+A navigation (:class:`sc_partner.Navigation`) runs on the measurements a partition run
+recorded (``recording.mcap``, channel ``safe_capture/sim/measurement``), one estimate
+per measurement, compared with the estimates the run's navigation answered (channel
+``safe_capture/navigation/estimate``)::
+
+    python -m sc_partner.harness sc_partner.examples.navigation \\
+        --mcap out/partition/recording.mcap --config config/partition.toml --out estimates.csv
+
 or from Python::
 
     states = states_from_telemetry("out/run/telemetry.csv")
@@ -55,6 +63,7 @@ from . import config as sc_config
 from . import icd
 from . import mcap
 from .controller import NominalController, State
+from .navigation import Navigation
 
 #: One command of an offline run: the state's tick, time and phase, whether the
 #: command is valid (1/0), its values and, if invalid, why.
@@ -219,6 +228,96 @@ def states_from_mcap(path, scenario):
     return states
 
 
+def _nav_state(path, service, m):
+    """The ``NavState`` of the JSON message `m` of channel `service` in `path`."""
+    raw = icd.NavState()
+    for name, _ in icd.NavState._fields_:
+        if name not in m:
+            raise ValueError(f"{path}: a {service} message without `{name}`")
+        value = m[name]
+        if isinstance(value, list):
+            getattr(raw, name)[:] = [_json_number(x) for x in value]
+        elif isinstance(getattr(raw, name), float):
+            setattr(raw, name, _json_number(value))
+        else:
+            setattr(raw, name, int(value))
+    return raw
+
+
+def nav_states_from_mcap(path, service=icd.SERVICE_MEASUREMENT):
+    """The ``NavState`` messages of channel `service` in a partition run's
+    ``recording.mcap``: the measurements the navigation got (default) or, with
+    ``icd.SERVICE_ESTIMATE``, the estimates it answered."""
+    return [_nav_state(path, service, m) for _, _, m in mcap.messages(path, {service})]
+
+
+#: One estimate of an offline run: the measurement's tick, time and measurement time,
+#: whether there is an estimate (1/0), the estimate (a ``NavState``, or None) and, if
+#: there is none, why.
+OfflineEstimate = namedtuple("OfflineEstimate", "tick t measured_t valid estimate reason")
+
+
+def run_offline_navigation(navigation, measurements, scenario, period_s):
+    """Runs `navigation` on `measurements` (``NavState``) as the partition would:
+    ``setup(scenario, period_s)`` once, then one estimate per measurement."""
+    navigation.setup(scenario, period_s)
+    out = []
+    for m in measurements:
+        estimate, reason = navigation.message(m)
+        out.append(OfflineEstimate(m.tick, m.t, m.measured_t, int(estimate is not None), estimate, reason))
+    return out
+
+
+def nav_columns():
+    """The columns of a ``NavState`` in an estimates CSV (``r_i_0``, ``q_ib_3``, ...)."""
+    cols = []
+    for name, ctype in icd.NavState._fields_:
+        if name in ("tick", "t", "measured_t", "publish_ns"):
+            continue
+        n = getattr(ctype, "_length_", 0)
+        cols += [f"{name}_{i}" for i in range(n)] if n else [name]
+    return cols
+
+
+def _nav_values(raw):
+    """The values of `raw` in :func:`nav_columns`' order."""
+    values = []
+    for name, ctype in icd.NavState._fields_:
+        if name in ("tick", "t", "measured_t", "publish_ns"):
+            continue
+        v = getattr(raw, name)
+        values += list(v) if getattr(ctype, "_length_", 0) else [v]
+    return values
+
+
+def write_estimates(path, estimates):
+    """Writes `estimates` as CSV: step, t_s, measured_t_s, valid and the estimate's
+    fields (empty where there is no estimate)."""
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        cols = nav_columns()
+        w.writerow(["step", "t_s", "measured_t_s", "valid"] + cols)
+        for e in estimates:
+            values = [repr(float(x)) for x in _nav_values(e.estimate)] if e.estimate is not None else [""] * len(cols)
+            w.writerow([e.tick, repr(e.t), repr(e.measured_t), e.valid] + values)
+
+
+def largest_estimate_difference(estimates, recorded):
+    """(difference, tick, column) of the largest absolute difference between
+    `estimates` and the `recorded` ones ({tick: NavState}) over the ticks both have,
+    or (nan, None, None)."""
+    best = (math.nan, None, None)
+    cols = nav_columns()
+    for e in estimates:
+        if e.estimate is None or e.tick not in recorded:
+            continue
+        for col, a, b in zip(cols, _nav_values(e.estimate), _nav_values(recorded[e.tick])):
+            d = abs(a - b)
+            if not math.isnan(d) and not (d <= best[0]):
+                best = (d, e.tick, col)
+    return best
+
+
 def run_offline(controller, states, scenario, period_s):
     """Runs `controller` on `states` as the partition would: ``setup(scenario,
     period_s)`` once, then one command per state whose tick the subsystem is due in.
@@ -268,9 +367,9 @@ _SERVICE_FIELD = {
 
 
 def load_controller(spec):
-    """The controller class named by `spec`: ``package.module:Class`` or
+    """The controller or navigation class named by `spec`: ``package.module:Class`` or
     ``path/to/file.py:Class``; without ``:Class`` the module's one subclass of
-    :class:`NominalController`."""
+    :class:`NominalController` or :class:`Navigation`."""
     target, _, cls_name = spec.partition(":")
     if target.endswith(".py") or os.sep in target:
         name = os.path.splitext(os.path.basename(target))[0]
@@ -286,12 +385,16 @@ def load_controller(spec):
     found = [
         c
         for c in vars(module).values()
-        if inspect.isclass(c) and issubclass(c, NominalController) and c is not NominalController
+        if inspect.isclass(c)
+        and issubclass(c, (NominalController, Navigation))
+        and c not in (NominalController, Navigation)
         and c.__module__ == module.__name__
     ]
     if len(found) != 1:
         names = ", ".join(c.__name__ for c in found) or "none"
-        raise ValueError(f"{spec}: name the class (module:Class); NominalController subclasses found: {names}")
+        raise ValueError(
+            f"{spec}: name the class (module:Class); NominalController and Navigation subclasses found: {names}"
+        )
     return found[0]
 
 
@@ -299,7 +402,8 @@ def main(argv=None):
     """Command line: see the module's documentation (``--help``)."""
     p = argparse.ArgumentParser(
         prog="python -m sc_partner.harness",
-        description="Run a nominal controller offline on the states of a recorded telemetry.csv or recording.mcap.",
+        description="Run a nominal controller offline on the states of a recorded telemetry.csv or recording.mcap,"
+        " or a navigation on the measurements of a recording.mcap.",
     )
     p.add_argument("controller", help="package.module:Class or path/to/file.py:Class")
     rec = p.add_mutually_exclusive_group(required=True)
@@ -313,6 +417,8 @@ def main(argv=None):
     args = p.parse_args(argv)
 
     controller = load_controller(args.controller)()
+    if isinstance(controller, Navigation):
+        return _main_navigation(p, args, controller)
     if args.config:
         partition = sc_config.read_toml(args.config)
         scenario = sc_config.read_toml(sc_config.scenario_path(args.config, partition))
@@ -340,6 +446,35 @@ def main(argv=None):
     )
     for c in invalid[:1]:
         print(f"harness: first invalid, tick {c.tick}: {c.reason}", file=sys.stderr)
+    return 1 if args.strict and invalid else 0
+
+
+def _main_navigation(parser, args, navigation):
+    """`main` for a navigation: its estimates of a partition run's recorded measurements."""
+    if not args.mcap:
+        parser.error("a navigation runs on the measurements of a partition run: give its --mcap recording.mcap")
+    if args.config:
+        scenario = sc_config.read_toml(sc_config.scenario_path(args.config))
+        period_s = sc_config.base_period(sc_config.read_toml(args.config))
+    else:
+        scenario = sc_config.read_toml(args.scenario)
+        period_s = float(scenario["mission"]["control_period_s"])
+    measurements = nav_states_from_mcap(args.mcap)
+    estimates = run_offline_navigation(navigation, measurements, scenario, period_s)
+    if args.out:
+        write_estimates(args.out, estimates)
+    recorded = {e.tick: e for e in nav_states_from_mcap(args.mcap, icd.SERVICE_ESTIMATE)}
+    diff, tick, col = largest_estimate_difference(estimates, recorded)
+    where = f" (tick {tick}, {col}; units of the ICD's NavState)" if diff > 0 else ""
+    invalid = [e for e in estimates if not e.valid]
+    print(
+        f"harness: {type(navigation).__name__} (navigation) on {len(measurements)} measurements: "
+        f"{len(estimates) - len(invalid)} estimates, {len(invalid)} without one"
+        + (f" -> {args.out}" if args.out else "")
+        + f"; largest difference to the recorded estimate: {diff:.6g}{where}"
+    )
+    for e in invalid[:1]:
+        print(f"harness: first without an estimate, tick {e.tick}: {e.reason}", file=sys.stderr)
     return 1 if args.strict and invalid else 0
 
 

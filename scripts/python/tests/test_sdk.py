@@ -10,7 +10,7 @@ import unittest
 
 import numpy as np
 
-from sc_partner import NominalController, State, icd
+from sc_partner import Measurement, Navigation, NominalController, State, icd
 from sc_partner import mcap
 from sc_partner.config import group_periods, phase_index
 from sc_partner.harness import quaternion_from_matrix, rotation_between
@@ -39,6 +39,51 @@ class Rotations(unittest.TestCase):
         a, b = rng.normal(size=3) * 10.0, rng.normal(size=3) * 10.0
         est = rotation_between(a, b, r @ a, r @ b)
         self.assertLess(np.max(np.abs(est - r)), 1e-13)
+
+
+class Navigations(unittest.TestCase):
+    class Nav(Navigation):
+        def __init__(self, behaviour):
+            self.behaviour = behaviour
+
+        def estimate(self, m):
+            if self.behaviour == "raise":
+                raise ValueError("deliberate")
+            if self.behaviour == "none":
+                return None
+            if self.behaviour == "list":
+                return [1.0, 2.0]
+            e = m.estimate()
+            e.r_i[0] += 0.5
+            e.tick = m.tick + 1
+            return e
+
+    def measurement(self):
+        raw = icd.NavState(tick=7, t=0.7, measured_t=0.6)
+        raw.r_i[:] = [1.0, 2.0, 3.0]
+        raw.q_ib[:] = [1.0, 0.0, 0.0, 0.0]
+        return raw
+
+    def test_a_measurement_is_read_only_and_its_estimate_a_writable_copy(self):
+        raw = self.measurement()
+        m = Measurement(raw)
+        with self.assertRaises(ValueError):
+            m.r_i[0] = 5.0
+        msg, reason = self.Nav("edit").message(raw)
+        self.assertIsNone(reason)
+        self.assertEqual((msg.tick, msg.t, msg.measured_t), (8, 0.7, 0.6))
+        self.assertEqual(list(msg.r_i), [1.5, 2.0, 3.0])
+        self.assertEqual(list(raw.r_i), [1.0, 2.0, 3.0], "the measurement itself is unchanged")
+
+    def test_no_estimate_publishes_nothing_and_says_why(self):
+        for behaviour, why in [
+            ("raise", "ValueError: deliberate"),
+            ("none", "no estimate"),
+            ("list", "not an Estimate"),
+        ]:
+            msg, reason = self.Nav(behaviour).message(self.measurement())
+            self.assertIsNone(msg, behaviour)
+            self.assertIn(why, reason)
 
 
 class Controllers(unittest.TestCase):

@@ -1,1 +1,1 @@
-"""Worked examples of partner controllers on :class:`sc_partner.NominalController`."""
+"""Worked examples: a nominal controller (:class:`sc_partner.NominalController`) and a navigation (:class:`sc_partner.Navigation`)."""
