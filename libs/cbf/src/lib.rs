@@ -25,6 +25,7 @@
 //! calls before it. A filter never panics, never outputs a non-finite command and never
 //! one outside its input bounds.
 
+pub mod arm_model_error;
 pub mod attitude;
 pub mod barrier;
 pub mod chain;

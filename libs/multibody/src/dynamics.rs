@@ -97,6 +97,20 @@ impl Robot {
     /// `(θ, ν)` (no gravity, base frame for the base part). With `nu_dot = 0` this is
     /// Pinocchio's `nonLinearEffects`.
     pub fn rnea(&self, theta: &Vector7, nu: &Vector13, nu_dot: &Vector13) -> Vector13 {
+        self.rnea_with(&self.inertias, theta, nu, nu_dot)
+    }
+
+    /// [`Self::rnea`] with the bodies' inertias `inertias` (base first) in place of the
+    /// model's: linear in them, so with one body's inertia a direction of its mass
+    /// properties and every other zero it is that direction's column of the inverse
+    /// dynamics' regressor (the robotic filter's bound on a model error).
+    pub fn rnea_with(
+        &self,
+        inertias: &[Inertia; NJ + 1],
+        theta: &Vector7,
+        nu: &Vector13,
+        nu_dot: &Vector13,
+    ) -> Vector13 {
         let x = self.placements(theta);
         let mut v = [Motion::ZERO; NJ + 1];
         let mut f = [Force::ZERO; NJ + 1];
@@ -105,13 +119,13 @@ impl Robot {
             nu_dot.fixed_rows::<3>(0).into(),
             nu_dot.fixed_rows::<3>(3).into(),
         );
-        let iv = self.inertias[0].mul_motion(&v[0]);
-        f[0] = self.inertias[0].mul_motion(&a) + v[0].cross_force(&iv);
+        let iv = inertias[0].mul_motion(&v[0]);
+        f[0] = inertias[0].mul_motion(&a) + v[0].cross_force(&iv);
         for i in 0..NJ {
             let s_qd = self.joint_motion(i, nu[NB + i]);
             let vi = x[i].inv_act_motion(&v[i]) + s_qd;
             a = x[i].inv_act_motion(&a) + self.joint_motion(i, nu_dot[NB + i]) + vi.cross(&s_qd);
-            let inertia = &self.inertias[i + 1];
+            let inertia = &inertias[i + 1];
             let iv = inertia.mul_motion(&vi);
             f[i + 1] = inertia.mul_motion(&a) + vi.cross_force(&iv);
             v[i + 1] = vi;
@@ -136,8 +150,14 @@ impl Robot {
     /// Composite-rigid-body algorithm: the 13×13 free-flyer mass matrix `M(θ)` (symmetric,
     /// both triangles filled). Rows/columns ordered like `ν`.
     pub fn mass_matrix(&self, theta: &Vector7) -> Matrix13 {
+        self.mass_matrix_with(&self.inertias, theta)
+    }
+
+    /// [`Self::mass_matrix`] with the bodies' inertias `inertias` (base first): linear in
+    /// them, as [`Self::rnea_with`].
+    pub fn mass_matrix_with(&self, inertias: &[Inertia; NJ + 1], theta: &Vector7) -> Matrix13 {
         let x = self.placements(theta);
-        let mut ic: [Inertia; NJ + 1] = self.inertias;
+        let mut ic: [Inertia; NJ + 1] = *inertias;
         for i in (0..NJ).rev() {
             let t = ic[i + 1].transformed(&x[i]);
             ic[i] = ic[i].add(&t);
