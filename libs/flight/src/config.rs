@@ -58,8 +58,9 @@ pub struct RoleExec {
     pub cpus: Vec<usize>,
 }
 
-/// Per-stage deadlines in real-time mode, measured from the simulator's publication
-/// of the tick's state [ms].
+/// Per-stage deadlines in real-time mode [ms]: the navigation's and the simulator's from
+/// the tick (the measurement's publication), the filters' from the simulator's
+/// publication of the tick's state (after the estimate's admission).
 #[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Deadlines {
@@ -182,8 +183,9 @@ impl Schedule {
 }
 
 /// The navigation deadline of a config that names none [ms]: an estimator answers
-/// within a few hundred µs here (docs/PARTITION.md); 10 ms leaves the filters 30 of the
-/// translational stage's 40.
+/// within a few hundred µs here (docs/PARTITION.md). It counts from the tick (the
+/// measurement is published then); the filters' deadlines count from the state, which
+/// follows the estimate's admission, and the simulator's from the tick.
 pub const DEFAULT_NAVIGATION_MS: f64 = 10.0;
 
 fn default_navigation_ms() -> f64 {

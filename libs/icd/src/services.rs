@@ -28,13 +28,14 @@ icd_services! {
         TICK = "safe_capture/scheduler/tick", Tick, Flight;
         /// Tick commands to every other process; today only the stop, sent with the stop
         /// tick (read at every wake-up, no listener). Kept apart from `TICK` so that a
-        /// tick is delivered to the two processes that need it, not to all eight: each
+        /// tick is delivered to the two processes that need it, not to all nine: each
         /// subscriber costs the scheduler's send, on the critical path.
         CONTROL = "safe_capture/scheduler/control", Tick, Flight;
         /// What the sensors measured at the start of each step, for the navigation (the
         /// process partners replace): the true state `uncertainty.navigation.measurement_age_s`
         /// old, on a newest-wins service (a navigation that stops reading can never make
-        /// the simulator wait). Published before anything else of the tick.
+        /// the simulator wait). Published when the tick starts (after the truth, with a
+        /// declared uncertainty).
         MEASUREMENT = "safe_capture/sim/measurement", NavState, Partner;
         /// The navigation's estimate of the tick's state; the simulator wakes on it,
         /// admits it (or substitutes its own navigation, flagged) and publishes the

@@ -132,7 +132,8 @@ impl Mission {
             .is_some()
             .then(|| Monitor::from_scenario(&setup.scenario, setup.robot.clone()));
         let navigation = default_navigation(realisation.as_ref());
-        let substitute = substitute_navigation(realisation.as_ref());
+        let declared_navigation = setup.scenario.uncertainty_bounds().navigation;
+        let substitute = substitute_navigation(realisation.as_ref(), &declared_navigation);
         let gate = NavigationGate::new(&setup.scenario, setup.robot.clone(), substitute)
             .map_err(|e| SetupError::Other(e.to_string()))?;
         Ok(Self {

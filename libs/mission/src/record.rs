@@ -164,13 +164,16 @@ pub fn timing_columns() -> Vec<String> {
     .collect()
 }
 
-/// Columns of `navigation.csv` (written when the scenario declares an uncertainty):
-/// the realised navigation errors of each control step (`nav_err_*`, each against the
-/// truth at the measurement's time, docs/UNCERTAINTY.md) and every barrier on knowledge
-/// (`hk_*`: the estimate with the declared model — what the filters saw; `h_*` in
-/// `telemetry.csv` is the truth's).
+/// Columns of `navigation.csv` (written when the scenario declares an uncertainty, or a
+/// navigation's estimate was refused): whether the step's estimate was refused and the
+/// simulator's own navigation substituted (`navigation_rejected`, 0/1), the realised
+/// navigation errors of each control step (`nav_err_*`, each against the truth at the
+/// measurement's time, docs/UNCERTAINTY.md) and every barrier on knowledge (`hk_*`: the
+/// estimate with the declared model — what the filters saw; `h_*` in `telemetry.csv` is
+/// the truth's). Without a declared uncertainty the errors and barriers on knowledge are
+/// empty (knowledge is the truth).
 pub fn knowledge_columns() -> Vec<String> {
-    let mut c: Vec<String> = vec!["step".into(), "t_s".into()];
+    let mut c: Vec<String> = vec!["step".into(), "t_s".into(), "navigation_rejected".into()];
     c.extend(
         sc_sim::uncertainty::NAVIGATION_ERROR_NAMES
             .iter()
@@ -180,26 +183,45 @@ pub fn knowledge_columns() -> Vec<String> {
     c
 }
 
-/// One record as a `navigation.csv` line, if it has knowledge apart from the truth.
-pub fn knowledge_line(r: &StepRecord) -> Option<String> {
-    let (e, h) = (r.navigation_error?, r.knowledge_barriers?);
-    let mut v: Vec<String> = vec![r.step.to_string(), r.t.to_string()];
-    v.extend(e.values().iter().chain(h.iter()).map(|x| x.to_string()));
-    Some(v.join(","))
+/// One record as a `navigation.csv` line.
+pub fn knowledge_line(r: &StepRecord) -> String {
+    let mut v: Vec<String> = vec![
+        r.step.to_string(),
+        r.t.to_string(),
+        u8::from(r.navigation_rejected).to_string(),
+    ];
+    let n_err = sc_sim::uncertainty::NAVIGATION_ERROR_NAMES.len();
+    match r.navigation_error {
+        Some(e) => v.extend(e.values().iter().map(|x| x.to_string())),
+        None => v.extend(std::iter::repeat_n(String::new(), n_err)),
+    }
+    match r.knowledge_barriers {
+        Some(h) => v.extend(h.iter().map(|x| x.to_string())),
+        None => v.extend(std::iter::repeat_n(String::new(), sc_cbf::monitor::N_ALL)),
+    }
+    v.join(",")
+}
+
+/// Whether `records` have anything for `navigation.csv`: knowledge apart from the truth
+/// (a declared uncertainty) or a refused estimate.
+fn has_knowledge(records: &[StepRecord]) -> bool {
+    records
+        .iter()
+        .any(|r| r.navigation_error.is_some() || r.navigation_rejected)
 }
 
 /// Writes `navigation.csv` at `path` when the records have knowledge apart from the
-/// truth (a declared uncertainty); nothing otherwise. `safe-capture run` and the
-/// partition's recorder write it with this one function.
+/// truth (a declared uncertainty) or a refused estimate; nothing otherwise. `safe-capture
+/// run` and the partition's recorder write it with this one function.
 pub fn write_knowledge(path: &std::path::Path, records: &[StepRecord]) -> std::io::Result<()> {
     use std::io::Write;
-    if records.iter().all(|r| r.navigation_error.is_none()) {
+    if !has_knowledge(records) {
         return Ok(());
     }
     let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
     writeln!(f, "{}", knowledge_columns().join(","))?;
-    for line in records.iter().filter_map(knowledge_line) {
-        writeln!(f, "{line}")?;
+    for r in records {
+        writeln!(f, "{}", knowledge_line(r))?;
     }
     f.flush()
 }
@@ -224,16 +246,15 @@ pub fn read_knowledge(text: &str, records: &mut [StepRecord]) -> Result<(), Tele
             .get_mut(i)
             .filter(|r| r.step == step && same_bits(r.t, t))
             .ok_or(TelemetryError::KnowledgeStep { line: n, step })?;
-        let mut e = [0.0; 10];
-        for x in &mut e {
-            *x = c.parse("a number")?;
-        }
-        let mut h = [0.0; sc_cbf::monitor::N_ALL];
-        for x in &mut h {
-            *x = c.parse("a number")?;
-        }
-        r.navigation_error = Some(sc_sim::uncertainty::NavigationError::from_values(&e));
-        r.knowledge_barriers = Some(h);
+        r.navigation_rejected = match c.parse::<u8>("0 or 1")? {
+            0 => false,
+            1 => true,
+            v => return Err(c.invalid(&v.to_string(), "0 or 1")),
+        };
+        r.navigation_error = c
+            .optional::<10>("a number")?
+            .map(|e| sc_sim::uncertainty::NavigationError::from_values(&e));
+        r.knowledge_barriers = c.optional::<{ sc_cbf::monitor::N_ALL }>("a number")?;
         rows += 1;
     }
     if rows != records.len() {
@@ -452,6 +473,34 @@ impl<'a> Fields<'a> {
             fields,
             next: 0,
         })
+    }
+
+    /// The next `N` fields as numbers, or `None` when all of them are empty.
+    fn optional<const N: usize>(
+        &mut self,
+        what: &'static str,
+    ) -> Result<Option<[f64; N]>, TelemetryError> {
+        let at = self.next;
+        if self.fields[at..at + N].iter().all(|f| f.is_empty()) {
+            self.next += N;
+            return Ok(None);
+        }
+        let mut v = [0.0; N];
+        for x in &mut v {
+            *x = self.parse(what)?;
+        }
+        Ok(Some(v))
+    }
+
+    /// The error for the value `v` of the last field read, which is not `what`.
+    fn invalid(&self, v: &str, what: &'static str) -> TelemetryError {
+        TelemetryError::Field {
+            file: self.file,
+            line: self.line,
+            column: self.names[self.next - 1].clone(),
+            value: v.to_string(),
+            what,
+        }
     }
 
     fn raw(&mut self) -> (&'a str, &'a str) {

@@ -348,3 +348,74 @@ fn knowledge_round_trips_bit_for_bit() {
     let err = sc_mission::record::read_knowledge(&short, &mut back).unwrap_err();
     assert!(err.to_string().contains("rows for the"), "{err}");
 }
+
+/// A refused navigation estimate survives the files: with nothing declared, a run whose
+/// navigation is refused on some steps writes navigation.csv with the flags and without
+/// errors or barriers on knowledge (knowledge is the truth), and reading it back gives the
+/// same flags, no knowledge apart from the truth — and the same summary as the run, its
+/// `navigation` fault events included (a partition campaign rebuilds its runs this way).
+#[test]
+fn a_refused_estimate_round_trips_without_a_declared_uncertainty() {
+    struct Jump;
+    impl sc_sim::Estimator for Jump {
+        fn estimate(&mut self, m: &sc_sim::NavSample) -> sc_sim::NavSample {
+            let mut e = *m;
+            if e.tick % 3 == 1 {
+                e.state.dr[0] += 1.0;
+            }
+            e
+        }
+    }
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/scenario.toml");
+    let mut setup = Setup::load(&path).unwrap();
+    setup.scenario.mission.duration_s = 2.0;
+    let names: Vec<String> = setup
+        .scenario
+        .mission
+        .phases
+        .iter()
+        .map(|p| p.name.clone())
+        .collect();
+    let mut records = Vec::new();
+    let mut m = Mission::new(setup, RunOptions { no_filter: false }).unwrap();
+    m.set_navigation(Box::new(Jump));
+    let end = m.run(|_, r| records.push(*r));
+    let rejected: Vec<u64> = records
+        .iter()
+        .filter(|r| r.navigation_rejected)
+        .map(|r| r.step)
+        .collect();
+    assert!(
+        rejected.len() >= 5 && rejected.iter().all(|k| k % 3 == 1),
+        "{rejected:?}"
+    );
+    let dir = std::env::temp_dir().join(format!("sc-refused-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("navigation.csv");
+    sc_mission::record::write_knowledge(&file, &records).unwrap();
+    let text = std::fs::read_to_string(&file).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    let mut back: Vec<StepRecord> = records
+        .iter()
+        .map(|r| StepRecord {
+            navigation_rejected: false,
+            ..*r
+        })
+        .collect();
+    sc_mission::record::read_knowledge(&text, &mut back).unwrap();
+    for (a, b) in records.iter().zip(&back) {
+        assert_eq!(
+            a.navigation_rejected, b.navigation_rejected,
+            "step {}",
+            a.step
+        );
+        assert!(b.navigation_error.is_none() && b.knowledge_barriers.is_none());
+    }
+    let summary = |r: &[StepRecord]| {
+        serde_json::to_value(sc_mission::summarize(r, &end, &names, true)).unwrap()
+    };
+    let (a, b) = (summary(&records), summary(&back));
+    assert_eq!(a["faults"], b["faults"]);
+    assert_eq!(a["fault_count"], b["fault_count"]);
+    assert!(a["faults"].to_string().contains("NAVIGATION_REJECTED"));
+}

@@ -78,6 +78,15 @@ pub struct DeclaredNavigation {
     rng: ChaCha8Rng,
 }
 
+/// `v` scaled into the ball of `radius` (unchanged, bit for bit, when inside it).
+fn clamp3(v: &mut [f64; 3], radius: f64) {
+    let n = Vector3::from(*v).norm();
+    if n > radius {
+        let k = radius / n;
+        v.iter_mut().for_each(|x| *x *= k);
+    }
+}
+
 /// Adds a bias plus a truncated noise draw to a 3-vector.
 fn err3(rng: &mut ChaCha8Rng, bias: &[f64; 3], b: BiasNoise) -> Vector3<f64> {
     Vector3::from(*bias) + truncated(rng, b.noise)
@@ -98,10 +107,29 @@ impl DeclaredNavigation {
         }
     }
 
-    /// The same errors with noise of its own (the simulator's substitute).
-    pub fn substitute(&self) -> Self {
+    /// The simulator's substitute: the same errors with noise of its own, held to the
+    /// `declared` bounds (a truth drawn from wider ones, `[uncertainty.truth]`, must not
+    /// reach the filters through the substitute): every bias within the declared bias,
+    /// the noise truncated at the declared noise.
+    pub fn substitute(&self, declared: &NavigationBounds) -> Self {
         let mut s = self.clone();
         s.rng.set_stream(SUBSTITUTE_STREAM);
+        s.bounds = *declared;
+        let b = &mut s.bias;
+        let d = declared;
+        clamp3(&mut b.relative_position_m, d.relative_position_m.bias);
+        clamp3(&mut b.relative_velocity_m_s, d.relative_velocity_m_s.bias);
+        clamp3(&mut b.servicer_attitude_rad, d.servicer_attitude_rad.bias);
+        clamp3(&mut b.servicer_rate_rad_s, d.servicer_rate_rad_s.bias);
+        clamp3(&mut b.target_attitude_rad, d.target_attitude_rad.bias);
+        clamp3(&mut b.target_rate_rad_s, d.target_rate_rad_s.bias);
+        clamp3(&mut b.grasp_point_m, d.grasp_point_m.bias);
+        for x in b.joint_angle_rad.iter_mut() {
+            *x = x.clamp(-d.joint_angle_rad.bias, d.joint_angle_rad.bias);
+        }
+        for x in b.joint_rate_rad_s.iter_mut() {
+            *x = x.clamp(-d.joint_rate_rad_s.bias, d.joint_rate_rad_s.bias);
+        }
         s
     }
 }
@@ -175,8 +203,10 @@ pub struct Knowledge {
 
 /// The simulator's side of navigation: the sensors, the gate, the declared model.
 pub struct NavigationGate {
-    /// The declared measurement age [s].
+    /// The sensors' measurement age [s] (the truth's).
     age_s: f64,
+    /// The declared navigation bounds.
+    declared: NavigationBounds,
     /// The declared bounds, in [`NAVIGATION_ERROR_NAMES`]' order.
     bounds: [f64; 10],
     /// A simulator of the declared scenario and robot: knowledge is its observation.
@@ -196,7 +226,13 @@ impl NavigationGate {
     ) -> Result<Self, crate::SimError> {
         let nav = declared.uncertainty_bounds().navigation;
         Ok(Self {
-            age_s: nav.measurement_age_s,
+            // the sensors' age is the truth's ([uncertainty.truth] may declare it longer
+            // than the filters were told: then the realised errors say so)
+            age_s: declared
+                .uncertainty_truth_bounds()
+                .navigation
+                .measurement_age_s,
+            declared: nav,
             bounds: NavigationError::bounds(&nav),
             knower: Simulator::new(declared, robot)?,
             exact: declared.uncertainty.is_none(),
@@ -211,6 +247,11 @@ impl NavigationGate {
         let q = self.age_s / truth.p.physics_step;
         let steps = (q * (1.0 + AGE_ROUNDING)).floor();
         (steps as usize).min(truth.p.substeps)
+    }
+
+    /// The declared navigation bounds the gate checks against.
+    pub fn declared(&self) -> &NavigationBounds {
+        &self.declared
     }
 
     /// Substitutes `substitute` for a refused estimate from now on.
@@ -247,7 +288,7 @@ impl NavigationGate {
         truth: &Simulator,
         truth_obs: &Observation,
     ) -> (Knowledge, Option<Rejection>) {
-        let age_s = self.measurement_age(truth);
+        let age_s = realised_age(m, truth);
         let checked = estimate
             .ok_or(Rejection::Missing)
             .and_then(|e| self.check(e, m, age_s).map(|err| (*e, err)));
@@ -323,6 +364,14 @@ impl NavigationGate {
     }
 }
 
+/// The age of measurement `m` of `truth` [s]: its whole physics steps (the first ticks of a
+/// run have less history than the declared age; a difference of two times would add its
+/// rounding).
+fn realised_age(m: &NavSample, truth: &Simulator) -> f64 {
+    let h = truth.p.physics_step;
+    ((m.state.t - m.measured_t) / h).round() * h
+}
+
 /// Every number of `e` is finite.
 fn finite(e: &NavSample) -> bool {
     let s = &e.state;
@@ -374,9 +423,10 @@ pub fn default_navigation(realisation: Option<&crate::Realisation>) -> Box<dyn E
 /// The simulator's substitute for a rejected estimate of `realisation`'s navigation.
 pub fn substitute_navigation(
     realisation: Option<&crate::Realisation>,
+    declared: &NavigationBounds,
 ) -> Box<dyn Estimator + Send> {
     match realisation {
-        Some(r) => Box::new(r.navigation.substitute()),
+        Some(r) => Box::new(r.navigation.substitute(declared)),
         None => Box::new(PassThrough),
     }
 }

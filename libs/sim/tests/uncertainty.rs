@@ -164,3 +164,42 @@ fn every_realistic_plant_of_a_campaign_is_physical() {
         .collect();
     assert!(refused.is_empty(), "seeds refused: {refused:?}");
 }
+
+/// The simulator's substitute for a refused estimate stays within the **declared**
+/// navigation bounds also when the truth is drawn from bounds three times as wide
+/// (`[uncertainty.truth]`): its bias is held to the declared one, its noise truncated
+/// at the declared noise — what the filters' margins are derived for.
+#[test]
+fn the_substitute_keeps_the_declared_bounds_under_a_wider_truth() {
+    let (s, robot) = setup();
+    let declared = example();
+    let wide = scaled(&declared, 3.0);
+    let bounds = NavigationError::bounds(&declared.navigation);
+    let mut outside_truth = 0;
+    for seed in 0..20 {
+        let mut r = Realisation::draw(&wide, seed, &s, &robot).unwrap();
+        let sim = Simulator::new(&r.true_scenario, Arc::new(r.true_robot.clone())).unwrap();
+        let m = gate(&r.true_scenario).measure(&sim, 0);
+        let mut sub = r.navigation.substitute(&declared.navigation);
+        for _ in 0..20 {
+            let e = error_of(&sub.estimate(&m), &m, 0.0);
+            for ((name, v), b) in NAVIGATION_ERROR_NAMES.iter().zip(e.values()).zip(bounds) {
+                assert!(
+                    v <= b * (1.0 + 1e-12),
+                    "seed {seed}: substitute {name} = {v} > {b}"
+                );
+            }
+            let t = error_of(&r.navigation.estimate(&m), &m, 0.0);
+            outside_truth += t
+                .values()
+                .iter()
+                .zip(bounds)
+                .filter(|(v, b)| **v > *b)
+                .count();
+        }
+    }
+    assert!(
+        outside_truth > 0,
+        "the wide truth never left the declared bounds: no test"
+    );
+}

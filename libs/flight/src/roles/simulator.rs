@@ -146,6 +146,8 @@ pub struct SimulatorRole {
     estimate: Option<sc_icd::NavState>,
     /// The navigation missed its deadline and has not answered since: not waited for.
     navigation_absent: bool,
+    /// The tick of the last measurement published.
+    measured_tick: Option<u64>,
     navigation_rejected: u64,
     navigation_deadline_ns: u64,
     scenario: Scenario,
@@ -190,6 +192,7 @@ impl SimulatorRole {
             gate,
             estimate: None,
             navigation_absent: false,
+            measured_tick: None,
             navigation_rejected: 0,
             navigation_deadline_ns: deadline_ns,
             scenario,
@@ -224,8 +227,9 @@ impl SimulatorRole {
         self.sim = Simulator::new(truth, robot.clone())
             .map_err(|e| FlightError::Simulator(e.to_string()))?;
         let known = std::mem::replace(&mut self.monitor, Monitor::from_scenario(truth, robot));
+        let declared = *self.gate.declared();
         self.gate
-            .set_substitute(substitute_navigation(Some(&realisation)));
+            .set_substitute(substitute_navigation(Some(&realisation), &declared));
         self.realisation = Some((realisation, known));
         Ok(self)
     }
@@ -266,10 +270,12 @@ impl SimulatorRole {
             if let Message::Tick(t) = m {
                 self.ticks.push_back(*t);
             } else if let Message::Estimate(e) = m {
-                let known = self.pending.as_ref().map(|p| p.measurement.tick);
-                // an estimate of the awaited tick or the one before brings it back
+                // an estimate of the last measured tick or the one before brings an absent
+                // navigation back, also when that tick is already done
+                let known = self.measured_tick;
+                let want = in_tick.or(known);
                 let came =
-                    super::keep_for_tick(vec![*e], &mut self.estimate, in_tick, known, |e| e.tick);
+                    super::keep_for_tick(vec![*e], &mut self.estimate, want, known, |e| e.tick);
                 self.navigation_absent &= !came;
             } else if let Some((s, r)) = Received::of(m, &self.scenario.limits) {
                 if in_tick.is_some() {
@@ -312,6 +318,10 @@ impl SimulatorRole {
         }
         let measurement = self.gate.measure(&self.sim, t.tick);
         out.send(Message::Measurement(convert::nav_state(&measurement)));
+        // nothing received before this measurement answers it (a late estimate of an
+        // earlier tick would otherwise be refused as not current at this one's deadline)
+        self.estimate = None;
+        self.measured_tick = Some(t.tick);
         let wait = if self.navigation_absent {
             0
         } else {
@@ -334,7 +344,8 @@ impl SimulatorRole {
     /// Admits the tick's estimate (or substitutes the simulator's own navigation) and
     /// publishes the knowledge: the realised errors (with a declared uncertainty), then
     /// the state, flight side first (a nominal command can then never reach a filter
-    /// before the state it answers); the safe commands are awaited from `now_ns`.
+    /// before the state it answers); the safe commands are awaited until `simulator_ms`
+    /// after the tick.
     fn publish_knowledge(&mut self, p: &mut InTick, now_ns: u64, out: &mut Outbox) {
         let k = p.tick.tick;
         let estimate = self.estimate.take().map(|e| convert::nav_sample(&e));
@@ -369,7 +380,9 @@ impl SimulatorRole {
         out.send(Message::State(msg));
         out.send(Message::PartnerState(msg));
         p.known = Some(known.observation);
-        p.until_ns = now_ns.saturating_add(self.deadline_ns);
+        // the safe commands' deadline counts from the tick, as before the navigation had a
+        // stage of its own: waiting for the estimate does not lengthen the tick
+        p.until_ns = p.recv_ns.saturating_add(self.deadline_ns).max(now_ns);
     }
 
     /// Logs and counts a refused or missing estimate (a missing one once per absence).
