@@ -707,6 +707,8 @@ mod tests {
     use sc_icd::{SafeAttitude, SafeRobotic, SafeTranslational};
 
     const DEADLINE_NS: u64 = 90_000_000;
+    /// The navigation's deadline of the realistic role (the configs' 10 ms).
+    const NAV_NS: u64 = 10_000_000;
 
     fn role() -> SimulatorRole {
         let su = setup();
@@ -790,6 +792,7 @@ mod tests {
         let sim = Simulator::new(&su.scenario, su.robot.clone()).unwrap();
         let role = SimulatorRole::new(sim, None, su.scenario, su.robot, DEADLINE_NS, false)
             .unwrap()
+            .with_navigation_deadline(NAV_NS)
             .with_realisation(real.clone())
             .unwrap();
         (role, real)
@@ -829,7 +832,7 @@ mod tests {
             let mut out = handle(&mut r, 1, Woke::Event, &[Message::Estimate(e)]);
             if why == "not current" {
                 assert!(out.send.is_empty(), "the tick's estimate is still awaited");
-                out = handle(&mut r, DEADLINE_NS, Woke::Timeout, &[]);
+                out = handle(&mut r, NAV_NS, Woke::Timeout, &[]);
             }
             assert!(
                 out.log.iter().any(
@@ -883,15 +886,46 @@ mod tests {
         // a missing estimate is logged once, at the deadline
         let (mut r, _) = realistic_role();
         handle(&mut r, 10, Woke::Event, &[tick(0, SubsystemSet::ALL)]);
-        let out = handle(&mut r, 10 + DEADLINE_NS, Woke::Timeout, &[]);
+        let out = handle(&mut r, 10 + NAV_NS, Woke::Timeout, &[]);
         assert!(
             out.log.iter().any(|l| l
                 .contains("FAULT tick 0: navigation estimate missing at the navigation deadline")),
             "{:?}",
             out.log
         );
-        let res = result(&handle(&mut r, 11 + DEADLINE_NS, Woke::Event, &safe(0)));
+        let res = result(&handle(&mut r, 11 + NAV_NS, Woke::Event, &safe(0)));
         assert_eq!(res.fault_flags, fault::NAVIGATION_REJECTED);
+    }
+
+    /// A late estimate (of a tick whose knowledge was already published) brings an
+    /// absent navigation back but never answers the next tick: that tick's deadline finds
+    /// it missing, not "not current".
+    #[test]
+    fn a_late_estimate_is_not_the_next_ticks() {
+        let (mut r, real) = realistic_role();
+        let mut nav = real.navigation.clone();
+        let out = handle(&mut r, 0, Woke::Event, &[tick(0, SubsystemSet::ALL)]);
+        let late = declared_estimate(&mut nav, &out);
+        handle(&mut r, NAV_NS, Woke::Timeout, &[]);
+        assert!(r.navigation_absent, "missing at its deadline");
+        handle(&mut r, NAV_NS + 1, Woke::Event, &[late]);
+        assert!(!r.navigation_absent, "a late answer brings it back");
+        result(&handle(&mut r, NAV_NS + 2, Woke::Event, &safe(0)));
+        let t1 = 100_000_000;
+        handle(&mut r, t1, Woke::Event, &[tick(1, SubsystemSet::ALL)]);
+        assert_eq!(
+            r.pending.as_ref().map(|p| p.until_ns),
+            Some(t1 + NAV_NS),
+            "awaited"
+        );
+        let out = handle(&mut r, t1 + NAV_NS, Woke::Timeout, &[]);
+        assert!(
+            out.log
+                .iter()
+                .any(|l| l.contains("FAULT tick 1: navigation estimate missing")),
+            "{:?}",
+            out.log
+        );
     }
 
     /// With a declared uncertainty the truth (with the monitor's barriers) and the
