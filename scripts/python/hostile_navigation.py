@@ -14,8 +14,11 @@ itself until tick ``--from-tick``, and from then on with what ``--strategy`` say
 - ``nonunit``: the servicer's attitude quaternion scaled by 1.01;
 - ``silent``: no estimate at all (the simulator's navigation deadline passes).
 
-The simulator refuses each of them (``sc_sim::navigation::NavigationGate``), substitutes
-its own navigation and flags the tick ``NAVIGATION_REJECTED``. By hand::
+The simulator refuses each of them (``sc_sim::navigation::NavigationGate``) — ``jump``
+and ``stale`` when they leave the declared bounds, which under ``exact`` (all zero) they
+always do — substitutes its own navigation and flags the tick ``NAVIGATION_REJECTED``.
+Until ``stale:<n>`` has ``n`` measurements of history it answers with the measurement.
+By hand::
 
     [roles.navigation]
     exec = "../scripts/.venv/bin/python"
@@ -62,25 +65,30 @@ class HostileNavigation(Navigation):
     def estimate(self, m):
         self.history.append(m.raw)
         e = m.estimate()
-        if m.tick < self.from_tick:
+        if m.tick < self.from_tick or len(self.history) < self.history.maxlen:
             return e
         self.attacks += 1
         if self.strategy == "nan":
             e.r_i[1] = math.nan
         elif self.strategy == "jump":
             e.r_i[0] += self.arg
-        elif self.strategy == "stale" and len(self.history) == self.history.maxlen:
+        elif self.strategy == "stale":
             old = icd.NavState.from_buffer_copy(self.history[0])
             old.tick, old.t, old.measured_t = m.tick, m.t, m.measured_t
             old.target_r[:], old.target_v[:] = m.target_r, m.target_v
             return old
         elif self.strategy == "old_tick":
-            e.tick = m.tick - 1
+            e.tick = max(m.tick, 1) - 1
         elif self.strategy == "nonunit":
             e.q_ib[:] = 1.01 * m.q_ib
-        elif self.strategy == "silent":
-            return None
         return e
+
+    def message(self, raw, recv_ns=0):
+        # silent: nothing published at all (the SDK would answer a None with NaN)
+        if self.strategy == "silent" and raw.tick >= self.from_tick:
+            self.attacks += 1
+            return None, None
+        return super().message(raw, recv_ns)
 
 
 def main(argv=None):

@@ -83,8 +83,20 @@ fn python_navigation_runs_the_mission_as_the_rust_one() {
     assert_no_lost_wakeups(&out);
     let (tel, _) = in_process(&dir, None);
     let part = std::fs::read(out.join("telemetry.csv")).unwrap();
-    assert!(part == tel, "telemetry.csv differs from the in-process run");
     let s = summary(&out);
+    if part != tel {
+        let (a, b) = (
+            String::from_utf8_lossy(&part),
+            String::from_utf8_lossy(&tel),
+        );
+        let d = a.lines().zip(b.lines()).position(|(x, y)| x != y);
+        panic!(
+            "telemetry.csv differs from the in-process run from line {d:?} ({} vs {} lines); faults {}",
+            a.lines().count(),
+            b.lines().count(),
+            s["faults"]
+        );
+    }
     assert_eq!(s["fault_count"], 0, "{s}");
     let log = std::fs::read_to_string(out.join("logs/navigation.log")).unwrap();
     assert!(

@@ -142,8 +142,8 @@ impl ModelErrorBound {
 
     /// The bound on `|ν̇_t − ν̇|` beyond the joint-torque error's own first-order effect
     /// (module documentation), elementwise, `[v̇_B; ω̇_B; θ̈]`; `None` when the model's mass
-    /// matrix is singular, an input is not finite, or the spectral radius of `B` is not
-    /// below 1 (the errors' coupling would not be bounded).
+    /// matrix is singular, `ε*` is not below 1, or the result is not finite. `rho` and the
+    /// torque error are taken by magnitude.
     pub fn acceleration_error(&self, robot: &Robot, op: &Operating) -> Option<Vector13> {
         // NaN as well as ε* ≥ 1: no bound
         if self.relative.is_nan() || self.relative >= 1.0 {
@@ -158,6 +158,7 @@ impl ModelErrorBound {
         let mut f_norm = 0.0;
         let mut b = Matrix13::zeros();
         let minv_joints = minv.fixed_columns::<NJ>(6).into_owned();
+        let (rho, e) = (op.rho.abs(), op.joint_torque_error.abs());
         let mut inertias = [Inertia::ZERO; NJ + 1];
         for d in &self.directions {
             inertias[d.body] = d.unit;
@@ -166,10 +167,7 @@ impl ModelErrorBound {
             inertias[d.body] = Inertia::ZERO;
             // the direction's own effect, and its coupling with the joint-torque error
             // (`Σ_k |(G_p M⁻¹_J)_ik| e_k`: the exact dual over both boxes)
-            f += (chol.solve(&w).abs()
-                + g.abs() * op.rho
-                + (g * minv_joints).abs() * op.joint_torque_error)
-                * d.bound;
+            f += (chol.solve(&w).abs() + g.abs() * rho + (g * minv_joints).abs() * e) * d.bound;
             f_norm += m_norm(&w) * d.bound;
             b += g.abs() * d.bound;
         }
@@ -178,9 +176,9 @@ impl ModelErrorBound {
         du13.fixed_rows_mut::<6>(0).copy_from(&du);
         f += minv.abs() * du13;
         f_norm += du13.dot(&(minv.abs() * du13)).sqrt();
-        f_norm += self.relative * op.rho.dot(&(m.abs() * op.rho)).sqrt();
+        f_norm += self.relative * rho.dot(&(m.abs() * rho)).sqrt();
         let mut e13 = Vector13::zeros();
-        e13.fixed_rows_mut::<NJ>(6).copy_from(op.joint_torque_error);
+        e13.fixed_rows_mut::<NJ>(6).copy_from(&e);
         let torque_norm = e13.dot(&(minv.abs() * e13)).sqrt();
         // second order: |(M⁻¹ΔM z)_i| ≤ √(M⁻¹)_ii ε* ‖z‖_M, ‖z‖_M ≤ (F + T)/(1 − ε*)
         let z_norm = (f_norm + torque_norm) / (1.0 - self.relative);
@@ -248,7 +246,8 @@ pub fn acceleration_box(
 /// congruence `X ↦ I₀^{-½} X I₀^{-½}` and `P(c) = from_com(1, c, 0)` a unit point mass:
 /// `ΔI₀ = δm m P(c) + δI [0 0; 0 I_c] + m(1 + δm)(P(c + δ) − P(c))`, and
 /// `P(c + δ) − P(c) = Σ_k δ_k L_k + [0 0; 0 ‖δ‖²1 − δδᵀ]` with `L_k` the derivative along
-/// `e_k`, so `λ = ε_m m‖P(c)‖ + ε_I ‖[0 0; 0 I_c]‖ + m(1 + ε_m)(d √(Σ_k ‖L_k‖²) + d² ‖[0 0; 0 1]‖)`.
+/// `e_k`; `m P(c)` and `[0 0; 0 I_c]` are ⪰ 0 and add up to `I₀`, so
+/// `λ = max(ε_m, ε_I) + m(1 + ε_m)(d √(Σ_k ‖L_k‖²) + d² ‖[0 0; 0 1]‖)`.
 /// Infinite when the base's inertia is not positive definite.
 fn base_relative(robot: &Robot, model: &ModelBounds) -> f64 {
     let Some(body) = robot.body_inertia(0) else {
@@ -267,7 +266,7 @@ fn base_relative(robot: &Robot, model: &ModelBounds) -> f64 {
             .iter()
             .fold(0.0f64, |m, v| m.max(v.abs()))
     };
-    let (m, c, i_c) = (body.mass, body.com(), body.i_com());
+    let (m, c) = (body.mass, body.com());
     let point = |c: Vector3<f64>| Inertia::from_com(1.0, c, Matrix3::zeros()).to_matrix();
     let angular = |a: Matrix3<f64>| {
         let mut x = Matrix6::zeros();
@@ -282,9 +281,9 @@ fn base_relative(robot: &Robot, model: &ModelBounds) -> f64 {
         model.servicer_inertia_rel,
         model.servicer_com_m,
     );
-    em * m * norm(point(c))
-        + ei * norm(angular(i_c))
-        + m * (1.0 + em) * (d * linear + d * d * norm(angular(Matrix3::identity())))
+    // m P(c) ⪰ 0 and [0 0; 0 I_c] ⪰ 0 add up to I₀: scaled by δm and δI they stay
+    // within ±max(ε_m, ε_I) I₀
+    em.max(ei) + m * (1.0 + em) * (d * linear + d * d * norm(angular(Matrix3::identity())))
 }
 
 /// The base's ten inertial parameters (mass, first moment, rotational inertia about the
@@ -390,8 +389,8 @@ mod tests {
     }
 
     /// For plants anywhere in the `realistic` box, states and commands over the arm's
-    /// range and the base wrench's errors within the declared scales: the realised
-    /// `|ν̇_t − ν̇|` is within the bound evaluated at the model's own acceleration
+    /// range, the base wrench's errors within the declared scales and the joint torques'
+    /// within theirs: the realised `|ν̇_t − ν̇ − M⁻¹[0; Δτ]|` is within the bound evaluated at the model's own acceleration
     /// (`ρ = 0`), and within the bound for a box of accelerations around another centre
     /// that contains it. Prints how tight it is per component.
     #[test]
@@ -426,11 +425,21 @@ mod tests {
                 u_t[i] *= 1.0 + pick(&mut seed, act.thruster_force_scale_rel);
                 u_t[3 + i] *= 1.0 + pick(&mut seed, act.body_torque_scale_rel);
             }
+            // the joint torques' declared error, whose own first-order effect the rows
+            // carry: the bound is for the rest
+            let e = Vector7::from_fn(|k, _| {
+                act.joint_torque_bias_nm + act.joint_torque_scale_rel * u[6 + k].abs()
+            });
+            let mut du = Vector13::zeros();
+            for k in 0..NJ {
+                du[6 + k] = pick(&mut seed, e[k]);
+            }
+            u_t += du;
             let nd = r.forward_dynamics(&theta, &nu, &u).unwrap();
-            let nd_t = p.forward_dynamics(&theta, &nu, &u_t).unwrap();
+            let first = r.mass_matrix(&theta).cholesky().unwrap().solve(&du);
+            let nd_t = p.forward_dynamics(&theta, &nu, &u_t).unwrap() - first;
             let fb = Vector3::new(u[0], u[1], u[2]);
             let tb = Vector3::new(u[3], u[4], u[5]);
-            let zero7 = Vector7::zeros();
             let at = |centre: &Vector13, rho: &Vector13| {
                 let op = Operating {
                     theta: &theta,
@@ -439,7 +448,7 @@ mod tests {
                     rho,
                     force_b: &fb,
                     torque_b: &tb,
-                    joint_torque_error: &zero7,
+                    joint_torque_error: &e,
                 };
                 bound.acceleration_error(&r, &op).expect("a bound")
             };
@@ -458,6 +467,9 @@ mod tests {
                 worst[i] = worst[i].max(got / own[i]);
             }
         }
-        println!("realised / bound, largest per component [v̇_B; ω̇_B; θ̈]: {worst:.2?}");
+        println!(
+            "realised / bound, largest per component [v̇_B; ω̇_B; θ̈]: {worst:.2?}; ε* = {:.3}",
+            bound.relative
+        );
     }
 }

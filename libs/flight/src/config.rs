@@ -58,9 +58,8 @@ pub struct RoleExec {
     pub cpus: Vec<usize>,
 }
 
-/// Per-stage deadlines in real-time mode [ms]: the navigation's and the simulator's from
-/// the tick (the measurement's publication), the filters' from the simulator's
-/// publication of the tick's state (after the estimate's admission).
+/// Per-stage deadlines in real-time mode [ms], every one from the tick (the simulator's
+/// receipt of it; the scheduler's stage-deadline watchdog counts from its send).
 #[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Deadlines {
@@ -183,9 +182,8 @@ impl Schedule {
 }
 
 /// The navigation deadline of a config that names none [ms]: an estimator answers
-/// within a few hundred µs here (docs/PARTITION.md). It counts from the tick (the
-/// measurement is published then); the filters' deadlines count from the state, which
-/// follows the estimate's admission, and the simulator's from the tick.
+/// within a few hundred µs here (docs/PARTITION.md). Like every stage deadline it counts
+/// from the tick, so the navigation's share comes out of the translational filter's.
 pub const DEFAULT_NAVIGATION_MS: f64 = 10.0;
 
 fn default_navigation_ms() -> f64 {
@@ -217,15 +215,16 @@ impl Deadlines {
         ]
     }
 
-    /// Positive and in causal order.
+    /// Positive and in causal order, strictly (a stage with no time after its input's
+    /// deadline could only ever use its fallback).
     fn validate(&self) -> Result<(), ConfigError> {
         let ds = self.keyed();
         if let Some((k, v)) = ds.iter().find(|(_, v)| !(v.is_finite() && *v > 0.0)) {
             return err(format!("{k} = {v}: must be > 0"));
         }
-        match ds.windows(2).find(|w| w[1].1 < w[0].1) {
+        match ds.windows(2).find(|w| w[1].1 <= w[0].1) {
             Some(w) => err(format!(
-                "{} = {} is earlier than {} = {}: deadlines must follow the causal order",
+                "{} = {} is not later than {} = {}: deadlines must follow the causal order, each after the one before",
                 w[1].0, w[1].1, w[0].0, w[0].1
             )),
             None => Ok(()),

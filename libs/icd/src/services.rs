@@ -32,8 +32,8 @@ icd_services! {
         /// subscriber costs the scheduler's send, on the critical path.
         CONTROL = "safe_capture/scheduler/control", Tick, Flight;
         /// What the sensors measured at the start of each step, for the navigation (the
-        /// process partners replace): the true state `uncertainty.navigation.measurement_age_s`
-        /// old, on a newest-wins service (a navigation that stops reading can never make
+        /// process partners replace): the true state the sensors' measurement age old
+        /// (`measurement_age_s` of the truth's bounds), on a newest-wins service (a navigation that stops reading can never make
         /// the simulator wait). Published when the tick starts (after the truth, with a
         /// declared uncertainty).
         MEASUREMENT = "safe_capture/sim/measurement", NavState, Partner;

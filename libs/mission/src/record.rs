@@ -231,10 +231,16 @@ pub fn write_knowledge(path: &std::path::Path, records: &[StepRecord]) -> std::i
 /// knowledge go to the record of its step, bit for bit.
 pub fn read_knowledge(text: &str, records: &mut [StepRecord]) -> Result<(), TelemetryError> {
     const FILE: &str = "navigation.csv";
-    let names = knowledge_columns();
+    let mut names = knowledge_columns();
     let mut lines = text.lines();
-    if lines.next() != Some(names.join(",").as_str()) {
-        return Err(TelemetryError::Header { file: FILE });
+    let header = lines.next();
+    // a file written before the refusal flag (0e6ee4a) has no `navigation_rejected`
+    let flagged = header == Some(names.join(",").as_str());
+    if !flagged {
+        names.retain(|n| n != "navigation_rejected");
+        if header != Some(names.join(",").as_str()) {
+            return Err(TelemetryError::Header { file: FILE });
+        }
     }
     let mut rows = 0;
     for (i, line) in lines.enumerate() {
@@ -246,11 +252,12 @@ pub fn read_knowledge(text: &str, records: &mut [StepRecord]) -> Result<(), Tele
             .get_mut(i)
             .filter(|r| r.step == step && same_bits(r.t, t))
             .ok_or(TelemetryError::KnowledgeStep { line: n, step })?;
-        r.navigation_rejected = match c.parse::<u8>("0 or 1")? {
-            0 => false,
-            1 => true,
-            v => return Err(c.invalid(&v.to_string(), "0 or 1")),
-        };
+        r.navigation_rejected = flagged
+            && match c.parse::<u8>("0 or 1")? {
+                0 => false,
+                1 => true,
+                v => return Err(c.invalid(&v.to_string(), "0 or 1")),
+            };
         r.navigation_error = c
             .optional::<10>("a number")?
             .map(|e| sc_sim::uncertainty::NavigationError::from_values(&e));

@@ -342,6 +342,22 @@ fn knowledge_round_trips_bit_for_bit() {
             a.step,
         );
     }
+    // a file from before the refusal flag still reads, every step unflagged
+    let old: String = text
+        .lines()
+        .map(|l| {
+            let mut f: Vec<&str> = l.split(',').collect();
+            f.remove(2);
+            format!("{}\n", f.join(","))
+        })
+        .collect();
+    let mut older = back.clone();
+    sc_mission::record::read_knowledge(&old, &mut older).unwrap();
+    assert!(
+        older
+            .iter()
+            .all(|r| !r.navigation_rejected && r.navigation_error.is_some())
+    );
     let err = sc_mission::record::read_knowledge(&text, &mut back[1..]).unwrap_err();
     assert!(err.to_string().contains("is not the step"), "{err}");
     let short: String = text.lines().take(3).map(|l| format!("{l}\n")).collect();

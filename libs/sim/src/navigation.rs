@@ -2,8 +2,9 @@
 //! gate an estimate passes before it becomes knowledge.
 //!
 //! * [`NavigationGate::measure`] — the simulator's sensors: the true state
-//!   `uncertainty.navigation.measurement_age_s` old (whole physics steps, at most one
-//!   control period) and the true grasping point. The sensors have no noise of their
+//!   measurement age of the truth's bounds old (`uncertainty.truth`, else the declared
+//!   `uncertainty.navigation.measurement_age_s`; whole physics steps, at most one control
+//!   period, less in a run's first steps) and the true grasping point. The sensors have no noise of their
 //!   own: the declared navigation errors are the navigation's.
 //! * [`Estimator`] — the navigation (the partition's `navigation` role, which a
 //!   partner's estimator may replace): [`PassThrough`] for the `exact` profile,

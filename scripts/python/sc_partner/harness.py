@@ -307,15 +307,25 @@ def largest_estimate_difference(estimates, recorded):
     `estimates` and the `recorded` ones ({tick: NavState}) over the ticks both have,
     or (nan, None, None)."""
     best = (math.nan, None, None)
-    cols = nav_columns()
+    labels = ("tick", "t", "measured_t")
+    cols = list(labels) + nav_columns()
     for e in estimates:
         if e.estimate is None or e.tick not in recorded:
             continue
-        for col, a, b in zip(cols, _nav_values(e.estimate), _nav_values(recorded[e.tick])):
-            d = abs(a - b)
-            if not math.isnan(d) and not (d <= best[0]):
+        mine = [getattr(e.estimate, k) for k in labels] + _nav_values(e.estimate)
+        theirs = [getattr(recorded[e.tick], k) for k in labels] + _nav_values(recorded[e.tick])
+        for col, a, b in zip(cols, mine, theirs):
+            d = _difference(a, b)
+            if not (d <= best[0]):
                 best = (d, e.tick, col)
     return best
+
+
+def _difference(a, b):
+    """|a - b|, 0 for two NaNs, infinite for a NaN against a number."""
+    if math.isnan(a) or math.isnan(b):
+        return 0.0 if math.isnan(a) and math.isnan(b) else math.inf
+    return abs(a - b)
 
 
 def run_offline(controller, states, scenario, period_s):

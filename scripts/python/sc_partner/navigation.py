@@ -10,7 +10,7 @@ with its estimate on ``safe_capture/navigation/estimate`` (:mod:`sc_partner.proc
 Frames and fields are the ICD's ``NavState`` (docs/ICD.md): inertial positions and
 velocities, ``q_it`` and ``q_ib`` scalar-first, body rates in the bodies' frames, the
 joints, the grasping point in F_T. ``measured_t`` is the time the measurement was
-taken (``t`` minus the declared measurement age): an estimate is of the tick's time
+taken (``t`` minus the sensors' measurement age): an estimate is of the tick's time
 ``t`` from that measurement.
 
 The simulator admits an estimate only if it is current (the measurement's ``tick``,
@@ -22,10 +22,11 @@ otherwise it substitutes its own navigation (the declared error model), flags th
 the only admissible estimate is the measurement itself.
 
 An ``estimate`` that raises, returns ``None`` or anything but an :class:`Estimate` (or
-an ``icd.NavState``) publishes nothing for that tick: the simulator substitutes its own
-navigation at the navigation deadline (``deadlines.navigation_ms``) and does not wait
-for this process again until it answers. The first such failure is logged with its
-reason, the count at the end.
+an ``icd.NavState``) publishes the measurement's labels (``tick``, ``t``,
+``measured_t``) with every value NaN: the simulator refuses it at once (not finite) and
+substitutes its own navigation for that tick only — no wait for the navigation
+deadline, the next tick's estimate used as usual. The first such failure is logged with
+its reason, the count at the end.
 
 The same subclass runs offline on a partition run's recorded measurements
 (``python -m sc_partner.harness ... --mcap recording.mcap``).
@@ -125,25 +126,35 @@ class Navigation:
         return self.name or type(self).__name__
 
     def message(self, raw, recv_ns=0):
-        """The ``NavState`` answering the measurement `raw` (None: publish nothing), and
-        the reason there is no estimate (None if there is one)."""
+        """The ``NavState`` answering the measurement `raw`, and the reason there is no
+        estimate (None if there is one; then the message is :func:`no_estimate`'s)."""
         del recv_ns  # NavState carries no receive stamp
         try:
             out = self.estimate(Measurement(raw))
         except Exception:
-            return None, "estimate raised:\n" + traceback.format_exc().rstrip()
+            return no_estimate(raw), "estimate raised:\n" + traceback.format_exc().rstrip()
         if isinstance(out, Estimate):
             out = out.raw
         if isinstance(out, icd.NavState):
             return icd.NavState.from_buffer_copy(out), None
         if out is None:
-            return None, "no estimate (estimate returned None)"
-        return None, f"estimate returned {out!r}, not an Estimate"
+            return no_estimate(raw), "no estimate (estimate returned None)"
+        return no_estimate(raw), f"estimate returned {out!r}, not an Estimate"
 
     @classmethod
     def main(cls, argv=None):
         """Entry point of a navigation script: ``sys.exit(MyNavigation.main())``."""
         return run_partition(cls(), argv)
+
+
+def no_estimate(raw):
+    """The answer to measurement `raw` when there is no estimate: its labels, every value
+    NaN — refused by the simulator at once, for this tick only."""
+    msg = icd.NavState(tick=raw.tick, t=raw.t, measured_t=raw.measured_t)
+    for name, ctype in icd.NavState._fields_:
+        if getattr(ctype, "_length_", 0):
+            getattr(msg, name)[:] = [float("nan")] * ctype._length_
+    return msg
 
 
 def run_partition(navigation, argv=None):

@@ -75,14 +75,16 @@ class Navigations(unittest.TestCase):
         self.assertEqual(list(msg.r_i), [1.5, 2.0, 3.0])
         self.assertEqual(list(raw.r_i), [1.0, 2.0, 3.0], "the measurement itself is unchanged")
 
-    def test_no_estimate_publishes_nothing_and_says_why(self):
+    def test_no_estimate_answers_the_labels_with_nan_and_says_why(self):
         for behaviour, why in [
             ("raise", "ValueError: deliberate"),
             ("none", "no estimate"),
             ("list", "not an Estimate"),
         ]:
             msg, reason = self.Nav(behaviour).message(self.measurement())
-            self.assertIsNone(msg, behaviour)
+            self.assertEqual((msg.tick, msg.t, msg.measured_t), (7, 0.7, 0.6), behaviour)
+            self.assertTrue(all(math.isnan(x) for x in msg.r_i), behaviour)
+            self.assertTrue(all(math.isnan(x) for x in msg.q_ib), behaviour)
             self.assertIn(why, reason)
 
 

@@ -232,7 +232,9 @@ impl FilterRole {
                     return;
                 };
                 self.last_state = Some(s);
-                let until_ns = deadline_from(s.publish_ns, now_ns, self.deadline_ns);
+                // from the tick (the simulator's receipt of it), like the navigation's and
+                // the simulator's deadlines: the wait for the estimate does not shift it
+                let until_ns = deadline_from(s.recv_ns, now_ns, self.deadline_ns);
                 self.pending = Some(Pending { state: s, until_ns });
             }
             let Some(p) = self.pending else { return };
@@ -595,6 +597,8 @@ mod tests {
 
     const DEADLINE_NS: u64 = 40_000_000;
     const PUBLISHED_NS: u64 = 1_000;
+    /// When the simulator received the tick: the stage deadlines count from it.
+    const TICK_RECV_NS: u64 = 500;
 
     fn role(s: Subsystem) -> FilterRole {
         let su = setup();
@@ -605,6 +609,7 @@ mod tests {
     fn tick_state(k: u64) -> Message {
         let mut s = state(k, SubsystemSet::ALL.bits());
         s.publish_ns = PUBLISHED_NS;
+        s.recv_ns = TICK_RECV_NS;
         Message::State(s)
     }
 
@@ -688,7 +693,7 @@ mod tests {
             out.send.is_empty(),
             "waits for its nominal until the deadline"
         );
-        let until = PUBLISHED_NS + DEADLINE_NS;
+        let until = TICK_RECV_NS + DEADLINE_NS;
         assert_eq!(
             r.next(2_000),
             Next::Wait {
@@ -774,7 +779,7 @@ mod tests {
             &[nominal(Subsystem::Attitude, 0, 1), tick_state(0)],
         );
         assert!(out.send.is_empty(), "waits for the translational command");
-        let until = PUBLISHED_NS + DEADLINE_NS;
+        let until = TICK_RECV_NS + DEADLINE_NS;
         let out = handle(&mut r, until, Woke::Timeout, &[]);
         assert!(out.log[0].contains("translational safe command missing at the deadline"));
         assert_ne!(sent_faults(&out) & faults::UPSTREAM_MISSING, 0);

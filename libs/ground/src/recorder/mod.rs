@@ -89,6 +89,10 @@ pub struct RecorderRole<S: RecordSink> {
     last_t: f64,
     /// Required (service, tick) pairs not there when their step was written.
     absent_at_write: BTreeSet<(&'static str, u64)>,
+    /// The newest tick the simulator published something of (that the recorder read): a
+    /// message labelled more than [`FUTURE_TICKS`] later is recorded (at that tick's time)
+    /// but not filed, so that a hostile label cannot grow the recorder's memory.
+    newest_tick: Option<u64>,
     started: bool,
     stop: bool,
     final_pass: bool,
@@ -114,6 +118,7 @@ impl<S: RecordSink> RecorderRole<S> {
             end: None,
             last_t: 0.0,
             absent_at_write: BTreeSet::new(),
+            newest_tick: None,
             started: false,
             stop: false,
             final_pass: false,
@@ -148,6 +153,14 @@ impl<S: RecordSink> RecorderRole<S> {
             _ => {}
         }
         let Some(tick) = tick_of(m) else { return };
+        let newest = self.newest_tick.unwrap_or(0);
+        if from_simulator(m) {
+            self.newest_tick = self.newest_tick.max(Some(tick));
+        } else if tick > newest.saturating_add(FUTURE_TICKS) {
+            let at = newest;
+            let r = self.sink.message(self.mission_ns(at), m);
+            return self.keep(r);
+        }
         if self.absent_at_write.remove(&(svc, tick)) {
             *self.rep.late.entry(svc.into()).or_default() += 1;
         }
@@ -305,6 +318,22 @@ fn tick_of(m: &Message) -> Option<u64> {
         Message::SafeRobotic(x) => x.tick,
         _ => return None,
     })
+}
+
+/// How far ahead of the newest simulator tick read a message's tick may be and still be
+/// filed: more than any queue the recorder reads holds (16 samples), so that a genuine
+/// message read before its tick's state (another queue, the same wake-up) is never lost.
+pub const FUTURE_TICKS: u64 = 64;
+
+/// Published by the simulator (its tick is the run's, not a partner's label).
+fn from_simulator(m: &Message) -> bool {
+    matches!(
+        m,
+        Message::State(_)
+            | Message::Truth(_)
+            | Message::NavigationError(_)
+            | Message::Measurement(_)
+    )
 }
 
 /// Files a message of a tick into the tick's set.
@@ -651,5 +680,27 @@ mod tests {
             "{:?}",
             fin.log
         );
+    }
+
+    /// A partner labelling its messages with ticks far ahead cannot grow the recorder:
+    /// they are recorded, not filed; one a few ticks ahead (read before its state, from
+    /// another queue) still is.
+    #[test]
+    fn far_future_labels_are_recorded_not_filed() {
+        let mut r = role();
+        let mut inputs = tick(0);
+        inputs.truncate(1);
+        for k in 0..1000u64 {
+            let mut e = sc_icd::NavState::default();
+            e.tick = u64::MAX - k;
+            inputs.push(Message::Estimate(e));
+        }
+        inputs.push(Message::NominalTranslational(NominalTranslational {
+            tick: 3,
+            ..Default::default()
+        }));
+        handle(&mut r, 1, &inputs);
+        assert_eq!(r.sink.messages, 1002, "every message recorded");
+        assert_eq!(r.pending.keys().copied().collect::<Vec<_>>(), vec![0, 3]);
     }
 }
