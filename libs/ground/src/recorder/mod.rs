@@ -691,9 +691,10 @@ mod tests {
         let mut inputs = tick(0);
         inputs.truncate(1);
         for k in 0..1000u64 {
-            let mut e = sc_icd::NavState::default();
-            e.tick = u64::MAX - k;
-            inputs.push(Message::Estimate(e));
+            inputs.push(Message::Estimate(sc_icd::NavState {
+                tick: u64::MAX - k,
+                ..Default::default()
+            }));
         }
         inputs.push(Message::NominalTranslational(NominalTranslational {
             tick: 3,
