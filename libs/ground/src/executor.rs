@@ -64,7 +64,7 @@ pub enum PartitionError {
     /// A file of the run cannot be read or makes no sense.
     #[error("partition: {}: {message}", .path.display())]
     File { path: PathBuf, message: String },
-    #[error("partition: the recorder missed {missing} of the samples the schedule requires ({}): the telemetry is incomplete", .report.display())]
+    #[error("partition: the recorder missed {missing} of the samples the schedule requires, lost or late for their step ({}): the telemetry is incomplete", .report.display())]
     SamplesMissed { missing: u64, report: PathBuf },
     #[error("partition: telemetry.csv has {rows} steps, the recorder wrote {steps} ({})", .report.display())]
     StepCount {
@@ -399,14 +399,28 @@ fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, Partition
 /// Reads a finished partition run back from `out` into step records and the mission's
 /// end, after checking that the telemetry is complete: every tick of the scheduler
 /// recorded, no step missing, and no sample the schedule requires missing at the
-/// recorder except on the services in `may_miss` (a partner's own).
+/// recorder except on the services in `may_miss` (a partner's own), and none of the
+/// simulator's own there only after its step was written (a late truth leaves its step's
+/// barriers unevaluated).
 pub fn read_run(out: &Path, may_miss: &[&str]) -> Result<Executed, PartitionError> {
     let report = out.join("recorder.json");
     let rec: RecorderReport = read_json(&report)?;
+    // the simulator's own samples are late only in transport (the commands may be late
+    // by a process's fault, which the run's faults and fallbacks already tell)
+    let simulator = [
+        sc_icd::services::TRUTH.as_str(),
+        sc_icd::services::SIM_STATE.as_str(),
+        sc_icd::services::NAVIGATION_ERROR.as_str(),
+    ];
+    let late = rec
+        .late
+        .iter()
+        .filter(|(svc, _)| simulator.contains(&svc.as_str()));
     let missing: u64 = rec
         .missing
         .iter()
         .filter(|(svc, _)| !may_miss.contains(&svc.as_str()))
+        .chain(late)
         .map(|(_, n)| n)
         .sum();
     if missing > 0 {
@@ -586,5 +600,37 @@ mod tests {
             .execute(job)
             .unwrap_err();
         assert!(matches!(e, ExecError::Unsupported(_)), "{e}");
+    }
+
+    /// A late sample of the simulator's own (its step's truth unevaluated) makes the run
+    /// unreadable, like a lost one; a late partner command does not.
+    #[test]
+    fn a_late_truth_is_refused_a_late_partner_command_is_not() {
+        let dir = std::env::temp_dir().join(format!("sc-late-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let write = |late: &str| {
+            let rep = RecorderReport {
+                late: [(late.to_string(), 1)].into_iter().collect(),
+                ..Default::default()
+            };
+            std::fs::write(
+                dir.join("recorder.json"),
+                serde_json::to_string(&rep).unwrap(),
+            )
+            .unwrap();
+            read_run(&dir, &[])
+        };
+        let truth = write("safe_capture/sim/truth");
+        assert!(
+            matches!(truth, Err(PartitionError::SamplesMissed { missing: 1, .. })),
+            "{truth:?}"
+        );
+        // past the check, to the missing telemetry
+        let partner = write("safe_capture/nominal/robotic");
+        assert!(
+            matches!(partner, Err(PartitionError::File { .. })),
+            "{partner:?}"
+        );
+        std::fs::remove_dir_all(&dir).ok();
     }
 }
