@@ -37,11 +37,16 @@ pub mod faults {
     /// of the input bound); without one the backup law is used
     /// ([`QP_FAILED_FALLBACK`]).
     pub const QP_SECOND_OPINION: u32 = 1 << 8;
+    /// No command is certified for the declared errors (a declared uncertainty): the
+    /// command is the solution of the rows with the largest feasible share `λ` of the
+    /// declared margins, `FilterReport::violation = 1 − λ` (`λ = 0`: the nominal model's
+    /// rows). Only the translational filter degrades so (docs/SAFETY.md).
+    pub const MARGINS_DEGRADED: u32 = 1 << 9;
     /// All flags, for masks.
-    pub const ALL: u32 = (1 << 9) - 1;
+    pub const ALL: u32 = (1 << 10) - 1;
 
     /// Names of the flags in bit order.
-    pub const NAMES: [&str; 9] = [
+    pub const NAMES: [&str; 10] = [
         "invalid_state",
         "invalid_nominal",
         "invalid_coupling",
@@ -51,6 +56,7 @@ pub mod faults {
         "output_clamped",
         "nominal_missing",
         "qp_second_opinion",
+        "margins_degraded",
     ];
 }
 

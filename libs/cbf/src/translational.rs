@@ -567,8 +567,9 @@ impl TranslationalFilter {
     /// No command is certified for the declared errors: the command of the rows with the
     /// share `λ` of the declared errors that are still feasible, found by bisection — the
     /// largest when feasibility falls with `λ`, not proven in general (for every command
-    /// in the box; bisection, [`DEGRADE_ROUNDS`] halvings), reported as relaxed with the
-    /// violation `1 − λ` (the share of the margins given up). `λ = 0` is the nominal
+    /// in the box; bisection, [`DEGRADE_ROUNDS`] halvings), flagged
+    /// [`crate::common::faults::MARGINS_DEGRADED`] with the violation `1 − λ` (the share of the margins
+    /// given up). `λ = 0` is the nominal
     /// model's rows; when even they are infeasible, their relaxed problem as without
     /// declared errors. Never the relaxed problem of infeasible margins, which can give up
     /// the zone for the corridor (docs/SAFETY.md).
@@ -601,8 +602,10 @@ impl TranslationalFilter {
                 hi = mid;
             }
         }
-        best.kind = Kind::Relaxed;
+        // a solution of the degraded rows (verify-qp checks it as such), flagged apart
+        // from the relaxed problem
         best.violation = 1.0 - share;
+        report.faults |= crate::common::faults::MARGINS_DEGRADED;
         self.conclude_solved(x, p, u_nom, &best, &best_rows, report)
     }
 

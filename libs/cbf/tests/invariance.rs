@@ -123,7 +123,9 @@ fn translational_run_in(
             if out.report.status != FilterStatus::Skipped {
                 run.interventions += 1;
             }
-            if out.report.status == FilterStatus::Relaxed {
+            if out.report.status == FilterStatus::Relaxed
+                || out.report.faults & sc_cbf::faults::MARGINS_DEGRADED != 0
+            {
                 run.relaxed += 1;
             }
             out.actuated

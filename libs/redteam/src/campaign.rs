@@ -56,8 +56,9 @@ pub struct CaseResult {
     /// Applied commands outside the input bounds (`‖f_B‖∞ ≤ F`, `‖τ_B‖∞ ≤ T`,
     /// `‖τ_M‖∞ ≤ T_M`).
     pub out_of_bounds_applied: usize,
-    /// Per filter: steps on the substitute nominal (invalid or missing), on the relaxed
-    /// problem, on the backup law.
+    /// Per filter: steps on the substitute nominal (invalid or missing), without a certified
+    /// command (the relaxed problem, or degraded margins under a declared uncertainty), on
+    /// the backup law.
     #[serde(with = "per_subsystem")]
     pub substituted_steps: PerSubsystem<usize>,
     #[serde(with = "per_subsystem")]
@@ -253,7 +254,7 @@ fn count_steps(r: &mut CaseResult, records: &[StepRecord], lim: &sc_scenario::Li
             if f & (faults::INVALID_NOMINAL | faults::NOMINAL_MISSING) != 0 {
                 r.substituted_steps[s] += 1;
             }
-            if f & faults::QP_INFEASIBLE_RELAXED != 0 {
+            if f & (faults::QP_INFEASIBLE_RELAXED | faults::MARGINS_DEGRADED) != 0 {
                 r.relaxed_steps[s] += 1;
             }
             if f & (faults::QP_FAILED_FALLBACK | faults::INVALID_STATE) != 0 {

@@ -270,7 +270,7 @@ fn markdown_header(m: &mut String, s: &CampaignSummary, how: &str) {
     );
     let _ = writeln!(
         m,
-        "{how} Columns: how the mission ended, the barrier closest to its boundary (value / barrier scale, `figures/redteam_margins.svg`), and per filter (translational/attitude/robotic) the steps on the substitute nominal, on the relaxed problem and on the backup law, and the steps on which a subsystem the case does not attack was disturbed.\n"
+        "{how} Columns: how the mission ended, the barrier closest to its boundary (value / barrier scale, `figures/redteam_margins.svg`), and per filter (translational/attitude/robotic) the steps on the substitute nominal, without a certified command (on the relaxed problem, or with degraded margins under a declared uncertainty) and on the backup law, and the steps on which a subsystem the case does not attack was disturbed.\n"
     );
 }
 
