@@ -65,7 +65,8 @@ class HostileNavigation(Navigation):
     def estimate(self, m):
         self.history.append(m.raw)
         e = m.estimate()
-        if m.tick < self.from_tick or len(self.history) < self.history.maxlen:
+        attack_possible = not (self.strategy == "old_tick" and m.tick == 0)
+        if m.tick < self.from_tick or len(self.history) < self.history.maxlen or not attack_possible:
             return e
         self.attacks += 1
         if self.strategy == "nan":
@@ -87,7 +88,7 @@ class HostileNavigation(Navigation):
         # silent: nothing published at all (the SDK would answer a None with NaN)
         if self.strategy == "silent" and raw.tick >= self.from_tick:
             self.attacks += 1
-            return None, None
+            return None, "silent"
         return super().message(raw, recv_ns)
 
 

@@ -141,7 +141,8 @@ fn uncertified_note(s: &Scenario) -> Result<String, Problem> {
             Some(r) => format!(
                 "; NOTE: under the declared uncertainty the translational rows cannot certify \
                  a state on the approach corridor's wall at ranges up to {r:.2} m (there the \
-                 filter keeps the largest share of the margins it can, flagged relaxed; \
+                 filter keeps the largest share of the margins it can, flagged \
+                 margins_degraded; \
                  docs/SAFETY.md)"
             ),
             None => String::new(),

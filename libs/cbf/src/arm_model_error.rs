@@ -427,9 +427,10 @@ mod tests {
             }
             // the joint torques' declared error, whose own first-order effect the rows
             // carry: the bound is for the rest
-            let e = Vector7::from_fn(|k, _| {
-                act.joint_torque_bias_nm + act.joint_torque_scale_rel * u[6 + k].abs()
-            });
+            // scale and ripple multiply (TorqueError: rel = s + r + s r)
+            let (s, rp) = (act.joint_torque_scale_rel, act.joint_torque_ripple_rel);
+            let rel = s + rp + s * rp;
+            let e = Vector7::from_fn(|k, _| act.joint_torque_bias_nm + rel * u[6 + k].abs());
             let mut du = Vector13::zeros();
             for k in 0..NJ {
                 du[6 + k] = pick(&mut seed, e[k]);

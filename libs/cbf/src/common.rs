@@ -60,6 +60,14 @@ pub mod faults {
     ];
 }
 
+/// Whether the step's command is certified for every declared error: solved (or skipped,
+/// the nominal meeting every row) and not on degraded margins
+/// ([`faults::MARGINS_DEGRADED`], reported with status solved).
+pub fn certified<const N: usize>(r: &FilterReport<N>) -> bool {
+    matches!(r.status, FilterStatus::Solved | FilterStatus::Skipped)
+        && r.faults & faults::MARGINS_DEGRADED == 0
+}
+
 /// A nominal command is rejected when `‖u_nom‖∞ > NOMINAL_RANGE × bound` (it would only be
 /// clipped anyway, and astronomically large costs ruin the solver's conditioning).
 pub const NOMINAL_RANGE: f64 = 1e3;

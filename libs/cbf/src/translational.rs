@@ -603,7 +603,8 @@ impl TranslationalFilter {
             }
         }
         // a solution of the degraded rows (verify-qp checks it as such), flagged apart
-        // from the relaxed problem
+        // from the relaxed problem; never "skipped" (that says every declared row held)
+        best.kind = Kind::Solved;
         best.violation = 1.0 - share;
         report.faults |= crate::common::faults::MARGINS_DEGRADED;
         self.conclude_solved(x, p, u_nom, &best, &best_rows, report)

@@ -344,11 +344,9 @@ pub fn wall_uncertifiable_below(s: &sc_scenario::Scenario, robot: &Robot) -> Opt
                 sc_models::quat::IDENTITY,
             );
             x.com_error = com_error;
-            // relaxed, refused or braked without a solver: not certified
-            !matches!(
-                filter.backup(&x).report.status,
-                crate::common::FilterStatus::Solved | crate::common::FilterStatus::Skipped
-            )
+            // relaxed, degraded, refused or braked without a solver: not certified
+            let r = filter.backup(&x).report;
+            !crate::common::certified(&r)
         })
         .last()
 }

@@ -264,7 +264,9 @@ def run_offline_navigation(navigation, measurements, scenario, period_s):
     out = []
     for m in measurements:
         estimate, reason = navigation.message(m)
-        out.append(OfflineEstimate(m.tick, m.t, m.measured_t, int(estimate is not None), estimate, reason))
+        if reason is not None:
+            estimate = None  # the partition's answer would be the refusable NaN
+        out.append(OfflineEstimate(m.tick, m.t, m.measured_t, int(reason is None), estimate, reason))
     return out
 
 

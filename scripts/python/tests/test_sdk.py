@@ -190,3 +190,28 @@ class Lz4(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class OfflineNavigation(unittest.TestCase):
+    """The harness judges a navigation's answers as the partition would: an estimate that
+    raises or returns None is a step without an estimate, even though the partition gets
+    the refusable NaN answer."""
+
+    def test_no_estimate_is_counted_and_left_blank(self):
+        from sc_partner.harness import run_offline_navigation
+
+        class Sometimes(Navigation):
+            def estimate(self, m):
+                if m.tick % 2:
+                    return None
+                return m.estimate()
+
+        ms = []
+        for k in range(4):
+            raw = icd.NavState(tick=k, t=0.1 * k, measured_t=0.1 * k)
+            raw.q_ib[:] = [1.0, 0.0, 0.0, 0.0]
+            ms.append(raw)
+        out = run_offline_navigation(Sometimes(), ms, {}, 0.1)
+        self.assertEqual([e.valid for e in out], [1, 0, 1, 0])
+        self.assertIsNone(out[1].estimate)
+        self.assertIn("no estimate", out[1].reason)

@@ -211,7 +211,7 @@ pub fn summary(out: &Path) -> serde_json::Value {
 /// No process of a healthy lock-step run slept through an input it had already
 /// been sent (a lost wake-up):
 /// - no stage was woken by the scheduler's stage-deadline watchdog. Its lock-step
-///   deadlines are 20 times the real-time ones (0.8 s and more after the state), so
+///   deadlines are 20 times the real-time ones (0.8 s and more after the tick), so
 ///   a wake-up there means a lost wake-up, not a slow machine;
 /// - no process saw the stop only when its 1 s wait ran out (it logs
 ///   [`sc_flight::roles::LOST_STOP_WAKEUP`] then).
