@@ -460,3 +460,44 @@ fn a_partition_red_team_refuses_a_profile_the_file_does_not_declare() {
     assert!(text(&o).contains("--partition"), "{}", text(&o));
     assert!(!d.0.join("o").exists(), "a case was started");
 }
+
+/// Plant mismatch through the partition, not declared: the filters are told `exact`
+/// while the partition's simulator propagates a plant drawn from `realistic`
+/// (`[uncertainty.truth]`: other masses, inertias and CoM, actuator and navigation
+/// errors). `launch` says the realised errors left the declared bounds, naming them, and
+/// exits 1 — never silently; the navigation's estimates, beyond the declared bounds, are
+/// refused and flagged.
+#[test]
+fn an_undeclared_plant_mismatch_through_the_partition_is_said() {
+    let d = tmp("unc-partition-truth");
+    let s = short_scenario(&d.0, DURATION_S);
+    let realistic =
+        std::fs::read_to_string(root().join("config/uncertainty/realistic.toml")).unwrap();
+    let truth: String = realistic
+        .lines()
+        .map(|l| match l.trim() {
+            "[model]" | "[actuators]" | "[navigation]" => {
+                format!("[uncertainty.truth.{}]\n", &l.trim()[1..l.trim().len() - 1])
+            }
+            _ => format!("{l}\n"),
+        })
+        .collect();
+    let mut text_s = std::fs::read_to_string(&s).unwrap();
+    text_s.push_str("\n[uncertainty]\nprofile = \"exact\"\nseed = 5\n\n");
+    text_s.push_str(&truth);
+    std::fs::write(&s, text_s).unwrap();
+    let p = partition_config(&d.0, &s, "");
+    let o = launch(&p, &d.0.join("launch"));
+    let out = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{out}");
+    assert!(out.contains("LEFT the declared bounds"), "{out}");
+    assert!(out.contains("model.link_mass_rel"), "{out}");
+    assert!(
+        out.contains("partition: timeout at t = 8.0 s"),
+        "the run went through: {out}"
+    );
+    // the navigation's errors drawn from `realistic` are beyond `exact`'s zero bounds: the
+    // simulator's gate refuses them and the filters get the measurement, flagged
+    let summary = std::fs::read_to_string(d.0.join("launch/summary.json")).unwrap();
+    assert!(summary.contains("NAVIGATION_REJECTED"), "{summary}");
+}
