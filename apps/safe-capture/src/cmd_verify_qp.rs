@@ -18,8 +18,10 @@ use std::process::ExitCode;
 /// Where no exact reference is found, the distance to Clarabel's own solution is judged
 /// with its looser tolerance (the count is printed). For information, the KKT
 /// stationarity residual with multipliers recomputed by non-negative least squares over
-/// the rows active at the engine's solution. Lengths are relative to the filter's input
-/// bound.
+/// the rows active at the engine's solution; and the dump's own multipliers, which must
+/// certify the solution (stationarity, sign and complementarity with the dumped rows and
+/// bounds; the exact engine's own solutions, not Clarabel's second opinion). Lengths are
+/// relative to the filter's input bound.
 ///
 /// Prints per filter: QPs checked, largest relative violation, stationarity residual,
 /// distance to the exact reference and to Clarabel, and the step of each largest value.
@@ -42,6 +44,10 @@ pub struct Args {
     /// agrees to about this).
     #[arg(long, value_name = "REL", default_value_t = 1e-6)]
     clarabel_tolerance: f64,
+    /// Largest accepted residual of the dump's own multipliers (stationarity, sign,
+    /// complementarity; `sc_cbf::verify::dual_residual`), relative to the input bound.
+    #[arg(long, value_name = "REL", default_value_t = 1e-9)]
+    certificate_tolerance: f64,
 }
 
 /// The exact reference must be a KKT point to this (relative to the input bound): rows
@@ -66,6 +72,9 @@ struct Worst {
     clarabel_failed: usize,
     violation: (f64, u64),
     stationarity: (f64, u64),
+    /// The dump's own multipliers: how far from certifying the solution
+    /// (`sc_cbf::verify::dual_residual`), over the exact engine's own solutions.
+    certificate: (f64, u64),
     clarabel: (f64, u64),
     exact: (f64, u64),
     /// QPs without an exact reference: their distance to Clarabel (judged instead).
@@ -86,8 +95,11 @@ fn raise(slot: &mut (f64, u64), v: f64, step: u64) {
 
 impl Worst {
     /// Adds the check `c` of the QP of `step`, lengths relative to the input bound `u_inf`.
-    fn add(&mut self, c: &Check, u_inf: f64, step: u64) {
+    fn add(&mut self, c: &Check, certificate: Option<f64>, u_inf: f64, step: u64) {
         self.checked += 1;
+        if let Some(r) = certificate {
+            raise(&mut self.certificate, r / u_inf, step);
+        }
         raise(&mut self.violation, c.violation / u_inf, step);
         raise(&mut self.stationarity, c.stationarity / u_inf, step);
         match c.clarabel_distance {
@@ -110,7 +122,8 @@ impl Worst {
 
     /// Every check within the tolerances of `a`.
     fn within(&self, a: &Args) -> bool {
-        let kkt_ok = self.violation.0 <= a.feasibility_tolerance;
+        let kkt_ok = self.violation.0 <= a.feasibility_tolerance
+            && self.certificate.0 <= a.certificate_tolerance;
         let exact_ok = self.exact.0 <= a.exact_tolerance;
         // a QP without any reference (Clarabel failed, no KKT point found) is not verified
         let unverified = self.checked - self.exact_n;
@@ -139,7 +152,12 @@ fn check_dump(a: &Args) -> anyhow::Result<BTreeMap<String, Worst>> {
             ACTIVE_TOLERANCE * u_inf,
             EXACT_KKT_TOLERANCE * u_inf,
         );
-        worst.entry(l.filter).or_default().add(&c, u_inf, l.step);
+        let certificate = (l.qp.solver_status == sc_cbf::engine::ACTIVE_SET_STATUS)
+            .then(|| sc_cbf::verify::dual_residual(&l.qp));
+        worst
+            .entry(l.filter)
+            .or_default()
+            .add(&c, certificate, u_inf, l.step);
     }
     Ok(worst)
 }
@@ -147,12 +165,14 @@ fn check_dump(a: &Args) -> anyhow::Result<BTreeMap<String, Worst>> {
 /// The line of filter `f`'s worst values and verdict.
 fn filter_line(f: &str, w: &Worst, ok: bool) {
     outln!(
-        "{f:<14} {:>6} QPs  violation {:.1e} (step {})  stationarity {:.1e} (step {})  distance to exact {:.1e} (step {}) on {}  to Clarabel {:.1e} (step {}){}{}  {}",
+        "{f:<14} {:>6} QPs  violation {:.1e} (step {})  stationarity {:.1e} (step {})  dumped duals {:.1e} (step {})  distance to exact {:.1e} (step {}) on {}  to Clarabel {:.1e} (step {}){}{}  {}",
         w.checked,
         w.violation.0,
         w.violation.1,
         w.stationarity.0,
         w.stationarity.1,
+        w.certificate.0,
+        w.certificate.1,
         w.exact.0,
         w.exact.1,
         w.exact_n,
@@ -187,8 +207,9 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let total: usize = worst.values().map(|w| w.checked).sum();
     let exact: usize = worst.values().map(|w| w.exact_n).sum();
     outln!(
-        "verify-qp: {total} solved QPs checked, {exact} against an exact reference (relative to the input bound: violation <= {:e}, distance to exact <= {:e}, to Clarabel where none <= {:e}): {}",
+        "verify-qp: {total} solved QPs checked, {exact} against an exact reference (relative to the input bound: violation <= {:e}, dumped duals <= {:e}, distance to exact <= {:e}, to Clarabel where none <= {:e}): {}",
         a.feasibility_tolerance,
+        a.certificate_tolerance,
         a.exact_tolerance,
         a.clarabel_tolerance,
         if ok { "all within" } else { "NOT all within" }

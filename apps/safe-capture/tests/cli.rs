@@ -684,8 +684,9 @@ fn run_and_verify_qps(d: &Path, extra: &[&str]) -> (PathBuf, Output, Output) {
     (dump, out, v)
 }
 
-/// `verify-qp` on every QP of the default mission: each solved QP's solution is feasible and
-/// Clarabel's solution of the same data agrees with it; a tampered solution is caught.
+/// `verify-qp` on every QP of the default mission: each solved QP's solution is feasible,
+/// Clarabel's solution of the same data agrees with it and the dump's own multipliers
+/// certify it; a tampered solution or multiplier is caught.
 #[test]
 fn verify_qp_agrees_with_clarabel_on_the_default_mission_and_catches_a_tampered_solution() {
     let d = tmp("verify-qp");
@@ -738,6 +739,32 @@ fn verify_qp_agrees_with_clarabel_on_the_default_mission_and_catches_a_tampered_
             "shift {shift}: {stdout}"
         );
     }
+    // the dump's own multipliers certify each solution; one doubled no longer does
+    let mut tampered = Vec::new();
+    let mut done = false;
+    for l in text.lines() {
+        let mut j: Value = serde_json::from_str(l).unwrap();
+        if !done && j["qp"]["outcome"] == "Solved" {
+            for key in ["row_duals", "bound_duals"] {
+                let duals = j["qp"][key].as_array_mut().unwrap();
+                if let Some(x) = duals.iter_mut().find(|x| x.as_f64().unwrap() > 0.0) {
+                    *x = serde_json::json!(2.0 * x.as_f64().unwrap());
+                    done = true;
+                    break;
+                }
+            }
+        }
+        tampered.push(j.to_string());
+    }
+    assert!(
+        done,
+        "no solved QP with an active row in the default mission"
+    );
+    let bad = d.join("tampered_duals.jsonl");
+    std::fs::write(&bad, tampered.join("\n") + "\n").unwrap();
+    let v = bin().arg("verify-qp").arg(&bad).output().unwrap();
+    let stdout = String::from_utf8_lossy(&v.stdout).to_string();
+    assert_eq!(v.status.code(), Some(1), "doubled multiplier: {stdout}");
     let _ = std::fs::remove_dir_all(&d);
 }
 

@@ -47,6 +47,14 @@ pub enum Kind {
     Failed,
 }
 
+/// The dump's `solver_status` of the exact engine's own solution (its multipliers
+/// recorded) and of Clarabel's second opinion (not recorded).
+pub const ACTIVE_SET_STATUS: &str = "active_set";
+pub const SECOND_OPINION_STATUS: &str = "second_opinion";
+
+/// Most hard rows a filter has (the robotic filter's 2·7 + 6) with room to spare.
+pub const MAX_HARD_ROWS: usize = 32;
+
 /// Result of [`Engine::solve`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Outcome<const M: usize> {
@@ -59,6 +67,10 @@ pub struct Outcome<const M: usize> {
     pub iterations: u32,
     /// Multipliers of the barrier rows (0 when skipped; 0 from the second opinion).
     pub row_duals: [f64; 64],
+    /// Multipliers of the hard rows, the same convention (`u − u_nom = Σλ_i a_i` over the
+    /// barrier and the hard rows as solved; 0 when skipped, relaxed or from the second
+    /// opinion).
+    pub bound_duals: [f64; MAX_HARD_ROWS],
     /// The active-set solver stopped at its iteration limit (degeneracy or cycling) and
     /// the command is Clarabel's solution of the same hard problem (flagged by the
     /// filters as [`crate::faults::QP_SECOND_OPINION`]).
@@ -198,6 +210,7 @@ impl<const M: usize, const N: usize> Engine<M, N> {
             violation: 0.0,
             iterations: 0,
             row_duals: [0.0; 64],
+            bound_duals: [0.0; MAX_HARD_ROWS],
             second_opinion: false,
         };
         let nb = rows.len();
@@ -254,6 +267,8 @@ impl<const M: usize, const N: usize> Engine<M, N> {
                 out.kind = Kind::Solved;
                 out.u = SVector::from(hard.x);
                 out.row_duals[..nb].copy_from_slice(&hard.lambda[..nb]);
+                let nh = (n - nb).min(MAX_HARD_ROWS);
+                out.bound_duals[..nh].copy_from_slice(&hard.lambda[nb..nb + nh]);
             }
             Status::Infeasible if !relax => {}
             Status::Infeasible => {
@@ -455,6 +470,9 @@ pub struct LastProblem<const M: usize> {
     pub violation: f64,
     pub iterations: u32,
     pub row_duals: Vec<f64>,
+    pub bound_duals: Vec<f64>,
+    /// The command is Clarabel's second opinion (its multipliers are not recorded).
+    pub second_opinion: bool,
 }
 
 impl<const M: usize> LastProblem<M> {
@@ -470,6 +488,8 @@ impl<const M: usize> LastProblem<M> {
             violation: 0.0,
             iterations: 0,
             row_duals: Vec::with_capacity(rows),
+            bound_duals: Vec::with_capacity(hard),
+            second_opinion: false,
         }
     }
 
@@ -496,6 +516,10 @@ impl<const M: usize> LastProblem<M> {
         self.row_duals.clear();
         self.row_duals
             .extend_from_slice(&out.row_duals[..rows.len().min(64)]);
+        self.second_opinion = out.second_opinion;
+        self.bound_duals.clear();
+        self.bound_duals
+            .extend_from_slice(&out.bound_duals[..hard.len().min(MAX_HARD_ROWS)]);
     }
 
     /// As a [`crate::QpDump`] (allocates).
@@ -517,7 +541,7 @@ impl<const M: usize> LastProblem<M> {
             bounds_g_max: self.hard.iter().map(|r| r.c).collect(),
             solution: self.u.iter().copied().collect(),
             row_duals: self.row_duals.clone(),
-            bound_duals: vec![0.0; self.hard.len()],
+            bound_duals: self.bound_duals.clone(),
             slack: self.violation,
             outcome: self.kind.map(|k| match k {
                 Kind::Skipped => QpOutcome::Skipped,
@@ -525,7 +549,12 @@ impl<const M: usize> LastProblem<M> {
                 Kind::Relaxed => QpOutcome::Relaxed,
                 Kind::Failed => QpOutcome::Failed,
             }),
-            solver_status: "active_set".into(),
+            solver_status: if self.second_opinion {
+                SECOND_OPINION_STATUS
+            } else {
+                ACTIVE_SET_STATUS
+            }
+            .into(),
             hard_status: String::new(),
             iterations: self.iterations,
         }

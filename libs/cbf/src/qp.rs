@@ -111,8 +111,8 @@ pub struct QpDump {
     /// Multipliers λ_i ≥ 0 of the barrier rows. Exact engine: `u − u_nom = Σλ_i a_i −
     /// Σμ_k g_k` (the cost `½‖u − u_nom‖²`); Clarabel engine: `2(u − u_nom) = Σλ_i a_i − Gᵀμ`.
     pub row_duals: Vec<f64>,
-    /// Multipliers μ_k ≥ 0 of the hard rows (Clarabel engine only; zero from the exact
-    /// engine, which does not record them).
+    /// Multipliers μ_k ≥ 0 of the hard rows (exact engine: of the hard solve, zero when
+    /// skipped, relaxed or from the second opinion).
     pub bound_duals: Vec<f64>,
     /// Exact engine: the largest allowance `t*` of the relaxed problem (a fraction of the
     /// rows' weights); Clarabel engine: the slack of its relaxed problem. 0 otherwise.

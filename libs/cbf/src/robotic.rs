@@ -419,6 +419,9 @@ struct Verified {
     violation: f64,
     /// It is Clarabel's second opinion.
     second_opinion: bool,
+    /// The multipliers of its solve.
+    row_duals: [f64; 64],
+    bound_duals: [f64; crate::engine::MAX_HARD_ROWS],
 }
 
 /// Rows of relative degree two: the joint angles and the link spheres (not the rates).
@@ -1000,7 +1003,9 @@ impl RoboticFilter {
             u: c.res.u,
             violation: 0.0,
             iterations: c.iterations,
-            row_duals: [0.0; 64],
+            // the multipliers of the solve the dump's rows are (`behind.solved`)
+            row_duals: c.res.row_duals,
+            bound_duals: c.res.bound_duals,
             second_opinion: false,
         };
         if behind.certifying.is_some() {
@@ -1023,6 +1028,7 @@ impl RoboticFilter {
             };
             o.u = v.u;
             o.second_opinion = v.second_opinion;
+            (o.row_duals, o.bound_duals) = (v.row_duals, v.bound_duals);
             behind.solved = Some(v.rows);
             behind.certifying = Some(v.rows);
             return o;
@@ -1069,6 +1075,8 @@ impl RoboticFilter {
                 rows,
                 violation: 0.0,
                 second_opinion: res.second_opinion,
+                row_duals: res.row_duals,
+                bound_duals: res.bound_duals,
             };
             if v.ok {
                 let violation = if res.kind == Kind::Relaxed {

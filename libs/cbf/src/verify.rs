@@ -300,6 +300,40 @@ pub fn check(d: &QpDump, u_inf: f64, act_tol: f64, exact_tol: f64) -> Check {
     }
 }
 
+/// How far the dump's own multipliers are from certifying its solution, the largest of:
+/// the stationarity residual `‖(u − u_nom) − Σλ_i a_i + Σμ_k g_k‖∞` (the exact engine's
+/// convention, [`QpDump::row_duals`]), a negative multiplier's pull `−λ_i‖a_i‖`, and the
+/// complementarity `min(λ_i‖a_i‖, slack_i/‖a_i‖)` (a pull on a row that is not active)
+/// [u]. 0 for the exact certificate.
+pub fn dual_residual(d: &QpDump) -> f64 {
+    let m = d.solution.len();
+    let mut r: Vec<f64> = (0..m).map(|j| d.solution[j] - d.u_nom[j]).collect();
+    let mut worst = 0.0f64;
+    let dot = |a: &[f64]| a.iter().zip(&d.solution).map(|(x, y)| x * y).sum::<f64>();
+    let norm = |a: &[f64]| {
+        a.iter()
+            .map(|x| x * x)
+            .sum::<f64>()
+            .sqrt()
+            .max(f64::MIN_POSITIVE)
+    };
+    for ((lam, a), c) in d.row_duals.iter().zip(&d.rows_a).zip(&d.rows_c) {
+        for j in 0..m {
+            r[j] -= lam * a[j];
+        }
+        let (pull, slack) = (lam * norm(a), (c + dot(a)) / norm(a));
+        worst = worst.max(-pull).max(pull.min(slack.abs()));
+    }
+    for ((mu, g), gm) in d.bound_duals.iter().zip(&d.bounds_g).zip(&d.bounds_g_max) {
+        for j in 0..m {
+            r[j] += mu * g[j];
+        }
+        let (pull, slack) = (mu * norm(g), (gm - dot(g)) / norm(g));
+        worst = worst.max(-pull).max(pull.min(slack.abs()));
+    }
+    r.iter().fold(worst, |w, x| w.max(x.abs()))
+}
+
 /// The scale of the filter's inputs: the largest half-width `g_max/‖g‖` of its hard rows
 /// (the input bound for a box, also a rotated one); `fallback` when there is none. A box
 /// rotated in `m` dimensions bounds `‖u‖∞` by `√m` times this.
