@@ -207,39 +207,6 @@ impl ModelErrorBound {
     }
 }
 
-/// The model accelerations `ν̇` of commands whose joint accelerations are within `spread`
-/// of `centre` [rad/s²] at `(θ, ν)` under the base wrench `[f_B; τ_B]`, as a centre and an
-/// elementwise radius: the base's `v̇_B = M_bb⁻¹(u_B − b_B − M_bθ θ̈)`.
-pub fn acceleration_box(
-    robot: &Robot,
-    theta: &Vector7,
-    nu: &Vector13,
-    force_b: &Vector3<f64>,
-    torque_b: &Vector3<f64>,
-    centre: &Vector7,
-    spread: &Vector7,
-) -> Option<(Vector13, Vector13)> {
-    let m = robot.mass_matrix(theta);
-    let b = robot.nonlinear_effects(theta, nu);
-    let inv_bb = m
-        .fixed_view::<6, 6>(0, 0)
-        .into_owned()
-        .cholesky()?
-        .inverse();
-    let u_b = Vector6::new(
-        force_b.x, force_b.y, force_b.z, torque_b.x, torque_b.y, torque_b.z,
-    );
-    let k = inv_bb * m.fixed_view::<6, NJ>(0, 6);
-    let v0 = inv_bb * (u_b - b.fixed_rows::<6>(0)) - k * centre;
-    let mut c13 = Vector13::zeros();
-    c13.fixed_rows_mut::<6>(0).copy_from(&v0);
-    c13.fixed_rows_mut::<NJ>(6).copy_from(centre);
-    let mut rho = Vector13::zeros();
-    rho.fixed_rows_mut::<6>(0).copy_from(&(k.abs() * spread));
-    rho.fixed_rows_mut::<NJ>(6).copy_from(spread);
-    (c13.iter().chain(rho.iter()).all(|v| v.is_finite())).then_some((c13, rho))
-}
-
 /// A bound on the base's inertia error relative to its inertia in the PSD order:
 /// `−λI₀ ⪯ ΔI₀ ⪯ λI₀` for every plant in the declared box (the base's inertia in its own
 /// frame is constant, so this is computed once). With `‖·‖` the spectral norm after the

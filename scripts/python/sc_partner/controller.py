@@ -69,6 +69,19 @@ _SUBSYSTEM = {
 HANDSHAKE_TIMEOUT_S = 60.0
 
 
+def field(raw, name, writeable=False):
+    """Field `name` of the ctypes message `raw`: a scalar as a Python number, an array as
+    a ``numpy`` float64 view of the message's memory (read-only unless `writeable`)."""
+    if name.startswith("_"):
+        raise AttributeError(name)
+    value = getattr(raw, name)
+    if isinstance(value, ctypes.Array):
+        array = np.ctypeslib.as_array(value)
+        array.flags.writeable = writeable
+        return array
+    return value
+
+
 class State:
     """One state of the mission as a controller sees it (a copy of ``SimState``).
 
@@ -86,14 +99,7 @@ class State:
         self.phase = phase
 
     def __getattr__(self, name):
-        if name.startswith("_"):
-            raise AttributeError(name)
-        value = getattr(self.raw, name)
-        if isinstance(value, ctypes.Array):
-            array = np.ctypeslib.as_array(value)
-            array.flags.writeable = False
-            return array
-        return value
+        return field(self.raw, name)
 
     def __repr__(self):
         return f"State(tick={self.raw.tick}, t={self.raw.t}, phase={self.phase})"

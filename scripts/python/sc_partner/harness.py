@@ -431,14 +431,7 @@ def main(argv=None):
     controller = load_controller(args.controller)()
     if isinstance(controller, Navigation):
         return _main_navigation(p, args, controller)
-    if args.config:
-        partition = sc_config.read_toml(args.config)
-        scenario = sc_config.read_toml(sc_config.scenario_path(args.config, partition))
-        period_s, _ = sc_config.group_periods(partition, controller.subsystem)
-    else:
-        partition = None
-        scenario = sc_config.read_toml(args.scenario)
-        period_s = float(scenario["mission"]["control_period_s"])
+    partition, scenario, period_s = _sources(args, controller.subsystem)
     if args.mcap:
         states = states_from_mcap(args.mcap, scenario)
     else:
@@ -461,16 +454,25 @@ def main(argv=None):
     return 1 if args.strict and invalid else 0
 
 
+def _sources(args, subsystem):
+    """(partition config or None, scenario, period [s]) of `--config` or `--scenario`:
+    the period of `subsystem`'s rate group, or (None) the base period; a scenario alone
+    runs every subsystem at its control period."""
+    if not args.config:
+        scenario = sc_config.read_toml(args.scenario)
+        return None, scenario, float(scenario["mission"]["control_period_s"])
+    partition = sc_config.read_toml(args.config)
+    scenario = sc_config.read_toml(sc_config.scenario_path(args.config, partition))
+    if subsystem is None:
+        return partition, scenario, sc_config.base_period(partition)
+    return partition, scenario, sc_config.group_periods(partition, subsystem)[0]
+
+
 def _main_navigation(parser, args, navigation):
     """`main` for a navigation: its estimates of a partition run's recorded measurements."""
     if not args.mcap:
         parser.error("a navigation runs on the measurements of a partition run: give its --mcap recording.mcap")
-    if args.config:
-        scenario = sc_config.read_toml(sc_config.scenario_path(args.config))
-        period_s = sc_config.base_period(sc_config.read_toml(args.config))
-    else:
-        scenario = sc_config.read_toml(args.scenario)
-        period_s = float(scenario["mission"]["control_period_s"])
+    _, scenario, period_s = _sources(args, None)
     measurements = nav_states_from_mcap(args.mcap)
     estimates = run_offline_navigation(navigation, measurements, scenario, period_s)
     if args.out:

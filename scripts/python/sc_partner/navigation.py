@@ -33,7 +33,6 @@ The same subclass runs offline on a partition run's recorded measurements
 """
 
 import argparse
-import ctypes
 import os
 import sys
 import traceback
@@ -42,6 +41,7 @@ import numpy as np
 
 from . import config as sc_config
 from . import icd
+from .controller import field
 
 HANDSHAKE_TIMEOUT_S = 60.0
 
@@ -57,14 +57,7 @@ class Measurement:
         self.raw = raw
 
     def __getattr__(self, name):
-        if name.startswith("_"):
-            raise AttributeError(name)
-        value = getattr(self.raw, name)
-        if isinstance(value, ctypes.Array):
-            array = np.ctypeslib.as_array(value)
-            array.flags.writeable = False
-            return array
-        return value
+        return field(self.raw, name)
 
     def estimate(self):
         """A writable :class:`Estimate` holding the measurement's values (tick, times
@@ -85,17 +78,12 @@ class Estimate:
         object.__setattr__(self, "raw", raw)
 
     def __getattr__(self, name):
-        if name.startswith("_"):
-            raise AttributeError(name)
-        value = getattr(self.raw, name)
-        if isinstance(value, ctypes.Array):
-            return np.ctypeslib.as_array(value)
-        return value
+        return field(self.raw, name, writeable=True)
 
     def __setattr__(self, name, value):
-        current = getattr(self.raw, name)
-        if isinstance(current, ctypes.Array):
-            np.ctypeslib.as_array(current)[:] = value
+        current = field(self.raw, name, writeable=True)
+        if isinstance(current, np.ndarray):
+            current[:] = value
         else:
             setattr(self.raw, name, value)
 
