@@ -70,7 +70,7 @@ pub enum BusError {
     },
     /// A subscriber did not take the sample within the backpressure timeout
     /// (it is stuck or dead); the sample was dropped for that subscriber only.
-    #[error("send on {service:?}: a subscriber did not drain its buffer within {timeout:?}")]
+    #[error("send on {service:?}: a subscriber's queue stayed full (waited {timeout:?}); the sample was dropped for it alone")]
     Backpressure {
         /// Service name.
         service: String,

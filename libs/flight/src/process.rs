@@ -29,7 +29,11 @@ pub struct Proc {
 }
 
 /// Service settings of the partition's data services: no sample is ever lost
-/// silently; a full subscriber (dead or stuck) delays a send by at most 50 ms. Every
+/// silently, and no subscriber can make a flight publisher wait. A subscriber whose
+/// queue is full (dead, hung, or one that never reads) loses that sample at once, alone,
+/// and the publisher reports it: the causal chain's timing never depends on a reader.
+/// The queue (16) holds more than the recorder is allowed to lag in lock-step
+/// (`recorder_window_ticks` ≤ 14), so a healthy run loses nothing. Every
 /// service has exactly one publisher, its owner (docs/ICD.md): a second one is refused
 /// by iceoryx2, a service created with room for more is refused by `sc_bus`, and
 /// subscribers accept samples only from the first publisher they heard.
@@ -37,6 +41,7 @@ pub fn qos() -> ServiceSettings {
     ServiceSettings {
         subscriber_buffer: 16,
         max_publishers: 1,
+        backpressure_timeout: std::time::Duration::ZERO,
         ..ServiceSettings::lock_step()
     }
 }

@@ -288,8 +288,9 @@ impl ConstGroup {
 /// Quality of service of a service: how a full subscriber is treated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Qos {
-    /// The flight side: lossless, a full subscriber makes the publisher wait up to its
-    /// backpressure timeout (`sc_flight::process::qos`, Python `sc_bus.PARTITION`).
+    /// The flight side: never silently lossy; a full subscriber loses the sample at once,
+    /// alone, and the publisher reports it — a flight publisher never waits for a reader
+    /// (`sc_flight::process::qos`, Python `sc_bus.PARTITION`).
     Flight,
     /// Partner-facing: newest wins, nobody ever waits (`sc_flight::process::partner_qos`,
     /// Python `sc_bus.NOMINAL`).

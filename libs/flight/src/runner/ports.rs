@@ -136,8 +136,8 @@ impl<T: core::fmt::Debug + ZeroCopySend + Copy + 'static> OutPort for PubPort<T>
         let msg = (self.unwrap)(m).ok_or(FlightError::WrongMessage(self.service.as_str()))?;
         match self.publisher.send(msg) {
             Ok(_) => Ok(()),
-            // a dead or stuck subscriber delays a send by at most its backpressure
-            // timeout and is reported; the run goes on
+            // a full subscriber (dead, hung or never reading) loses the sample, alone,
+            // without delaying the send (`process::qos`); reported, the run goes on
             Err(e @ sc_bus::BusError::Backpressure { .. }) => {
                 eprintln!("warning: {e}");
                 Ok(())
