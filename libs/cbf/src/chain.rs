@@ -17,7 +17,7 @@ use crate::{
     TranslationalOutput,
 };
 use nalgebra::{SVector, Vector3};
-use sc_core::{Command, Observation};
+use sc_core::{Command, Observation, PerSubsystem, Subsystem};
 use sc_models::quat;
 use sc_multibody::{Robot, Vector7};
 use std::sync::Arc;
@@ -92,6 +92,35 @@ impl SafetyLayer {
             translational: TranslationalFilter::new(TranslationalParams::from_model(s, &robot)),
             attitude: AttitudeFilter::from_scenario(s, mass),
             robotic: RoboticFilter::from_scenario(s, robot.clone()),
+            model: robot,
+        }
+    }
+
+    /// The three filters, each certifying its command (and its backup) for the hold it
+    /// gets in a multi-rate partition: `hold_s[s]` [s], its rate group's period, in place
+    /// of the scenario's control period. A backup recomputed at a shorter period keeps its
+    /// barriers over the shorter hold too: condition C1 of the sampled-data rows bounds
+    /// the barrier at every instant of the hold (`sampled`, docs/SAFETY.md).
+    pub fn with_holds(
+        s: &sc_scenario::Scenario,
+        robot: Arc<Robot>,
+        hold_s: &PerSubsystem<f64>,
+    ) -> Self {
+        let held = |sub: Subsystem| {
+            let mut x = s.clone();
+            x.mission.control_period_s = hold_s[sub];
+            x
+        };
+        let (t, a, r) = (
+            held(Subsystem::Translational),
+            held(Subsystem::Attitude),
+            held(Subsystem::Robotic),
+        );
+        let mass = robot.total_mass();
+        Self {
+            translational: TranslationalFilter::new(TranslationalParams::from_model(&t, &robot)),
+            attitude: AttitudeFilter::from_scenario(&a, mass),
+            robotic: RoboticFilter::from_scenario(&r, robot.clone()),
             model: robot,
         }
     }

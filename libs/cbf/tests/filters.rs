@@ -246,6 +246,12 @@ fn fault_flags_are_stable_and_the_layer_is_built_from_the_model() {
     assert_eq!(layer.translational.params.mass, robot().total_mass());
     assert_eq!(layer.attitude.params.mass, robot().total_mass());
     assert_eq!(layer.robotic.params.period, s.mission.control_period_s);
+    // in a multi-rate partition each filter certifies for its rate group's hold
+    let hold = sc_core::PerSubsystem([0.2, 0.1, 0.02]);
+    let held = sc_cbf::SafetyLayer::with_holds(&s, robot(), &hold);
+    assert_eq!(held.translational.params.period, 0.2);
+    assert_eq!(held.attitude.params.period, 0.1);
+    assert_eq!(held.robotic.params.period, 0.02);
     // the translational dump: the two barrier rows and the tangential speed, the force box
     let mut f = layer.translational;
     let (x, u) = tr_cases(21, 1)[0];

@@ -132,6 +132,8 @@ pub struct SafeHead<'a> {
     pub phi: &'a mut [f64],
     pub u: &'a mut [f64],
     pub actuated: &'a mut [f64],
+    pub xi_f_b: &'a mut [f64; 3],
+    pub xi_tau_b: &'a mut [f64; 3],
 }
 
 macro_rules! safe_impl {
@@ -158,6 +160,8 @@ macro_rules! safe_impl {
                     phi: &mut self.phi,
                     u: &mut self.u,
                     actuated: &mut self.actuated,
+                    xi_f_b: &mut self.xi_f_b,
+                    xi_tau_b: &mut self.xi_tau_b,
                 }
             }
             fn tick(&self) -> u64 {
@@ -175,9 +179,11 @@ safe_impl!(
 safe_impl!(sc_icd::SafeAttitude, 3, sc_icd::N_CONSTRAINTS_ATTITUDE);
 safe_impl!(sc_icd::SafeRobotic, 7, sc_icd::N_CONSTRAINTS_ROBOTIC);
 
-/// The message of a filter output.
+/// The message of a filter output certified against the upstream commands `xi` (the
+/// force and torque acting upstream; zero where the filter has no such upstream).
 pub fn safe_msg<T: SafeMsg, const M: usize, const N: usize>(
     out: &FilterOutput<M, N>,
+    xi: &Coupling,
     tick: u64,
     t: f64,
     phase: usize,
@@ -200,8 +206,30 @@ pub fn safe_msg<T: SafeMsg, const M: usize, const N: usize>(
         h.phi.copy_from_slice(&out.report.phi);
         h.u.copy_from_slice(out.u.as_slice());
         h.actuated.copy_from_slice(out.actuated.as_slice());
+        *h.xi_f_b = a3(&xi.force_b);
+        *h.xi_tau_b = a3(&xi.torque_b);
     }
     m
+}
+
+/// The upstream commands a filter's command was certified against (the paper's ξ): the
+/// base force and torque acting [N, N m, F_B].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Coupling {
+    pub force_b: Vector3<f64>,
+    pub torque_b: Vector3<f64>,
+}
+
+impl Coupling {
+    /// The coupling a safe command `m` says it was certified against.
+    pub fn of<T: SafeMsg>(m: &T) -> Self {
+        let mut m = *m;
+        let h = m.head();
+        Self {
+            force_b: v3(h.xi_f_b),
+            torque_b: v3(h.xi_tau_b),
+        }
+    }
 }
 
 /// The filter output carried by a message.

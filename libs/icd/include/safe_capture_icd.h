@@ -59,9 +59,9 @@ extern "C" {
 #define SC_TYPE_NAME_NOMINAL_TRANSLATIONAL "safe_capture::v2::NominalTranslational"
 #define SC_TYPE_NAME_NOMINAL_ATTITUDE "safe_capture::v2::NominalAttitude"
 #define SC_TYPE_NAME_NOMINAL_ROBOTIC "safe_capture::v2::NominalRobotic"
-#define SC_TYPE_NAME_SAFE_TRANSLATIONAL "safe_capture::v2::SafeTranslational"
-#define SC_TYPE_NAME_SAFE_ATTITUDE "safe_capture::v2::SafeAttitude"
-#define SC_TYPE_NAME_SAFE_ROBOTIC "safe_capture::v2::SafeRobotic"
+#define SC_TYPE_NAME_SAFE_TRANSLATIONAL "safe_capture::v3::SafeTranslational"
+#define SC_TYPE_NAME_SAFE_ATTITUDE "safe_capture::v3::SafeAttitude"
+#define SC_TYPE_NAME_SAFE_ROBOTIC "safe_capture::v3::SafeRobotic"
 #define SC_TYPE_NAME_STEP_RESULT "safe_capture::v1::StepResult"
 #define SC_TYPE_NAME_NAVIGATION_ERROR "safe_capture::v1::NavigationError"
 #define SC_TYPE_NAME_NAV_STATE "safe_capture::v1::NavState"
@@ -107,6 +107,7 @@ extern "C" {
 #define SC_FAULT_PEER_DEAD 128u /* A peer process was detected dead. */
 #define SC_FAULT_REJECTED_COMMAND 256u /* The simulator rejected a safe command (not finite or beyond the input bounds, `sc_flight::admission`) and applied the filter's backup instead. */
 #define SC_FAULT_NAVIGATION_REJECTED 512u /* The navigation's estimate was missing at the navigation deadline or rejected (not finite, not current, a quaternion off the unit sphere, or farther from the measurement than the declared navigation bounds, `sc_sim::navigation`); the simulator's own navigation (the declared error model) was substituted. */
+#define SC_FAULT_COUPLING_MISMATCH 1024u /* A safe command was not applied because it does not fit the chain the filters certified: it was certified against other upstream commands than those acting, or it came after the downstream filters had given up on it and certified against its backup; the backup acts instead (docs/PARTITION.md). */
 
 /* Values of `Health.state`. */
 #define SC_HEALTH_STARTING 0u /* Process started, ports being created. */
@@ -305,7 +306,7 @@ SC_ICD_STATIC_ASSERT(offsetof(ScNominalRobotic, recv_ns) == 24, "ScNominalRoboti
 SC_ICD_STATIC_ASSERT(offsetof(ScNominalRobotic, publish_ns) == 32, "ScNominalRobotic.publish_ns: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScNominalRobotic, tau_m) == 40, "ScNominalRobotic.tau_m: offset");
 
-/* SafeTranslational -- safe_capture::v2::SafeTranslational, 160 B. Translational safety filter → attitude and robotic filters, simulator, recorder. Constraint order: AC, CAZ. */
+/* SafeTranslational -- safe_capture::v3::SafeTranslational, 208 B. Translational safety filter → attitude and robotic filters, simulator, recorder. Constraint order: AC, CAZ. */
 typedef struct ScSafeTranslational {
     uint64_t tick; /* Tick index this command answers [-] */
     double t; /* Simulation time of the state used [s] */
@@ -324,12 +325,14 @@ typedef struct ScSafeTranslational {
     double phi[2]; /* CBF conditions Φ_i at the safe command [unit per constraint / s] */
     double u[3]; /* Safe force f_H, frame F_H [N] */
     double actuated[3]; /* Safe force f_B = R_BH f_H (what the thrusters apply), frame F_B [N] */
+    double xi_f_b[3]; /* Coupling ξ this command was certified against: the base force f_B acting upstream (the translational command or its backup; 0 for the translational filter, which has no upstream). The simulator applies the command only with exactly this force acting (docs/PARTITION.md), frame F_B [N] */
+    double xi_tau_b[3]; /* Coupling ξ this command was certified against: the base torque τ_B acting upstream (the attitude command or its backup; 0 for the translational and attitude filters), frame F_B [N·m] */
 #if defined(__cplusplus) && __cplusplus >= 201703L
     /* the name iceoryx2's C++ API matches the payload type by */
-    static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v2::SafeTranslational";
+    static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v3::SafeTranslational";
 #endif
 } ScSafeTranslational;
-SC_ICD_STATIC_ASSERT(sizeof(ScSafeTranslational) == 160, "ScSafeTranslational: size");
+SC_ICD_STATIC_ASSERT(sizeof(ScSafeTranslational) == 208, "ScSafeTranslational: size");
 SC_ICD_STATIC_ASSERT(SC_ICD_ALIGNOF(ScSafeTranslational) == 8, "ScSafeTranslational: alignment");
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeTranslational, tick) == 0, "ScSafeTranslational.tick: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeTranslational, t) == 8, "ScSafeTranslational.t: offset");
@@ -348,8 +351,10 @@ SC_ICD_STATIC_ASSERT(offsetof(ScSafeTranslational, h) == 80, "ScSafeTranslationa
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeTranslational, phi) == 96, "ScSafeTranslational.phi: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeTranslational, u) == 112, "ScSafeTranslational.u: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeTranslational, actuated) == 136, "ScSafeTranslational.actuated: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScSafeTranslational, xi_f_b) == 160, "ScSafeTranslational.xi_f_b: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScSafeTranslational, xi_tau_b) == 184, "ScSafeTranslational.xi_tau_b: offset");
 
-/* SafeAttitude -- safe_capture::v2::SafeAttitude, 240 B. Attitude safety filter → robotic filter, simulator, recorder. Constraint order: ATT, ω1..3 upper, ω1..3 lower. */
+/* SafeAttitude -- safe_capture::v3::SafeAttitude, 288 B. Attitude safety filter → robotic filter, simulator, recorder. Constraint order: ATT, ω1..3 upper, ω1..3 lower. */
 typedef struct ScSafeAttitude {
     uint64_t tick; /* Tick index this command answers [-] */
     double t; /* Simulation time of the state used [s] */
@@ -368,12 +373,14 @@ typedef struct ScSafeAttitude {
     double phi[7]; /* CBF conditions Φ_i at the safe command [unit per constraint / s] */
     double u[3]; /* Safe torque τ_B, frame F_B [N·m] */
     double actuated[3]; /* Actuated torque τ_B (equals `u`), frame F_B [N·m] */
+    double xi_f_b[3]; /* Coupling ξ this command was certified against: the base force f_B acting upstream (the translational command or its backup; 0 for the translational filter, which has no upstream). The simulator applies the command only with exactly this force acting (docs/PARTITION.md), frame F_B [N] */
+    double xi_tau_b[3]; /* Coupling ξ this command was certified against: the base torque τ_B acting upstream (the attitude command or its backup; 0 for the translational and attitude filters), frame F_B [N·m] */
 #if defined(__cplusplus) && __cplusplus >= 201703L
     /* the name iceoryx2's C++ API matches the payload type by */
-    static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v2::SafeAttitude";
+    static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v3::SafeAttitude";
 #endif
 } ScSafeAttitude;
-SC_ICD_STATIC_ASSERT(sizeof(ScSafeAttitude) == 240, "ScSafeAttitude: size");
+SC_ICD_STATIC_ASSERT(sizeof(ScSafeAttitude) == 288, "ScSafeAttitude: size");
 SC_ICD_STATIC_ASSERT(SC_ICD_ALIGNOF(ScSafeAttitude) == 8, "ScSafeAttitude: alignment");
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeAttitude, tick) == 0, "ScSafeAttitude.tick: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeAttitude, t) == 8, "ScSafeAttitude.t: offset");
@@ -392,8 +399,10 @@ SC_ICD_STATIC_ASSERT(offsetof(ScSafeAttitude, h) == 80, "ScSafeAttitude.h: offse
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeAttitude, phi) == 136, "ScSafeAttitude.phi: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeAttitude, u) == 192, "ScSafeAttitude.u: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeAttitude, actuated) == 216, "ScSafeAttitude.actuated: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScSafeAttitude, xi_f_b) == 240, "ScSafeAttitude.xi_f_b: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScSafeAttitude, xi_tau_b) == 264, "ScSafeAttitude.xi_tau_b: offset");
 
-/* SafeRobotic -- safe_capture::v2::SafeRobotic, 864 B. Robotic safety filter → simulator, recorder. Constraint order: θ limits 0..7, θ̇ upper 7..14, θ̇ lower 14..21, link-base 21..42. */
+/* SafeRobotic -- safe_capture::v3::SafeRobotic, 912 B. Robotic safety filter → simulator, recorder. Constraint order: θ limits 0..7, θ̇ upper 7..14, θ̇ lower 14..21, link-base 21..42. */
 typedef struct ScSafeRobotic {
     uint64_t tick; /* Tick index this command answers [-] */
     double t; /* Simulation time of the state used [s] */
@@ -412,12 +421,14 @@ typedef struct ScSafeRobotic {
     double phi[42]; /* CBF conditions Φ_i at the safe command [unit per constraint / s] */
     double u[7]; /* Safe joint torques τ_M, frame M [N·m] */
     double actuated[7]; /* Actuated joint torques τ_M (equals `u`), frame M [N·m] */
+    double xi_f_b[3]; /* Coupling ξ this command was certified against: the base force f_B acting upstream (the translational command or its backup; 0 for the translational filter, which has no upstream). The simulator applies the command only with exactly this force acting (docs/PARTITION.md), frame F_B [N] */
+    double xi_tau_b[3]; /* Coupling ξ this command was certified against: the base torque τ_B acting upstream (the attitude command or its backup; 0 for the translational and attitude filters), frame F_B [N·m] */
 #if defined(__cplusplus) && __cplusplus >= 201703L
     /* the name iceoryx2's C++ API matches the payload type by */
-    static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v2::SafeRobotic";
+    static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v3::SafeRobotic";
 #endif
 } ScSafeRobotic;
-SC_ICD_STATIC_ASSERT(sizeof(ScSafeRobotic) == 864, "ScSafeRobotic: size");
+SC_ICD_STATIC_ASSERT(sizeof(ScSafeRobotic) == 912, "ScSafeRobotic: size");
 SC_ICD_STATIC_ASSERT(SC_ICD_ALIGNOF(ScSafeRobotic) == 8, "ScSafeRobotic: alignment");
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, tick) == 0, "ScSafeRobotic.tick: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, t) == 8, "ScSafeRobotic.t: offset");
@@ -436,6 +447,8 @@ SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, h) == 80, "ScSafeRobotic.h: offset"
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, phi) == 416, "ScSafeRobotic.phi: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, u) == 752, "ScSafeRobotic.u: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, actuated) == 808, "ScSafeRobotic.actuated: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, xi_f_b) == 864, "ScSafeRobotic.xi_f_b: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, xi_tau_b) == 888, "ScSafeRobotic.xi_tau_b: offset");
 
 /* StepResult -- safe_capture::v1::StepResult, 152 B. Simulator → scheduler, recorder: the command applied over the step and how the step ended. Sent once all due safe commands of the tick are in (or their deadline passed and the simulator used the filter's fallback). */
 typedef struct ScStepResult {
@@ -444,7 +457,7 @@ typedef struct ScStepResult {
     uint32_t end; /* How the step ended, one of `end` (0 running, 1 captured, 2 timeout, 3 simulator failed) [-] */
     uint32_t fallback_mask; /* Subsystems (bits of `due`) whose command is the filter fallback computed by the simulator because the safe command was missing at the deadline (1 translational, 2 attitude, 4 robotic, 7 all) [-] */
     uint32_t held_mask; /* Subsystems (bits of `due`) whose command was held from an earlier tick (slower rate group) (1 translational, 2 attitude, 4 robotic, 7 all) [-] */
-    uint32_t fault_flags; /* Partition fault flags, bits of `fault` (1 stale input, 2 non finite input, 4 solver failed, 8 infeasible, 16 saturated, 32 nominal missing, 64 deadline miss, 128 peer dead, 256 rejected command, 512 navigation rejected) [-] */
+    uint32_t fault_flags; /* Partition fault flags, bits of `fault` (1 stale input, 2 non finite input, 4 solver failed, 8 infeasible, 16 saturated, 32 nominal missing, 64 deadline miss, 128 peer dead, 256 rejected command, 512 navigation rejected, 1024 coupling mismatch) [-] */
     uint64_t safe_recv_ns; /* Stamp at which the robotic safe command (the tick's last) was delivered, host CLOCK_MONOTONIC [ns] */
     uint64_t publish_ns; /* Publish stamp, host CLOCK_MONOTONIC [ns] */
     double force_b[3]; /* Applied base force f_B, frame F_B [N] */
@@ -548,7 +561,7 @@ typedef struct ScHealth {
     uint32_t role; /* Role id: the role's position in the role table `ROLES` [-] */
     uint32_t pid; /* Operating-system process id [-] */
     uint32_t state; /* State, one of `health_state` (0 starting, 1 ready, 2 running, 3 faulted, 4 stopping) [-] */
-    uint32_t last_fault_flags; /* Last fault flags, bits of `fault` (1 stale input, 2 non finite input, 4 solver failed, 8 infeasible, 16 saturated, 32 nominal missing, 64 deadline miss, 128 peer dead, 256 rejected command, 512 navigation rejected) [-] */
+    uint32_t last_fault_flags; /* Last fault flags, bits of `fault` (1 stale input, 2 non finite input, 4 solver failed, 8 infeasible, 16 saturated, 32 nominal missing, 64 deadline miss, 128 peer dead, 256 rejected command, 512 navigation rejected, 1024 coupling mismatch) [-] */
     uint64_t ticks_handled; /* Ticks handled since start [-] */
     uint64_t deadline_misses; /* Deadline misses since start [-] */
     uint64_t cycle_slips; /* Cycle slips (a tick answered late or skipped) since start [-] */

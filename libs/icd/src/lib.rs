@@ -164,6 +164,11 @@ icd_constants! {
         /// the measurement than the declared navigation bounds, `sc_sim::navigation`);
         /// the simulator's own navigation (the declared error model) was substituted.
         NAVIGATION_REJECTED = 1 << 9,
+        /// A safe command was not applied because it does not fit the chain the filters
+        /// certified: it was certified against other upstream commands than those acting,
+        /// or it came after the downstream filters had given up on it and certified
+        /// against its backup; the backup acts instead (docs/PARTITION.md).
+        COUPLING_MISMATCH = 1 << 10,
     }
 }
 
@@ -427,6 +432,15 @@ macro_rules! safe_msg {
                 pub u: [f64; $nu] = [$unit, $frame, $comp],
                 $(#[doc = $adoc])+
                 pub actuated: [f64; $nu] = [$unit, $aframe, $comp],
+                /// Coupling ξ this command was certified against: the base force f_B acting
+                /// upstream (the translational command or its backup; 0 for the
+                /// translational filter, which has no upstream). The simulator applies the
+                /// command only with exactly this force acting (docs/PARTITION.md)
+                pub xi_f_b: [f64; 3] = ["N", Base, Xyz],
+                /// Coupling ξ this command was certified against: the base torque τ_B
+                /// acting upstream (the attitude command or its backup; 0 for the
+                /// translational and attitude filters)
+                pub xi_tau_b: [f64; 3] = ["N·m", Base, Xyz],
             }
         }
     };
@@ -435,7 +449,7 @@ macro_rules! safe_msg {
 safe_msg! {
     /// Translational safety filter → attitude and robotic filters, simulator, recorder.
     /// Constraint order: AC, CAZ.
-    SafeTranslational = "safe_capture::v2::SafeTranslational", Translational,
+    SafeTranslational = "safe_capture::v3::SafeTranslational", Translational,
     N_CONSTRAINTS_TRANSLATIONAL,
     /// Safe force f_H
     u: [f64; 3] = ["N", Hill, Xyz],
@@ -445,7 +459,7 @@ safe_msg! {
 safe_msg! {
     /// Attitude safety filter → robotic filter, simulator, recorder.
     /// Constraint order: ATT, ω1..3 upper, ω1..3 lower.
-    SafeAttitude = "safe_capture::v2::SafeAttitude", Attitude, N_CONSTRAINTS_ATTITUDE,
+    SafeAttitude = "safe_capture::v3::SafeAttitude", Attitude, N_CONSTRAINTS_ATTITUDE,
     /// Safe torque τ_B
     u: [f64; 3] = ["N·m", Base, Xyz],
     /// Actuated torque τ_B (equals `u`)
@@ -454,7 +468,7 @@ safe_msg! {
 safe_msg! {
     /// Robotic safety filter → simulator, recorder.
     /// Constraint order: θ limits 0..7, θ̇ upper 7..14, θ̇ lower 14..21, link-base 21..42.
-    SafeRobotic = "safe_capture::v2::SafeRobotic", Robotic, N_CONSTRAINTS_ROBOTIC,
+    SafeRobotic = "safe_capture::v3::SafeRobotic", Robotic, N_CONSTRAINTS_ROBOTIC,
     /// Safe joint torques τ_M
     u: [f64; N_JOINTS] = ["N·m", Joints, Joints],
     /// Actuated joint torques τ_M (equals `u`)
@@ -628,9 +642,9 @@ const _: () = assert!(core::mem::size_of::<SimState>() == 1568);
 const _: () = assert!(core::mem::size_of::<NominalTranslational>() == 64);
 const _: () = assert!(core::mem::size_of::<NominalAttitude>() == 64);
 const _: () = assert!(core::mem::size_of::<NominalRobotic>() == 96);
-const _: () = assert!(core::mem::size_of::<SafeTranslational>() == 160);
-const _: () = assert!(core::mem::size_of::<SafeAttitude>() == 240);
-const _: () = assert!(core::mem::size_of::<SafeRobotic>() == 864);
+const _: () = assert!(core::mem::size_of::<SafeTranslational>() == 208);
+const _: () = assert!(core::mem::size_of::<SafeAttitude>() == 288);
+const _: () = assert!(core::mem::size_of::<SafeRobotic>() == 912);
 const _: () = assert!(core::mem::size_of::<StepResult>() == 152);
 const _: () = assert!(core::mem::size_of::<NavigationError>() == 96);
 const _: () = assert!(core::mem::size_of::<NavState>() == 376);
@@ -649,7 +663,7 @@ mod tests {
         assert_eq!(type_name_of::<Tick>(), "safe_capture::v2::Tick");
         assert_eq!(
             type_name_of::<SafeRobotic>(),
-            "safe_capture::v2::SafeRobotic"
+            "safe_capture::v3::SafeRobotic"
         );
     }
 

@@ -103,6 +103,7 @@ FAULT_DEADLINE_MISS = 64  # Deadline missed.
 FAULT_PEER_DEAD = 128  # A peer process was detected dead.
 FAULT_REJECTED_COMMAND = 256  # The simulator rejected a safe command (not finite or beyond the input bounds, `sc_flight::admission`) and applied the filter's backup instead.
 FAULT_NAVIGATION_REJECTED = 512  # The navigation's estimate was missing at the navigation deadline or rejected (not finite, not current, a quaternion off the unit sphere, or farther from the measurement than the declared navigation bounds, `sc_sim::navigation`); the simulator's own navigation (the declared error model) was substituted.
+FAULT_COUPLING_MISMATCH = 1024  # A safe command was not applied because it does not fit the chain the filters certified: it was certified against other upstream commands than those acting, or it came after the downstream filters had given up on it and certified against its backup; the backup acts instead (docs/PARTITION.md).
 
 # Values of `Health.state`.
 HEALTH_STARTING = 0  # Process started, ports being created.
@@ -278,11 +279,13 @@ class SafeTranslational(ctypes.Structure):
         ("phi", ctypes.c_double * 2),  # CBF conditions Φ_i at the safe command [unit per constraint / s]
         ("u", ctypes.c_double * 3),  # Safe force f_H, frame F_H [N]
         ("actuated", ctypes.c_double * 3),  # Safe force f_B = R_BH f_H (what the thrusters apply), frame F_B [N]
+        ("xi_f_b", ctypes.c_double * 3),  # Coupling ξ this command was certified against: the base force f_B acting upstream (the translational command or its backup; 0 for the translational filter, which has no upstream). The simulator applies the command only with exactly this force acting (docs/PARTITION.md), frame F_B [N]
+        ("xi_tau_b", ctypes.c_double * 3),  # Coupling ξ this command was certified against: the base torque τ_B acting upstream (the attitude command or its backup; 0 for the translational and attitude filters), frame F_B [N·m]
     ]
 
     @staticmethod
     def type_name():
-        return "safe_capture::v2::SafeTranslational"
+        return "safe_capture::v3::SafeTranslational"
 
 
 class SafeAttitude(ctypes.Structure):
@@ -306,11 +309,13 @@ class SafeAttitude(ctypes.Structure):
         ("phi", ctypes.c_double * 7),  # CBF conditions Φ_i at the safe command [unit per constraint / s]
         ("u", ctypes.c_double * 3),  # Safe torque τ_B, frame F_B [N·m]
         ("actuated", ctypes.c_double * 3),  # Actuated torque τ_B (equals `u`), frame F_B [N·m]
+        ("xi_f_b", ctypes.c_double * 3),  # Coupling ξ this command was certified against: the base force f_B acting upstream (the translational command or its backup; 0 for the translational filter, which has no upstream). The simulator applies the command only with exactly this force acting (docs/PARTITION.md), frame F_B [N]
+        ("xi_tau_b", ctypes.c_double * 3),  # Coupling ξ this command was certified against: the base torque τ_B acting upstream (the attitude command or its backup; 0 for the translational and attitude filters), frame F_B [N·m]
     ]
 
     @staticmethod
     def type_name():
-        return "safe_capture::v2::SafeAttitude"
+        return "safe_capture::v3::SafeAttitude"
 
 
 class SafeRobotic(ctypes.Structure):
@@ -334,11 +339,13 @@ class SafeRobotic(ctypes.Structure):
         ("phi", ctypes.c_double * 42),  # CBF conditions Φ_i at the safe command [unit per constraint / s]
         ("u", ctypes.c_double * 7),  # Safe joint torques τ_M, frame M [N·m]
         ("actuated", ctypes.c_double * 7),  # Actuated joint torques τ_M (equals `u`), frame M [N·m]
+        ("xi_f_b", ctypes.c_double * 3),  # Coupling ξ this command was certified against: the base force f_B acting upstream (the translational command or its backup; 0 for the translational filter, which has no upstream). The simulator applies the command only with exactly this force acting (docs/PARTITION.md), frame F_B [N]
+        ("xi_tau_b", ctypes.c_double * 3),  # Coupling ξ this command was certified against: the base torque τ_B acting upstream (the attitude command or its backup; 0 for the translational and attitude filters), frame F_B [N·m]
     ]
 
     @staticmethod
     def type_name():
-        return "safe_capture::v2::SafeRobotic"
+        return "safe_capture::v3::SafeRobotic"
 
 
 class StepResult(ctypes.Structure):
@@ -350,7 +357,7 @@ class StepResult(ctypes.Structure):
         ("end", ctypes.c_uint32),  # How the step ended, one of `end` (0 running, 1 captured, 2 timeout, 3 simulator failed) [-]
         ("fallback_mask", ctypes.c_uint32),  # Subsystems (bits of `due`) whose command is the filter fallback computed by the simulator because the safe command was missing at the deadline (1 translational, 2 attitude, 4 robotic, 7 all) [-]
         ("held_mask", ctypes.c_uint32),  # Subsystems (bits of `due`) whose command was held from an earlier tick (slower rate group) (1 translational, 2 attitude, 4 robotic, 7 all) [-]
-        ("fault_flags", ctypes.c_uint32),  # Partition fault flags, bits of `fault` (1 stale input, 2 non finite input, 4 solver failed, 8 infeasible, 16 saturated, 32 nominal missing, 64 deadline miss, 128 peer dead, 256 rejected command, 512 navigation rejected) [-]
+        ("fault_flags", ctypes.c_uint32),  # Partition fault flags, bits of `fault` (1 stale input, 2 non finite input, 4 solver failed, 8 infeasible, 16 saturated, 32 nominal missing, 64 deadline miss, 128 peer dead, 256 rejected command, 512 navigation rejected, 1024 coupling mismatch) [-]
         ("safe_recv_ns", ctypes.c_uint64),  # Stamp at which the robotic safe command (the tick's last) was delivered, host CLOCK_MONOTONIC [ns]
         ("publish_ns", ctypes.c_uint64),  # Publish stamp, host CLOCK_MONOTONIC [ns]
         ("force_b", ctypes.c_double * 3),  # Applied base force f_B, frame F_B [N]
@@ -419,7 +426,7 @@ class Health(ctypes.Structure):
         ("role", ctypes.c_uint32),  # Role id: the role's position in the role table `ROLES` [-]
         ("pid", ctypes.c_uint32),  # Operating-system process id [-]
         ("state", ctypes.c_uint32),  # State, one of `health_state` (0 starting, 1 ready, 2 running, 3 faulted, 4 stopping) [-]
-        ("last_fault_flags", ctypes.c_uint32),  # Last fault flags, bits of `fault` (1 stale input, 2 non finite input, 4 solver failed, 8 infeasible, 16 saturated, 32 nominal missing, 64 deadline miss, 128 peer dead, 256 rejected command, 512 navigation rejected) [-]
+        ("last_fault_flags", ctypes.c_uint32),  # Last fault flags, bits of `fault` (1 stale input, 2 non finite input, 4 solver failed, 8 infeasible, 16 saturated, 32 nominal missing, 64 deadline miss, 128 peer dead, 256 rejected command, 512 navigation rejected, 1024 coupling mismatch) [-]
         ("ticks_handled", ctypes.c_uint64),  # Ticks handled since start [-]
         ("deadline_misses", ctypes.c_uint64),  # Deadline misses since start [-]
         ("cycle_slips", ctypes.c_uint64),  # Cycle slips (a tick answered late or skipped) since start [-]
@@ -505,6 +512,7 @@ __all__ = [
     "FAULT_PEER_DEAD",
     "FAULT_REJECTED_COMMAND",
     "FAULT_NAVIGATION_REJECTED",
+    "FAULT_COUPLING_MISMATCH",
     "HEALTH_STARTING",
     "HEALTH_READY",
     "HEALTH_RUNNING",

@@ -16,7 +16,7 @@
 use super::{LOST_STOP_WAKEUP, deadline_from, keep_for_tick};
 use crate::admission;
 use crate::component::{Component, Env, Finish, Message, Next, Outbox, WakeSet, Wakeup, Woke};
-use crate::convert;
+use crate::convert::{self, Coupling};
 use crate::error::FlightError;
 use crate::process::Proc;
 use nalgebra::{SVector, Vector3};
@@ -151,11 +151,12 @@ impl FilterRole {
         }
     }
 
-    /// From the process's config: the scenario's safety layer, the stage deadline of
+    /// From the process's config: the scenario's safety layer with every subsystem's
+    /// command (and backup) certified for its rate group's hold, the stage deadline of
     /// `[deadlines]` in the run's clock mode.
     pub fn from_process(subsystem: Subsystem, p: &Proc) -> Result<Self, FlightError> {
         let s = &p.setup.scenario;
-        let layer = SafetyLayer::from_scenario(s, p.setup.robot.clone());
+        let layer = SafetyLayer::with_holds(s, p.setup.robot.clone(), &p.schedule.period_s);
         let deadline = p.deadline(p.cfg.deadlines.filter_ms(subsystem));
         let ns = deadline.as_nanos().min(u128::from(u64::MAX)) as u64;
         Ok(Self::new(subsystem, layer, s.clone(), ns))
@@ -292,25 +293,52 @@ impl FilterRole {
         }
     }
 
-    /// The upstream safe torque of tick `s` [N m, F_B] with the force `f_b` acting, as
-    /// [`Self::upstream_force`].
-    fn upstream_torque(
-        &mut self,
-        s: &SimState,
-        o: &sc_core::Observation,
-        f_b: &Vector3<f64>,
-    ) -> (Vector3<f64>, bool) {
+    /// The upstream attitude command in force at tick `s` (this tick's or the held one of
+    /// a slower group) if it passes the simulator's admission; `None` when it is missing,
+    /// refused or its filter absent.
+    fn upstream_attitude(&self, s: &SimState) -> Option<SafeAttitude> {
         let need = s.due_mask & Subsystem::Attitude.bit() != 0;
         let absent = self.absent.attitude;
-        let lim = &self.scenario.limits;
-        match self
-            .up_a
+        self.up_a
             .filter(|m| if need { m.tick == s.tick } else { !absent })
-            .filter(|m| admission::attitude(m, lim))
-        {
-            Some(m) => (convert::vec3(&m.u), false),
-            None => (self.layer.backup_attitude(o, f_b).u, true),
+            .filter(|m| admission::attitude(m, &self.scenario.limits))
+    }
+
+    /// What this filter certifies against at tick `s` (the paper's ξ) and whether a
+    /// backup stands in for an upstream command.
+    fn coupling(&mut self, s: &SimState, o: &sc_core::Observation) -> (Coupling, bool) {
+        match self.subsystem {
+            Subsystem::Translational => (Coupling::default(), false),
+            Subsystem::Attitude => {
+                let (force_b, backup) = self.upstream_force(s, o);
+                let torque_b = Vector3::zeros();
+                (Coupling { force_b, torque_b }, backup)
+            }
+            Subsystem::Robotic => self.robotic_coupling(s, o),
         }
+    }
+
+    /// The robotic filter's coupling: the attitude command together with the force it
+    /// was certified against — the translational command, or its backup when the
+    /// attitude filter gave up on a translational command that came later — so that the
+    /// chain the simulator applies is one the filters certified link by link. An attitude
+    /// command certified against any other force, or a missing or refused one, is
+    /// replaced by the attitude backup with the translational command in force.
+    fn robotic_coupling(&mut self, s: &SimState, o: &sc_core::Observation) -> (Coupling, bool) {
+        let (force_b, backup) = self.upstream_force(s, o);
+        if let Some(a) = self.upstream_attitude(s) {
+            let xi = convert::vec3(&a.xi_f_b);
+            let torque_b = convert::vec3(&a.u);
+            if xi == force_b {
+                return (Coupling { force_b, torque_b }, backup);
+            }
+            let force_b = self.layer.backup_translational(o).actuated;
+            if xi == force_b {
+                return (Coupling { force_b, torque_b }, true);
+            }
+        }
+        let torque_b = self.layer.backup_attitude(o, &force_b).u;
+        (Coupling { force_b, torque_b }, true)
     }
 
     /// This filter's safe command for tick `s`, received complete (or at its deadline) at
@@ -319,37 +347,32 @@ impl FilterRole {
         let o = convert::observation(s);
         // the mission's own schedule (a nominal's report of its phase is not trusted)
         let phase = self.scenario.phase_index(o.t);
-        let (mut f_b, mut tau_b) = (Vector3::zeros(), Vector3::zeros());
-        let mut missing = false;
-        if self.subsystem > Subsystem::Translational {
-            let (f, m) = self.upstream_force(s, &o);
-            (f_b, missing) = (f, m);
-        }
-        if self.subsystem == Subsystem::Robotic {
-            let (t, m) = self.upstream_torque(s, &o, &f_b);
-            (tau_b, missing) = (t, missing | m);
-        }
+        let (xi, missing) = self.coupling(s, &o);
         // a command for another tick, or one its sender marks invalid, is no command:
         // the filter runs its QP on the substitute nominal
         let nominal = self.nominal.filter(|m| m.tick == s.tick && m.valid != 0);
         let (k, t) = (s.tick, s.t);
+        let (f_b, tau_b) = (&xi.force_b, &xi.torque_b);
         let mut msg = match self.subsystem {
             Subsystem::Translational => {
                 let out = self
                     .layer
                     .translational_stage(&o, nominal.map(|n| n.vec()).as_ref());
-                Message::SafeTranslational(convert::safe_msg(&flagged(out, missing), k, t, phase))
+                let out = flagged(out, missing);
+                Message::SafeTranslational(convert::safe_msg(&out, &xi, k, t, phase))
             }
             Subsystem::Attitude => {
                 let out = self
                     .layer
-                    .attitude_stage(&o, &f_b, nominal.map(|n| n.vec()).as_ref());
-                Message::SafeAttitude(convert::safe_msg(&flagged(out, missing), k, t, phase))
+                    .attitude_stage(&o, f_b, nominal.map(|n| n.vec()).as_ref());
+                let out = flagged(out, missing);
+                Message::SafeAttitude(convert::safe_msg(&out, &xi, k, t, phase))
             }
             Subsystem::Robotic => {
                 let nom = nominal.map(|n| n.vec());
-                let out = self.layer.robotic_stage(&o, &f_b, &tau_b, nom.as_ref());
-                Message::SafeRobotic(convert::safe_msg(&flagged(out, missing), k, t, phase))
+                let out = self.layer.robotic_stage(&o, f_b, tau_b, nom.as_ref());
+                let out = flagged(out, missing);
+                Message::SafeRobotic(convert::safe_msg(&out, &xi, k, t, phase))
             }
         };
         set_recv_ns(&mut msg, now_ns);
@@ -791,6 +814,67 @@ mod tests {
         });
         handle(&mut r, until + 1, Woke::Event, &[up]);
         assert!(!r.absent.translational);
+    }
+
+    /// The coupling the robotic filter's command `out` says it was certified against.
+    fn sent_coupling(out: &Outbox) -> Coupling {
+        match out.send.as_slice() {
+            [Message::SafeRobotic(m)] => Coupling::of(m),
+            other => panic!("expected one robotic command, got {other:?}"),
+        }
+    }
+
+    /// The robotic filter certifies against the force the attitude command was certified
+    /// against: the translational command, or its backup when the attitude filter gave
+    /// up on it; an attitude command certified against any other force is replaced by
+    /// the attitude backup.
+    #[test]
+    fn the_robotic_filter_takes_the_force_the_attitude_command_assumed() {
+        let su = setup();
+        let mut layer = SafetyLayer::from_scenario(&su.scenario, su.robot.clone());
+        let Message::State(st) = tick_state(0) else {
+            unreachable!()
+        };
+        let o = convert::observation(&st);
+        let f = Vector3::new(0.05, 0.0, 0.0);
+        let backup_f = layer.backup_translational(&o).actuated;
+        let run = |xi: Vector3<f64>| {
+            let mut r = role(Subsystem::Robotic);
+            let t = SafeTranslational {
+                tick: 0,
+                actuated: f.into(),
+                ..Default::default()
+            };
+            let a = SafeAttitude {
+                tick: 0,
+                u: [0.0, 0.01, 0.0],
+                xi_f_b: xi.into(),
+                ..Default::default()
+            };
+            let inputs = [
+                Message::SafeAttitude(a),
+                Message::SafeTranslational(t),
+                nominal(Subsystem::Robotic, 0, 1),
+                tick_state(0),
+            ];
+            let out = handle(&mut r, 10, Woke::Event, &inputs);
+            (sent_coupling(&out), sent_faults(&out))
+        };
+        let tau = Vector3::new(0.0, 0.01, 0.0);
+        let (xi, flags) = run(f);
+        assert_eq!((xi.force_b, xi.torque_b), (f, tau));
+        assert_eq!(flags & faults::UPSTREAM_MISSING, 0);
+        let (xi, flags) = run(backup_f);
+        assert_eq!(
+            (xi.force_b, xi.torque_b),
+            (backup_f, tau),
+            "as the attitude filter"
+        );
+        assert_ne!(flags & faults::UPSTREAM_MISSING, 0);
+        let (xi, flags) = run(f + Vector3::new(1e-9, 0.0, 0.0));
+        let backup_tau = layer.backup_attitude(&o, &f).u;
+        assert_eq!((xi.force_b, xi.torque_b), (f, backup_tau), "refused");
+        assert_ne!(flags & faults::UPSTREAM_MISSING, 0);
     }
 
     #[test]

@@ -16,7 +16,7 @@
 
 use crate::admission;
 use crate::component::{Component, Env, Finish, Message, Next, Outbox, WakeSet, Wakeup};
-use crate::convert;
+use crate::convert::{self, Coupling};
 use crate::error::FlightError;
 use crate::process::Proc;
 use sc_cbf::SafetyLayer;
@@ -37,30 +37,35 @@ struct Received {
     admitted: bool,
     /// What it applies: `f_B`, `τ_B` or `τ_M` (the first 3 or 7 components).
     command: [f64; 7],
+    /// The upstream commands it was certified against.
+    xi: Coupling,
 }
 
 impl Received {
     /// The safe command carried by `m` with its subsystem, judged against `limits`.
     fn of(m: &Message, limits: &sc_scenario::Limits) -> Option<(Subsystem, Self)> {
         let pad3 = |a: &[f64; 3]| [a[0], a[1], a[2], 0.0, 0.0, 0.0, 0.0];
-        let (s, tick, admitted, command) = match m {
+        let (s, tick, admitted, command, xi) = match m {
             Message::SafeTranslational(x) => (
                 Subsystem::Translational,
                 x.tick,
                 admission::translational(x, limits),
                 pad3(&x.actuated),
+                Coupling::of(x),
             ),
             Message::SafeAttitude(x) => (
                 Subsystem::Attitude,
                 x.tick,
                 admission::attitude(x, limits),
                 pad3(&x.u),
+                Coupling::of(x),
             ),
             Message::SafeRobotic(x) => (
                 Subsystem::Robotic,
                 x.tick,
                 admission::robotic(x, limits),
                 x.u,
+                Coupling::of(x),
             ),
             _ => return None,
         };
@@ -70,6 +75,7 @@ impl Received {
                 tick,
                 admitted,
                 command,
+                xi,
             },
         ))
     }
@@ -247,8 +253,10 @@ impl SimulatorRole {
         let ns = |ms| p.deadline(ms).as_nanos().min(u128::from(u64::MAX)) as u64;
         let keep_going = p.cfg.max_ticks > 0;
         let deadline = ns(p.cfg.deadlines.simulator_ms);
-        let mut role = Self::new(sim, None, scenario, robot, deadline, keep_going)?
+        let mut role = Self::new(sim, None, scenario, robot.clone(), deadline, keep_going)?
             .with_navigation_deadline(ns(p.cfg.deadlines.navigation_ms));
+        // the backups act for their group's hold, as the filters certify them
+        role.layer = SafetyLayer::with_holds(&p.setup.scenario, robot, &p.schedule.period_s);
         if let Some(r) = realisation {
             if !p.cfg.simulator.plant.is_empty() {
                 // as the preflight: the plant process would propagate the model
@@ -379,7 +387,8 @@ impl SimulatorRole {
         );
         out.send(Message::State(msg));
         out.send(Message::PartnerState(msg));
-        p.known = Some(known.observation);
+        // the backups are computed on exactly what the filters read (the published state)
+        p.known = Some(convert::observation(&msg));
         // the safe commands' deadline counts from the tick, as before the navigation had a
         // stage of its own: waiting for the estimate does not lengthen the tick
         p.until_ns = p.recv_ns.saturating_add(self.deadline_ns).max(now_ns);
@@ -393,9 +402,11 @@ impl SimulatorRole {
         }
     }
 
-    /// What acts for subsystem `s` over tick `k`: the fresh safe command if it passed
-    /// the re-validation, the held one of a slower group, or the filter's backup (a
-    /// missing or refused command), which is flagged, counted and logged.
+    /// What acts for subsystem `s` over tick `k` (decided in causal order): the fresh
+    /// safe command if it passed the re-validation and was certified against exactly the
+    /// upstream commands now acting, and unless the downstream filters certified against
+    /// its backup instead (they gave up on it at their earlier deadline); the held one of
+    /// a slower group; else the filter's backup, which is flagged, counted and logged.
     fn apply(
         &mut self,
         s: Subsystem,
@@ -410,14 +421,23 @@ impl SimulatorRole {
             return;
         }
         let fresh = self.got[s].filter(|m| m.tick == k);
-        if let Some(m) = fresh.filter(|m| m.admitted) {
+        let admitted = fresh.filter(|m| m.admitted);
+        let certified = admitted.filter(|m| self.certified_against_acting(s, &m.xi));
+        let applied = certified.filter(|m| !self.downstream_took_backup(s, o, k, &m.command));
+        if let Some(m) = applied {
             self.hold(s, &m.command);
             return;
         }
         let backup = self.backup(s, o);
         self.hold(s, &backup);
         res.fallback_mask |= s.bit();
-        if fresh.is_some() {
+        if certified.is_some() {
+            out.log(format!("simulator: FAULT tick {k}: {s} safe command came after the downstream filters certified against its backup; backup applied"));
+            res.fault_flags |= fault::COUPLING_MISMATCH;
+        } else if admitted.is_some() {
+            out.log(format!("simulator: FAULT tick {k}: {s} safe command certified against other upstream commands than those applied; backup applied"));
+            res.fault_flags |= fault::COUPLING_MISMATCH;
+        } else if fresh.is_some() {
             self.rejected[s] += 1;
             out.log(format!("simulator: FAULT tick {k}: {s} safe command rejected (not finite or beyond the input bounds), backup applied"));
             res.fault_flags |= fault::REJECTED_COMMAND;
@@ -430,6 +450,46 @@ impl SimulatorRole {
             self.absent[s] = true;
             res.fault_flags |= fault::DEADLINE_MISS;
         }
+    }
+
+    /// Whether a command of `s` certified against `xi` may act with the upstream
+    /// commands already decided for this tick (bit for bit: what the filter's certificate
+    /// assumed is what acts).
+    fn certified_against_acting(&self, s: Subsystem, xi: &Coupling) -> bool {
+        let force = || xi.force_b == self.held.force_b;
+        match s {
+            Subsystem::Translational => true,
+            Subsystem::Attitude => force(),
+            Subsystem::Robotic => force() && xi.torque_b == self.held.torque_b,
+        }
+    }
+
+    /// Whether the downstream commands of tick `k` that would act were certified against
+    /// the backup of `s` and none against its command `command`: the downstream filters
+    /// gave up on `command` at their deadline, so its backup is what they certified.
+    fn downstream_took_backup(
+        &mut self,
+        s: Subsystem,
+        o: &Observation,
+        k: u64,
+        command: &[f64; 7],
+    ) -> bool {
+        let claims: Vec<nalgebra::Vector3<f64>> = Subsystem::ALL
+            .into_iter()
+            .filter(|d| *d > s)
+            .filter_map(|d| self.got[d].filter(|m| m.tick == k && m.admitted))
+            .filter_map(|m| match s {
+                Subsystem::Translational => Some(m.xi.force_b),
+                Subsystem::Attitude => Some(m.xi.torque_b),
+                Subsystem::Robotic => None,
+            })
+            .collect();
+        let v3 = |c: &[f64; 7]| nalgebra::Vector3::new(c[0], c[1], c[2]);
+        if claims.is_empty() || claims.contains(&v3(command)) {
+            return false;
+        }
+        let backup = v3(&self.backup(s, o));
+        claims.contains(&backup)
     }
 
     /// The backup of subsystem `s` with what acts upstream (the causal chain's backups).
@@ -1038,6 +1098,91 @@ mod tests {
                 until_ns: None
             }
         );
+    }
+
+    /// The observation the filters read in tick `k` (the state in `out`).
+    fn published(out: &Outbox) -> Observation {
+        match out.send.iter().find_map(|m| match m {
+            Message::State(x) => Some(*x),
+            _ => None,
+        }) {
+            Some(s) => convert::observation(&s),
+            None => panic!("no state in {:?}", out.send),
+        }
+    }
+
+    /// Tick 0's three commands: the translational force `f`, the attitude command
+    /// certified against `xi_a`, the robotic one against `xi_r`.
+    fn chain(
+        f: [f64; 3],
+        xi_a: [f64; 3],
+        xi_r: (nalgebra::Vector3<f64>, [f64; 3]),
+    ) -> [Message; 3] {
+        [
+            Message::SafeRobotic(SafeRobotic {
+                xi_f_b: xi_r.0.into(),
+                xi_tau_b: xi_r.1,
+                ..Default::default()
+            }),
+            Message::SafeAttitude(SafeAttitude {
+                u: [0.0, 0.01, 0.0],
+                xi_f_b: xi_a,
+                ..Default::default()
+            }),
+            Message::SafeTranslational(SafeTranslational {
+                actuated: f,
+                ..Default::default()
+            }),
+        ]
+    }
+
+    /// The translational command came after the attitude and robotic filters had given
+    /// up on it and certified against its backup (the 60–90 ms window): its backup acts,
+    /// with the attitude and robotic commands certified against it; flagged and logged.
+    #[test]
+    fn a_command_the_downstream_filters_gave_up_on_is_not_applied() {
+        let mut r = role();
+        let o = published(&start(&mut r, 0, 0, SubsystemSet::ALL));
+        let backup = r.layer.backup_translational(&o).actuated;
+        let out = handle(
+            &mut r,
+            10,
+            Woke::Event,
+            &chain([0.05, 0.0, 0.0], backup.into(), (backup, [0.0, 0.01, 0.0])),
+        );
+        let res = result(&out);
+        assert_eq!(res.force_b, <[f64; 3]>::from(backup));
+        assert_eq!(res.torque_b, [0.0, 0.01, 0.0], "the attitude command acts");
+        assert_eq!(res.fallback_mask, Subsystem::Translational.bit());
+        assert_eq!(res.fault_flags, fault::COUPLING_MISMATCH);
+        assert!(out.log.iter().any(|l| l.contains(
+            "FAULT tick 0: translational safe command came after the downstream filters certified against its backup"
+        )));
+    }
+
+    /// A command certified against other upstream commands than those acting never acts:
+    /// its backup does (on what acts upstream), and so do the commands downstream of it.
+    #[test]
+    fn a_command_certified_against_other_upstream_commands_is_replaced() {
+        let mut r = role();
+        let o = published(&start(&mut r, 0, 0, SubsystemSet::ALL));
+        let f = nalgebra::Vector3::new(0.05, 0.0, 0.0);
+        let other = [0.05 + 1e-9, 0.0, 0.0];
+        let out = handle(
+            &mut r,
+            10,
+            Woke::Event,
+            &chain(f.into(), other, (f, [0.0, 0.01, 0.0])),
+        );
+        let res = result(&out);
+        assert_eq!(res.force_b, <[f64; 3]>::from(f));
+        let tau = r.layer.backup_attitude(&o, &f).u;
+        assert_eq!(res.torque_b, <[f64; 3]>::from(tau), "the attitude backup");
+        let tau_m = r.layer.backup_robotic(&o, &f, &tau).u;
+        assert_eq!(res.tau, convert::arr7(&tau_m), "the robotic backup on it");
+        let both = Subsystem::Attitude.bit() | Subsystem::Robotic.bit();
+        assert_eq!(res.fallback_mask, both);
+        assert_eq!(res.fault_flags, fault::COUPLING_MISMATCH);
     }
 
     #[test]
