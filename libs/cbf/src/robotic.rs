@@ -897,6 +897,36 @@ impl RoboticFilter {
         common::sat_inf(&t, self.command_limit().min())
     }
 
+    /// The emergency brake (no solver produced a command): the braking law pulled towards
+    /// the holding torque `τ_hold` until the arm-reaction contract rows hold,
+    /// `τ = τ_hold + s (τ_brake − τ_hold)` with the largest `s ∈ [0, 1]` that keeps every
+    /// contract row ([`Self::hard_rows`]) — the attitude filter's certificate assumes the
+    /// arm's reaction on the base stays within `arm_reaction_budget` whatever the robotic
+    /// filter does, its emergencies included. The joints then decelerate at `s` times the
+    /// braking law's rate. When the rows cannot hold even at `τ_hold` (the budget below
+    /// the declared torque error's share) `s = 0`; the command box is enforced last.
+    pub fn emergency_brake(&self, x: &RoboticInput) -> Vector7 {
+        let brake = self.brake(x);
+        let hold = hold_torque(x);
+        if !(common::finite(&hold) && common::finite(&x.reaction)) {
+            return brake;
+        }
+        let d = brake - hold;
+        let rows = self.hard_rows(x);
+        let s = rows[2 * NJ..].iter().fold(1.0f64, |s, r| {
+            let (at_hold, slope) = (r.a.dot(&hold) + r.c, r.a.dot(&d));
+            if slope < 0.0 {
+                s.min((at_hold / -slope).max(0.0))
+            } else {
+                s
+            }
+        });
+        if s >= 1.0 {
+            return brake;
+        }
+        common::sat_inf(&(hold + d * s), self.command_limit().min())
+    }
+
     /// The filter's command when its nominal is missing: the safety QP on the substitute.
     pub fn backup(&mut self, x: &RoboticInput) -> FilterOutput<NJ, N> {
         self.filter_with(x, None)
@@ -1035,7 +1065,7 @@ impl RoboticFilter {
         }
         match c.res.kind {
             Kind::Relaxed => o.violation = c.res.violation,
-            Kind::Failed => o.u = self.brake(x),
+            Kind::Failed => o.u = self.emergency_brake(x),
             Kind::Skipped | Kind::Solved => {}
         }
         o
@@ -1649,6 +1679,38 @@ mod tests {
         );
         let x = robotic_input_from_model(&robot, &theta, &theta_dot, &w, &fb, &tb).unwrap();
         (s, x)
+    }
+
+    /// The emergency brake keeps the arm-reaction contract the attitude filter relies on:
+    /// a fast arm whose plain braking law breaks it is braked more gently, within it; a
+    /// slow one gets the plain braking law.
+    #[test]
+    fn the_emergency_brake_keeps_the_arm_reaction_contract() {
+        let (s, x) = moving_arm();
+        let f = RoboticFilter::new(RoboticParams::from_scenario(&s));
+        let holds = |u: &Vector7| {
+            f.hard_rows(&x)[2 * NJ..]
+                .iter()
+                .all(|r| r.a.dot(u) + r.c >= -1e-12)
+        };
+        let fast = RoboticInput {
+            theta_dot: x.theta_dot * 20.0,
+            ..x
+        };
+        assert!(
+            !holds(&f.brake(&fast)),
+            "the plain brake breaks the contract"
+        );
+        let u = f.emergency_brake(&fast);
+        assert!(holds(&u) && u.amax() <= f.command_limit().min(), "{u}");
+        // still a brake: it takes kinetic energy out of the joints
+        assert!(u.dot(&fast.theta_dot) < 0.0);
+        let slow = RoboticInput {
+            theta_dot: x.theta_dot * 1e-3,
+            ..x
+        };
+        assert!(holds(&f.brake(&slow)));
+        assert_eq!(f.emergency_brake(&slow), f.brake(&slow));
     }
 
     /// The rows built from offsets and normals are the sampled-data rows of their
