@@ -26,7 +26,7 @@ from sc_partner import bus as sc_bus  # noqa: E402
 from sc_partner import icd as sc_icd  # noqa: E402
 
 TIMEOUT_S = 60.0
-DEFAULT_DELAY_MS = 85.0
+DEFAULT_DELAY_MS = 85.0  # between the default robotic (80 ms) and simulator (90 ms) deadlines
 
 
 def drain(sub, cls):

@@ -1,8 +1,9 @@
 //! The partition applies only what was certified: a command acts only with exactly the
 //! upstream commands it was certified against (its ξ, carried in the safe messages).
 //! A late attitude safety filter (`scripts/python/late_attitude_filter.py`) answers every
-//! tick 85 ms after it started — after the robotic filter gave up on it (80 ms) and
-//! certified against the attitude backup, before the simulator's own deadline (90 ms).
+//! tick 65 ms after it started — after the robotic filter gave up on it (its deadline cut
+//! to 45 ms here, for 20 ms of room on both sides on a loaded machine) and certified
+//! against the attitude backup, before the simulator's own deadline (90 ms).
 //! Read back from the run's recording: in every step where the robotic command acts, the
 //! force and torque applied are the ones it was certified against; the window was hit;
 //! no barrier went below zero. Needs a Python with iceoryx2 (`SC_PYTHON`, set by
@@ -10,33 +11,6 @@
 
 mod common;
 use common::*;
-use serde_json::Value;
-use std::collections::BTreeMap;
-use std::path::Path;
-
-/// The messages of `topic` in the recording of `out`, by tick.
-fn by_tick(out: &Path, topic: &str) -> BTreeMap<u64, Value> {
-    let bytes = std::fs::read(out.join("recording.mcap")).unwrap();
-    let mut m = BTreeMap::new();
-    for msg in mcap::MessageStream::new(&bytes).unwrap() {
-        let msg = msg.unwrap();
-        if msg.channel.topic == topic {
-            let v: Value = serde_json::from_slice(&msg.data).unwrap();
-            m.insert(v["tick"].as_u64().unwrap(), v);
-        }
-    }
-    m
-}
-
-fn vec3(v: &Value) -> [f64; 3] {
-    let a = v.as_array().unwrap();
-    [0, 1, 2].map(|i| a[i].as_f64().unwrap())
-}
-
-/// `sc_core::Subsystem::Robotic.bit()` (docs/ICD.md, `due`).
-const ROBOTIC: u64 = 4;
-/// `sc_icd::fault::COUPLING_MISMATCH`.
-const COUPLING_MISMATCH: u64 = 1 << 10;
 
 #[test]
 fn a_command_late_for_its_downstream_filter_never_acts() {
@@ -47,7 +21,17 @@ fn a_command_late_for_its_downstream_filter_never_acts() {
     let out = dir.join("out");
     let config = write_config(&dir, Some(20.0), None, 20.0);
     let text = std::fs::read_to_string(&config).unwrap();
-    let real_time = text.replace("clock = \"lock_step\"", "clock = \"real_time\"");
+    let mut real_time = text.replace("clock = \"lock_step\"", "clock = \"real_time\"");
+    for (stage, ms) in [
+        ("translational", "20.0"),
+        ("attitude", "30.0"),
+        ("robotic", "45.0"),
+    ] {
+        let key = format!("safety_{stage}_ms = ");
+        let at = real_time.find(&key).unwrap() + key.len();
+        let end = at + real_time[at..].find('\n').unwrap();
+        real_time.replace_range(at..end, ms);
+    }
     assert_ne!(text, real_time, "the config names its clock");
     std::fs::write(&config, real_time).unwrap();
     let mut opts = options(&config, &out, "late");
@@ -59,35 +43,21 @@ fn a_command_late_for_its_downstream_filter_never_acts() {
                 .join("scripts/python/late_attitude_filter.py")
                 .display()
                 .to_string(),
+            "--delay-ms".into(),
+            "65".into(),
         ],
     ));
     let rep = sc_ground::launch(&opts).unwrap();
     assert_clean(&rep, &out);
-    let robotic = by_tick(&out, "safe_capture/safe/robotic");
-    let results = by_tick(&out, "safe_capture/sim/step_result");
-    assert!(results.len() >= 150, "{} steps", results.len());
-    let (mut acted, mut mismatched) = (0, 0);
-    for (k, r) in &results {
-        let flags = r["fault_flags"].as_u64().unwrap();
-        mismatched += usize::from(flags & COUPLING_MISMATCH != 0);
-        if r["fallback_mask"].as_u64().unwrap() & ROBOTIC != 0 {
-            continue;
-        }
-        let cmd = &robotic[k];
-        let applied = (vec3(&r["force_b"]), vec3(&r["torque_b"]));
-        let xi = (vec3(&cmd["xi_f_b"]), vec3(&cmd["xi_tau_b"]));
-        assert_eq!(
-            applied, xi,
-            "tick {k}: the robotic command acted with other upstream commands than it was certified against"
-        );
-        acted += 1;
-    }
+    let (steps, acted, mismatched) = assert_applied_as_certified(&out);
     eprintln!(
-        "{acted} steps with the robotic command acting, {mismatched} with a command refused for its coupling"
+        "{steps} steps: the robotic command acted in {acted}, a command was refused for its coupling in {mismatched}"
     );
+    assert!(steps >= 150, "{steps} steps");
     // the late commands reached the simulator inside its deadline and were refused there
+    // (in most steps: with 20 ms of room on both sides)
     assert!(
-        acted > 0 && mismatched > 0,
+        acted > 0 && 2 * mismatched >= steps,
         "acted {acted}, mismatched {mismatched}"
     );
     let sim = std::fs::read_to_string(out.join("logs/simulator.log")).unwrap();

@@ -147,6 +147,10 @@ fn multi_rate_schedule_runs_to_capture() {
         held > n / 2,
         "slower groups' commands are held on most ticks ({held} of {n})"
     );
+    // each command acted with exactly what it was certified against, the held upstream
+    // commands included, and none was refused for it
+    let (steps, acted, mismatched) = assert_applied_as_certified(&out);
+    assert_eq!((acted, mismatched), (steps, 0));
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -70,7 +70,9 @@ pub enum BusError {
     },
     /// A subscriber did not take the sample within the backpressure timeout
     /// (it is stuck or dead); the sample was dropped for that subscriber only.
-    #[error("send on {service:?}: a subscriber's queue stayed full (waited {timeout:?}); the sample was dropped for it alone")]
+    #[error(
+        "send on {service:?}: a subscriber's queue stayed full (waited {timeout:?}); the sample was dropped for it alone"
+    )]
     Backpressure {
         /// Service name.
         service: String,

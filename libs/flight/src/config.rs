@@ -412,6 +412,7 @@ impl PartitionConfig {
             }
             ratio[s] = ri as u64;
         }
+        nested(&period, &ratio)?;
         Ok(Schedule {
             base_period_s: base,
             period_s: period,
@@ -465,6 +466,33 @@ fn downstream_not_slower(period: &PerSubsystem<f64>) -> Result<(), ConfigError> 
             return err(format!(
                 "rate groups: the {s} filter (period {} s) is slower than its upstream {u} filter (period {} s); a downstream filter must run at least as fast as its upstream one",
                 period[s], period[u]
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Longest hold in base periods: a group's filter is woken by its own inputs, not by
+/// every state, so the states of the base periods between its ticks queue up in its
+/// subscriber buffer (16 samples, `process::qos`) and must not overflow it.
+pub const MAX_RATIO: u64 = 15;
+
+/// Every group's period divides its upstream group's (when an upstream command is due,
+/// its downstream one is too, so a held downstream command never meets a new upstream
+/// one), and none holds longer than [`MAX_RATIO`] base periods.
+fn nested(period: &PerSubsystem<f64>, ratio: &PerSubsystem<u64>) -> Result<(), ConfigError> {
+    for s in Subsystem::ALL {
+        if ratio[s] > MAX_RATIO {
+            return err(format!(
+                "rate groups: `{s}` is held {} base periods (period {} s); at most {MAX_RATIO}: its filter's state queue holds 16",
+                ratio[s], period[s]
+            ));
+        }
+        let Some(u) = s.upstream() else { continue };
+        if !ratio[u].is_multiple_of(ratio[s]) {
+            return err(format!(
+                "rate groups: the period {} s of `{u}` is not an integer multiple of the period {} s of its downstream `{s}`: a new {u} command would meet a held {s} command certified against the previous one",
+                period[u], period[s]
             ));
         }
     }
@@ -550,6 +578,14 @@ mod tests {
             (
                 "[[rate_groups]]\nname = \"t\"\nperiod_s = 0.15\nmembers = [\"translational\"]\n[[rate_groups]]\nname = \"r\"\nperiod_s = 0.1\nmembers = [\"attitude\", \"robotic\"]\n",
                 "integer multiple",
+            ),
+            (
+                "[[rate_groups]]\nname = \"t\"\nperiod_s = 0.3\nmembers = [\"translational\"]\n[[rate_groups]]\nname = \"a\"\nperiod_s = 0.2\nmembers = [\"attitude\"]\n[[rate_groups]]\nname = \"r\"\nperiod_s = 0.1\nmembers = [\"robotic\"]\n",
+                "is not an integer multiple of the period 0.2 s of its downstream `attitude`",
+            ),
+            (
+                "[[rate_groups]]\nname = \"t\"\nperiod_s = 1.6\nmembers = [\"translational\"]\n[[rate_groups]]\nname = \"r\"\nperiod_s = 0.1\nmembers = [\"attitude\", \"robotic\"]\n",
+                "held 16 base periods",
             ),
             ("rate_groups = 3\n", "invalid type"),
         ] {

@@ -140,7 +140,7 @@ fn header_compiles_as_cpp17() {
     std::fs::write(
         src,
         "#include \"safe_capture_icd.h\"\n#include <cstring>\n\
-         static_assert(sizeof(ScSimState) == 1568, \"size\");\n\
+         static_assert(sizeof(ScSimState) == 1616, \"size\");\n\
          int main() { ScNominalTranslational m{}; m.tick = 1; m.f_h[2] = 1.0;\n\
          if (m.f_h[2] != 1.0 || m.tick != 1) return 2;\n\
          return std::strcmp(ScNominalTranslational::IOX2_TYPE_NAME, SC_TYPE_NAME_NOMINAL_TRANSLATIONAL); }\n",

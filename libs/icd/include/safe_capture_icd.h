@@ -55,7 +55,7 @@ extern "C" {
 
 /* iceoryx2 type names: give them when opening a service (iceoryx2 matches types by name, size and alignment) */
 #define SC_TYPE_NAME_TICK "safe_capture::v2::Tick"
-#define SC_TYPE_NAME_SIM_STATE "safe_capture::v3::SimState"
+#define SC_TYPE_NAME_SIM_STATE "safe_capture::v4::SimState"
 #define SC_TYPE_NAME_NOMINAL_TRANSLATIONAL "safe_capture::v2::NominalTranslational"
 #define SC_TYPE_NAME_NOMINAL_ATTITUDE "safe_capture::v2::NominalAttitude"
 #define SC_TYPE_NAME_NOMINAL_ROBOTIC "safe_capture::v2::NominalRobotic"
@@ -152,7 +152,7 @@ SC_ICD_STATIC_ASSERT(offsetof(ScTick, send_ns) == 24, "ScTick.send_ns: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScTick, command) == 32, "ScTick.command: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScTick, _pad0) == 36, "ScTick._pad0: offset");
 
-/* SimState -- safe_capture::v3::SimState, 1568 B. Simulator → nominal controllers, safety filters, recorder: the observation at the start of the step. Every field of `sc_core::Observation`, copied as f64, so that the stages compute exactly what they compute in one process. */
+/* SimState -- safe_capture::v4::SimState, 1616 B. Simulator → nominal controllers, safety filters, recorder: the observation at the start of the step. Every field of `sc_core::Observation`, copied as f64, so that the stages compute exactly what they compute in one process. */
 typedef struct ScSimState {
     uint64_t tick; /* Tick index this state answers (= simulator step count at the base rate) [-] */
     double t; /* Simulation time [s] */
@@ -190,12 +190,14 @@ typedef struct ScSimState {
     double com_v_r[3]; /* Inertial velocity of the servicer system centre of mass, frame F_R [m/s] */
     double barriers[51]; /* Every barrier h at this state, from the simulator's own state (the safety monitor), in telemetry order; NaN (null in the MCAP) = not evaluated. With a declared `[uncertainty]` the state is the estimate and these the barriers on knowledge (the declared model on it) [unit per constraint] */
     double barriers_between[51]; /* The smallest value of every barrier over the physics steps since the previous state message (this state included); with a declared `[uncertainty]` equal to `barriers` (knowledge exists at the ticks only) [unit per constraint] */
+    double held_f_b[3]; /* The base force the simulator holds from the previous step: what acts in this tick while the translational group is not due (a downstream filter certifies against it then; docs/PARTITION.md, "Only what was certified acts"), frame F_B [N] */
+    double held_tau_b[3]; /* The base torque the simulator holds from the previous step, as `held_f_b`, frame F_B [N·m] */
 #if defined(__cplusplus) && __cplusplus >= 201703L
     /* the name iceoryx2's C++ API matches the payload type by */
-    static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v3::SimState";
+    static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v4::SimState";
 #endif
 } ScSimState;
-SC_ICD_STATIC_ASSERT(sizeof(ScSimState) == 1568, "ScSimState: size");
+SC_ICD_STATIC_ASSERT(sizeof(ScSimState) == 1616, "ScSimState: size");
 SC_ICD_STATIC_ASSERT(SC_ICD_ALIGNOF(ScSimState) == 8, "ScSimState: alignment");
 SC_ICD_STATIC_ASSERT(offsetof(ScSimState, tick) == 0, "ScSimState.tick: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSimState, t) == 8, "ScSimState.t: offset");
@@ -233,6 +235,8 @@ SC_ICD_STATIC_ASSERT(offsetof(ScSimState, com_r) == 704, "ScSimState.com_r: offs
 SC_ICD_STATIC_ASSERT(offsetof(ScSimState, com_v_r) == 728, "ScSimState.com_v_r: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSimState, barriers) == 752, "ScSimState.barriers: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSimState, barriers_between) == 1160, "ScSimState.barriers_between: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScSimState, held_f_b) == 1568, "ScSimState.held_f_b: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScSimState, held_tau_b) == 1592, "ScSimState.held_tau_b: offset");
 
 /* NominalTranslational -- safe_capture::v2::NominalTranslational, 64 B. Nominal translational controller → translational safety filter, recorder. */
 typedef struct ScNominalTranslational {
@@ -455,7 +459,7 @@ typedef struct ScStepResult {
     uint64_t tick; /* Tick index [-] */
     double t; /* Simulation time at the start of the step [s] */
     uint32_t end; /* How the step ended, one of `end` (0 running, 1 captured, 2 timeout, 3 simulator failed) [-] */
-    uint32_t fallback_mask; /* Subsystems (bits of `due`) whose command is the filter fallback computed by the simulator because the safe command was missing at the deadline (1 translational, 2 attitude, 4 robotic, 7 all) [-] */
+    uint32_t fallback_mask; /* Subsystems (bits of `due`) whose command is the filter fallback computed by the simulator: the safe command was missing at the deadline, refused, or did not fit what acts upstream (`fault::COUPLING_MISMATCH`) (1 translational, 2 attitude, 4 robotic, 7 all) [-] */
     uint32_t held_mask; /* Subsystems (bits of `due`) whose command was held from an earlier tick (slower rate group) (1 translational, 2 attitude, 4 robotic, 7 all) [-] */
     uint32_t fault_flags; /* Partition fault flags, bits of `fault` (1 stale input, 2 non finite input, 4 solver failed, 8 infeasible, 16 saturated, 32 nominal missing, 64 deadline miss, 128 peer dead, 256 rejected command, 512 navigation rejected, 1024 coupling mismatch) [-] */
     uint64_t safe_recv_ns; /* Stamp at which the robotic safe command (the tick's last) was delivered, host CLOCK_MONOTONIC [ns] */

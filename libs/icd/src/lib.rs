@@ -247,7 +247,7 @@ icd_message! {
     /// Simulator → nominal controllers, safety filters, recorder: the observation at
     /// the start of the step. Every field of `sc_core::Observation`, copied as f64, so
     /// that the stages compute exactly what they compute in one process.
-    #[type_name("safe_capture::v3::SimState")]
+    #[type_name("safe_capture::v4::SimState")]
     pub struct SimState {
         /// Tick index this state answers (= simulator step count at the base rate)
         pub tick: u64 = ["-"],
@@ -326,6 +326,12 @@ icd_message! {
         /// previous state message (this state included); with a declared
         /// `[uncertainty]` equal to `barriers` (knowledge exists at the ticks only)
         pub barriers_between: [f64; N_BARRIERS] = ["unit per constraint", None, Barriers],
+        /// The base force the simulator holds from the previous step: what acts in this
+        /// tick while the translational group is not due (a downstream filter certifies
+        /// against it then; docs/PARTITION.md, "Only what was certified acts")
+        pub held_f_b: [f64; 3] = ["N", Base, Xyz],
+        /// The base torque the simulator holds from the previous step, as `held_f_b`
+        pub held_tau_b: [f64; 3] = ["N·m", Base, Xyz],
     }
 }
 
@@ -488,7 +494,8 @@ icd_message! {
         /// How the step ended, one of `end`
         pub end: u32 = ["-"] => end,
         /// Subsystems (bits of `due`) whose command is the filter fallback computed by
-        /// the simulator because the safe command was missing at the deadline
+        /// the simulator: the safe command was missing at the deadline, refused, or did
+        /// not fit what acts upstream (`fault::COUPLING_MISMATCH`)
         pub fallback_mask: u32 = ["-"] => due,
         /// Subsystems (bits of `due`) whose command was held from an earlier tick
         /// (slower rate group)
@@ -638,7 +645,7 @@ pub fn type_name_of<T: ZeroCopySend>() -> &'static str {
 // Size guards: a change of one is a change of the ICD (regenerate the artefacts with
 // `SC_WRITE_ICD=1 cargo test -p sc-icd-gen`, and version the type name).
 const _: () = assert!(core::mem::size_of::<Tick>() == 40);
-const _: () = assert!(core::mem::size_of::<SimState>() == 1568);
+const _: () = assert!(core::mem::size_of::<SimState>() == 1616);
 const _: () = assert!(core::mem::size_of::<NominalTranslational>() == 64);
 const _: () = assert!(core::mem::size_of::<NominalAttitude>() == 64);
 const _: () = assert!(core::mem::size_of::<NominalRobotic>() == 96);

@@ -197,11 +197,13 @@ class SimState(ctypes.Structure):
         ("com_v_r", ctypes.c_double * 3),  # Inertial velocity of the servicer system centre of mass, frame F_R [m/s]
         ("barriers", ctypes.c_double * 51),  # Every barrier h at this state, from the simulator's own state (the safety monitor), in telemetry order; NaN (null in the MCAP) = not evaluated. With a declared `[uncertainty]` the state is the estimate and these the barriers on knowledge (the declared model on it) [unit per constraint]
         ("barriers_between", ctypes.c_double * 51),  # The smallest value of every barrier over the physics steps since the previous state message (this state included); with a declared `[uncertainty]` equal to `barriers` (knowledge exists at the ticks only) [unit per constraint]
+        ("held_f_b", ctypes.c_double * 3),  # The base force the simulator holds from the previous step: what acts in this tick while the translational group is not due (a downstream filter certifies against it then; docs/PARTITION.md, "Only what was certified acts"), frame F_B [N]
+        ("held_tau_b", ctypes.c_double * 3),  # The base torque the simulator holds from the previous step, as `held_f_b`, frame F_B [N·m]
     ]
 
     @staticmethod
     def type_name():
-        return "safe_capture::v3::SimState"
+        return "safe_capture::v4::SimState"
 
 
 class NominalTranslational(ctypes.Structure):
@@ -355,7 +357,7 @@ class StepResult(ctypes.Structure):
         ("tick", ctypes.c_uint64),  # Tick index [-]
         ("t", ctypes.c_double),  # Simulation time at the start of the step [s]
         ("end", ctypes.c_uint32),  # How the step ended, one of `end` (0 running, 1 captured, 2 timeout, 3 simulator failed) [-]
-        ("fallback_mask", ctypes.c_uint32),  # Subsystems (bits of `due`) whose command is the filter fallback computed by the simulator because the safe command was missing at the deadline (1 translational, 2 attitude, 4 robotic, 7 all) [-]
+        ("fallback_mask", ctypes.c_uint32),  # Subsystems (bits of `due`) whose command is the filter fallback computed by the simulator: the safe command was missing at the deadline, refused, or did not fit what acts upstream (`fault::COUPLING_MISMATCH`) (1 translational, 2 attitude, 4 robotic, 7 all) [-]
         ("held_mask", ctypes.c_uint32),  # Subsystems (bits of `due`) whose command was held from an earlier tick (slower rate group) (1 translational, 2 attitude, 4 robotic, 7 all) [-]
         ("fault_flags", ctypes.c_uint32),  # Partition fault flags, bits of `fault` (1 stale input, 2 non finite input, 4 solver failed, 8 infeasible, 16 saturated, 32 nominal missing, 64 deadline miss, 128 peer dead, 256 rejected command, 512 navigation rejected, 1024 coupling mismatch) [-]
         ("safe_recv_ns", ctypes.c_uint64),  # Stamp at which the robotic safe command (the tick's last) was delivered, host CLOCK_MONOTONIC [ns]

@@ -267,3 +267,65 @@ pub fn python_with(module: &str) -> Option<PathBuf> {
     );
     None
 }
+
+/// The messages of `topic` in the recording of `out`, by tick.
+pub fn recorded_by_tick(
+    out: &Path,
+    topic: &str,
+) -> std::collections::BTreeMap<u64, serde_json::Value> {
+    let bytes = std::fs::read(out.join("recording.mcap")).unwrap();
+    let mut m = std::collections::BTreeMap::new();
+    for msg in mcap::MessageStream::new(&bytes).unwrap() {
+        let msg = msg.unwrap();
+        if msg.channel.topic == topic {
+            let v: serde_json::Value = serde_json::from_slice(&msg.data).unwrap();
+            m.insert(v["tick"].as_u64().unwrap(), v);
+        }
+    }
+    m
+}
+
+fn json3(v: &serde_json::Value) -> [f64; 3] {
+    let a = v.as_array().unwrap();
+    [0, 1, 2].map(|i| a[i].as_f64().unwrap())
+}
+
+/// From the recording of `out`: in every step where the robotic (attitude) safe command of
+/// the tick acted, the force and torque (force) applied are exactly those it was certified
+/// against (its `xi`). Returns (steps, steps where the robotic command acted, steps with
+/// `COUPLING_MISMATCH`).
+pub fn assert_applied_as_certified(out: &Path) -> (usize, usize, usize) {
+    let results = recorded_by_tick(out, "safe_capture/sim/step_result");
+    let robotic = recorded_by_tick(out, "safe_capture/safe/robotic");
+    let attitude = recorded_by_tick(out, "safe_capture/safe/attitude");
+    let (mut acted, mut mismatched) = (0, 0);
+    for (k, r) in &results {
+        let flags = r["fault_flags"].as_u64().unwrap();
+        mismatched += usize::from(flags & u64::from(sc_icd::fault::COUPLING_MISMATCH) != 0);
+        let (force, torque) = (json3(&r["force_b"]), json3(&r["torque_b"]));
+        let acts = |bit: u32| {
+            let bit = u64::from(bit);
+            r["fallback_mask"].as_u64().unwrap() & bit == 0
+                && r["held_mask"].as_u64().unwrap() & bit == 0
+        };
+        if acts(sc_icd::due::ATTITUDE) {
+            let a = &attitude[k];
+            assert_eq!(
+                force,
+                json3(&a["xi_f_b"]),
+                "tick {k}: attitude command acted with another force"
+            );
+        }
+        if acts(sc_icd::due::ROBOTIC) {
+            let c = &robotic[k];
+            let xi = (json3(&c["xi_f_b"]), json3(&c["xi_tau_b"]));
+            assert_eq!(
+                (force, torque),
+                xi,
+                "tick {k}: robotic command acted with other upstream commands than it was certified against"
+            );
+            acted += 1;
+        }
+    }
+    (results.len(), acted, mismatched)
+}

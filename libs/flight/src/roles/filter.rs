@@ -276,16 +276,18 @@ impl FilterRole {
         }
     }
 
-    /// The upstream safe force of tick `s` [N, F_B]: this tick's, the held one of a slower
-    /// group, or — missing, dead upstream, or one the simulator would refuse — the
-    /// upstream backup, which is what the simulator applies. `true` when it is the backup.
+    /// The upstream safe force of tick `s` [N, F_B]: this tick's, or — missing, dead
+    /// upstream, or one the simulator would refuse — the upstream backup, which is what the
+    /// simulator applies (`true`: the backup). While the translational group is not due,
+    /// the force the simulator holds, published with the state.
     fn upstream_force(&mut self, s: &SimState, o: &sc_core::Observation) -> (Vector3<f64>, bool) {
-        let need = s.due_mask & Subsystem::Translational.bit() != 0;
-        let absent = self.absent.translational;
+        if s.due_mask & Subsystem::Translational.bit() == 0 {
+            return (convert::vec3(&s.held_f_b), false);
+        }
         let lim = &self.scenario.limits;
         match self
             .up_t
-            .filter(|m| if need { m.tick == s.tick } else { !absent })
+            .filter(|m| m.tick == s.tick)
             .filter(|m| admission::translational(m, lim))
         {
             Some(m) => (convert::vec3(&m.actuated), false),
@@ -293,14 +295,11 @@ impl FilterRole {
         }
     }
 
-    /// The upstream attitude command in force at tick `s` (this tick's or the held one of
-    /// a slower group) if it passes the simulator's admission; `None` when it is missing,
-    /// refused or its filter absent.
+    /// This tick's attitude command if it passes the simulator's admission; `None` when it
+    /// is missing or refused.
     fn upstream_attitude(&self, s: &SimState) -> Option<SafeAttitude> {
-        let need = s.due_mask & Subsystem::Attitude.bit() != 0;
-        let absent = self.absent.attitude;
         self.up_a
-            .filter(|m| if need { m.tick == s.tick } else { !absent })
+            .filter(|m| m.tick == s.tick)
             .filter(|m| admission::attitude(m, &self.scenario.limits))
     }
 
@@ -326,6 +325,12 @@ impl FilterRole {
     /// replaced by the attitude backup with the translational command in force.
     fn robotic_coupling(&mut self, s: &SimState, o: &sc_core::Observation) -> (Coupling, bool) {
         let (force_b, backup) = self.upstream_force(s, o);
+        if s.due_mask & Subsystem::Attitude.bit() == 0 {
+            // not due: the torque the simulator holds (the translational group is not due
+            // either: a downstream group's period divides its upstream's)
+            let torque_b = convert::vec3(&s.held_tau_b);
+            return (Coupling { force_b, torque_b }, backup);
+        }
         if let Some(a) = self.upstream_attitude(s) {
             let xi = convert::vec3(&a.xi_f_b);
             let torque_b = convert::vec3(&a.u);

@@ -166,6 +166,9 @@ pub struct SimulatorRole {
     absent: PerSubsystem<bool>,
     rejected: PerSubsystem<u64>,
     held: Command,
+    /// The coupling each held command was certified against (a backup: the upstream
+    /// commands it was computed with).
+    held_xi: PerSubsystem<Coupling>,
     between: Option<Barriers>,
     pending: Option<InTick>,
     ended: bool,
@@ -209,6 +212,7 @@ impl SimulatorRole {
             absent: PerSubsystem::default(),
             rejected: PerSubsystem::default(),
             held: Command::zero(),
+            held_xi: PerSubsystem::default(),
             between: None,
             pending: None,
             ended: false,
@@ -380,11 +384,14 @@ impl SimulatorRole {
                 &known.error,
             )));
         }
-        let msg = with_barriers(
+        let mut msg = with_barriers(
             stamp(convert::sim_state(&known.observation), &p.tick, p.recv_ns),
             b,
             between,
         );
+        // what acts while a group is not due: the downstream filters certify against it
+        msg.held_f_b = convert::arr3(&self.held.force_b);
+        msg.held_tau_b = convert::arr3(&self.held.torque_b);
         out.send(Message::State(msg));
         out.send(Message::PartnerState(msg));
         // the backups are computed on exactly what the filters read (the published state)
@@ -416,8 +423,18 @@ impl SimulatorRole {
         res: &mut StepResult,
         out: &mut Outbox,
     ) {
-        if !(due.contains(s) || self.absent[s]) {
-            res.held_mask |= s.bit();
+        if !due.contains(s) {
+            if self.certified_against_acting(s, &self.held_xi[s]) {
+                res.held_mask |= s.bit();
+                return;
+            }
+            // held, but what acts upstream changed under it (an absent upstream's backup
+            // recomputed every base period): its backup on what acts now, as the filters
+            // downstream of it compute it
+            let backup = self.backup(s, o);
+            self.hold(s, &backup, self.acting());
+            res.fallback_mask |= s.bit();
+            res.fault_flags |= fault::COUPLING_MISMATCH;
             return;
         }
         let fresh = self.got[s].filter(|m| m.tick == k);
@@ -425,11 +442,11 @@ impl SimulatorRole {
         let certified = admitted.filter(|m| self.certified_against_acting(s, &m.xi));
         let applied = certified.filter(|m| !self.downstream_took_backup(s, o, k, &m.command));
         if let Some(m) = applied {
-            self.hold(s, &m.command);
+            self.hold(s, &m.command, m.xi);
             return;
         }
         let backup = self.backup(s, o);
-        self.hold(s, &backup);
+        self.hold(s, &backup, self.acting());
         res.fallback_mask |= s.bit();
         if certified.is_some() {
             out.log(format!("simulator: FAULT tick {k}: {s} safe command came after the downstream filters certified against its backup; backup applied"));
@@ -507,8 +524,17 @@ impl SimulatorRole {
         }
     }
 
-    /// Holds `command` for subsystem `s` until it is due again.
-    fn hold(&mut self, s: Subsystem, command: &[f64; 7]) {
+    /// The upstream commands acting now (for a backup computed on them).
+    fn acting(&self) -> Coupling {
+        Coupling {
+            force_b: self.held.force_b,
+            torque_b: self.held.torque_b,
+        }
+    }
+
+    /// Holds `command`, certified against `xi`, for subsystem `s` until it is due again.
+    fn hold(&mut self, s: Subsystem, command: &[f64; 7], xi: Coupling) {
+        self.held_xi[s] = xi;
         let v3 = nalgebra::Vector3::new(command[0], command[1], command[2]);
         match s {
             Subsystem::Translational => self.held.force_b = v3,

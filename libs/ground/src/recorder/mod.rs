@@ -356,12 +356,14 @@ impl RecorderRole<FileSink> {
     /// From the process's config, writing into its output folder.
     pub fn from_process(p: &Proc) -> Result<Self, sc_flight::FlightError> {
         let sink = FileSink::new(p).map_err(|e| sc_flight::FlightError::Usage(e.to_string()))?;
-        Ok(Self::new(
-            sink,
-            &p.setup,
-            p.schedule.base_period_s,
-            std::process::id(),
-        ))
+        let mut role = Self::new(sink, &p.setup, p.schedule.base_period_s, std::process::id());
+        // the backups as the simulator computes them: certified for their group's hold
+        role.layer = SafetyLayer::with_holds(
+            &p.setup.scenario,
+            p.setup.robot.clone(),
+            &p.schedule.period_s,
+        );
+        Ok(role)
     }
 }
 

@@ -62,8 +62,8 @@ impl Tickset {
 
 /// What the simulator applied for one subsystem, as a filter output: the backup when the
 /// simulator applied the backup (the command was missing at its deadline, or it refused
-/// the one that came), else the tick's safe command (then held), else the held one of a
-/// slower group, else the backup.
+/// the one that came; then held), else the tick's safe command (then held), else the held
+/// one of a slower group, else the backup.
 fn applied_output<T: SafeMsg, const M: usize, const N: usize>(
     fresh: Option<T>,
     held: &mut Option<T>,
@@ -71,7 +71,16 @@ fn applied_output<T: SafeMsg, const M: usize, const N: usize>(
     backup: impl FnOnce() -> FilterOutput<M, N>,
 ) -> FilterOutput<M, N> {
     if fell_back {
-        return backup();
+        // the simulator holds the backup until the group is due again
+        let out = backup();
+        *held = Some(convert::safe_msg(
+            &out,
+            &convert::Coupling::default(),
+            0,
+            0.0,
+            0,
+        ));
+        return out;
     }
     match fresh {
         Some(m) => {
