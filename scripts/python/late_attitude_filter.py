@@ -87,7 +87,7 @@ def main():
                 for t in drain(up_sub, sc_icd.SafeTranslational):
                     forces[t.tick] = list(t.actuated)
                 m = sc_icd.SafeAttitude(tick=s.tick, t=s.t, n_constraints=sc_icd.N_CONSTRAINTS_ATTITUDE, solver_status=1)
-                for i, f in enumerate(forces.pop(s.tick, [0.0, 0.0, 0.0])):
+                for i, f in enumerate(forces.pop(s.tick, list(s.held_f_b))):
                     m.xi_f_b[i] = f
                 forces = {k: v for k, v in forces.items() if k > s.tick}
                 m.publish_ns = time.monotonic_ns()

@@ -904,7 +904,8 @@ impl RoboticFilter {
     /// arm's reaction on the base stays within `arm_reaction_budget` whatever the robotic
     /// filter does, its emergencies included. The joints then decelerate at `s` times the
     /// braking law's rate. When the rows cannot hold even at `τ_hold` (the budget below
-    /// the declared torque error's share) `s = 0`; the command box is enforced last.
+    /// the declared torque error's share) `s = 0`. The command box comes first: where
+    /// `τ_hold` is beyond it, `s` is at least what brings the command into the box.
     pub fn emergency_brake(&self, x: &RoboticInput) -> Vector7 {
         let brake = self.brake(x);
         let hold = hold_torque(x);
@@ -913,18 +914,21 @@ impl RoboticFilter {
         }
         let d = brake - hold;
         let rows = self.hard_rows(x);
-        let s = rows[2 * NJ..].iter().fold(1.0f64, |s, r| {
-            let (at_hold, slope) = (r.a.dot(&hold) + r.c, r.a.dot(&d));
-            if slope < 0.0 {
-                s.min((at_hold / -slope).max(0.0))
-            } else {
-                s
-            }
+        // along the segment every row is `at_hold + s slope ≥ 0`
+        let along = |r: &Row<NJ>| (r.a.dot(&hold) + r.c, r.a.dot(&d));
+        let contract = rows[2 * NJ..].iter().map(along).fold(1.0f64, |s, (h, m)| {
+            if m < 0.0 { s.min((h / -m).max(0.0)) } else { s }
         });
+        // the box first: the brake (s = 1) is in it, so a lower bound below 1 exists
+        let in_box = rows[..2 * NJ].iter().map(along).fold(0.0f64, |s, (h, m)| {
+            if h < 0.0 && m > 0.0 { s.max(-h / m) } else { s }
+        });
+        let s = contract.max(in_box).min(1.0);
         if s >= 1.0 {
             return brake;
         }
-        common::sat_inf(&(hold + d * s), self.command_limit().min())
+        let lim = self.command_limit();
+        (hold + d * s).zip_map(&lim, |u, l| u.clamp(-l, l))
     }
 
     /// The filter's command when its nominal is missing: the safety QP on the substitute.
@@ -1524,6 +1528,10 @@ impl FilterStep<NJ, N> for RoboticFilter {
         self.brake(x)
     }
 
+    fn emergency(&self, x: &RoboticInput, _: &Prepared) -> Vector7 {
+        self.emergency_brake(x)
+    }
+
     /// The command ([`RoboticFilter::command`]) with the rows it was solved with and the
     /// rows that certify it, kept here (they are large).
     fn solve_qp(
@@ -1688,8 +1696,8 @@ mod tests {
     fn the_emergency_brake_keeps_the_arm_reaction_contract() {
         let (s, x) = moving_arm();
         let f = RoboticFilter::new(RoboticParams::from_scenario(&s));
-        let holds = |u: &Vector7| {
-            f.hard_rows(&x)[2 * NJ..]
+        let holds = |x: &RoboticInput, u: &Vector7| {
+            f.hard_rows(x)[2 * NJ..]
                 .iter()
                 .all(|r| r.a.dot(u) + r.c >= -1e-12)
         };
@@ -1698,18 +1706,21 @@ mod tests {
             ..x
         };
         assert!(
-            !holds(&f.brake(&fast)),
+            !holds(&fast, &f.brake(&fast)),
             "the plain brake breaks the contract"
         );
         let u = f.emergency_brake(&fast);
-        assert!(holds(&u) && u.amax() <= f.command_limit().min(), "{u}");
+        assert!(
+            holds(&fast, &u) && u.amax() <= f.command_limit().min(),
+            "{u}"
+        );
         // still a brake: it takes kinetic energy out of the joints
         assert!(u.dot(&fast.theta_dot) < 0.0);
         let slow = RoboticInput {
             theta_dot: x.theta_dot * 1e-3,
             ..x
         };
-        assert!(holds(&f.brake(&slow)));
+        assert!(holds(&slow, &f.brake(&slow)));
         assert_eq!(f.emergency_brake(&slow), f.brake(&slow));
     }
 

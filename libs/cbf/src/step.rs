@@ -86,6 +86,12 @@ pub(crate) trait FilterStep<const M: usize, const N: usize> {
     /// produce one.
     fn braking_law(&self, x: &Self::Input, p: &Self::Prepared) -> SVector<f64, M>;
 
+    /// The command when no solver produced one: the braking law, unless the filter
+    /// keeps a contract with the other filters that its brake must keep too.
+    fn emergency(&self, x: &Self::Input, p: &Self::Prepared) -> SVector<f64, M> {
+        self.braking_law(x, p)
+    }
+
     /// The filter's own QP step on the resolved nominal `u_nom` (its rows, its certificate
     /// or verification), handed to [`conclude`] with the rows it was solved with — kept
     /// where the filter built them, so that nothing large is copied.
@@ -208,7 +214,7 @@ where
         }
         Kind::Failed => {
             report.faults |= faults::QP_FAILED_FALLBACK;
-            u = f.braking_law(x, p);
+            u = f.emergency(x, p);
             FilterStatus::Fallback
         }
     };

@@ -222,7 +222,8 @@ fn solver_failure_falls_back_to_the_braking_law() {
     let o = f.filter(&x, &Vector7::repeat(0.5));
     assert_eq!(o.report.status, FilterStatus::Fallback, "{:?}", o.report);
     assert_ne!(o.report.faults & faults::QP_FAILED_FALLBACK, 0);
-    assert_eq!(o.u, f.brake(&x));
+    // the emergency brake: the braking law within the arm-reaction contract
+    assert_eq!(o.u, f.emergency_brake(&x));
     assert_output_sane(&o, s.limits.joint_torque_max_nm);
     // the braking law opposes the joint rates through the arm's inertia
     assert!(f.brake(&x).dot(&(x.m_eff * thd)) < 0.0);

@@ -16,10 +16,12 @@ from .config import load_scenario  # noqa: F401  (the scripts' entry point to th
 
 # sc_bus::ServiceSettings::lock_step()
 LOCK_STEP = dict(buffer=4, history=0, max_publishers=2, max_subscribers=8, max_nodes=16, safe_overflow=False)
-# sc_partition::process::qos(): the partition's data services (lossless: a full queue
-# makes the publisher wait; exactly one publisher, the owner)
+# sc_flight::process::qos(): the partition's data services (never silently lossy; exactly
+# one publisher, the owner). The Rust publishers never wait for a full queue (that
+# subscriber loses the sample, reported); a Python publisher on them (only the test
+# scripts' hostile filters) keeps iceoryx2's own default.
 PARTITION = dict(LOCK_STEP, buffer=16, max_publishers=1, safe_overflow=False)
-# sc_partition::process::partner_qos(): the services a partner's nominal controller
+# sc_flight::process::partner_qos(): the services a partner's nominal controller
 # publishes on (safe_capture/nominal/*): newest wins, nobody ever waits
 NOMINAL = dict(PARTITION, safe_overflow=True)
 # event ids up to this on data services (sc_bus::pubsub::EVENT_ID_MAX)

@@ -290,8 +290,10 @@ impl SimulatorRole {
                     super::keep_for_tick(vec![*e], &mut self.estimate, want, known, |e| e.tick);
                 self.navigation_absent &= !came;
             } else if let Some((s, r)) = Received::of(m, &self.scenario.limits) {
-                if in_tick.is_some() {
-                    // within a tick a command brings an absent filter back
+                if in_tick.is_some() || Some(r.tick) == self.measured_tick {
+                    // within a tick, or for the tick just finished (a filter that answers
+                    // after the simulator stopped waiting for it), a command brings an
+                    // absent filter back
                     self.absent[s] = false;
                 }
                 if s == Subsystem::Robotic && Some(r.tick) == in_tick {
@@ -321,7 +323,9 @@ impl SimulatorRole {
         let barriers = self.monitor.evaluate(&o.barrier_state());
         let barriers_between = self.between.unwrap_or(barriers);
         if self.realisation.is_some() {
-            let truth = stamp(convert::sim_state(&o), &t, now_ns);
+            let mut truth = stamp(convert::sim_state(&o), &t, now_ns);
+            truth.held_f_b = convert::arr3(&self.held.force_b);
+            truth.held_tau_b = convert::arr3(&self.held.torque_b);
             out.send(Message::Truth(with_barriers(
                 truth,
                 barriers,
@@ -428,9 +432,11 @@ impl SimulatorRole {
                 res.held_mask |= s.bit();
                 return;
             }
-            // held, but what acts upstream changed under it (an absent upstream's backup
-            // recomputed every base period): its backup on what acts now, as the filters
-            // downstream of it compute it
+            // held, but something else acts upstream: cannot happen with nested rate
+            // groups (`config::nested`: an upstream group is due only with its downstream
+            // one); should it, the held command does not act uncertified — its backup on
+            // what acts now does, said and flagged
+            out.log(format!("simulator: FAULT tick {k}: held {s} command certified against other upstream commands than those acting; backup applied"));
             let backup = self.backup(s, o);
             self.hold(s, &backup, self.acting());
             res.fallback_mask |= s.bit();
