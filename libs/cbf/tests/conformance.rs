@@ -56,6 +56,11 @@ trait Conformance<const M: usize, const N: usize>:
     /// Its braking law at `x`: the substitute nominal and the command when no solver
     /// produces one.
     fn braking_law(&self, x: &Self::Input) -> SVector<f64, M>;
+    /// The command when no solver produces one: the braking law, unless the filter keeps
+    /// a contract with the others (the robotic filter's arm-reaction budget).
+    fn emergency(&self, x: &Self::Input) -> SVector<f64, M> {
+        self.braking_law(x)
+    }
     /// The motion the braking law opposes (`braking_law · motion < 0` while moving).
     fn motion(x: &Self::Input) -> SVector<f64, M>;
     /// Inputs near the barriers, moving towards them, with nominals up to 1.5× the bound.
@@ -576,6 +581,9 @@ impl Conformance<7, 42> for RoboticFilter {
     fn braking_law(&self, x: &RoboticInput) -> Vector7 {
         self.brake(x)
     }
+    fn emergency(&self, x: &RoboticInput) -> Vector7 {
+        self.emergency_brake(x)
+    }
     /// `M_eff θ̇`: the arm's momentum.
     fn motion(x: &RoboticInput) -> Vector7 {
         x.m_eff * x.theta_dot
@@ -1038,8 +1046,9 @@ where
 }
 
 /// When no solver produces a command (here: the relaxed problem's LP allowed no
-/// iteration, on states whose rows cannot all hold), the command is the braking law,
-/// flagged; and the braking law brakes the subsystem's motion, inside the bound.
+/// iteration, on states whose rows cannot all hold), the command is the emergency command
+/// (the braking law, the robotic one within its arm-reaction contract), flagged; and the
+/// braking law brakes the subsystem's motion, inside the bound.
 fn solver_failure_gives_the_braking_law<F, const M: usize, const N: usize>()
 where
     F: Conformance<M, N>,
@@ -1068,7 +1077,7 @@ where
         assert_eq!(o.report.status, FilterStatus::Fallback, "{:?}", o.report);
         assert_ne!(o.report.faults & faults::QP_FAILED_FALLBACK, 0);
         assert_eq!(o.report.faults & faults::QP_INFEASIBLE_RELAXED, 0);
-        assert_eq!(o.u, brake);
+        assert_eq!(o.u, failing.emergency(&x));
         assert_output_sane(&o, bound);
     }
     println!("{:?}: {relaxed} states braked", F::SUBSYSTEM);
