@@ -8,9 +8,11 @@
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
+pub mod envelope;
 pub mod uncertainty;
 mod validate;
 
+pub use envelope::LineOfSightEnvelope;
 pub use uncertainty::{Uncertainty, UncertaintySpec};
 pub use validate::ScenarioError;
 
@@ -242,16 +244,44 @@ pub struct SafetyTranslational {
     /// (docs/SAFETY.md, "The corridor's curvature").
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub curvature_share: Option<f64>,
+    /// The line-of-sight contract: the servicer's speed across the line of sight to the
+    /// grasping point, per axis, at most this times its length [rad/s], so that the
+    /// servicer's own motion turns the line of sight at most √2 times this; absent:
+    /// [`DEFAULT_LOS_SPEED_BUDGET`] (docs/SAFETY.md, "The certified envelope").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub los_speed_budget_rad_s: Option<f64>,
+    /// γ of the line-of-sight contract's rows [1/s]; absent: [`DEFAULT_LOS_SPEED_GAMMA`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub los_speed_gamma_per_s: Option<f64>,
 }
 
 /// The curvature's share of the corridor's braking authority when a scenario does not set
 /// `safety.translational.curvature_share` [-].
 pub const DEFAULT_CURVATURE_SHARE: f64 = 0.5;
 
+/// The line-of-sight contract when a scenario does not set
+/// `safety.translational.los_speed_budget_rad_s` [rad/s].
+pub const DEFAULT_LOS_SPEED_BUDGET: f64 = 0.005;
+/// γ of the line-of-sight contract's rows when a scenario does not set
+/// `safety.translational.los_speed_gamma_per_s` [1/s].
+pub const DEFAULT_LOS_SPEED_GAMMA: f64 = 10.0;
+
 impl SafetyTranslational {
     /// `curvature_share`, or [`DEFAULT_CURVATURE_SHARE`].
     pub fn curvature_share(&self) -> f64 {
         self.curvature_share.unwrap_or(DEFAULT_CURVATURE_SHARE)
+    }
+
+    /// `los_speed_budget_rad_s`, or [`DEFAULT_LOS_SPEED_BUDGET`].
+    pub fn los_speed_budget(&self) -> f64 {
+        self.los_speed_budget_rad_s
+            .unwrap_or(DEFAULT_LOS_SPEED_BUDGET)
+    }
+
+    /// `los_speed_gamma_per_s`, or [`DEFAULT_LOS_SPEED_GAMMA`].
+    pub fn los_speed_gamma(&self) -> f64 {
+        self.los_speed_gamma_per_s
+            .unwrap_or(DEFAULT_LOS_SPEED_GAMMA)
     }
 }
 

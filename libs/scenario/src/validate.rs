@@ -67,7 +67,7 @@ impl ScenarioError {
     }
 }
 
-fn invalid(key: &str, value: impl Debug, rule: impl Into<String>) -> ScenarioError {
+pub(crate) fn invalid(key: &str, value: impl Debug, rule: impl Into<String>) -> ScenarioError {
     ScenarioError::Invalid {
         key: key.to_string(),
         value: format!("{value:?}"),
@@ -174,7 +174,8 @@ impl Scenario {
         self.validate_limits()?;
         self.validate_safety()?;
         self.validate_nominal()?;
-        self.validate_uncertainty()
+        self.validate_uncertainty()?;
+        self.validate_envelope()
     }
 
     fn validate_uncertainty(&self) -> Result<(), ScenarioError> {
@@ -368,7 +369,15 @@ impl Scenario {
                 "must be in (0, 1]",
             ));
         }
-        positive("safety.translational.u_max_caz_m2_s2", tr.u_max_caz_m2_s2)
+        positive("safety.translational.u_max_caz_m2_s2", tr.u_max_caz_m2_s2)?;
+        positive(
+            "safety.translational.los_speed_budget_rad_s",
+            tr.los_speed_budget(),
+        )?;
+        positive(
+            "safety.translational.los_speed_gamma_per_s",
+            tr.los_speed_gamma(),
+        )
     }
 
     /// The rules that need the servicer's total mass `m` [kg], which the scenario does not
