@@ -279,14 +279,11 @@ pub fn omega_limits(
     })
 }
 
-/// Two unit axes across the boresight `d` (unit): `e₁ ⊥ d`, `e₂ = d × e₁`.
+/// Two unit axes across the boresight `d` (unit): `e₁ ⊥ d`, `e₂ = d × e₁` — the scenario's
+/// envelope computes its steady-state rates on the same axes
+/// ([`sc_scenario::envelope::across_boresight`], one definition).
 pub fn across_boresight(d: &Vector3<f64>) -> [Vector3<f64>; 2] {
-    // the body axis least aligned with d, made orthogonal to it
-    let k = d.iamin();
-    let mut e = Vector3::zeros();
-    e[k] = 1.0;
-    let e1 = (e - d * d.dot(&e)).normalize();
-    [e1, d.cross(&e1)]
+    sc_scenario::envelope::across_boresight(&[d.x, d.y, d.z]).map(Vector3::from)
 }
 
 /// The boresight's rate across itself, constraints of the certified set (not among the

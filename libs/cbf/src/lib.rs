@@ -35,6 +35,7 @@ pub mod engine;
 pub mod envelope;
 pub mod filter;
 pub mod knowledge;
+pub mod los_contract;
 pub mod monitor;
 pub mod qp;
 pub mod robotic;

@@ -27,7 +27,7 @@ use crate::filter::{Coupling, SafetyFilter};
 use crate::sampled::{self, RateBounds, RelDeg1, RelDeg2, SampleBounds};
 use crate::step::{self, Actuated, FilterStep, Invalid, Solved};
 use crate::translational_margins::{ForceError, InertialMotion, TranslationalErrors, Unknowns};
-use crate::{Formulation, qp::SolverParams};
+use crate::{Formulation, los_contract, qp::SolverParams};
 use nalgebra::{Matrix3, Vector3};
 use sc_core::{Observation, Subsystem};
 use sc_models::quat::{self, Quat};
@@ -37,9 +37,23 @@ use sc_multibody::Robot;
 pub const NAMES: [&str; 2] = ["approach_corridor", "collision_avoidance_zone"];
 /// Number of constraints.
 pub const N: usize = 2;
+/// Rows of the QP besides the force box: the [`NAMES`] rows, the tangential-speed row and
+/// the line-of-sight contract's ([`crate::los_contract`]).
+pub const ROWS: usize = N + 1 + los_contract::ROWS;
+/// Priority tier of each row in the relaxed problem (0 first): the barriers and the
+/// tangential-speed limit before the line-of-sight contract, so that a contract that
+/// cannot hold never buys a corridor or zone violation.
+pub const TIERS: [u8; ROWS] = [0, 0, 0, 1, 1, 1, 1];
+/// A row that never binds: the contract's rows where they are not defined.
+const NEVER_BINDING: Row<3> = Row {
+    a: Vector3::new(0.0, 0.0, 0.0),
+    c: 1.0,
+};
 
 /// Accepted state range: `MIN_RANGE_M ≤ ‖r_H‖ ≤ MAX_RANGE_M` (the corridor's cone is not
-/// differentiable at its apex), `‖v_H‖ ≤ MAX_SPEED_M_S`, `‖ω_H‖, ‖ω̇_H‖ ≤ MAX_FRAME_RATE`.
+/// differentiable at its apex), `‖v_H‖ ≤ MAX_SPEED_M_S`, `‖ω_H‖, ‖ω̇_H‖ ≤ MAX_FRAME_RATE`. (A
+/// grasping point or target rate outside these ranges drops the line-of-sight contract's
+/// rows only: [`TranslationalFilter::los_rows`].)
 pub const MIN_RANGE_M: f64 = 1e-6;
 pub const MAX_RANGE_M: f64 = 1e5;
 pub const MAX_SPEED_M_S: f64 = 1e3;
@@ -87,6 +101,15 @@ pub struct TranslationalParams {
     /// The declared errors the rows budget for (docs/SAFETY.md, "Margins for the declared
     /// errors"); `None`: none declared (the `exact` profile), the rows are the nominal ones.
     pub errors: Option<TranslationalErrors>,
+    /// The line-of-sight contract `w_tr` [rad/s] ([`crate::los_contract`]).
+    pub los_speed_budget: f64,
+    /// γ of the line-of-sight contract's rows [1/s].
+    pub gamma_los_speed: f64,
+    /// The fixed reference of the contract's axes ([`los_contract::reference`], F_R).
+    pub los_reference: Vector3<f64>,
+    /// `κ ≥ λ_max/λ_min` of the target's inertia with its declared error: its rate stays
+    /// within `κ ‖ω_T‖` and `‖ω̇_T‖ ≤ κ ‖ω_T‖²` (torque free, `‖Iω‖` conserved).
+    pub target_inertia_ratio: f64,
 }
 
 impl TranslationalParams {
@@ -118,6 +141,10 @@ impl TranslationalParams {
                 .norm(),
             orbit_radius: a,
             errors: None,
+            los_speed_budget: t.los_speed_budget(),
+            gamma_los_speed: t.los_speed_gamma(),
+            los_reference: los_contract::reference(&Vector3::from(t.corridor_axis).normalize()),
+            target_inertia_ratio: s.target_inertia_ratio(),
         }
     }
 
@@ -154,6 +181,13 @@ pub struct TranslationalInput {
     /// Bounds on the error of `r_H` [m] and `v_H` [m/s] against the plant's true CoM
     /// ([`crate::knowledge::ComKnowledge::com_error`]); zero when nothing is declared.
     pub com_error: (f64, f64),
+    /// The grasping point relative to the target's CoM in F_R [m] and its velocity [m/s]:
+    /// the line of sight of the contract ([`crate::los_contract`]).
+    pub grasp_r: Vector3<f64>,
+    /// The grasping point's velocity relative to the target's CoM in F_R [m/s].
+    pub grasp_v_r: Vector3<f64>,
+    /// The target's rate `‖ω_T‖` [rad/s].
+    pub target_spin: f64,
 }
 
 impl TranslationalInput {
@@ -168,6 +202,9 @@ impl TranslationalInput {
             q_rb,
             omega_b: Vector3::zeros(),
             com_error: (0.0, 0.0),
+            grasp_r: Vector3::zeros(),
+            grasp_v_r: Vector3::zeros(),
+            target_spin: 0.0,
         }
     }
 }
@@ -290,8 +327,8 @@ pub(crate) struct Prepared {
     terms: [RelDegTwo<3>; N],
     /// The barrier rows ([`NAMES`] order) and the tangential-speed row — with declared
     /// errors, those for every command in the force box.
-    rows: [Row<3>; N + 1],
-    weights: [f64; N + 1],
+    rows: [Row<3>; ROWS],
+    weights: [f64; ROWS],
     bounds: [Row<3>; 6],
     /// With declared errors: what the rows for a smaller force are built from.
     known: Option<KnownInputs>,
@@ -307,6 +344,8 @@ pub(crate) struct KnownInputs {
     r_r: Vector3<f64>,
     v_r: Vector3<f64>,
     tide: Vector3<f64>,
+    /// `R_HR`.
+    r_hr: Matrix3<f64>,
 }
 
 /// Rounds of [`TranslationalFilter::solve_known`] before the rows for the whole force box.
@@ -320,7 +359,7 @@ pub const DEGRADE_ROUNDS: usize = 6;
 /// The translational CBF-QP safety filter (paper eq. "translation_qp").
 pub struct TranslationalFilter {
     pub params: TranslationalParams,
-    engine: Engine<3, { N + 1 + 6 }>,
+    engine: Engine<3, { ROWS + 6 }>,
     last: LastProblem<3>,
 }
 
@@ -329,7 +368,7 @@ impl TranslationalFilter {
         Self {
             params,
             engine: Engine::new(),
-            last: LastProblem::with_capacity(N + 1, 6),
+            last: LastProblem::with_capacity(ROWS, 6),
         }
     }
 
@@ -448,7 +487,7 @@ impl TranslationalFilter {
         r_hr: &Matrix3<f64>,
         axis: &CorridorAxis,
         terms: &[RelDegTwo<3>; N],
-    ) -> ([Row<3>; N + 1], [f64; N + 1], Option<KnownInputs>) {
+    ) -> ([Row<3>; ROWS], [f64; ROWS], Option<KnownInputs>) {
         let p = &self.params;
         let mu = [p.u_max_ac, p.u_max_caz];
         let c_t = tangential_coefficient(p);
@@ -465,34 +504,45 @@ impl TranslationalFilter {
             r_r,
             v_r,
             tide: tidal,
+            r_hr: *r_hr,
         });
-        let rows: [Row<3>; N + 1] = match (p.formulation, &p.errors, &known) {
+        let rows: [Row<3>; ROWS] = match (p.formulation, &p.errors, &known) {
             (Formulation::SampledData, Some(errors), Some(k)) => {
                 self.known_rows(x, terms, k, errors.force, self.full_force(), 1.0)
             }
             (Formulation::SampledData, _, _) => {
                 let (b, bt) = self.sample_bounds(&x.r_h, &x.v_h, &x.omega_b, axis);
-                [
+                let own = [
                     RelDeg2::from(terms[0]).row(&b[0], mu[0], p.gamma),
                     RelDeg2::from(terms[1]).row(&b[1], mu[1], p.gamma),
                     RelDeg1::from(tangential).row(&bt, p.gamma, 0.0),
-                ]
+                ];
+                let los = self.los_rows(x, r_hr, &r_r, &v_r, &tidal, (0.0, ForceError::NONE));
+                std::array::from_fn(|i| if i < N + 1 { own[i] } else { los[i - N - 1] })
             }
-            (Formulation::Paper, _, _) => [
-                terms[0].row(p.gamma, p.eps_ac, p.u_max_ac),
-                terms[1].row(p.gamma, p.eps_caz, p.u_max_caz),
-                // the paper has no tangential limit: a row that never binds
-                Row {
-                    a: Vector3::zeros(),
-                    c: 1.0,
-                },
-            ],
+            (Formulation::Paper, _, _) => {
+                let own = [
+                    terms[0].row(p.gamma, p.eps_ac, p.u_max_ac),
+                    terms[1].row(p.gamma, p.eps_caz, p.u_max_caz),
+                ];
+                // the paper has no tangential limit nor line-of-sight contract: rows that
+                // never bind
+                std::array::from_fn(|i| {
+                    own.get(i).copied().unwrap_or(Row {
+                        a: Vector3::zeros(),
+                        c: 1.0,
+                    })
+                })
+            }
         };
-        let weights = [
-            p.u_max_ac,
-            p.u_max_caz,
-            2.0 * (c_t.max(0.0) * p.r_caz).sqrt() * p.force_max / p.mass,
-        ];
+        let tangential_weight = 2.0 * (c_t.max(0.0) * p.r_caz).sqrt() * p.force_max / p.mass;
+        let weights = std::array::from_fn(|i| match i {
+            0 => p.u_max_ac,
+            1 => p.u_max_caz,
+            2 => tangential_weight,
+            // the contract's rows: measured against the thrust's acceleration across
+            _ => p.force_max / p.mass,
+        });
         (rows, weights, known)
     }
 
@@ -524,8 +574,23 @@ impl TranslationalFilter {
                 return self.conclude_solved(x, p, u_nom, &outcome, &rows, report);
             }
         }
-        let outcome = self.engine.solve(u_nom, &p.rows, &p.weights, &p.bounds);
+        let outcome = self.solve_rows(u_nom, &p.rows, p);
         if matches!(outcome.kind, Kind::Solved | Kind::Skipped) {
+            return self.conclude_solved(x, p, u_nom, &outcome, &p.rows, report);
+        }
+        // only the contract at fault: its rows relaxed, every barrier's margin kept
+        let barriers_only: [Row<3>; ROWS] = std::array::from_fn(|i| {
+            if TIERS[i] == 0 {
+                p.rows[i]
+            } else {
+                NEVER_BINDING
+            }
+        });
+        if self
+            .engine
+            .solve_hard(u_nom, &barriers_only, &p.bounds)
+            .is_some()
+        {
             return self.conclude_solved(x, p, u_nom, &outcome, &p.rows, report);
         }
         self.solve_degraded(x, p, k, force, u_nom, report)
@@ -543,12 +608,12 @@ impl TranslationalFilter {
         force: ForceError,
         u_nom: &Vector3<f64>,
         start: f64,
-    ) -> Option<(crate::engine::Outcome<3>, [Row<3>; N + 1])> {
+    ) -> Option<(crate::engine::Outcome<3>, [Row<3>; ROWS])> {
         let full = self.full_force();
         let mut cap = start;
         for _ in 0..FORCE_CAP_ROUNDS {
             let rows = self.known_rows(x, &p.terms, k, force, cap, 1.0);
-            let outcome = self.engine.solve(u_nom, &rows, &p.weights, &p.bounds);
+            let outcome = self.solve_rows(u_nom, &rows, p);
             if !matches!(outcome.kind, Kind::Solved | Kind::Skipped) {
                 return None;
             }
@@ -584,9 +649,7 @@ impl TranslationalFilter {
     ) -> Actuated<3> {
         let full = self.full_force();
         let nominal_rows = self.known_rows(x, &p.terms, k, force, full, 0.0);
-        let first = self
-            .engine
-            .solve(u_nom, &nominal_rows, &p.weights, &p.bounds);
+        let first = self.solve_rows(u_nom, &nominal_rows, p);
         if !matches!(first.kind, Kind::Solved | Kind::Skipped) {
             return self.conclude_solved(x, p, u_nom, &first, &nominal_rows, report);
         }
@@ -595,7 +658,7 @@ impl TranslationalFilter {
         for _ in 0..DEGRADE_ROUNDS {
             let mid = 0.5 * (lo + hi);
             let rows = self.known_rows(x, &p.terms, k, force, full, mid);
-            let outcome = self.engine.solve(u_nom, &rows, &p.weights, &p.bounds);
+            let outcome = self.solve_rows(u_nom, &rows, p);
             if matches!(outcome.kind, Kind::Solved | Kind::Skipped) {
                 (best, best_rows, share, lo) = (outcome, rows, mid, mid);
             } else {
@@ -617,7 +680,7 @@ impl TranslationalFilter {
         p: &Prepared,
         u_nom: &Vector3<f64>,
         outcome: &crate::engine::Outcome<3>,
-        rows: &[Row<3>; N + 1],
+        rows: &[Row<3>; ROWS],
         report: &mut FilterReport<N>,
     ) -> Actuated<3> {
         let solved = Solved {
@@ -628,6 +691,17 @@ impl TranslationalFilter {
             certifying: &rows[..N],
         };
         step::conclude(self, x, p, u_nom, solved, report)
+    }
+
+    /// The QP on `rows` with the prepared weights and force box, relaxed in [`TIERS`].
+    fn solve_rows(
+        &mut self,
+        u_nom: &Vector3<f64>,
+        rows: &[Row<3>; ROWS],
+        p: &Prepared,
+    ) -> crate::engine::Outcome<3> {
+        self.engine
+            .solve_tiered(u_nom, rows, &p.weights, &TIERS, &p.bounds)
     }
 
     /// `√3 F` [N]: the largest force the box `‖f_B‖∞ ≤ F` admits.
@@ -651,7 +725,7 @@ impl TranslationalFilter {
         force: ForceError,
         force_cap: f64,
         share: f64,
-    ) -> [Row<3>; N + 1] {
+    ) -> [Row<3>; ROWS] {
         let p = &self.params;
         let axis = &k.axis;
         let force = force.share(share);
@@ -703,11 +777,13 @@ impl TranslationalFilter {
                 c: force.scaled_offset(t.hddot_drift - req),
             }
         });
-        [
-            rows[0],
-            rows[1],
-            self.tangential_known_row(k, &u, &bt, force),
-        ]
+        let tangential = self.tangential_known_row(k, &u, &bt, force);
+        let los = self.los_rows(x, &k.r_hr, &k.r_r, &k.v_r, &k.tide, (force_cap, force));
+        std::array::from_fn(|i| match i {
+            0 | 1 => rows[i],
+            2 => tangential,
+            _ => los[i - N - 1],
+        })
     }
 
     /// The tangential-speed row of [`Self::known_rows`] (relative degree one, in F_R): the
@@ -741,6 +817,98 @@ impl TranslationalFilter {
         Row {
             a: tangential.hdot_u,
             c: force.scaled_offset(tangential.hdot_drift - req_t),
+        }
+    }
+
+    /// The line-of-sight contract's rows ([`crate::los_contract`]) at the CoM `r`, `v` and
+    /// tide in F_R. `force = (cap, error)`: with declared errors, the delivered force may
+    /// turn by `θ̄` for commands up to `cap` [N] (in `D`) and its scale acts on the offsets;
+    /// the navigation errors are not in these rows (docs/SAFETY.md).
+    fn los_rows(
+        &self,
+        x: &TranslationalInput,
+        r_hr: &Matrix3<f64>,
+        r: &Vector3<f64>,
+        v: &Vector3<f64>,
+        tide: &Vector3<f64>,
+        force: (f64, ForceError),
+    ) -> [Row<3>; los_contract::ROWS] {
+        let p = &self.params;
+        let (cap, err) = force;
+        let grasp_known = in_range3(&x.grasp_r, MAX_RANGE_M)
+            && in_range3(&x.grasp_v_r, MAX_SPEED_M_S)
+            && (0.0..=MAX_FRAME_RATE).contains(&x.target_spin);
+        let line = los_contract::LineOfSight {
+            rho: x.grasp_r - r,
+            rho_dot: x.grasp_v_r - v,
+            v: *v,
+            tide: *tide,
+        };
+        let w = p.los_speed_budget;
+        let Some((terms, sigma)) =
+            los_contract::terms(&line, &p.los_reference, r_hr, p.mass, w).filter(|_| grasp_known)
+        else {
+            // outside the certified set (no valid grasping point, a line of sight too short
+            // or too far off the corridor axis): the barriers' rows still filter
+            return [NEVER_BINDING; los_contract::ROWS];
+        };
+        let motion = self.los_sample_motion(x, r, v, err, cap);
+        let bounds = los_contract::bounds(line.rho.norm(), sigma, w, &motion);
+        let decay = sampled::RateDecay::new(p.gamma_los_speed, 0.0, p.period);
+        let rows = terms.map(|t| {
+            let row = RelDeg1::from(t).row_at(&bounds, &decay);
+            Row {
+                c: err.scaled_offset(row.c),
+                ..row
+            }
+        });
+        if rows.iter().all(Row::is_finite) {
+            rows
+        } else {
+            [NEVER_BINDING; los_contract::ROWS]
+        }
+    }
+
+    /// The bounds over one sample the contract's `J` and `D` rest on (inertial, F_R): the
+    /// acceleration `A = k_hi √3F/m + 2n²R`, the speed `‖v‖ + AT`, the jerk of the body-held
+    /// force turning at `Ω` and of the tide, `A_f Ω + 2n²V + 6n³R`; the grasping point's
+    /// speed `min(κ‖ω_T‖‖p_G‖, ‖v_G‖ + a_G T)` and acceleration `a_G = (κ + 1)(κ‖ω_T‖)²‖p_G‖`;
+    /// `D`: the gravity model's error and, with declared errors, the turn of the force. With
+    /// declared navigation errors the CoM's range and speed grow by their bounds.
+    fn los_sample_motion(
+        &self,
+        x: &TranslationalInput,
+        r: &Vector3<f64>,
+        v: &Vector3<f64>,
+        err: ForceError,
+        cap: f64,
+    ) -> los_contract::SampleMotion {
+        let p = &self.params;
+        let (t, n) = (p.period, p.mean_motion);
+        let (e_r, e_v) = x.com_error;
+        let rate_err = p.errors.as_ref().map_or(0.0, |e| e.com.rate_rad_s);
+        let f_acc = 3f64.sqrt() * p.force_max / p.mass * err.k_hi;
+        let (r0, v0) = (r.norm() + e_r, v.norm() + e_v);
+        let mut r_hi = r0 + v0 * t;
+        let mut accel = f_acc + 2.0 * n * n * r_hi;
+        let speed = v0 + accel * t;
+        r_hi = r0 + speed * t;
+        accel = f_acc + 2.0 * n * n * r_hi;
+        let speed = v0 + accel * t;
+        let omega = (x.omega_b.norm() + rate_err).max(p.omega_bound);
+        let kappa = p.target_inertia_ratio;
+        let spin = kappa * x.target_spin;
+        let lever = x.grasp_r.norm();
+        let grasp_accel = (kappa + 1.0) * spin * spin * lever;
+        los_contract::SampleMotion {
+            period: t,
+            speed,
+            accel,
+            jerk: f_acc * omega + 2.0 * n * n * speed + 6.0 * n * n * n * r_hi,
+            grasp_speed: (spin * lever).min(x.grasp_v_r.norm() + grasp_accel * t),
+            grasp_accel,
+            model_accel: 3.0 * n * n * r_hi * r_hi / p.orbit_radius
+                + err.k_hi * cap * err.turn_rad / p.mass,
         }
     }
 
@@ -899,7 +1067,7 @@ impl FilterStep<3, N> for TranslationalFilter {
             let force = errors.force;
             return self.solve_known(x, p, k, force, u_nom, report);
         }
-        let outcome = self.engine.solve(u_nom, &p.rows, &p.weights, &p.bounds);
+        let outcome = self.solve_rows(u_nom, &p.rows, p);
         let solved = Solved {
             outcome: &outcome,
             rows: &p.rows,
@@ -948,6 +1116,9 @@ impl SafetyFilter<3, N> for TranslationalFilter {
                 Some(e) => e.com.com_error(robot, &o.theta, &o.theta_dot, &o.omega_b),
                 None => (0.0, 0.0),
             },
+            grasp_r: o.grasp_r,
+            grasp_v_r: o.grasp_v_r,
+            target_spin: o.omega_t.norm(),
         })
     }
 

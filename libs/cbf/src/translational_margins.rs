@@ -333,7 +333,9 @@ pub fn wall_uncertifiable_below(s: &sc_scenario::Scenario, robot: &Robot) -> Opt
         .map(|i| params.r_caz + i as f64 * WALL_RANGE_STEP_M)
         .filter(|&range| {
             let r_r = wall * range;
-            let v_r = sideways * (c_t * range).sqrt();
+            // at the tangential-speed limit and inside the line-of-sight contract (the
+            // line of sight to the target's centre here: `|e_kᵀv| ≤ w L`)
+            let v_r = sideways * (c_t * range).sqrt().min(params.los_speed_budget * range);
             let r_h = r_hr * r_r;
             let w = Vector3::new(0.0, 0.0, n);
             let mut x = TranslationalInput::circular(

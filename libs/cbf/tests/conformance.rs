@@ -212,6 +212,9 @@ impl Conformance<3, 2> for TranslationalFilter {
                     q_rb: qrb,
                     omega_b: wb,
                     com_error: (0.0, 0.0),
+                    grasp_r: Vector3::new(-0.55, 0.35, 0.0),
+                    grasp_v_r: Vector3::new(0.0, 0.0, -0.028),
+                    target_spin: 0.08,
                 },
                 realistic: false,
             })
@@ -228,12 +231,24 @@ impl Conformance<3, 2> for TranslationalFilter {
             q_rb: [v; 4],
             omega_b: v3,
             com_error: (v, v),
+            grasp_r: v3,
+            grasp_v_r: v3,
+            target_spin: v,
         }
     }
     fn state_finite(x: &TranslationalInput) -> bool {
-        [x.r_h, x.v_h, x.omega_h, x.omega_dot_h, x.omega_b]
-            .iter()
-            .all(finite)
+        [
+            x.r_h,
+            x.v_h,
+            x.omega_h,
+            x.omega_dot_h,
+            x.omega_b,
+            x.grasp_r,
+            x.grasp_v_r,
+        ]
+        .iter()
+        .all(finite)
+            && x.target_spin.is_finite()
             && [x.com_error.0, x.com_error.1]
                 .iter()
                 .all(|e| e.is_finite() && *e >= 0.0)
@@ -1438,7 +1453,7 @@ impl Lexicographic<3, 2> for TranslationalFilter {
     ) -> Option<(Vec<sc_cbf::Row<3>>, Vec<f64>, Vec<sc_cbf::Row<3>>)> {
         TranslationalFilter::rows(self, x)
     }
-    const TIERS: &'static [u8] = &[];
+    const TIERS: &'static [u8] = &sc_cbf::translational::TIERS;
 }
 
 impl Lexicographic<3, 7> for AttitudeFilter {

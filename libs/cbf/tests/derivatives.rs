@@ -293,8 +293,8 @@ fn tangential_speed_row_matches_frame_consistent_finite_differences_in_f_r() {
             }
             // the filter builds its third row from exactly these terms
             let (rows, weights, _) = filt.rows(&x).unwrap();
-            assert_eq!(rows.len(), 3);
-            assert_eq!(weights.len(), 3);
+            assert_eq!(rows.len(), translational::ROWS);
+            assert_eq!(weights.len(), translational::ROWS);
             let axis = translational::corridor_axis(&r_hr0, &p.axis_r, &x.omega_h, &x.omega_dot_h);
             let (_, bt) = filt.sample_bounds(&x.r_h, &x.v_h, &x.omega_b, &axis);
             let row = RelDeg1::from(terms).row(&bt, p.gamma, 0.0);

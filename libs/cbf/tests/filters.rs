@@ -253,13 +253,14 @@ fn fault_flags_are_stable_and_the_layer_is_built_from_the_model() {
     assert_eq!(held.translational.params.period, 0.2);
     assert_eq!(held.attitude.params.period, 0.1);
     assert_eq!(held.robotic.params.period, 0.02);
-    // the translational dump: the two barrier rows and the tangential speed, the force box
+    // the translational dump: the two barrier rows, the tangential speed and the
+    // line-of-sight contract's four rows, the force box
     let mut f = layer.translational;
     let (x, u) = tr_cases(21, 1)[0];
     f.filter(&x, &u);
     let d = f.dump_qp();
     assert_eq!(d.u_nom.len(), 3);
-    assert_eq!(d.rows_a.len(), 3);
+    assert_eq!(d.rows_a.len(), sc_cbf::translational::ROWS);
     assert_eq!(d.bounds_g.len(), 6);
 }
 

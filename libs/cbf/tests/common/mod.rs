@@ -76,6 +76,8 @@ pub fn tr_input(
     let w = Vector3::new(0.0, 0.0, n);
     let mut x = TranslationalInput::circular(r_h, r_hr * v_r - w.cross(&r_h), q_hr, n, q_rb);
     x.omega_b = omega_b;
+    let (grasp_r, grasp_v_r, _, omega_t) = grasp_at(s, 0.0);
+    (x.grasp_r, x.grasp_v_r, x.target_spin) = (grasp_r, grasp_v_r, omega_t.norm());
     x
 }
 
