@@ -83,11 +83,14 @@ fn check_file(path: &Path, kind: Option<Kind>, mc_scenario: &Path) -> Result<Str
     match kind {
         Kind::Scenario => {
             let s = Scenario::load(path).map_err(|e| scenario_problem(&e))?;
+            let env = s.line_of_sight_envelope();
             Ok(format!(
-                "scenario: {} phases, {} s at most, control period {} s{}",
+                "scenario: {} phases, {} s at most, control period {} s; tumble {:.4} rad/s, the certified envelope's limit {:.4} rad/s{}",
                 s.mission.phases.len(),
                 s.mission.duration_s,
                 s.mission.control_period_s,
+                env.spin_rad_s,
+                env.max_spin_rad_s(),
                 uncertified_note(&s)?
             ))
         }

@@ -70,14 +70,14 @@ fn the_shipped_configs_are_valid() {
     assert_eq!(
         lines,
         [
-            "config/scenario.toml: ok (scenario: 3 phases, 240 s at most, control period 0.1 s)"
+            "config/scenario.toml: ok (scenario: 3 phases, 240 s at most, control period 0.1 s; tumble 0.0800 rad/s, the certified envelope's limit 0.1292 rad/s)"
                 .to_string(),
             format!(
                 "config/partition.toml: ok (partition: {} roles, scenario config/scenario.toml)",
                 sc_icd::ROLES.len()
             ),
             format!(
-                "config/montecarlo.toml: ok (montecarlo: distance 7–11 m, tumbling rate 0–0.15 rad/s; fits the scenario {})",
+                "config/montecarlo.toml: ok (montecarlo: distance 7–11 m, tumbling rate 0–0.125 rad/s; fits the scenario {})",
                 installed.display()
             ),
         ],
@@ -104,7 +104,7 @@ fn a_declared_uncertainty_the_rows_cannot_certify_is_named_before_the_run() {
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(
         out.contains("NOTE: under the declared uncertainty the translational rows cannot certify")
-            && out.contains("corridor's wall at ranges up to 9.00 m"),
+            && out.contains("corridor's wall at ranges up to 3.65 m"),
         "{}",
         text(&o)
     );
@@ -116,6 +116,29 @@ fn a_scenario_with_a_bad_value_names_the_key_and_the_rule() {
     let s = shipped_with(&d, "scenario.toml", "mass_kg = 800.0", "mass_kg = -800.0");
     let o = check(&[s.to_str().unwrap()]);
     assert_invalid(&o, &s, &["`target.mass_kg` = -800.0", "must be"]);
+}
+
+/// A tumble beyond the certified envelope (the 0.17 rad/s, which ended with the line
+/// of sight far below zero) is refused before anything runs, on one line naming the key,
+/// its value and the limit (docs/SAFETY.md, "The certified envelope").
+#[test]
+fn a_tumble_outside_the_certified_envelope_is_refused() {
+    let d = tmp("check-envelope");
+    let s = shipped_with(
+        &d,
+        "scenario.toml",
+        "initial_omega_rad_s = [-0.08, 0.0, 0.0]",
+        "initial_omega_rad_s = [-0.17, 0.0, 0.0]",
+    );
+    let o = check(&[s.to_str().unwrap()]);
+    assert_invalid(
+        &o,
+        &s,
+        &[
+            "`target.initial_omega_rad_s` = [-0.17, 0.0, 0.0]: outside the certified envelope",
+            "at most 0.1292 rad/s",
+        ],
+    );
 }
 
 #[test]
@@ -243,7 +266,7 @@ fn a_malformed_montecarlo_config_is_invalid() {
     let m = shipped_with(
         &d,
         "montecarlo.toml",
-        "rate_max_rad_s = 0.15",
+        "rate_max_rad_s = 0.125",
         "rate_max_rad_s = ",
     );
     let o = check(&[m.to_str().unwrap()]);

@@ -192,6 +192,30 @@ impl MonteCarloConfig {
                 &format!("must be > the collision-avoidance radius {caz} m"),
             ));
         }
-        Ok(())
+        self.check_envelope(s)
+    }
+
+    /// The fastest tumble the campaign draws is inside the scenario's certified envelope
+    /// (docs/SAFETY.md, "The certified envelope"): otherwise some runs would start outside
+    /// the promise.
+    fn check_envelope(&self, s: &sc_scenario::Scenario) -> Result<(), ConfigError> {
+        let r = &self.target_rate;
+        let axis = r.axis_t;
+        let k =
+            r.rate_max_rad_s / (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+        let env = s.line_of_sight_envelope_for(&axis.map(|a| a * k));
+        if env.target_rate_rad_s() <= env.limit_rad_s() && env.base_can_hold_the_rate() {
+            return Ok(());
+        }
+        Err(invalid(
+            "target_rate.rate_max_rad_s",
+            r.rate_max_rad_s,
+            &format!(
+                "outside the scenario's certified envelope (docs/SAFETY.md, \"The certified envelope\"): with the grasping point's lever {:.3} m (from the spin axis, or the CoM off the principal axes), the servicer as close as {:.3} m to it and the base's rate limits, the tumble may be at most {:.4} rad/s",
+                env.lever_m,
+                env.los_min_m,
+                env.max_spin_rad_s()
+            ),
+        ))
     }
 }
