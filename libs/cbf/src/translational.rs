@@ -50,6 +50,17 @@ const NEVER_BINDING: Row<3> = Row {
     c: 1.0,
 };
 
+/// `rows` with the line-of-sight contract's (tier 1) made [`NEVER_BINDING`].
+fn without_contract(rows: &[Row<3>; ROWS]) -> [Row<3>; ROWS] {
+    std::array::from_fn(|i| {
+        if TIERS[i] == 0 {
+            rows[i]
+        } else {
+            NEVER_BINDING
+        }
+    })
+}
+
 /// Accepted state range: `MIN_RANGE_M ≤ ‖r_H‖ ≤ MAX_RANGE_M` (the corridor's cone is not
 /// differentiable at its apex), `‖v_H‖ ≤ MAX_SPEED_M_S`, `‖ω_H‖, ‖ω̇_H‖ ≤ MAX_FRAME_RATE`. (A
 /// grasping point or target rate outside these ranges drops the line-of-sight contract's
@@ -325,8 +336,8 @@ pub fn tangential_speed(
 pub(crate) struct Prepared {
     r_bh: Matrix3<f64>,
     terms: [RelDegTwo<3>; N],
-    /// The barrier rows ([`NAMES`] order) and the tangential-speed row — with declared
-    /// errors, those for every command in the force box.
+    /// The barrier rows ([`NAMES`] order), the tangential-speed row and the line-of-sight
+    /// contract's four — with declared errors, those for every command in the force box.
     rows: [Row<3>; ROWS],
     weights: [f64; ROWS],
     bounds: [Row<3>; 6],
@@ -550,8 +561,10 @@ impl TranslationalFilter {
     /// `‖f‖ ≤ c` only ([`Self::rising_cap`]). First from the nominal's norm (a feasible
     /// nominal is certified by its own rows); when that finds nothing, from zero (the rows
     /// get stricter as `c` grows, so a large nominal must not hide a certified smaller
-    /// command); then the rows for every command in the box. Nothing certified: the
-    /// a feasible share of the margins ([`Self::solve_degraded`]).
+    /// command); then the rows for every command in the box. Nothing certified: the rows
+    /// with a feasible share of the margins ([`Self::solve_degraded`]). Certified means
+    /// every barrier row at its full margins; the line-of-sight contract may be relaxed
+    /// ([`Self::solve_certifying`]).
     fn solve_known(
         &mut self,
         x: &TranslationalInput,
@@ -574,26 +587,32 @@ impl TranslationalFilter {
                 return self.conclude_solved(x, p, u_nom, &outcome, &rows, report);
             }
         }
-        let outcome = self.solve_rows(u_nom, &p.rows, p);
-        if matches!(outcome.kind, Kind::Solved | Kind::Skipped) {
-            return self.conclude_solved(x, p, u_nom, &outcome, &p.rows, report);
-        }
-        // only the contract at fault: its rows relaxed, every barrier's margin kept
-        let barriers_only: [Row<3>; ROWS] = std::array::from_fn(|i| {
-            if TIERS[i] == 0 {
-                p.rows[i]
-            } else {
-                NEVER_BINDING
-            }
-        });
-        if self
-            .engine
-            .solve_hard(u_nom, &barriers_only, &p.bounds)
-            .is_some()
-        {
+        if let Some(outcome) = self.solve_certifying(u_nom, &p.rows, p) {
             return self.conclude_solved(x, p, u_nom, &outcome, &p.rows, report);
         }
         self.solve_degraded(x, p, k, force, u_nom, report)
+    }
+
+    /// The QP on `rows` when it certifies every barrier row at its full margins: solved,
+    /// or relaxed in the line-of-sight contract's tier only (the barriers and the
+    /// tangential limit alone are feasible, so the lexicographic relaxation gives them no
+    /// allowance). `None` otherwise.
+    fn solve_certifying(
+        &mut self,
+        u_nom: &Vector3<f64>,
+        rows: &[Row<3>; ROWS],
+        p: &Prepared,
+    ) -> Option<crate::engine::Outcome<3>> {
+        let outcome = self.solve_rows(u_nom, rows, p);
+        match outcome.kind {
+            Kind::Solved | Kind::Skipped => Some(outcome),
+            Kind::Relaxed => {
+                let barriers = without_contract(rows);
+                let tier0 = self.engine.solve_hard(u_nom, &barriers, &p.bounds);
+                tier0.map(|_| outcome)
+            }
+            _ => None,
+        }
     }
 
     /// Solves with the rows for the force bound `c` from `start`: a solution of
@@ -613,10 +632,7 @@ impl TranslationalFilter {
         let mut cap = start;
         for _ in 0..FORCE_CAP_ROUNDS {
             let rows = self.known_rows(x, &p.terms, k, force, cap, 1.0);
-            let outcome = self.solve_rows(u_nom, &rows, p);
-            if !matches!(outcome.kind, Kind::Solved | Kind::Skipped) {
-                return None;
-            }
+            let outcome = self.solve_certifying(u_nom, &rows, p)?;
             let size = outcome.u.norm();
             if size <= cap {
                 return Some((outcome, rows));
@@ -637,7 +653,9 @@ impl TranslationalFilter {
     /// given up). `λ = 0` is the nominal
     /// model's rows; when even they are infeasible, their relaxed problem as without
     /// declared errors. Never the relaxed problem of infeasible margins, which can give up
-    /// the zone for the corridor (docs/SAFETY.md).
+    /// the zone for the corridor (docs/SAFETY.md). The line-of-sight contract is left out
+    /// of these rows: with the barriers' margins already given up it must not cost them
+    /// more (the step is flagged either way).
     fn solve_degraded(
         &mut self,
         x: &TranslationalInput,
@@ -648,7 +666,7 @@ impl TranslationalFilter {
         report: &mut FilterReport<N>,
     ) -> Actuated<3> {
         let full = self.full_force();
-        let nominal_rows = self.known_rows(x, &p.terms, k, force, full, 0.0);
+        let nominal_rows = without_contract(&self.known_rows(x, &p.terms, k, force, full, 0.0));
         let first = self.solve_rows(u_nom, &nominal_rows, p);
         if !matches!(first.kind, Kind::Solved | Kind::Skipped) {
             return self.conclude_solved(x, p, u_nom, &first, &nominal_rows, report);
@@ -657,7 +675,7 @@ impl TranslationalFilter {
         let (mut lo, mut hi) = (0.0, 1.0);
         for _ in 0..DEGRADE_ROUNDS {
             let mid = 0.5 * (lo + hi);
-            let rows = self.known_rows(x, &p.terms, k, force, full, mid);
+            let rows = without_contract(&self.known_rows(x, &p.terms, k, force, full, mid));
             let outcome = self.solve_rows(u_nom, &rows, p);
             if matches!(outcome.kind, Kind::Solved | Kind::Skipped) {
                 (best, best_rows, share, lo) = (outcome, rows, mid, mid);
@@ -975,7 +993,8 @@ impl TranslationalFilter {
         self.last.dump()
     }
 
-    /// The rows (barrier rows in [`NAMES`] order, then the tangential-speed row), their
+    /// The rows (barrier rows in [`NAMES`] order, the tangential-speed row, the
+    /// line-of-sight contract's four), their
     /// weights in the relaxed problem, and the six bound rows at state `x` — for
     /// verification and `--dump-qp`.
     pub fn rows(&self, x: &TranslationalInput) -> Option<(Vec<Row<3>>, Vec<f64>, Vec<Row<3>>)> {

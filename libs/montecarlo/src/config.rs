@@ -204,8 +204,18 @@ impl MonteCarloConfig {
         let k =
             r.rate_max_rad_s / (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
         let env = s.line_of_sight_envelope_for(&axis.map(|a| a * k));
-        if env.target_rate_rad_s() <= env.limit_rad_s() && env.base_can_hold_the_rate() {
+        if env.contains() {
             return Ok(());
+        }
+        if !env.geometry_is_certifiable() {
+            return Err(invalid(
+                "target_rate.axis_t",
+                axis,
+                &format!(
+                    "outside the scenario's certified envelope (docs/SAFETY.md, \"The certified envelope\"): a tumble about this axis lets the servicer come to {:.3} m of the grasping point, or see it more than 84 deg off the corridor axis, or (off the target's principal axes, inertia ratio {:.2}) speed up beyond the filters' bounds; `safe-capture check` on the scenario with this tumble names which",
+                    env.los_min_m, env.amplification
+                ),
+            ));
         }
         Err(invalid(
             "target_rate.rate_max_rad_s",

@@ -115,6 +115,25 @@ fn default_config_is_the_papers_within_the_envelope() {
     );
 }
 
+/// The campaign's spin axis decides the geometry too: a fixture out of reach for the
+/// scenario's own spin (about -x) can come within reach of the servicer for a spin about
+/// z — refused under `target_rate.axis_t`, whatever the rate.
+#[test]
+fn a_campaign_axis_that_brings_the_fixture_within_reach_is_refused() {
+    let mut s = scenario();
+    s.target.grasp_point_m = [1.7, 0.3, 0.0];
+    s.validate()
+        .expect("the scenario's own spin keeps the fixture out of reach");
+    let mut c = config();
+    c.target_rate.axis_t = [0.0, 0.0, 1.0];
+    c.target_rate.rate_max_rad_s = 0.01;
+    let m = c.check_against(&s).unwrap_err().to_string();
+    assert!(
+        m.starts_with("`target_rate.axis_t` = [0.0, 0.0, 1.0]: "),
+        "{m}"
+    );
+}
+
 #[test]
 fn bad_configs_are_rejected_in_one_line() {
     let good = std::fs::read_to_string(root().join("config/montecarlo.toml")).unwrap();

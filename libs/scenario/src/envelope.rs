@@ -26,6 +26,11 @@ pub const PRINCIPAL_TOLERANCE: f64 = 1e-9;
 /// `acos(MIN_LOS_CONTRACT_SIGMA)` (84°) off the corridor axis.
 pub const MIN_LOS_CONTRACT_SIGMA: f64 = 0.1;
 
+/// The largest amplification `κ` of a tumble off the target's principal axes [-]: the
+/// attitude filter's in-sample bounds take the grasping point's acceleration as at most
+/// `2‖ω_T‖²‖p_G‖`, and a torque-free tumble's is at most `((κ + 1)/2)‖ω_T‖²‖p_G‖`.
+pub const MAX_OFF_PRINCIPAL_AMPLIFICATION: f64 = 3.0;
+
 /// Two unit axes across the boresight `d` (unit): `e₁ ⊥ d`, `e₂ = d × e₁` — the axes of the
 /// attitude filter's boresight-rate rows (`sc_cbf::attitude::boresight_rate`).
 pub fn across_boresight(d: &V3) -> [V3; 2] {
@@ -76,9 +81,30 @@ impl LineOfSightEnvelope {
         self.amplification * self.spin_rad_s * self.lever_m
     }
 
-    /// Bound on the rate at which the target turns the line of sight [rad/s].
+    /// Bound on the rate at which the target turns the line of sight [rad/s] (infinite
+    /// when the servicer could reach the fixture).
     pub fn target_rate_rad_s(&self) -> f64 {
+        if self.los_min_m <= 0.0 {
+            return f64::INFINITY;
+        }
         self.grasp_speed_m_s() / self.los_min_m
+    }
+
+    /// The geometry the rows are defined for: the fixture out of reach, the line of sight
+    /// within the contract's domain, a tumble whose rate the attitude filter's bounds cover.
+    pub fn geometry_is_certifiable(&self) -> bool {
+        self.los_min_m > 0.0
+            && self.contract_sigma_min >= MIN_LOS_CONTRACT_SIGMA
+            && self.amplification <= MAX_OFF_PRINCIPAL_AMPLIFICATION
+    }
+
+    /// Every rule of the envelope on the tumble and the geometry (what the validation
+    /// checks for the scenario's own tumble, for any `ω_T(0)`: a Monte Carlo's draws).
+    pub fn contains(&self) -> bool {
+        self.geometry_is_certifiable()
+            && self.limit_rad_s() > 0.0
+            && self.base_can_hold_the_rate()
+            && self.target_rate_rad_s() <= self.limit_rad_s()
     }
 
     /// What the target may take of the boresight's rate [rad/s].
@@ -341,6 +367,16 @@ impl Scenario {
         let key = "target.initial_omega_rad_s";
         let omega = self.target.initial_omega_rad_s;
         let peak = env.peak_spin_rad_s();
+        if env.amplification > MAX_OFF_PRINCIPAL_AMPLIFICATION {
+            return Err(outside(
+                key,
+                omega,
+                format!(
+                    "a tumble off the target's principal axes with the inertia ratio {:.2} (target.inertia_kg_m2 with its declared error) can speed up beyond what the attitude filter's in-sample bounds cover (ratio at most {MAX_OFF_PRINCIPAL_AMPLIFICATION}); spin about a principal axis",
+                    env.amplification
+                ),
+            ));
+        }
         if peak > env.sync_limit_rad_s {
             return Err(outside(
                 key,
@@ -443,6 +479,9 @@ fn rotate(q: &[f64; 4], v: &V3) -> V3 {
 /// The least and the largest eigenvalue of a symmetric 3×3 matrix (the trigonometric
 /// closed form; NaN for a non-finite matrix).
 fn symmetric_eigen_range(a: &[V3; 3]) -> (f64, f64) {
+    if !a.iter().flatten().all(|v| v.is_finite()) {
+        return (f64::NAN, f64::NAN);
+    }
     let p1 = a[0][1].powi(2) + a[0][2].powi(2) + a[1][2].powi(2);
     let diag = [a[0][0], a[1][1], a[2][2]];
     if p1 == 0.0 {

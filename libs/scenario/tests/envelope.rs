@@ -150,7 +150,7 @@ fn a_spin_across_the_corridor_axis_is_bounded_by_the_boresight_rate() {
 
 /// κ from the inertia's exact eigenvalues: products of inertia that Gershgorin's discs
 /// would take to zero give a finite ratio; an inertia that is not positive definite is
-/// refused naming its key.
+/// refused naming its key (by the target's own rule, before the envelope's).
 #[test]
 fn the_inertia_ratio_is_exact_and_an_indefinite_inertia_is_refused() {
     let mut s = default();
@@ -202,4 +202,19 @@ fn a_line_of_sight_beyond_the_contracts_domain_is_refused() {
     let msg = s.validate().expect_err("refused").to_string();
     assert!(msg.starts_with("`target.grasp_point_m` = "), "{msg}");
     assert!(msg.contains("off the corridor axis"), "{msg}");
+}
+
+/// A tumble off the principal axes of an elongated target can speed up beyond what the
+/// attitude filter's in-sample bounds take (`κ > 3`): refused; about a principal axis of
+/// the same target, accepted.
+#[test]
+fn an_elongated_target_tumbling_off_its_principal_axes_is_refused() {
+    let mut s = default();
+    s.target.inertia_kg_m2 = [[1000.0, 0.0, 0.0], [0.0, 950.0, 0.0], [0.0, 0.0, 100.0]];
+    s.target.initial_omega_rad_s = [-0.03, 0.02, 0.0];
+    let msg = s.validate().expect_err("refused").to_string();
+    assert!(msg.starts_with("`target.initial_omega_rad_s` = "), "{msg}");
+    assert!(msg.contains("inertia ratio 10.00"), "{msg}");
+    s.target.initial_omega_rad_s = [-0.03, 0.0, 0.0];
+    s.validate().expect("a principal spin is accepted");
 }

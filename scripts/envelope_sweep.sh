@@ -1,0 +1,75 @@
+#!/usr/bin/env bash
+# The certified envelope's sweep (docs/SAFETY.md, "The certified envelope"): for every
+# tumbling rate and grasping-point offset from the spin axis, a scenario that differs from
+# config/scenario.toml in those two values only; `safe-capture check` decides whether it is
+# inside the envelope, and every scenario it accepts runs the whole red team
+# (`safe-capture redteam --scenario`, in process; with --partition also through the
+# partition). One line per scenario in OUT/sweep.csv:
+#   spin_rad_s,offset_m,verdict,cases,unsafe,detail
+# verdict: refused (check refused it, its line in detail), safe (every case safe on the
+# true state), unsafe (a case unsafe: the envelope is wrong; exit 1), failed (the red team
+# could not run; exit 1).
+#
+# Usage: scripts/envelope_sweep.sh [--out DIR] [--spins "0.05 0.08 …"]
+#                                  [--offsets "0.1 0.35 0.6"] [--cases LIST] [--partition]
+# Defaults: the acceptance grid, spins 0.05–0.30 rad/s, offsets 0.1–0.6 m (measured on two
+# cores: ≈ 4 min in process, ≈ 7 min per accepted cell with --partition; --cases
+# narrows the red team).
+set -euo pipefail
+here="$(cd "$(dirname "$0")/.." && pwd)"
+out="out/envelope_sweep"
+spins="0.05 0.08 0.10 0.12 0.15 0.17 0.20 0.25 0.30"
+offsets="0.1 0.35 0.6"
+cases=""
+partition=
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --out) out="${2:?--out needs a directory}"; shift 2 ;;
+    --spins) spins="${2:?--spins needs a list}"; shift 2 ;;
+    --offsets) offsets="${2:?--offsets needs a list}"; shift 2 ;;
+    --cases) cases="${2:?--cases needs a list}"; shift 2 ;;
+    --partition) partition="--partition"; shift ;;
+    -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "envelope_sweep.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
+  esac
+done
+sc="${SC_BIN:-$here/target/release/safe-capture}"
+if [[ ! -x "$sc" ]]; then
+  cargo build --release --manifest-path "$here/Cargo.toml" -p safe-capture >&2
+fi
+mkdir -p "$out"
+csv="$out/sweep.csv"
+echo "spin_rad_s,offset_m,verdict,cases,unsafe,detail" > "$csv"
+status=0
+for w in $spins; do
+  for o in $offsets; do
+    dir="$out/spin${w}_offset${o}"
+    mkdir -p "$dir"
+    sed -e "s|^urdf = \"servicer.urdf\"|urdf = \"$here/config/servicer.urdf\"|" \
+        -e "/^\[target\]/,/^\[/ s|^initial_omega_rad_s = .*|initial_omega_rad_s = [-$w, 0.0, 0.0]|" \
+        -e "s|^grasp_point_m = .*|grasp_point_m = [-0.55, $o, 0.0]|" \
+        "$here/config/scenario.toml" > "$dir/scenario.toml"
+    if ! line="$("$sc" check "$dir/scenario.toml" 2>&1)"; then
+      echo "$w,$o,refused,0,0,\"${line//\"/\'}\"" >> "$csv"
+      echo "envelope_sweep: spin $w rad/s, offset $o m: refused by check" >&2
+      continue
+    fi
+    args=(redteam --scenario "$dir/scenario.toml" --out "$dir/redteam" --force ${partition:+"$partition"})
+    [[ -n "$cases" ]] && args+=(--cases "$cases")
+    rc=0
+    "$sc" "${args[@]}" > "$dir/redteam.log" 2>&1 || rc=$?
+    last="$(tail -1 "$dir/redteam.log")"
+    n="$(sed -n 's/.*: \([0-9]*\) of \([0-9]*\) cases safe.*/\2/p' <<< "$last")"
+    ok="$(sed -n 's/.*: \([0-9]*\) of \([0-9]*\) cases safe.*/\1/p' <<< "$last")"
+    case $rc in
+      0) verdict=safe ;;
+      1) verdict=unsafe; status=1 ;;
+      *) verdict=failed; status=1 ;; # the red team could not run (its log says why)
+    esac
+    echo "$w,$o,$verdict,${n:-0},$(( ${n:-0} - ${ok:-0} )),\"${last//\"/\'}\"" >> "$csv"
+    echo "envelope_sweep: spin $w rad/s, offset $o m: $verdict (${ok:-?} of ${n:-?} safe)" >&2
+  done
+done
+count() { grep -c "^[^,]*,[^,]*,$1," "$csv" || true; }
+echo "envelope_sweep: $(count safe) safe, $(count refused) refused, $(count unsafe) unsafe -> $csv" >&2
+exit $status
