@@ -76,35 +76,34 @@ impl Envelope {
         }
     }
 
-    /// A state and the base's force and torque, uniform inside the limits:
-    /// `(θ, θ̇, ω_B, f_B, τ_B)`.
-    fn draw(&self, rng: &mut u64) -> (Vector7, Vector7, Vector3<f64>, Vector3<f64>, Vector3<f64>) {
-        let mut r = || lcg(rng);
+    /// The state and the base's force and torque at the unit coordinates `z` (each in
+    /// [−1, 1]; uniform draws give the uniform distribution inside the limits):
+    /// `(θ, θ̇, ω_B, f_B, τ_B)` from `z[0..23]`.
+    fn state_at(&self, z: &Coordinates) -> BaseState {
         let (tmin, tmax) = (&self.theta_min, &self.theta_max);
         let th =
-            Vector7::from_fn(|i, _| 0.5 * (tmin[i] + tmax[i]) + 0.5 * (tmax[i] - tmin[i]) * r());
-        let thd = Vector7::from_fn(|i, _| self.theta_dot_max[i] * r());
-        let w = Vector3::from_fn(|i, _| self.omega_max[i] * r());
-        let f = Vector3::from_fn(|_, _| self.force_max * r());
-        let tb = Vector3::from_fn(|_, _| self.torque_max * r());
+            Vector7::from_fn(|i, _| 0.5 * (tmin[i] + tmax[i]) + 0.5 * (tmax[i] - tmin[i]) * z[i]);
+        let thd = Vector7::from_fn(|i, _| self.theta_dot_max[i] * z[7 + i]);
+        let w = Vector3::from_fn(|i, _| self.omega_max[i] * z[14 + i]);
+        let f = Vector3::from_fn(|i, _| self.force_max * z[17 + i]);
+        let tb = Vector3::from_fn(|i, _| self.torque_max * z[20 + i]);
         (th, thd, w, f, tb)
     }
 
-    /// Joint torques of the envelope: random in the box, the part beyond the holding
-    /// torque `hold` scaled into the contract (reaction `Q` on the base within `β`), then
-    /// towards `hold` until the joint accelerations `A (τ − c_eff)` are ones the
+    /// Joint torques of the envelope from `z[23..30]`: in the box, the part beyond the
+    /// holding torque `hold` scaled into the contract (reaction `Q` on the base within
+    /// `β`), then towards `hold` until the joint accelerations `A (τ − c_eff)` are ones the
     /// joint-rate rows admit (`|θ̈_i| ≤ 2 θ̇_max,i / T`). `None` when none is.
     fn joint_torque(
         &self,
-        rng: &mut u64,
+        z: &Coordinates,
         hold: &Vector7,
         q: &nalgebra::SMatrix<f64, 3, 7>,
         a: &nalgebra::SMatrix<f64, 7, 7>,
     ) -> Option<Vector7> {
-        let mut r = || lcg(rng);
         let beta = &self.beta;
         let lim = self.joint_torque_max;
-        let mut delta = Vector7::from_fn(|_, _| lim * r()) - hold;
+        let mut delta = Vector7::from_fn(|i, _| lim * z[23 + i]) - hold;
         let qt = q * delta;
         let k = (0..3)
             .map(|i| {
@@ -137,6 +136,61 @@ impl Envelope {
         }
         admitted(&from(lo)).then(|| from(lo))
     }
+
+    /// Every quantity the bounds cover ([`Quantities`]) at the envelope's point `z`;
+    /// `None` where the model cannot be evaluated or no joint torque is admitted.
+    fn quantities_at(&self, robot: &Robot, z: &Coordinates) -> Option<Quantities> {
+        let (th, thd, w, f, tb) = self.state_at(z);
+        let bd = robot.base_angular_dynamics(&th, &thd, &w, &f)?;
+        let wrench = Vector6::new(f.x, f.y, f.z, tb.x, tb.y, tb.z);
+        let red = robot.reduced_arm_dynamics(&th, &thd, &w, &wrench)?;
+        let a = red.m_eff.cholesky()?.inverse();
+        let tm = self.joint_torque(z, &red.c_eff, &bd.q, &a)?;
+        let mut u = Vector13::zeros();
+        u.fixed_rows_mut::<3>(0).copy_from(&f);
+        u.fixed_rows_mut::<3>(3).copy_from(&tb);
+        u.fixed_rows_mut::<7>(6).copy_from(&tm);
+        let mut m = EnvelopeMaxima::default();
+        record_jerks(&mut m, robot, &th, &thd, &w, &u).then(|| m.quantities())
+    }
+}
+
+/// `(θ, θ̇, ω_B, f_B, τ_B)`.
+type BaseState = (Vector7, Vector7, Vector3<f64>, Vector3<f64>, Vector3<f64>);
+/// The envelope's unit coordinates: `θ`, `θ̇`, `ω_B`, `f_B`, `τ_B`, the joint-torque draw.
+type Coordinates = [f64; DIMENSIONS];
+/// Their number.
+const DIMENSIONS: usize = 30;
+/// What the bounds cover, in [`EnvelopeMaxima`] order: `‖ω̇_B‖`, the angular jerk, the
+/// seven joint jerks, the 21 link spheres' jerks.
+type Quantities = [f64; QUANTITIES];
+const QUANTITIES: usize = 30;
+
+impl EnvelopeMaxima {
+    fn quantities(&self) -> Quantities {
+        let mut q = [0.0; QUANTITIES];
+        q[0] = self.angular_accel;
+        q[1] = self.angular_jerk;
+        q[2..9].copy_from_slice(&self.joint_jerk);
+        q[9..].copy_from_slice(&self.sphere_jerk);
+        q
+    }
+
+    fn from_quantities(q: &Quantities, samples: usize) -> Self {
+        let mut m = Self {
+            angular_accel: q[0],
+            angular_jerk: q[1],
+            samples,
+            ..Self::default()
+        };
+        m.joint_jerk.copy_from_slice(&q[2..9]);
+        m.sphere_jerk.copy_from_slice(&q[9..]);
+        m
+    }
+}
+
+fn draw(rng: &mut u64) -> Coordinates {
+    std::array::from_fn(|_| lcg(rng))
 }
 
 /// Samples the envelope of scenario `s` with the servicer model `robot`.
@@ -146,35 +200,83 @@ pub fn sample(
     samples: usize,
     seed: u64,
 ) -> EnvelopeMaxima {
+    sample_keeping_the_worst(s, robot, samples, seed).0
+}
+
+/// The worst point found so far of every quantity: `(value, where)`.
+type Worst = [(f64, Coordinates); QUANTITIES];
+
+/// [`sample`], and for every quantity the point where it was largest.
+fn sample_keeping_the_worst(
+    s: &sc_scenario::Scenario,
+    robot: &Robot,
+    samples: usize,
+    seed: u64,
+) -> (EnvelopeMaxima, Worst) {
     let env = Envelope::from_scenario(s);
-    let mut out = EnvelopeMaxima::default();
     let mut rng = seed.max(1);
+    let mut worst = [(0.0, [0.0; DIMENSIONS]); QUANTITIES];
+    let mut usable = 0;
     for _ in 0..samples {
-        let (th, thd, w, f, tb) = env.draw(&mut rng);
-        let Some(bd) = robot.base_angular_dynamics(&th, &thd, &w, &f) else {
+        let z = draw(&mut rng);
+        let Some(q) = env.quantities_at(robot, &z) else {
             continue;
         };
-        let wrench = Vector6::new(f.x, f.y, f.z, tb.x, tb.y, tb.z);
-        let Some(red) = robot.reduced_arm_dynamics(&th, &thd, &w, &wrench) else {
-            continue;
-        };
-        let Some(ch) = red.m_eff.cholesky() else {
-            continue;
-        };
-        let a = ch.inverse();
-        let Some(tm) = env.joint_torque(&mut rng, &red.c_eff, &bd.q, &a) else {
-            continue;
-        };
-        let mut u = Vector13::zeros();
-        u.fixed_rows_mut::<3>(0).copy_from(&f);
-        u.fixed_rows_mut::<3>(3).copy_from(&tb);
-        u.fixed_rows_mut::<7>(6).copy_from(&tm);
-        if record_jerks(&mut out, robot, &th, &thd, &w, &u) {
-            out.samples += 1;
+        usable += 1;
+        for (w, v) in worst.iter_mut().zip(q) {
+            if v > w.0 {
+                *w = (v, z);
+            }
         }
     }
-    out
+    let maxima = worst.map(|w| w.0);
+    (EnvelopeMaxima::from_quantities(&maxima, usable), worst)
 }
+
+/// A targeted worst-case search: from the sampled worst point of every quantity, a
+/// random local ascent inside the envelope (`rounds` proposals per quantity, steps of
+/// [`SEARCH_STEP`] in the unit coordinates, halved after [`SEARCH_PATIENCE`] failures in a
+/// row). Finds larger maxima than the samples; still not a proof (a local search).
+pub fn search(
+    s: &sc_scenario::Scenario,
+    robot: &Robot,
+    samples: usize,
+    seed: u64,
+    rounds: usize,
+) -> EnvelopeMaxima {
+    let env = Envelope::from_scenario(s);
+    let (sampled, worst) = sample_keeping_the_worst(s, robot, samples, seed);
+    let mut rng = seed.max(1) ^ SEARCH_SEED_SALT;
+    let found: Quantities = std::array::from_fn(|i| {
+        let (mut best, mut z) = worst[i];
+        let (mut step, mut fails) = (SEARCH_STEP, 0);
+        for _ in 0..rounds {
+            if best == 0.0 {
+                break; // nothing moves there (link 1's spheres)
+            }
+            let cand: Coordinates =
+                std::array::from_fn(|k| (z[k] + step * lcg(&mut rng)).clamp(-1.0, 1.0));
+            match env.quantities_at(robot, &cand) {
+                Some(q) if q[i] > best => (best, z, fails) = (q[i], cand, 0),
+                _ => fails += 1,
+            }
+            if fails > SEARCH_PATIENCE {
+                (step, fails) = ((step * 0.5).max(SEARCH_STEP_MIN), 0);
+            }
+        }
+        best
+    });
+    EnvelopeMaxima::from_quantities(&found, sampled.samples)
+}
+
+/// The search's first step in the unit coordinates [-].
+pub const SEARCH_STEP: f64 = 0.25;
+/// Its smallest step [-].
+pub const SEARCH_STEP_MIN: f64 = 1e-3;
+/// Failed proposals in a row before the step is halved.
+pub const SEARCH_PATIENCE: usize = 40;
+/// Makes the search's random stream differ from the samples'.
+const SEARCH_SEED_SALT: u64 = 0x5EA2C4;
 
 /// The accelerations at one state under the held input `u` and their rates of change,
 /// `d/dt` by central differences along the state's own motion (the body-fixed base force
