@@ -185,10 +185,25 @@ fn bounds_checks_every_envelope_bound() {
     assert!(!out.status.success(), "{text}");
     assert!(
         text.lines()
-            .any(|l| l.contains("angular_jerk_bound_rad_s3") && l.contains("raise it")),
+            .any(|l| l.contains("angular_jerk_bound_rad_s3") && l.contains("< 1.5")),
         "{text}"
     );
     let _ = std::fs::remove_dir_all(&d);
+    // nothing sampled is no evidence: refused, not "16 of 16"
+    let out = bin().args(["bounds", "--samples", "0"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no evidence"));
+    // the targeted search says it ran, and finds what sampling misses (docs/SAFETY.md)
+    let out = bin()
+        .args(["bounds", "--samples", "2000", "--search-rounds", "300"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("searched max"), "{text}");
+    assert!(
+        text.contains("then 300 search rounds per quantity"),
+        "{text}"
+    );
 }
 
 #[test]

@@ -20,7 +20,7 @@ use sc_multibody::{Robot, Vector7, Vector13};
 /// Factor the configured bounds must keep over the sampled maxima.
 pub const SAFETY_FACTOR: f64 = 1.5;
 
-/// Sampled maxima over the envelope.
+/// Maxima over the envelope: sampled ([`sample`]) or searched ([`search`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct EnvelopeMaxima {
     /// max ‖ω̇_B‖ [rad/s²].
@@ -31,7 +31,7 @@ pub struct EnvelopeMaxima {
     pub joint_jerk: [f64; 7],
     /// max ‖p⃛_k‖ of each link sphere's centre in the base frame [m/s³].
     pub sphere_jerk: [f64; 21],
-    /// Samples drawn.
+    /// Usable samples of the sampling stage (the search's proposals not counted).
     pub samples: usize,
 }
 
@@ -260,7 +260,7 @@ pub fn search(
                 Some(q) if q[i] > best => (best, z, fails) = (q[i], cand, 0),
                 _ => fails += 1,
             }
-            if fails > SEARCH_PATIENCE {
+            if fails >= SEARCH_PATIENCE {
                 (step, fails) = ((step * 0.5).max(SEARCH_STEP_MIN), 0);
             }
         }
