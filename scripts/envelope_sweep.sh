@@ -71,5 +71,5 @@ for w in $spins; do
   done
 done
 count() { grep -c "^[^,]*,[^,]*,$1," "$csv" || true; }
-echo "envelope_sweep: $(count safe) safe, $(count refused) refused, $(count unsafe) unsafe -> $csv" >&2
+echo "envelope_sweep: $(count safe) safe, $(count refused) refused, $(count unsafe) unsafe, $(count failed) failed -> $csv" >&2
 exit $status
