@@ -13,8 +13,8 @@
 # Usage: scripts/envelope_sweep.sh [--out DIR] [--spins "0.05 0.08 …"]
 #                                  [--offsets "0.1 0.35 0.6"] [--cases LIST] [--partition]
 # Defaults: the acceptance grid, spins 0.05–0.30 rad/s, offsets 0.1–0.6 m (measured on two
-# cores: ≈ 4 min in process, ≈ 7 min per accepted cell with --partition; --cases
-# narrows the red team).
+# cores: ≈ 4 min in process, ≈ 7 min and ≈ 1.5 GB of telemetry per accepted cell with
+# --partition; --cases narrows the red team).
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 out="out/envelope_sweep"
