@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 mod common;
-use common::{TmpDir, root};
+use common::{TmpDir, root, scenario_with};
 
 fn bin() -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_safe-capture"));
@@ -38,21 +38,6 @@ fn assert_one_line_error(out: &Output, needle: &str) {
     for (i, p) in parts.iter().enumerate() {
         assert!(!parts[i + 1..].contains(p), "`{p}` repeated: {err}");
     }
-}
-
-fn scenario_with(dir: &Path, from: &str, to: &str) -> PathBuf {
-    let text = std::fs::read_to_string(root().join("config/scenario.toml")).unwrap();
-    assert!(text.contains(from), "{from} not in the default scenario");
-    let text = text.replacen(from, to, 1).replace(
-        "urdf = \"servicer.urdf\"",
-        &format!(
-            "urdf = \"{}\"",
-            root().join("config/servicer.urdf").display()
-        ),
-    );
-    let p = dir.join("scenario.toml");
-    std::fs::write(&p, text).unwrap();
-    p
 }
 
 const HEADER: &str = "t_s,f_b_x_n,f_b_y_n,f_b_z_n,tau_b_x_nm,tau_b_y_nm,tau_b_z_nm,tau_m_1_nm,tau_m_2_nm,tau_m_3_nm,tau_m_4_nm,tau_m_5_nm,tau_m_6_nm,tau_m_7_nm";

@@ -84,6 +84,47 @@ fn every_strategy_on_every_target_in_process_is_safe() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
+/// The robotic filter's certificate does not rest on the envelope's jerk bounds (issue
+/// #26 item 2): it verifies every command on the sample the servicer model predicts. With
+/// every joint and link-sphere jerk bound cut to a tenth, the cases that broke the joint
+/// and link barriers before the per-step verification (measured: 21 of 95 unsafe over
+/// the whole red team) stay safe on the true state.
+#[test]
+fn the_arm_stays_safe_with_its_jerk_bounds_cut_to_a_tenth() {
+    let _cpu = exclusive();
+    let d = tmp("redteam-jerk-tenth");
+    let scenario = scenario_with(
+        &d,
+        "joint_jerk_bound_rad_s3 = [7.0, 2.4, 21.0, 5.6, 30.0, 12.5, 32.0]\n\
+         # ... and on the jerk of each link's sphere centres [m/s^3] (link 1's lie on joint 1's axis).\n\
+         link_sphere_jerk_bound_m_s3 = [0.0, 0.7, 1.7, 1.6, 2.8, 2.3, 6.8]",
+        "joint_jerk_bound_rad_s3 = [0.7, 0.24, 2.1, 0.56, 3.0, 1.25, 3.2]\n\
+         link_sphere_jerk_bound_m_s3 = [0.0, 0.07, 0.17, 0.16, 0.28, 0.23, 0.68]",
+    );
+    let out = d.join("rt");
+    let cases =
+        "robotic/toward:link_base_4_2,robotic/toward:link_base_5_1,robotic/random:1,all/random:1";
+    let o = cli(
+        &[
+            "redteam",
+            "--scenario",
+            scenario.to_str().unwrap(),
+            "--cases",
+            cases,
+            "-j",
+            "2",
+            "--out",
+            out.to_str().unwrap(),
+            "-q",
+        ],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let s = json(&out.join("summary.json"));
+    assert_eq!(s["cases"].as_u64(), Some(4), "{s}");
+    assert_eq!(s["unsafe_cases"].as_array().map(Vec::len), Some(0), "{s}");
+}
+
 /// `--telemetry` writes a case's steps in process, consistent with its verdict: one row
 /// per control step, and no logged barrier value below the case's minimum (which is
 /// taken over every physics step).

@@ -558,6 +558,9 @@ pub struct RoboticFilter {
     /// The servicer model for the verification path (without it, the envelope rows only).
     robot: Option<Arc<Robot>>,
     last: LastProblem<NJ>,
+    /// Commands the envelope bounds certified that did not verify on the model's sample
+    /// ([`Self::bounds_refuted`]).
+    bounds_refuted: u64,
 }
 
 /// Every entry finite and `|m_ij| ≤ max`. Compares the magnitudes' bit patterns (for
@@ -585,6 +588,7 @@ impl RoboticFilter {
             engine: Engine::new(),
             robot: None,
             last: LastProblem::with_capacity(N, 2 * NJ + 6),
+            bounds_refuted: 0,
         }
     }
 
@@ -595,6 +599,7 @@ impl RoboticFilter {
             engine: Engine::new(),
             robot: Some(robot),
             last: LastProblem::with_capacity(N, 2 * NJ + 6),
+            bounds_refuted: 0,
         }
     }
 
@@ -1042,13 +1047,16 @@ impl RoboticFilter {
             bound_duals: c.res.bound_duals,
             second_opinion: false,
         };
-        if behind.certifying.is_some() {
+        if behind.certifying.is_some()
+            && self.bounds_certificate_verifies(x, p, &o.u, &mut o.iterations)
+        {
             if o.kind != Kind::Skipped {
                 o.kind = Kind::Solved;
             }
             o.second_opinion = c.res.second_opinion;
             return o;
         }
+        behind.certifying = None;
         let verified = if self.params.formulation == Formulation::SampledData {
             self.verified(x, p, u_nom, &mut o.iterations)
         } else {
@@ -1073,6 +1081,34 @@ impl RoboticFilter {
             Kind::Skipped | Kind::Solved => {}
         }
         o
+    }
+
+    /// Whether the command the envelope bounds certified also verifies on the sample the
+    /// servicer model predicts ([`Self::verify`]): every command of the sampled-data
+    /// formulation is verified so, which makes its certificate independent of the
+    /// configured jerk bounds — they only decide how often the cheap certificate is
+    /// enough (docs/SAFETY.md, "The arm at 10 Hz"). A bound the arm exceeds shows as a
+    /// command that does not verify and goes to the verification path. Without a model,
+    /// or for the paper's rows, the bounds' certificate stands alone.
+    fn bounds_certificate_verifies(
+        &mut self,
+        x: &RoboticInput,
+        p: &Prepared,
+        u: &Vector7,
+        iterations: &mut u32,
+    ) -> bool {
+        let Some(robot) = self.robot.clone() else {
+            return true;
+        };
+        if self.params.formulation != Formulation::SampledData {
+            return true;
+        }
+        *iterations += 1;
+        let ok = self.verify(&robot, x, &p.terms, u, &p.weights).ok;
+        if !ok {
+            self.bounds_refuted += 1;
+        }
+        ok
     }
 
     /// The verification path: solve with the sample's own prediction, simulate the sample,
@@ -1349,6 +1385,13 @@ impl RoboticFilter {
             let target = (-g * p.period).exp() * (h0 - floor) + floor;
             (h < target).then(|| (target - h) / s)
         }
+    }
+
+    /// How many commands the envelope bounds certified did not verify on the servicer
+    /// model's sample (each then went to the verification path): how often the arm left
+    /// the configured jerk bounds.
+    pub fn bounds_refuted(&self) -> u64 {
+        self.bounds_refuted
     }
 
     /// Verification only: force the solver even when the nominal is feasible.

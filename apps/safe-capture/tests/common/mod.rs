@@ -56,6 +56,23 @@ pub fn short_scenario(dir: &Path, duration: f64) -> PathBuf {
     p
 }
 
+/// The default scenario with its first `from` replaced by `to` (absolute URDF path), in
+/// `dir`.
+pub fn scenario_with(dir: &Path, from: &str, to: &str) -> PathBuf {
+    let text = std::fs::read_to_string(root().join("config/scenario.toml")).unwrap();
+    assert!(text.contains(from), "{from} not in the default scenario");
+    let text = text.replacen(from, to, 1).replace(
+        "urdf = \"servicer.urdf\"",
+        &format!(
+            "urdf = \"{}\"",
+            root().join("config/servicer.urdf").display()
+        ),
+    );
+    let p = dir.join("scenario.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
 pub fn cli(args: &[&str], env: &[(&str, &str)]) -> Output {
     let mut c = Command::new(env!("CARGO_BIN_EXE_safe-capture"));
     c.current_dir(root()).args(args);
