@@ -255,7 +255,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let mut setups = a
         .scenario
         .iter()
-        .map(|p| Setup::load(p))
+        .map(|p| Setup::load(p).and_then(|s| s.check_envelope_bounds(p).map(|()| s)))
         .collect::<Result<Vec<_>, _>>()?;
     for s in &mut setups {
         a.uncertainty.apply(&mut s.scenario)?;

@@ -1,6 +1,7 @@
 //! `safe-capture check FILE…`: configuration files validated before anything runs.
 
 use sc_ground::PartitionConfig;
+use sc_mission::{Setup, SetupError};
 use sc_montecarlo::MonteCarloConfig;
 use sc_scenario::{Scenario, ScenarioError};
 use std::path::{Path, PathBuf};
@@ -82,7 +83,11 @@ fn check_file(path: &Path, kind: Option<Kind>, mc_scenario: &Path) -> Result<Str
     let in_file = |msg: String| without_prefix(path, msg);
     match kind {
         Kind::Scenario => {
-            let s = Scenario::load(path).map_err(|e| scenario_problem(&e))?;
+            let setup = Setup::load(path).map_err(|e| setup_problem(&e))?;
+            setup
+                .check_envelope_bounds(path)
+                .map_err(|e| setup_problem(&e))?;
+            let (s, robot) = (&setup.scenario, &setup.robot);
             let env = s.line_of_sight_envelope();
             Ok(format!(
                 "scenario: {} phases, {} s at most, control period {} s; tumble {:.4} rad/s, the certified envelope's limit {:.4} rad/s{}",
@@ -91,7 +96,7 @@ fn check_file(path: &Path, kind: Option<Kind>, mc_scenario: &Path) -> Result<Str
                 s.mission.control_period_s,
                 env.spin_rad_s,
                 env.max_spin_rad_s(),
-                uncertified_note(&s)?
+                uncertified_note(s, robot)
             ))
         }
         Kind::Partition => {
@@ -133,24 +138,20 @@ fn check_file(path: &Path, kind: Option<Kind>, mc_scenario: &Path) -> Result<Str
 /// What the declared uncertainty leaves without a certified command, said before
 /// anything runs (docs/SAFETY.md, "Translational: what the declared errors cost"); empty
 /// when everything is certifiable or nothing is declared.
-fn uncertified_note(s: &Scenario) -> Result<String, Problem> {
+fn uncertified_note(s: &Scenario, robot: &sc_multibody::Robot) -> String {
     if s.uncertainty.is_none() {
-        return Ok(String::new());
+        return String::new();
     }
-    let robot = sc_multibody::Robot::from_urdf_file(&s.urdf_path())
-        .map_err(|e| format!("servicer.urdf: {e}"))?;
-    Ok(
-        match sc_cbf::translational_margins::wall_uncertifiable_below(s, &robot) {
-            Some(r) => format!(
-                "; NOTE: under the declared uncertainty the translational rows cannot certify \
+    match sc_cbf::translational_margins::wall_uncertifiable_below(s, robot) {
+        Some(r) => format!(
+            "; NOTE: under the declared uncertainty the translational rows cannot certify \
                  a state on the approach corridor's wall at ranges up to {r:.2} m (there the \
                  filter keeps the largest share of the margins it can, flagged \
                  margins_degraded; \
                  docs/SAFETY.md)"
-            ),
-            None => String::new(),
-        },
-    )
+        ),
+        None => String::new(),
+    }
 }
 
 /// A scenario error without the file's name (the line starts with it).
@@ -158,6 +159,15 @@ fn scenario_problem(e: &ScenarioError) -> Problem {
     match e {
         ScenarioError::Io { message, .. } => format!("cannot read: {message}"),
         e => e.root().to_string(),
+    }
+}
+
+/// A setup error (the scenario's, or its cross-checks with the servicer model) without
+/// the file's name.
+fn setup_problem(e: &SetupError) -> Problem {
+    match e {
+        SetupError::Scenario(e) => scenario_problem(e),
+        e => e.to_string(),
     }
 }
 

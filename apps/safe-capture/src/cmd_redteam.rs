@@ -320,6 +320,7 @@ fn verdict_line(a: &Args, s: &report::CampaignSummary, wall: f64, under: &str) {
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let mut setup = Setup::load(&a.scenario)?;
+    setup.check_envelope_bounds(&a.scenario)?;
     a.uncertainty.refuse_truth("redteam")?;
     let declared_in_file = setup.scenario.uncertainty.clone();
     a.uncertainty.apply(&mut setup.scenario)?;

@@ -243,6 +243,7 @@ fn what_ran(a: &Args) -> String {
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let mut setup = Setup::load(&a.scenario)?;
+    setup.check_envelope_bounds(&a.scenario)?;
     a.uncertainty.apply(&mut setup.scenario)?;
     if a.basilisk && setup.scenario.uncertainty.is_some() {
         // Basilisk propagates the scenario file's model, not the drawn plant

@@ -70,14 +70,14 @@ fn the_shipped_configs_are_valid() {
     assert_eq!(
         lines,
         [
-            "config/scenario.toml: ok (scenario: 3 phases, 240 s at most, control period 0.1 s; tumble 0.0800 rad/s, the certified envelope's limit 0.1292 rad/s)"
+            "config/scenario.toml: ok (scenario: 3 phases, 240 s at most, control period 0.1 s; tumble 0.0800 rad/s, the certified envelope's limit 0.1241 rad/s)"
                 .to_string(),
             format!(
                 "config/partition.toml: ok (partition: {} roles, scenario config/scenario.toml)",
                 sc_icd::ROLES.len()
             ),
             format!(
-                "config/montecarlo.toml: ok (montecarlo: distance 7–11 m, tumbling rate 0–0.125 rad/s; fits the scenario {})",
+                "config/montecarlo.toml: ok (montecarlo: distance 7–11 m, tumbling rate 0–0.12 rad/s; fits the scenario {})",
                 installed.display()
             ),
         ],
@@ -136,7 +136,31 @@ fn a_tumble_outside_the_certified_envelope_is_refused() {
         &s,
         &[
             "`target.initial_omega_rad_s` = [-0.17, 0.0, 0.0]: outside the certified envelope",
-            "at most 0.1292 rad/s",
+            "at most 0.1241 rad/s",
+        ],
+    );
+}
+
+/// A bound a filter's certificate rests on, set below what the servicer model reaches in
+/// the certified envelope, is refused with the value a targeted search found there
+/// (issue #26 item 2).
+#[test]
+fn a_bound_the_model_exceeds_is_refused() {
+    let d = tmp("check-bound");
+    let s = shipped_with(
+        &d,
+        "scenario.toml",
+        "angular_jerk_bound_rad_s3 = 0.35",
+        "angular_jerk_bound_rad_s3 = 0.05",
+    );
+    let o = check(&[s.to_str().unwrap()]);
+    assert_invalid(
+        &o,
+        &s,
+        &[
+            "`safety.attitude.angular_jerk_bound_rad_s3` = 0.05: not a bound",
+            "the servicer model reaches 0.1",
+            "the filters' certificate rests on it",
         ],
     );
 }
@@ -266,7 +290,7 @@ fn a_malformed_montecarlo_config_is_invalid() {
     let m = shipped_with(
         &d,
         "montecarlo.toml",
-        "rate_max_rad_s = 0.125",
+        "rate_max_rad_s = 0.12",
         "rate_max_rad_s = ",
     );
     let o = check(&[m.to_str().unwrap()]);

@@ -141,8 +141,9 @@ fn help_on_every_subcommand() {
     }
 }
 
-/// `bounds` samples the envelope and compares every configured bound; with a bound cut
-/// below its sampled maximum it names the key and fails.
+/// `bounds` samples the envelope and compares every configured bound, saying what rests
+/// on each; with a load-bearing bound cut below its sampled maximum it names the key and
+/// fails, a robotic one (verified per step) it only reports.
 #[test]
 fn bounds_checks_every_envelope_bound() {
     let out = bin()
@@ -152,13 +153,34 @@ fn bounds_checks_every_envelope_bound() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{text}");
     assert!(
-        text.contains("16 of 16 bounds keep the factor 1.5"),
+        text.contains(
+            "1 of 1 bounds a certificate rests on keep the factor 1.5; of the 13 verified per step,"
+        ),
         "{text}"
     );
     let d = tmp("bounds");
     let sc = scenario_with(
         &d,
-        "angular_jerk_bound_rad_s3 = 0.15",
+        "joint_jerk_bound_rad_s3 = [7.0,",
+        "joint_jerk_bound_rad_s3 = [0.01,",
+    );
+    let out = bin()
+        .args(["bounds", "--samples", "2000", "--scenario"])
+        .arg(&sc)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    assert!(
+        text.lines()
+            .any(|l| l.contains("joint_jerk_bound_rad_s3[0]")
+                && l.contains("verified per step")
+                && !l.contains("< 1.5")),
+        "{text}"
+    );
+    let sc = scenario_with(
+        &d,
+        "angular_jerk_bound_rad_s3 = 0.35",
         "angular_jerk_bound_rad_s3 = 0.01",
     );
     let out = bin()
@@ -174,7 +196,7 @@ fn bounds_checks_every_envelope_bound() {
         "{text}"
     );
     let _ = std::fs::remove_dir_all(&d);
-    // nothing sampled is no evidence: refused, not "16 of 16"
+    // nothing sampled is no evidence: refused, not "1 of 1"
     let out = bin().args(["bounds", "--samples", "0"]).output().unwrap();
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no evidence"));
@@ -771,6 +793,9 @@ fn verify_qp_agrees_with_clarabel_on_the_default_mission_and_catches_a_tampered_
 /// Under a random all-subsystem attack every filter works on every step; the dump records
 /// the problem each command was solved with, so every solved QP agrees with Clarabel (the
 /// robotic filter once dumped its certifying rows instead: 3.2e-2 of the bound apart).
+/// Every robotic QP has an exact reference; a few attitude QPs may not (the exact solver
+/// stopped at its iteration limit and Clarabel's answer is the command, flagged
+/// `qp_second_opinion`: 2 of 2318 measured) and are checked against Clarabel.
 #[test]
 fn verify_qp_agrees_with_clarabel_under_a_random_attack() {
     let d = tmp("verify-qp-attack");
@@ -781,14 +806,16 @@ fn verify_qp_agrees_with_clarabel_under_a_random_attack() {
     let robotic = stdout.lines().find(|l| l.starts_with("robotic")).unwrap();
     let n: usize = robotic.split_whitespace().nth(1).unwrap().parse().unwrap();
     assert!(n > 2000, "only {n} robotic QPs solved: {robotic}");
+    assert!(!robotic.contains("no exact reference"), "{robotic}");
     let summary = stdout.lines().last().unwrap();
-    let total: &str = summary.split_whitespace().nth(1).unwrap();
-    assert!(
-        summary.contains(&format!(
-            "{total} solved QPs checked, {total} against an exact"
-        )),
-        "{stdout}"
-    );
+    let total: usize = summary.split_whitespace().nth(1).unwrap().parse().unwrap();
+    let exact: usize = summary
+        .split(", ")
+        .nth(1)
+        .and_then(|s| s.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(0);
+    assert!(exact * 100 >= total * 99, "{stdout}");
     let _ = std::fs::remove_dir_all(&d);
 }
 

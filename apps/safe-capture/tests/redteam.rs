@@ -86,9 +86,9 @@ fn every_strategy_on_every_target_in_process_is_safe() {
 
 /// The robotic filter's certificate does not rest on the envelope's jerk bounds (issue
 /// #26 item 2): it verifies every command on the sample the servicer model predicts. With
-/// every joint and link-sphere jerk bound cut to a tenth, the cases that broke the joint
-/// and link barriers before the per-step verification (measured: 21 of 95 unsafe over
-/// the whole red team) stay safe on the true state.
+/// every joint and link-sphere jerk bound cut to a tenth, cases that broke joint-rate
+/// barriers before the per-step verification (measured: 21 of 95 unsafe over the whole
+/// red team, all on joint rates) stay safe on the true state.
 #[test]
 fn the_arm_stays_safe_with_its_jerk_bounds_cut_to_a_tenth() {
     let _cpu = exclusive();

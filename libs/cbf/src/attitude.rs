@@ -100,8 +100,6 @@ pub struct AttitudeParams {
     /// The contract with the robotic filter: the joint torque the base wrench may take
     /// from each joint, `|(K [f_B; τ_B])_j| ≤ κ_j` [N m].
     pub joint_coupling_budget: SVector<f64, 7>,
-    /// Bound on `‖ω̇_B‖` over the certified set [rad/s²].
-    pub accel_bound: f64,
     /// Bound on `|ω̈_B,i|` over the certified set [rad/s³].
     pub jerk_bound: f64,
     /// The servicer's mass [kg] and force bound [N]: the relative motion of the line of
@@ -140,7 +138,6 @@ impl AttitudeParams {
             formulation: s.safety.formulation,
             arm_reaction_budget: Vector3::from(a.arm_reaction_budget_rad_s2),
             joint_coupling_budget: SVector::<f64, 7>::from(a.joint_coupling_budget_nm),
-            accel_bound: a.angular_accel_bound_rad_s2,
             jerk_bound: a.angular_jerk_bound_rad_s3,
             mass,
             force_max: s.limits.force_max_n,

@@ -16,12 +16,13 @@
 //! **Sampled data at 10 Hz.** The arm's light distal links make its joint accelerations
 //! change by tens of rad/s² inside one 0.1 s sample (docs/SAFETY.md, "The arm at 10 Hz"),
 //! so the analytic bounds of [`crate::sampled`] — with the joint jerk bounded over the
-//! envelope (`joint_jerk_bound_rad_s3`) — certify a command cheaply only away from the
-//! limits. Where they cannot, the filter **verifies** its command: with the servicer model
-//! it integrates the sample exactly as the simulator does (RK4 at the physics step, the
-//! upstream force and torque held) and checks every barrier at every physics step and the
-//! braking barrier at the next sample; a row whose prediction fell short gets the shortfall
-//! as a margin and the QP is solved again.
+//! envelope (`joint_jerk_bound_rad_s3`) — give a cheap candidate away from the limits.
+//! Every command is then **verified**: with the servicer model the filter integrates the
+//! sample exactly as the simulator does (RK4 at the physics step, the upstream force and
+//! torque held) and checks every barrier at every physics step and the braking barrier at
+//! the next sample, so the certificate does not rest on the jerk bounds (sampled maxima,
+//! not proven ones). Where the cheap candidate fails or does not verify, a row whose
+//! prediction fell short gets the shortfall as a margin and the QP is solved again.
 //!
 //! **Contract with the attitude filter.** The command keeps the reaction on the base
 //! angular acceleration of what the arm does beyond holding its joint rates within the
@@ -422,6 +423,13 @@ struct Verified {
     /// The multipliers of its solve.
     row_duals: [f64; 64],
     bound_duals: [f64; crate::engine::MAX_HARD_ROWS],
+}
+
+/// A command the envelope bounds certified that did not verify on the model's sample:
+/// where the verification path starts ([`RoboticFilter::verified`]).
+struct Refuted {
+    verdict: Verdict,
+    candidate: Verified,
 }
 
 /// Rows of relative degree two: the joint angles and the link spheres (not the rates).
@@ -1024,10 +1032,11 @@ impl RoboticFilter {
     }
 
     /// The command and how it came about, over all solves of the step (no multipliers
-    /// are recorded): first the a-posteriori certificate; where it fails (near the limits),
-    /// the verification with the servicer model (sampled-data rows only: the paper's rows
-    /// are for comparison); otherwise the last solve as it is, the braking law when it
-    /// failed. Writes the rows behind the command into `behind`.
+    /// are recorded): first the a-posteriori certificate, whose command is verified with
+    /// the servicer model; where it fails (near the limits) or does not verify, the
+    /// verification path (sampled-data rows only: the paper's rows are for comparison);
+    /// otherwise the last solve as it is, the braking law when it failed. Writes the rows
+    /// behind the command into `behind`.
     fn command(
         &mut self,
         x: &RoboticInput,
@@ -1047,18 +1056,31 @@ impl RoboticFilter {
             bound_duals: c.res.bound_duals,
             second_opinion: false,
         };
-        if behind.certifying.is_some()
-            && self.bounds_certificate_verifies(x, p, &o.u, &mut o.iterations)
-        {
-            if o.kind != Kind::Skipped {
-                o.kind = Kind::Solved;
+        let mut refuted = None;
+        if behind.certifying.is_some() {
+            let verdict = self.verify_certified(x, p, &o.u, &mut o.iterations);
+            if verdict.is_none_or(|v| v.ok) {
+                if o.kind != Kind::Skipped {
+                    o.kind = Kind::Solved;
+                }
+                o.second_opinion = c.res.second_opinion;
+                return o;
             }
-            o.second_opinion = c.res.second_opinion;
-            return o;
+            refuted = verdict.map(|verdict| Refuted {
+                verdict,
+                candidate: Verified {
+                    u: o.u,
+                    rows: behind.solved.unwrap_or(*local),
+                    violation: 0.0,
+                    second_opinion: c.res.second_opinion,
+                    row_duals: o.row_duals,
+                    bound_duals: o.bound_duals,
+                },
+            });
+            behind.certifying = None;
         }
-        behind.certifying = None;
         let verified = if self.params.formulation == Formulation::SampledData {
-            self.verified(x, p, u_nom, &mut o.iterations)
+            self.verified(x, p, u_nom, refuted, &mut o.iterations)
         } else {
             None
         };
@@ -1083,45 +1105,46 @@ impl RoboticFilter {
         o
     }
 
-    /// Whether the command the envelope bounds certified also verifies on the sample the
-    /// servicer model predicts ([`Self::verify`]): every command of the sampled-data
-    /// formulation is verified so, which makes its certificate independent of the
-    /// configured jerk bounds — they only decide how often the cheap certificate is
-    /// enough (docs/SAFETY.md, "The arm at 10 Hz"). A bound the arm exceeds shows as a
-    /// command that does not verify and goes to the verification path. Without a model,
-    /// or for the paper's rows, the bounds' certificate stands alone.
-    fn bounds_certificate_verifies(
+    /// The command the envelope bounds certified, verified on the sample the servicer
+    /// model predicts ([`Self::verify`]): every command of the sampled-data formulation is
+    /// verified so, which makes its certificate independent of the configured jerk bounds
+    /// — they only decide how often the cheap certificate is enough (docs/SAFETY.md, "The
+    /// arm at 10 Hz"). A bound the arm exceeds shows as a verdict that is not `ok`; the
+    /// command then goes to the verification path. `None` without a model, or for the
+    /// paper's rows: the bounds' certificate stands alone.
+    fn verify_certified(
         &mut self,
         x: &RoboticInput,
         p: &Prepared,
         u: &Vector7,
         iterations: &mut u32,
-    ) -> bool {
-        let Some(robot) = self.robot.clone() else {
-            return true;
-        };
+    ) -> Option<Verdict> {
+        let robot = self.robot.clone()?;
         if self.params.formulation != Formulation::SampledData {
-            return true;
+            return None;
         }
         *iterations += 1;
-        let ok = self.verify(&robot, x, &p.terms, u, &p.weights).ok;
-        if !ok {
+        let v = self.verify(&robot, x, &p.terms, u, &p.weights);
+        if !v.ok {
             self.bounds_refuted += 1;
         }
-        ok
+        Some(v)
     }
 
     /// The verification path: solve with the sample's own prediction, simulate the sample,
     /// tighten the rows that fell short, repeat. Returns the first verified command (with its
     /// rows and, if it came from the relaxed problem, its violation), or — when none verifies
     /// within [`MAX_VERIFY_ROUNDS`] — the candidate whose worst barrier over the sample is
-    /// best, flagged as relaxed. `None` without a model or when every solve failed.
+    /// best, flagged as relaxed. A command the bounds certified that did not verify
+    /// (`refuted`) starts it: its shortfalls are the first margins, and it is a candidate
+    /// too. `None` without a model or when every solve failed (and nothing was refuted).
     /// `iterations` counts the solver's iterations and one per verification.
     fn verified(
         &mut self,
         x: &RoboticInput,
         p: &Prepared,
         u_nom: &Vector7,
+        refuted: Option<Refuted>,
         iterations: &mut u32,
     ) -> Option<Verified> {
         let robot = self.robot.clone()?;
@@ -1130,6 +1153,13 @@ impl RoboticFilter {
         // the torques the rows take the declared torque error for: the holding torque's
         // (a safe command near the limits is close to it), then every candidate's as well
         let mut torque = hold_torque(x).abs();
+        if let Some(r) = refuted {
+            for (m, s) in margin.iter_mut().zip(&r.verdict.shortfall) {
+                *m += VERIFY_GAIN * s;
+            }
+            torque = torque.sup(&r.candidate.u.abs());
+            best = Some((r.verdict.worst, r.candidate));
+        }
         for _ in 0..MAX_VERIFY_ROUNDS {
             let rows = self.barrier_rows(x, &p.terms, Level::Local(torque), &margin);
             let res = self.engine.solve(u_nom, &rows, &p.weights, &p.hard);
@@ -1389,7 +1419,7 @@ impl RoboticFilter {
 
     /// How many commands the envelope bounds certified did not verify on the servicer
     /// model's sample (each then went to the verification path): how often the arm left
-    /// the configured jerk bounds.
+    /// the configured jerk bounds — or the model could not be integrated over the sample.
     pub fn bounds_refuted(&self) -> u64 {
         self.bounds_refuted
     }

@@ -54,7 +54,17 @@ pub fn check_scenario(cfg: &PartitionConfig) -> Result<PathBuf, ConfigError> {
             "scenario = {:?} declares an `[uncertainty]` profile, but `[simulator] plant` propagates the declared model only; drop the plant (the built-in simulator propagates the realised plant) or the section",
             cfg.scenario
         )),
-        Ok(_) => Ok(path),
+        // the cross-checks with the servicer model, and the envelope bounds every ground
+        // command checks (the flight processes trust them)
+        Ok(s) => sc_mission::Setup::from_scenario(s)
+            .and_then(|setup| setup.check_envelope_bounds(&path))
+            .map(|()| path.clone())
+            .map_err(|e| {
+                ConfigError(format!(
+                    "scenario = {:?}: {e}; correct the scenario or point `scenario` at another",
+                    cfg.scenario
+                ))
+            }),
         Err(e @ sc_scenario::ScenarioError::Io { .. }) => err(format!(
             "scenario = {:?}: {e}; point `scenario` at a scenario file (a relative path is relative to the config's directory {})",
             cfg.scenario,

@@ -82,6 +82,38 @@ impl Setup {
         })
     }
 
+    /// Refuses a bound a filter's certificate rests on that the servicer model exceeds at
+    /// a state of the certified envelope (a witness of `sc_cbf::envelope::witnesses`'
+    /// targeted search, 0.07 s): not a bound (docs/SAFETY.md, "The envelope bounds"). Every
+    /// ground command runs it before anything starts (`path`: the scenario file, for the
+    /// command that reproduces the witness); the flight processes trust the launcher's.
+    pub fn check_envelope_bounds(&self, path: &Path) -> Result<(), SetupError> {
+        use sc_cbf::envelope::{SAFETY_FACTOR, WITNESS_ROUNDS, WITNESS_SAMPLES, WITNESS_SEED};
+        let w = sc_cbf::envelope::witnesses(&self.scenario, &self.robot);
+        let reproduce = format!(
+            "`safe-capture bounds --scenario {} --samples {WITNESS_SAMPLES} --search-rounds {WITNESS_ROUNDS} --seed {WITNESS_SEED}`",
+            path.display()
+        );
+        if !w.evidence() {
+            return Err(SetupError::Other(format!(
+                "the envelope bounds cannot be checked: the servicer model could be evaluated at only {} of {} states of the certified envelope ({reproduce}); check the URDF and the limits",
+                w.usable, w.samples
+            )));
+        }
+        match w.refuted() {
+            Some(c) => Err(SetupError::Inconsistent {
+                key: c.key.clone(),
+                value: c.configured.to_string(),
+                rule: format!(
+                    "not a bound — the servicer model reaches {:.4} at a state of the certified envelope (a targeted search, {reproduce}), and the filters' certificate rests on it; set it to at least {:.4} ({SAFETY_FACTOR}× that; docs/SAFETY.md, \"The envelope bounds\")",
+                    c.sampled,
+                    SAFETY_FACTOR * c.sampled
+                ),
+            }),
+            None => Ok(()),
+        }
+    }
+
     /// Total servicer mass [kg] (base + arm), the `m` of the CW model.
     pub fn mass(&self) -> f64 {
         self.robot.total_mass()

@@ -173,7 +173,9 @@ pub fn shard_runs(runs: usize, shard: Option<(usize, usize)>) -> Vec<usize> {
 
 /// Loads the base scenario and checks the config against it.
 fn load_base(opts: &CampaignOptions) -> Result<Setup, McError> {
-    let mut setup = Setup::load(&opts.scenario).map_err(|e| McError::Setup(e.to_string()))?;
+    let mut setup = Setup::load(&opts.scenario)
+        .and_then(|s| s.check_envelope_bounds(&opts.scenario).map(|()| s))
+        .map_err(|e| McError::Setup(e.to_string()))?;
     if let Some(spec) = &opts.uncertainty {
         let s = &mut setup.scenario;
         s.set_uncertainty(spec.clone())

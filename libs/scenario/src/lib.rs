@@ -320,8 +320,6 @@ pub struct SafetyAttitude {
     /// Contract with the robotic filter: the joint torque the base wrench may take to
     /// hold the arm, `|(K [f_B; τ_B])_j| ≤ κ_j` per joint [N m].
     pub joint_coupling_budget_nm: J7,
-    /// Bound on ‖ω̇_B‖ over the certified set [rad/s²] (derived: `safe-capture bounds`).
-    pub angular_accel_bound_rad_s2: f64,
     /// Bound on |ω̈_B,i| over the certified set [rad/s³] (derived: `safe-capture bounds`).
     pub angular_jerk_bound_rad_s3: f64,
 }

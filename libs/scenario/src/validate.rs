@@ -479,10 +479,6 @@ impl Scenario {
                 at.joint_coupling_budget_nm[i],
             )?;
         }
-        positive(
-            "safety.attitude.angular_accel_bound_rad_s2",
-            at.angular_accel_bound_rad_s2,
-        )?;
         non_negative(
             "safety.attitude.angular_jerk_bound_rad_s3",
             at.angular_jerk_bound_rad_s3,
