@@ -255,8 +255,13 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let mut setups = a
         .scenario
         .iter()
-        .map(|p| Setup::load(p).and_then(|s| s.check_envelope_bounds(p).map(|()| s)))
-        .collect::<Result<Vec<_>, _>>()?;
+        .map(|p| {
+            let s = Setup::load(p)?;
+            s.check_before_run(p)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", p.display()))?;
+            Ok(s)
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
     for s in &mut setups {
         a.uncertainty.apply(&mut s.scenario)?;
     }

@@ -85,7 +85,7 @@ fn check_file(path: &Path, kind: Option<Kind>, mc_scenario: &Path) -> Result<Str
         Kind::Scenario => {
             let setup = Setup::load(path).map_err(|e| setup_problem(&e))?;
             setup
-                .check_envelope_bounds(path)
+                .check_before_run(path)
                 .map_err(|e| setup_problem(&e))?;
             let (s, robot) = (&setup.scenario, &setup.robot);
             let env = s.line_of_sight_envelope();

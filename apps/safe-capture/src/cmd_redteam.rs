@@ -320,7 +320,9 @@ fn verdict_line(a: &Args, s: &report::CampaignSummary, wall: f64, under: &str) {
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let mut setup = Setup::load(&a.scenario)?;
-    setup.check_envelope_bounds(&a.scenario)?;
+    setup
+        .check_before_run(&a.scenario)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", a.scenario.display()))?;
     a.uncertainty.refuse_truth("redteam")?;
     let declared_in_file = setup.scenario.uncertainty.clone();
     a.uncertainty.apply(&mut setup.scenario)?;

@@ -243,7 +243,9 @@ fn what_ran(a: &Args) -> String {
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let mut setup = Setup::load(&a.scenario)?;
-    setup.check_envelope_bounds(&a.scenario)?;
+    setup
+        .check_before_run(&a.scenario)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", a.scenario.display()))?;
     a.uncertainty.apply(&mut setup.scenario)?;
     if a.basilisk && setup.scenario.uncertainty.is_some() {
         // Basilisk propagates the scenario file's model, not the drawn plant

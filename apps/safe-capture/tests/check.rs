@@ -336,3 +336,92 @@ fn every_file_gets_its_line_and_the_kind_can_be_given() {
         &["cannot read"],
     );
 }
+
+/// Physically implausible scenarios (issue #27, "a partner's first day") are caught before
+/// anything runs, with one line each naming the key and the fix — by `check` and by `run`
+/// alike: an altitude typed in km into a metre key, a control period out of proportion to
+/// the dynamics, a start on the wrong side of the target, and a partition config given
+/// where a scenario is expected.
+#[test]
+fn implausible_scenarios_are_one_line_each_from_check_and_run() {
+    let d = tmp("check-implausible");
+    let cases: [(&str, &str, &[&str]); 3] = [
+        (
+            "altitude_m = 600000.0",
+            "altitude_m = 600.0",
+            &["`orbit.altitude_m` = 600.0", "in metres"],
+        ),
+        (
+            "control_period_s = 0.1 ",
+            "control_period_s = 100.0 ",
+            &["mission.control_period_s = 100 s", "could not follow"],
+        ),
+        (
+            "initial_position_m = [-9.0, 0.45, -0.35]",
+            "initial_position_m = [9.0, 0.45, -0.35]",
+            &[
+                "`servicer.initial_position_m` = [9.0, 0.45, -0.35]",
+                "the start is outside the certified set",
+                "approach_corridor",
+            ],
+        ),
+    ];
+    for (from, to, needles) in cases {
+        let s = shipped_with(&d, "scenario.toml", from, to);
+        assert_invalid(&check(&[s.to_str().unwrap()]), &s, needles);
+        let out = d.join("run");
+        let o = cli(
+            &[
+                "run",
+                "--scenario",
+                s.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            &[],
+        );
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{to}: {}", text(&o));
+        let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+        assert_eq!(lines.len(), 1, "{to}: one line expected: {err}");
+        assert!(lines[0].contains(&s.display().to_string()), "{err}");
+        for n in needles {
+            assert!(lines[0].contains(n), "`{n}` not in: {err}");
+        }
+        assert!(!out.exists(), "{to}: a refused run wrote {}", out.display());
+    }
+    // a partition config where a scenario is expected: named as what it is
+    let p = root().join("config/partition.toml");
+    let o = cli(
+        &[
+            "run",
+            "--scenario",
+            p.to_str().unwrap(),
+            "--out",
+            d.join("run").to_str().unwrap(),
+        ],
+        &[],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(
+        err.contains(
+            "a partition config, not a scenario: give it to `safe-capture launch --config FILE`"
+        ),
+        "{err}"
+    );
+    assert_eq!(
+        err.lines().filter(|l| !l.trim().is_empty()).count(),
+        1,
+        "{err}"
+    );
+    let m = root().join("config/montecarlo.toml");
+    let o = check(&["--kind", "scenario", m.to_str().unwrap()]);
+    assert_invalid(
+        &o,
+        &m,
+        &[
+            "a Monte Carlo config, not a scenario: give it to `safe-capture montecarlo --config FILE`",
+        ],
+    );
+}

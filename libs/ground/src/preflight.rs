@@ -57,7 +57,7 @@ pub fn check_scenario(cfg: &PartitionConfig) -> Result<PathBuf, ConfigError> {
         // the cross-checks with the servicer model, and the envelope bounds every ground
         // command checks (the flight processes trust them)
         Ok(s) => sc_mission::Setup::from_scenario(s)
-            .and_then(|setup| setup.check_envelope_bounds(&path))
+            .and_then(|setup| setup.check_before_run(&path))
             .map(|()| path.clone())
             .map_err(|e| {
                 ConfigError(format!(

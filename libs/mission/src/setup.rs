@@ -114,9 +114,70 @@ impl Setup {
         }
     }
 
+    /// What every ground command checks before a single run starts (`check`, `run`,
+    /// `redteam`, `bench`, `launch`'s preflight): the envelope bounds
+    /// ([`Self::check_envelope_bounds`]) and the start ([`Self::check_start`]).
+    pub fn check_before_run(&self, path: &Path) -> Result<(), SetupError> {
+        self.check_envelope_bounds(path)?;
+        self.check_start()
+    }
+
+    /// Refuses a start outside the certified set: a barrier already negative in the
+    /// scenario's initial state (the declared model's; a Monte Carlo draws its own
+    /// starts). From there the filters could only run the relaxed problem (docs/SAFETY.md,
+    /// "What is outside the promise"); a run would end unsafe or time out with faults.
+    pub fn check_start(&self) -> Result<(), SetupError> {
+        let sim = sc_sim::Simulator::new(&self.scenario, self.robot.clone())
+            .map_err(|e| SetupError::Other(e.to_string()))?;
+        let monitor = sc_cbf::monitor::Monitor::from_scenario(&self.scenario, self.robot.clone());
+        let h = monitor.evaluate(&sim.observe().barrier_state());
+        let Some((name, v)) = crate::constraint_names()
+            .into_iter()
+            .zip(h)
+            .find(|(_, v)| !(*v >= 0.0))
+        else {
+            return Ok(());
+        };
+        let s = &self.scenario.servicer;
+        let (key, value) = start_key(name, s);
+        Err(SetupError::Inconsistent {
+            key: key.into(),
+            value,
+            rule: format!(
+                "the start is outside the certified set: the barrier `{name}` is {v:.4e} < 0 at t = 0 (docs/SAFETY.md, \"The certified set\"); start where every barrier holds"
+            ),
+        })
+    }
+
     /// Total servicer mass [kg] (base + arm), the `m` of the CW model.
     pub fn mass(&self) -> f64 {
         self.robot.total_mass()
+    }
+}
+
+/// The scenario key of the initial state a barrier depends on, and its value.
+fn start_key(barrier: &str, s: &sc_scenario::Servicer) -> (&'static str, String) {
+    if barrier.starts_with("theta_dot") {
+        (
+            "servicer.initial_theta_dot_rad_s",
+            format!("{:?}", s.initial_theta_dot_rad_s),
+        )
+    } else if barrier.starts_with("theta_") || barrier.starts_with("link_base") {
+        (
+            "servicer.initial_theta_rad",
+            format!("{:?}", s.initial_theta_rad),
+        )
+    } else if barrier.starts_with("omega_") {
+        (
+            "servicer.initial_omega_rad_s",
+            format!("{:?}", s.initial_omega_rad_s),
+        )
+    } else {
+        // the corridor, the zone and the line of sight: where the servicer starts
+        (
+            "servicer.initial_position_m",
+            format!("{:?}", s.initial_position_m),
+        )
     }
 }
 

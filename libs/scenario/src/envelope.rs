@@ -334,8 +334,8 @@ impl Scenario {
                 "safety.attitude.boresight_rate_max_rad_s",
                 at.boresight_rate_max_rad_s,
                 format!(
-                    "its rows' margins take all of it ({:.4} rad/s left): the boresight could not follow the line of sight at all",
-                    env.boresight_follow_rad_s
+                    "its rows' margins take all of it ({:.4} rad/s left): the boresight could not follow the line of sight at all (the margins grow with the control period, mission.control_period_s = {} s, and the jerk bound)",
+                    env.boresight_follow_rad_s, self.mission.control_period_s
                 ),
             ));
         }
@@ -344,8 +344,8 @@ impl Scenario {
                 "safety.attitude.omega_max_rad_s",
                 at.omega_max_rad_s,
                 format!(
-                    "with omega_min_rad_s = {:?}, the rate rows' margins take all of the smallest limit ({:.4} rad/s left): the base could not turn at all",
-                    at.omega_min_rad_s, env.sync_limit_rad_s
+                    "with omega_min_rad_s = {:?}, the rate rows' margins take all of the smallest limit ({:.4} rad/s left): the base could not turn at all (the margins grow with the control period, mission.control_period_s = {} s, and the jerk bound)",
+                    at.omega_min_rad_s, env.sync_limit_rad_s, self.mission.control_period_s
                 ),
             ));
         }

@@ -445,7 +445,9 @@ impl Scenario {
 
     /// Parses and validates scenario text; relative paths resolve against `base_dir`.
     pub fn from_toml_str(text: &str, base_dir: &Path) -> Result<Self, ScenarioError> {
-        let mut s: Scenario = toml::from_str(text).map_err(|e| ScenarioError::parse(text, &e))?;
+        let mut s: Scenario = toml::from_str(text).map_err(|e| {
+            ScenarioError::other_kind(text).unwrap_or_else(|| ScenarioError::parse(text, &e))
+        })?;
         s.base_dir = base_dir.to_path_buf();
         if let Some(spec) = s.uncertainty.take() {
             s.set_uncertainty(spec)?;

@@ -16,6 +16,9 @@ pub enum ScenarioError {
         column: usize,
         message: String,
     },
+    /// Another kind of configuration file where a scenario is expected.
+    #[error("{kind}, not a scenario: {hint}")]
+    WrongKind { kind: String, hint: String },
     #[error("`{key}` = {value}: {rule}")]
     Invalid {
         key: String,
@@ -48,6 +51,34 @@ impl ScenarioError {
         }
     }
 
+    /// `text` that failed to parse as a scenario but is another kind of configuration,
+    /// told by its top-level keys (the same keys `safe-capture check` tells kinds by): a
+    /// partition config (`roles`, `rate_groups`) or a Monte Carlo config
+    /// (`initial_position`, `target_rate`). `None` when it is meant as a scenario.
+    pub(crate) fn other_kind(text: &str) -> Option<Self> {
+        let table: toml::Table = toml::from_str(text).ok()?;
+        let has = |keys: &[&str]| keys.iter().any(|k| table.contains_key(*k));
+        if has(&["servicer", "target", "mission"]) {
+            return None;
+        }
+        let (kind, command) = if has(&["roles", "rate_groups"]) {
+            ("a partition config", "safe-capture launch --config FILE")
+        } else if has(&["initial_position", "target_rate"]) {
+            (
+                "a Monte Carlo config",
+                "safe-capture montecarlo --config FILE",
+            )
+        } else {
+            return None;
+        };
+        Some(ScenarioError::WrongKind {
+            kind: kind.into(),
+            hint: format!(
+                "give it to `{command}`; a scenario (e.g. config/scenario.toml) has [servicer], [target] and [mission]"
+            ),
+        })
+    }
+
     pub(crate) fn in_file(self, path: &std::path::Path) -> Self {
         match self {
             e @ ScenarioError::Io { .. } => e,
@@ -66,6 +97,10 @@ impl ScenarioError {
         }
     }
 }
+
+/// The lowest altitude of a circular orbit the scenario accepts [m] (the Kármán line:
+/// below it the atmosphere brings an orbit down within a revolution).
+pub const MIN_ORBIT_ALTITUDE_M: f64 = 100_000.0;
 
 pub(crate) fn invalid(key: &str, value: impl Debug, rule: impl Into<String>) -> ScenarioError {
     ScenarioError::Invalid {
@@ -215,6 +250,15 @@ impl Scenario {
         non_negative("orbit.earth_mu_m3_s2", o.earth_mu_m3_s2)?;
         positive("orbit.earth_radius_m", o.earth_radius_m)?;
         positive("orbit.altitude_m", o.altitude_m)?;
+        if o.earth_mu_m3_s2 > 0.0 && o.altitude_m < MIN_ORBIT_ALTITUDE_M {
+            return Err(invalid(
+                "orbit.altitude_m",
+                o.altitude_m,
+                format!(
+                    "an orbit at least {MIN_ORBIT_ALTITUDE_M} m above the Earth's surface (below ~100 km no orbit lasts a revolution; the key is in metres — 600 km is 600000.0)"
+                ),
+            ));
+        }
         finite("orbit.inclination_deg", o.inclination_deg)?;
         finite("orbit.raan_deg", o.raan_deg)?;
         finite("orbit.argument_of_latitude_deg", o.argument_of_latitude_deg)
