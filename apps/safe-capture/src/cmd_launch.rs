@@ -89,6 +89,17 @@ fn outcome(summary: Option<&serde_json::Value>, scheduler: Option<&serde_json::V
     }
 }
 
+/// The reason a partner gave for its first step without a valid command: the SDK's line
+/// `<label>: tick N (t = … s): no valid command: <reason>` in `logs/<role>.log`
+/// (scripts/python/sc_partner/process.py); `None` when the log has none.
+fn first_invalid(logs: &std::path::Path, role: &str) -> Option<String> {
+    const MARK: &str = ": no valid command: ";
+    let log = std::fs::read_to_string(logs.join(format!("{role}.log"))).ok()?;
+    let line = log.lines().find(|l| l.contains(MARK))?;
+    let reason = &line[line.find(MARK)? + MARK.len()..];
+    Some(reason.trim().to_string())
+}
+
 /// The launcher's codes from this one on are the infrastructure's (a process failed,
 /// samples lost): the run is no mission result.
 const INFRASTRUCTURE_FAILURE: i32 = 3;
@@ -183,8 +194,19 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     if let Some(u) = uncertainty {
         outln!("{}", u.line());
     }
+    let logs = a.out.join("logs");
+    let verdict = summary
+        .as_ref()
+        .and_then(|s| serde_json::from_value::<sc_mission::Summary>(s.clone()).ok())
+        .map(|s| {
+            format!(
+                "; {}",
+                s.verdict_after_end(&|role| first_invalid(&logs, role))
+            )
+        })
+        .unwrap_or_default();
     outln!(
-        "partition: {}; {} processes, failed: [{}]; shm leftovers: {}; wall {:.2} s -> {}",
+        "partition: {}{verdict}; {} processes, failed: [{}]; shm leftovers: {}; wall {:.2} s -> {}",
         outcome(summary.as_ref(), scheduler.as_ref()),
         rep.exits.len(),
         failed.join(", "),

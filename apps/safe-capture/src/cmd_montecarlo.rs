@@ -45,9 +45,9 @@ const _: () = assert!(EXIT_FORCED == 130);
 /// Every report records the host's load at the start and end (1-minute load average,
 /// CPUs).
 ///
-/// Exit codes (a campaign, and `merge`): 0 every run completed safe and captured, 1 a
-/// run unsafe, not captured or failed (a partition run that could not be launched is a
-/// failed run), 2 bad arguments or configuration (checked before any run starts; with
+/// Exit codes (a campaign, and `merge`): 0 every run passed as `run` judges one (safe,
+/// captured, no fault: README, "Verdicts and exit codes"), 1 a run unsafe, not captured,
+/// with faults or failed (a partition run that could not be launched is a failed run), 2 bad arguments or configuration (checked before any run starts; with
 /// --resume also a DIR that holds another campaign), 3 interrupted by SIGINT/SIGTERM
 /// (the completed runs aggregated; --resume completes the campaign), 130 a second
 /// SIGINT/SIGTERM quit at once (in-process; the runs in flight abandoned).
@@ -70,8 +70,8 @@ enum Action {
     Rerun(RerunArgs),
     /// Merge shard directories into one campaign (same outputs as an unsharded run).
     ///
-    /// Exit codes: 0 every run safe and captured, 1 a run unsafe, not captured or
-    /// failed, 2 bad arguments or shards that do not fit together.
+    /// Exit codes: 0 every run safe, captured and without faults, 1 a run unsafe, not
+    /// captured, with faults or failed, 2 bad arguments or shards that do not fit together.
     Merge(MergeArgs),
 }
 
@@ -382,7 +382,7 @@ fn report(s: &CampaignSummary, out: &std::path::Path) -> ExitCode {
         );
     }
     outln!(
-        "montecarlo: {} runs{} (seed {}{}): {} safe, {} captured, {} failed; worst margin {}; total solve time geomean {:.1} us, max {:.1} us; wall {:.1} s -> {}",
+        "montecarlo: {} runs{} (seed {}{}): {} safe, {} captured, {} with faults, {} failed; worst margin {}; total solve time geomean {:.1} us, max {:.1} us; wall {:.1} s -> {}",
         s.runs,
         s.shard
             .map(|[i, n]| format!(" of shard {i}/{n}"))
@@ -394,6 +394,7 @@ fn report(s: &CampaignSummary, out: &std::path::Path) -> ExitCode {
             .unwrap_or_default(),
         s.safe_runs,
         s.captured_runs,
+        s.faulted_runs,
         s.failed_runs,
         worst
             .map(|(n, h, r)| format!(
@@ -424,7 +425,11 @@ fn report(s: &CampaignSummary, out: &std::path::Path) -> ExitCode {
         );
         return ExitCode::from(EXIT_INTERRUPTED);
     }
-    if s.failed_runs == 0 && s.safe_runs == s.runs && s.captured_runs == s.runs {
+    if s.failed_runs == 0
+        && s.safe_runs == s.runs
+        && s.captured_runs == s.runs
+        && s.faulted_runs == 0
+    {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)

@@ -293,25 +293,19 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         a.figures.export_dir(&out.join("figures"))?;
     }
     staged.commit()?;
-    let safe = summary.safe();
     if let Some(u) = &summary.uncertainty {
         outln!("{}", u.line());
     }
     outln!(
-        "{}: {} at t = {:.1} s; min margin {} = {:.3e}; violated: [{}]; faults: {}; total solve time geomean {:.1} us, max {:.1} us; wall {:.2} s -> {}",
+        "{}: {}; total solve time geomean {:.1} us, max {:.1} us; wall {:.2} s -> {}",
         what_ran(&a),
-        summary.end,
-        summary.final_time_s,
-        summary.min_margin.0,
-        summary.min_margin.1,
-        summary.violated_constraints.join(", "),
-        summary.fault_count,
+        summary.verdict(),
         summary.solve_time_us["total"].geomean,
         summary.solve_time_us["total"].max,
         started.elapsed().as_secs_f64(),
         a.out.display()
     );
-    Ok(if safe && summary.captured {
+    Ok(if summary.passed() {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)

@@ -281,7 +281,9 @@ fn a_launch_stopped_by_max_ticks_says_so() {
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(
         stdout.starts_with(&format!(
-            "partition: stopped after {SHORT_TICKS} ticks (--max-ticks) at t = 4.9 s, before the mission ended; {} processes, failed: []",
+            "partition: stopped after {SHORT_TICKS} ticks (--max-ticks) at t = 4.9 s, before the mission ended; min margin "
+        )) && stdout.contains(&format!(
+            "; violated: []; faults: 0; {} processes, failed: []",
             sc_icd::ROLES.len()
         )),
         "{t}"
@@ -301,6 +303,55 @@ fn a_launch_stopped_by_max_ticks_says_so() {
         .find(|e| e["role"] == "recorder")
         .unwrap();
     assert_eq!(recorder["code"], 0, "{launch}");
+}
+
+/// A partner's controller that fails — here one whose `step` raises from t = 3 s — is
+/// named in the verdict line with how many steps it gave no valid command and the
+/// reason for the first, quoted from its log; the run is not a pass (exit 1) (issue #27,
+/// "a failing partner controller looks like success").
+#[test]
+fn a_failing_partner_is_named_in_the_verdict() {
+    let _cpu = exclusive();
+    let Some(py) = python() else {
+        return;
+    };
+    let d = tmp("failing-partner");
+    let script = d.join("bad_attitude.py");
+    std::fs::write(
+        &script,
+        "import sys\nfrom sc_partner import NominalController\n\n\nclass Bad(NominalController):\n    subsystem = 'attitude'\n\n    def step(self, state):\n        if state.t > 2.95:\n            raise ValueError('boom')\n        return [0.0, 0.0, 0.0]\n\n\nsys.exit(Bad.main())\n",
+    )
+    .unwrap();
+    let cfg = partition_with(
+        &d,
+        "[roles.nominal_attitude]\n",
+        &format!("[roles.nominal_attitude]\nexec = {py:?}\nargs = [{script:?}]\n"),
+    );
+    let out = d.join("out");
+    let pythonpath = root().join("scripts/python");
+    let (o, _) = cli_partition(
+        &[
+            "launch",
+            "--config",
+            cfg.to_str().unwrap(),
+            "--max-ticks",
+            SHORT_TICKS,
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[("PYTHONPATH", pythonpath.to_str().unwrap())],
+    );
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{t}");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains(&format!(
+            "; nominal_attitude: 20 of {SHORT_TICKS} steps without a valid command (first at t = 3.0 s: step raised ValueError: boom); "
+        )),
+        "{t}"
+    );
+    let s = json(&out.join("summary.json"));
+    assert_eq!(s["partner_faults"]["nominal_attitude"]["steps"], 20, "{s}");
 }
 
 /// A launch whose reader has gone (`launch … | head`, stdout and stderr closed) neither

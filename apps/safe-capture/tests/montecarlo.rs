@@ -33,7 +33,7 @@ fn campaign_rerun_and_merge_from_the_command_line() {
     // 2 s missions do not capture: exit code 1, but the campaign is complete
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
     assert!(
-        text(&o).contains("3 runs (seed 5): 3 safe, 0 captured, 0 failed"),
+        text(&o).contains("3 runs (seed 5): 3 safe, 0 captured, 0 with faults, 0 failed"),
         "{}",
         text(&o)
     );
@@ -362,7 +362,7 @@ fn partition_mode_gives_exactly_the_in_process_results() {
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     let t = text(&o);
     assert!(
-        t.contains("3 runs (seed 2): 3 safe, 3 captured, 0 failed"),
+        t.contains("3 runs (seed 2): 3 safe, 3 captured, 0 with faults, 0 failed"),
         "{t}"
     );
     assert!(!t.contains("launch:"), "the launcher must be quiet: {t}");
@@ -484,7 +484,7 @@ fn a_failed_partition_launch_is_a_failed_run_and_the_campaign_goes_on() {
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
     let t = text(&o);
     assert!(
-        t.contains("3 runs (seed 1): 2 safe, 0 captured, 1 failed")
+        t.contains("3 runs (seed 1): 2 safe, 0 captured, 0 with faults, 1 failed")
             && t.contains("run 1 failed: partition: cannot start role `simulator`"),
         "{t}"
     );

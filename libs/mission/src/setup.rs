@@ -134,7 +134,7 @@ impl Setup {
         let Some((name, v)) = crate::constraint_names()
             .into_iter()
             .zip(h)
-            .find(|(_, v)| !(*v >= 0.0))
+            .find(|(_, v)| v.is_nan() || *v < 0.0)
         else {
             return Ok(());
         };

@@ -120,9 +120,66 @@ pub struct Summary {
     /// `exact` profile); see [`UncertaintySummary::of`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub uncertainty: Option<UncertaintySummary>,
+    /// Per nominal controller (`nominal_<subsystem>`, the partner's role) that failed to
+    /// give a valid command: how often and from when (absent when every one did).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub partner_faults: BTreeMap<String, PartnerFaults>,
+}
+
+/// Steps on which a nominal controller gave no valid command (its filter flagged
+/// `nominal_missing` or `invalid_nominal` and filtered the substitute nominal instead).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PartnerFaults {
+    /// Steps without a valid command.
+    pub steps: usize,
+    /// Of them, steps with no command at all (silent, late, dead) and with an invalid
+    /// one (non-finite, out of range, flagged invalid by the partner).
+    pub missing: usize,
+    pub invalid: usize,
+    /// Time of the first [s].
+    pub first_t_s: f64,
 }
 
 impl Summary {
+    /// The verdict of a run, as `run` and `launch` print it (one definition, README
+    /// "Verdicts and exit codes"): how it ended, the smallest margin, the violated
+    /// barriers, the fault count, and every partner that gave no valid command on some
+    /// steps (`nominal_attitude: 954 of 1255 steps without a valid command (first at t =
+    /// 30.0 s)`).
+    pub fn verdict(&self) -> String {
+        format!(
+            "{} at t = {:.1} s; {}",
+            self.end,
+            self.final_time_s,
+            self.verdict_after_end(&|_| None)
+        )
+    }
+
+    /// [`Self::verdict`] after how the run ended, each partner's fault with the reason
+    /// `reason(role)` gives for its first (e.g. from the partner's log).
+    pub fn verdict_after_end(&self, reason: &dyn Fn(&str) -> Option<String>) -> String {
+        let mut line = format!(
+            "min margin {} = {:.3e}; violated: [{}]; faults: {}",
+            self.min_margin.0,
+            self.min_margin.1,
+            self.violated_constraints.join(", "),
+            self.fault_count
+        );
+        for (role, f) in &self.partner_faults {
+            line.push_str(&format!(
+                "; {}",
+                f.line(role, self.steps, reason(role).as_deref())
+            ));
+        }
+        line
+    }
+
+    /// Passed, the exit code 0 of `run`, `launch` and every run of `montecarlo`:
+    /// captured and [`Self::safe`].
+    pub fn passed(&self) -> bool {
+        self.captured && self.safe()
+    }
+
     /// Safe as `run` and `launch` judge a run: every barrier held, no fault, and (with a
     /// declared uncertainty) the realised errors within the declared bounds.
     pub fn safe(&self) -> bool {
@@ -308,6 +365,7 @@ struct Tally {
     torque_peak: BTreeMap<String, f64>,
     fault_events: Vec<FaultEvent>,
     fault_count: usize,
+    partner_faults: BTreeMap<String, PartnerFaults>,
 }
 
 impl Tally {
@@ -337,6 +395,7 @@ impl Tally {
             torque_peak: BTreeMap::new(),
             fault_events: Vec::new(),
             fault_count: 0,
+            partner_faults: BTreeMap::new(),
         }
     }
 
@@ -431,10 +490,33 @@ impl Tally {
             if f != 0 {
                 self.fault(r, name, flag_names(f));
             }
+            self.partner(r, name, f);
         }
         if r.navigation_rejected {
             self.fault(r, NAVIGATION, vec![NAVIGATION_REJECTED.into()]);
         }
+    }
+
+    /// Counts a step on which the nominal controller of `filter`'s subsystem gave no valid
+    /// command (the filter's flags `f`).
+    fn partner(&mut self, r: &StepRecord, filter: &str, f: u32) {
+        let missing = f & faults::NOMINAL_MISSING != 0;
+        let invalid = f & faults::INVALID_NOMINAL != 0;
+        if !(missing || invalid) {
+            return;
+        }
+        let p = self
+            .partner_faults
+            .entry(format!("nominal_{filter}"))
+            .or_insert(PartnerFaults {
+                steps: 0,
+                missing: 0,
+                invalid: 0,
+                first_t_s: r.t,
+            });
+        p.steps += 1;
+        p.missing += usize::from(missing);
+        p.invalid += usize::from(invalid && !missing);
     }
 
     /// Counts a fault of `by` and keeps its event while there is room.
@@ -504,7 +586,21 @@ impl Tally {
             fault_count: self.fault_count,
             faults: self.fault_events,
             uncertainty: None,
+            partner_faults: self.partner_faults,
         }
+    }
+}
+
+impl PartnerFaults {
+    /// `nominal_attitude: 954 of 1255 steps without a valid command (first at t = 30.0 s)`,
+    /// with the first's reason when known (`… (first at t = 30.0 s: step raised …)`).
+    pub fn line(&self, role: &str, steps: usize, reason: Option<&str>) -> String {
+        format!(
+            "{role}: {} of {steps} steps without a valid command (first at t = {:.1} s{})",
+            self.steps,
+            self.first_t_s,
+            reason.map(|r| format!(": {r}")).unwrap_or_default()
+        )
     }
 }
 

@@ -152,16 +152,19 @@ class NominalController:
         zeros = np.zeros(n)
         try:
             out = self.step(state)
-        except Exception:
-            return zeros, "step raised:\n" + traceback.format_exc().rstrip()
+        except Exception as e:
+            # the first line is the reason (the launcher's verdict quotes it), then the traceback
+            return zeros, f"step raised {type(e).__name__}: {e}\n" + traceback.format_exc().rstrip()
         if out is None:
             return zeros, "step returned None"
         try:
-            values = np.asarray(out, dtype=np.float64).reshape(-1)
+            values = np.asarray(out, dtype=np.float64)
         except (TypeError, ValueError) as e:
             return zeros, f"step returned {out!r}, not numbers ({e})"
         if values.shape != (n,):
-            return zeros, f"step returned {values.size} values, the {self.subsystem} command has {n}"
+            return zeros, (
+                f"step returned shape {values.shape}, the {self.subsystem} command is {n} values (shape ({n},))"
+            )
         if not np.all(np.isfinite(values)):
             return zeros, f"step returned a non-finite command {values.tolist()}"
         return values, None

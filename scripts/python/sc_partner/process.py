@@ -98,7 +98,9 @@ def _answer_all(label, subscriber, msg_cls, answer, publisher, notifier, counts,
         if reason is not None:
             counts.invalid += 1
             if counts.invalid == 1:
-                print(f"{label}: tick {raw.tick}: no valid {noun}: {reason}", file=sys.stderr, flush=True)
+                print(
+                    f"{label}: tick {raw.tick} (t = {raw.t:.1f} s): no valid {noun}: {reason}", file=sys.stderr, flush=True
+                )
         if msg is not None:
             msg.publish_ns = time.monotonic_ns()
             publisher.loan_uninit().write_payload(msg).send()
