@@ -354,6 +354,107 @@ fn a_failing_partner_is_named_in_the_verdict() {
     assert_eq!(s["partner_faults"]["nominal_attitude"]["steps"], 20, "{s}");
 }
 
+/// A Python partner script (`script`) in `role`'s slot of the default partition: the launch's
+/// output (PYTHONPATH to the checkout's SDK), or `None` without a Python with iceoryx2.
+fn launch_partner(
+    dir: &std::path::Path,
+    role: &str,
+    script: &str,
+    args: &[&str],
+) -> Option<std::process::Output> {
+    let py = python()?;
+    let file = dir.join("partner.py");
+    std::fs::write(&file, script).unwrap();
+    let cfg = dir.join("partition.toml");
+    let text = partition_toml_absolute_scenario().replacen(
+        &format!("[roles.{role}]\n"),
+        &format!("[roles.{role}]\nexec = {py:?}\nargs = [{file:?}]\n"),
+        1,
+    );
+    std::fs::write(&cfg, text).unwrap();
+    let out = dir.join("out");
+    let pythonpath = root().join("scripts/python");
+    let mut a = vec![
+        "launch",
+        "--config",
+        cfg.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    a.extend_from_slice(args);
+    Some(cli_partition(&a, &[("PYTHONPATH", pythonpath.to_str().unwrap())]).0)
+}
+
+/// A controller in another role's slot (a translational controller as
+/// `nominal_attitude`) is named as such, before the run starts; a controller file that
+/// never calls its `main()` is reported as soon as it ends — not after the handshake
+/// timeout (30 s here) — with the fix (issue #27).
+#[test]
+fn a_partner_in_the_wrong_slot_or_without_main_is_named_at_once() {
+    let _cpu = exclusive();
+    let d = tmp("partner-start");
+    let wrong = "import sys\nfrom sc_partner import NominalController\n\n\nclass T(NominalController):\n    subsystem = 'translational'\n\n    def step(self, state):\n        return [0.0, 0.0, 0.0]\n\n\nsys.exit(T.main())\n";
+    let Some(o) = launch_partner(&d, "nominal_attitude", wrong, &[]) else {
+        return;
+    };
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(3), "{t}");
+    assert!(
+        t.contains("role `nominal_attitude` ended (exit code 2) before every process was ready")
+            && t.contains("this controller commands the translational subsystem")
+            && t.contains("put it under [roles.nominal_translational]"),
+        "{t}"
+    );
+    let d = tmp("partner-no-main");
+    let no_main = "from sc_partner import NominalController\n\n\nclass A(NominalController):\n    subsystem = 'attitude'\n\n    def step(self, state):\n        return [0.0, 0.0, 0.0]\n";
+    let o = launch_partner(&d, "nominal_attitude", no_main, &[]).unwrap();
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(3), "{t}");
+    assert!(
+        t.contains("role `nominal_attitude` ended (exit code 0) before every process was ready")
+            && t.contains("sys.exit(MyController.main())")
+            && !t.contains("handshake timed out"),
+        "{t}"
+    );
+}
+
+/// A partner that hangs (stops answering and ignores the stop tick) is a failed process:
+/// exit 3 as `launch --help` says, named as stopped by the launcher (issue #27).
+#[test]
+fn a_hung_partner_is_a_failed_process() {
+    let _cpu = exclusive();
+    let d = tmp("hung-partner");
+    let cfg = d.join("partition.toml");
+    std::fs::write(&cfg, partition_toml_absolute_scenario()).unwrap();
+    let Some(py) = python() else {
+        return;
+    };
+    let out = d.join("out");
+    let (o, _) = cli_partition(
+        &[
+            "launch",
+            "--config",
+            cfg.to_str().unwrap(),
+            "--max-ticks",
+            SHORT_TICKS,
+            "--hostile",
+            "attitude/spin:x+hang:20",
+            "--python",
+            py.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(3), "{t}");
+    assert!(
+        t.contains("did not end on the stop tick")
+            && t.contains("then stopped by the launcher: nominal_attitude"),
+        "{t}"
+    );
+}
+
 /// A launch whose reader has gone (`launch … | head`, stdout and stderr closed) neither
 /// panics nor stops before the teardown: its own exit code, its output committed,
 /// nothing left in /dev/shm (issue #16).

@@ -12,6 +12,9 @@ use std::time::Duration;
 pub const CONFIG_ENV: &str = "SC_PARTITION_CONFIG";
 /// Environment variable with the output directory (alternative to `--out`).
 pub const OUT_ENV: &str = "SC_OUT_DIR";
+/// Environment variable with the role the launcher started the process as (e.g.
+/// `nominal_attitude`): a partner's process checks that it is the role it implements.
+pub const ROLE_ENV: &str = "SC_ROLE";
 
 /// A started process: its run, node, config and scenario.
 pub struct Proc {

@@ -201,6 +201,18 @@ def run_partition(controller, argv=None):
         print(f"{label}: SC_RUN_ID and --config are required", file=sys.stderr)
         return 2
     role, service, msg_cls, _, due_bit, _ = controller.spec()
+    # the launcher says which role slot this process fills (SC_ROLE); a controller of
+    # another subsystem there would publish on another role's service
+    started_as = os.environ.get("SC_ROLE")
+    implements = f"nominal_{controller.subsystem}"
+    if started_as and started_as != implements:
+        print(
+            f"{label}: this controller commands the {controller.subsystem} subsystem ({type(controller).__name__}.subsystem"
+            f" = {controller.subsystem!r}) but was started as {started_as}: put it under [roles.{implements}] in"
+            " the partition config",
+            file=sys.stderr,
+        )
+        return 2
     partition = sc_config.read_toml(args.config)
     scenario = sc_config.read_toml(sc_config.scenario_path(args.config, partition))
     period_s, _ = sc_config.group_periods(partition, controller.subsystem)

@@ -160,6 +160,14 @@ def run_partition(navigation, argv=None):
     if not run_id or not args.config:
         print(f"{label}: SC_RUN_ID and --config are required", file=sys.stderr)
         return 2
+    started_as = os.environ.get("SC_ROLE")
+    if started_as and started_as != "navigation":
+        print(
+            f"{label}: this is a navigation (estimator) but was started as {started_as}: put it under"
+            " [roles.navigation] in the partition config",
+            file=sys.stderr,
+        )
+        return 2
     partition = sc_config.read_toml(args.config)
     scenario = sc_config.read_toml(sc_config.scenario_path(args.config, partition))
     navigation.setup(scenario, sc_config.base_period(partition))

@@ -130,6 +130,7 @@ fn spawn_role(
     cmd.env(sc_bus::RUN_ID_ENV, run.run_id())
         .env(sc_flight::process::CONFIG_ENV, eff)
         .env(sc_flight::process::OUT_ENV, out)
+        .env(sc_flight::process::ROLE_ENV, role)
         .stdin(Stdio::null())
         .stdout(log.0)
         .stderr(log.1);

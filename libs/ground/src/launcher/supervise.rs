@@ -49,6 +49,9 @@ pub(super) struct Supervisor<'a> {
     termed: bool,
     killed: bool,
     early_err: Option<String>,
+    /// The scheduler ended well: every process got the stop tick, and one still running
+    /// at the teardown is hung.
+    normal_end: bool,
 }
 
 /// How a process ended, in words.
@@ -80,6 +83,7 @@ impl<'a> Supervisor<'a> {
             termed: false,
             killed: false,
             early_err: None,
+            normal_end: false,
         }
     }
 
@@ -138,7 +142,10 @@ impl<'a> Supervisor<'a> {
                 how(ex.code, ex.signal, "code")
             );
         }
-        if !ok && !self.termed && !self.out.join(ALL_READY).exists() {
+        // before every process was ready even an exit 0 is a failure: the role can
+        // never join (e.g. a partner script that never calls its controller's main)
+        if !self.termed && !self.out.join(ALL_READY).exists() {
+            self.failed = true;
             self.early_failure(role, ex);
         }
         if !ok && !self.termed {
@@ -156,6 +163,7 @@ impl<'a> Supervisor<'a> {
         }
         if kind == Some(RoleKind::Scheduler) {
             // normal end: the others got the stop tick and finish their outputs
+            self.normal_end = ok && !self.termed;
             self.tear_down_in(AFTER_SCHEDULER);
         }
     }
@@ -166,12 +174,17 @@ impl<'a> Supervisor<'a> {
     fn early_failure(&mut self, role: &str, ex: &ProcessExit) {
         let log = self.out.join("logs").join(format!("{role}.log"));
         self.early_err.get_or_insert_with(|| {
+            let last = last_log_line(&log, QUOTED_LOG_CHARS);
+            // a script that ends at once with exit 0 and says nothing never ran its loop
+            let hint = if ex.ended_well() && last.is_none() {
+                " (a partner script must run its controller: `sys.exit(MyController.main())`, docs/PARTNER.md)"
+            } else {
+                ""
+            };
             format!(
-                "role `{role}` ended ({}) before every process was ready{}; see {}",
+                "role `{role}` ended ({}) before every process was ready{}{hint}; see {}",
                 how(ex.code, ex.signal, "exit code"),
-                last_log_line(&log, QUOTED_LOG_CHARS)
-                    .map(|l| format!(": {l}"))
-                    .unwrap_or_default(),
+                last.map(|l| format!(": {l}")).unwrap_or_default(),
                 log.display()
             )
         });
@@ -214,6 +227,17 @@ impl<'a> Supervisor<'a> {
         if now >= t && !self.termed {
             self.termed = true;
             for p in self.procs.iter().filter(|p| p.exit.is_none()) {
+                if self.normal_end {
+                    // it got the stop tick AFTER_SCHEDULER ago and still runs: hung
+                    self.failed = true;
+                    if !self.quiet {
+                        note!(
+                            "launch: {} (pid {}) did not end on the stop tick within {AFTER_SCHEDULER:?}: hung, stopping it",
+                            p.role,
+                            p.child.id()
+                        );
+                    }
+                }
                 signal_pid(p.child.id(), libc::SIGTERM);
             }
         }
