@@ -18,12 +18,57 @@ macro_rules! out_help {
 }
 
 /// `--help` of every command's `--force`.
-pub const FORCE_HELP: &str =
-    "Replace the --out folder even if safe-capture did not write it (its contents are deleted)";
+pub const FORCE_HELP: &str = "Replace the --out folder even if safe-capture did not write it (its contents are deleted; the command lists them first)";
 
 /// Starts writing the output folder `out` of `command` ([`Staged::begin`]).
 pub fn stage(out: &Path, command: &str, force: bool) -> anyhow::Result<Staged> {
-    Ok(Staged::begin(out, command, force)?)
+    let staged = Staged::begin(out, command, force)?;
+    say_what_force_replaces(out, command, force);
+    Ok(staged)
+}
+
+/// Entries of a forced folder named before it is replaced.
+const LISTED_ENTRIES: usize = 10;
+
+/// With `--force` over a folder safe-capture did not write, says on stderr what it held
+/// (its first entries by name and their count): the command replaces it when it
+/// finishes, and the user should not learn that from a missing file.
+fn say_what_force_replaces(out: &Path, command: &str, force: bool) {
+    if !force || !out.is_dir() || sc_mission::out_dir::is_ours(out) {
+        return;
+    }
+    let Ok(rd) = std::fs::read_dir(out) else {
+        return;
+    };
+    let mut names: Vec<String> = rd
+        .flatten()
+        .map(|e| {
+            let n = e.file_name().to_string_lossy().into_owned();
+            if e.path().is_dir() { n + "/" } else { n }
+        })
+        .collect();
+    if names.is_empty() {
+        return;
+    }
+    names.sort();
+    let more = names.len().saturating_sub(LISTED_ENTRIES);
+    names.truncate(LISTED_ENTRIES);
+    errln!(
+        "{command}: --force: {} was not written by safe-capture; it is replaced when the command finishes, with its {} {}: {}{}",
+        out.display(),
+        names.len() + more,
+        if names.len() + more == 1 {
+            "entry"
+        } else {
+            "entries"
+        },
+        names.join(", "),
+        if more > 0 {
+            format!(" and {more} more")
+        } else {
+            String::new()
+        }
+    );
 }
 
 /// [`stage`] for a command that reads `inputs`: an `out` that is or holds one of them
@@ -34,5 +79,7 @@ pub fn stage_reading(
     force: bool,
     inputs: &[&Path],
 ) -> anyhow::Result<Staged> {
-    Ok(Staged::begin_with_inputs(out, command, force, inputs)?)
+    let staged = Staged::begin_with_inputs(out, command, force, inputs)?;
+    say_what_force_replaces(out, command, force);
+    Ok(staged)
 }

@@ -538,3 +538,21 @@ fn an_interrupted_launch_says_so() {
         assert_eq!(shm_files_of(pid), Vec::<String>::new());
     }
 }
+
+/// The launch script's usage errors exit 2 with one line, before it builds anything
+/// (issue #27: `--out` without a value failed with `$2: unbound variable`).
+#[test]
+fn the_launch_scripts_usage_errors_exit_2() {
+    for args in [&["--out"][..], &["--max-ticks", "--out", "x"], &["--bogus"]] {
+        let o = std::process::Command::new("bash")
+            .arg(root().join("scripts/launch_partition.sh"))
+            .args(args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.starts_with("launch_partition.sh: "), "{args:?}: {err}");
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+        assert!(!err.contains("unbound variable"), "{args:?}: {err}");
+    }
+}

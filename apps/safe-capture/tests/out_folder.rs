@@ -125,7 +125,8 @@ fn every_command_refuses_a_folder_not_ours_and_writes_nothing() {
     assert_eq!(names(&parent), ["theirs"]);
 }
 
-/// --force replaces a folder that is not ours, as a whole, and marks it ours.
+/// --force replaces a folder that is not ours, as a whole, and marks it ours — after
+/// saying on stderr what it held (issue #27: it deleted a user's files without a word).
 #[test]
 fn force_replaces_a_folder_not_ours() {
     let d = tmp("out-force");
@@ -149,6 +150,14 @@ fn force_replaces_a_folder_not_ours() {
         Some(1),
         "short missions do not capture: {}",
         text(&o)
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains(&format!(
+            "run: --force: {} was not written by safe-capture; it is replaced when the command finishes, with its 1 entry: notes.txt",
+            theirs.display()
+        )),
+        "{err}"
     );
     let n = names(&theirs);
     assert!(!n.contains(&"notes.txt".into()), "{n:?}");
