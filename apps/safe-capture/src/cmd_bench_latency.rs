@@ -4,6 +4,9 @@ use sc_ground::latency::{BenchOptions, bench, markdown};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+/// Exit code of a measurement stopped by SIGINT/SIGTERM (as `launch` and `montecarlo`).
+const EXIT_INTERRUPTED: u8 = 3;
+
 /// Runs the partition in real-time mode (paced ticks) and reports per-hop and
 /// whole-tick latency (scheduler tick → robotic safe command delivered to the
 /// simulator): N, min/p50/p90/p99/p99.9/max, cycle slips, deadline misses, an HDR
@@ -12,11 +15,12 @@ use std::process::ExitCode;
 /// the paper's 3.75 ms maximum as labelled lines) and the machine's facts. Writes latency_report.{json,md} into OUT.
 ///
 /// Exit codes: 0 measured, 2 bad arguments or configuration, or the partition did not
-/// run.
+/// run, 3 interrupted (SIGINT/SIGTERM: no report; what was written stays in
+/// OUT.incomplete, OUT is not replaced).
 #[derive(clap::Args)]
 pub struct Args {
-    /// Measured ticks (after the warm-up).
-    #[arg(long, default_value_t = 3000)]
+    /// Measured ticks (after the warm-up; at least 1).
+    #[arg(long, default_value_t = 3000, value_parser = clap::value_parser!(u64).range(1..))]
     ticks: u64,
     /// Warm-up ticks excluded from the statistics.
     #[arg(long, default_value_t = 50)]
@@ -39,14 +43,26 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         .map_err(|e| anyhow::anyhow!("{}: {e}", a.config.display()))?;
     a.figures.check()?;
     let staged = crate::out_folder::stage(&a.out, "bench latency", a.force)?;
-    let r = bench(&BenchOptions {
+    let r = match bench(&BenchOptions {
         config: a.config,
         out: staged.path().to_path_buf(),
         ticks: a.ticks,
         warmup: a.warmup,
         bin_dir: None,
         run_id: None,
-    })?;
+    }) {
+        Ok(r) => r,
+        Err(e @ sc_ground::error::BenchError::Interrupted { .. }) => {
+            let kept = staged.abandon();
+            errln!(
+                "bench latency: {e}; no report (partial output in {}; {} not replaced)",
+                kept.as_deref().unwrap_or(&a.out).display(),
+                a.out.display()
+            );
+            return Ok(ExitCode::from(EXIT_INTERRUPTED));
+        }
+        Err(e) => return Err(e.into()),
+    };
     a.figures.export_dir(staged.path())?;
     staged.commit()?;
     out!("{}", markdown(&r));

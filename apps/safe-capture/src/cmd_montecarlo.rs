@@ -87,8 +87,9 @@ enum Mode {
 
 #[derive(clap::Args)]
 struct RunArgs {
-    /// Runs in the whole campaign [default: 100; with --resume the campaign's].
-    #[arg(long)]
+    /// Runs in the whole campaign, at least 1 [default: 100; with --resume the
+    /// campaign's].
+    #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..))]
     runs: Option<usize>,
     /// Campaign seed [default: 1; with --resume the campaign's].
     #[arg(long)]

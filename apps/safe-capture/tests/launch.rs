@@ -556,3 +556,62 @@ fn the_launch_scripts_usage_errors_exit_2() {
         assert!(!err.contains("unbound variable"), "{args:?}: {err}");
     }
 }
+
+/// An interrupted `bench latency` follows the output-folder policy (issue #27): exit 3,
+/// the word "interrupted", no report, OUT not written (what was written stays in
+/// OUT.incomplete) — before, it exited 0 and replaced OUT with a 29-tick report that
+/// nowhere said so. Zero ticks are refused before anything runs.
+#[test]
+fn an_interrupted_latency_bench_says_so_and_keeps_no_report() {
+    let _cpu = exclusive();
+    let d = tmp("bench-interrupted");
+    let cfg = d.join("partition.toml");
+    std::fs::write(&cfg, partition_toml_absolute_scenario()).unwrap();
+    let out = d.join("out");
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_safe-capture"))
+        .current_dir(root())
+        .args(["bench", "latency", "--ticks", "3000", "--config"])
+        .arg(&cfg)
+        .arg("--out")
+        .arg(&out)
+        .env("SC_PARTITION_BIN_DIR", partition_bin_dir())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let pid = child.id();
+    let started = std::time::Instant::now();
+    while !d.join("out.incomplete/all_ready").exists() {
+        assert!(started.elapsed() < READY_TIMEOUT, "never ready");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    let kill = std::process::Command::new("kill")
+        .args(["-INT", &pid.to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let o = child.wait_with_output().unwrap();
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(3), "{t}");
+    assert!(
+        t.contains("bench latency: interrupted by SIGINT/SIGTERM before the 3050 ticks were measured; no report"),
+        "{t}"
+    );
+    assert!(!out.exists(), "{t}");
+    assert!(!d.join("out.incomplete/latency_report.md").exists(), "{t}");
+    assert_eq!(shm_files_of(pid), Vec::<String>::new());
+    let (o, _) = cli_partition(
+        &[
+            "bench",
+            "latency",
+            "--ticks",
+            "0",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(!out.exists());
+}

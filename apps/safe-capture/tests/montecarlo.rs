@@ -685,3 +685,22 @@ fn ctrl_c_stops_an_in_process_campaign_and_resume_completes_it() {
         );
     }
 }
+
+/// A campaign of no runs is refused before anything runs (issue #27: it was accepted
+/// with exit 0).
+#[test]
+fn zero_runs_are_refused() {
+    let d = tmp("zero-runs");
+    let out = d.join("o");
+    let o = cli(
+        &["montecarlo", "--runs", "0", "--out", out.to_str().unwrap()],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("invalid value '0' for '--runs <RUNS>'"),
+        "{}",
+        text(&o)
+    );
+    assert!(!out.exists());
+}

@@ -8,6 +8,10 @@ use std::path::Path;
 pub enum BenchError {
     #[error(transparent)]
     Launch(#[from] LaunchError),
+    /// SIGINT/SIGTERM stopped the run: no report (a partial one would pass for a
+    /// qualification measurement).
+    #[error("interrupted by SIGINT/SIGTERM before the {planned} ticks were measured")]
+    Interrupted { planned: u64 },
     #[error(transparent)]
     Bus(#[from] sc_bus::BusError),
     #[error(transparent)]

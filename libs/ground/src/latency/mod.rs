@@ -235,6 +235,11 @@ pub fn bench(o: &BenchOptions) -> Result<LatencyReport, BenchError> {
     let series = sampler.finish();
     let steal_csv = o.out.join("steal.csv");
     crate::steal::write_csv(&steal_csv, &series).map_err(BenchError::write(&steal_csv))?;
+    if rep.interrupted {
+        return Err(BenchError::Interrupted {
+            planned: o.ticks + o.warmup,
+        });
+    }
     if rep.code == 3 {
         return Err(BenchError::Data(format!(
             "the partition run failed (see {}/logs)",
