@@ -427,31 +427,115 @@ def main(argv=None):
     p.add_argument("--out", help="write the commands to this CSV")
     p.add_argument("--strict", action="store_true", help="exit 1 if any due step has no valid command")
     args = p.parse_args(argv)
-
-    controller = load_controller(args.controller)()
-    if isinstance(controller, Navigation):
-        return _main_navigation(p, args, controller)
-    partition, scenario, period_s = _sources(args, controller.subsystem)
-    if args.mcap:
-        states = states_from_mcap(args.mcap, scenario)
-    else:
-        states = states_from_telemetry(args.telemetry, partition)
+    recording = args.mcap or args.telemetry
+    try:
+        controller = _controller(args.controller)
+        if isinstance(controller, Navigation):
+            return _main_navigation(p, args, controller)
+        partition, scenario, period_s = _sources(args, controller.subsystem)
+        if args.mcap:
+            states = states_from_mcap(args.mcap, scenario)
+        else:
+            _check_text(args.telemetry)
+            states = states_from_telemetry(args.telemetry, partition)
+        recorded = recorded_nominal(recording, controller.subsystem)
+    except InputError as e:
+        print(f"harness: {e}", file=sys.stderr)
+        return 2
+    except KeyError as e:
+        print(f"harness: {recording}: not a recording of safe-capture (no {e})", file=sys.stderr)
+        return 2
+    except (OSError, ValueError) as e:
+        msg = _one_line(e)
+        if not msg.startswith(str(recording)):
+            msg = f"{recording}: not a recording of safe-capture ({msg})"
+        print(f"harness: {msg}", file=sys.stderr)
+        return 2
     commands = run_offline(controller, states, scenario, period_s)
     if args.out:
         write_commands(args.out, controller, commands)
     invalid = [c for c in commands if not c.valid]
-    recorded = recorded_nominal(args.mcap or args.telemetry, controller.subsystem)
-    diffs = [float(np.max(np.abs(c.values - recorded[c.tick]))) for c in commands if c.valid and c.tick in recorded]
-    largest = max((d for d in diffs if math.isfinite(d)), default=math.nan)
     print(
         f"harness: {type(controller).__name__} ({controller.subsystem}) on {len(states)} states: "
         f"{len(commands)} commands, {len(invalid)} without a valid one"
         + (f" -> {args.out}" if args.out else "")
-        + f"; largest difference to the recorded nominal command: {largest:.6g}"
+        + "; "
+        + _largest_difference(commands, recorded, controller.subsystem)
     )
     for c in invalid[:1]:
         print(f"harness: first invalid, tick {c.tick}: {c.reason}", file=sys.stderr)
     return 1 if args.strict and invalid else 0
+
+
+class InputError(Exception):
+    """An input the harness cannot use, said in one line naming the file and the fix."""
+
+
+def _one_line(e):
+    return " ".join(str(e).split()) or type(e).__name__
+
+
+# the unit of each subsystem's nominal command
+_UNIT = {"translational": "N", "attitude": "N m", "robotic": "N m"}
+
+# the first bytes of an MCAP file
+_MCAP_MAGIC = b"\x89MCAP"
+
+
+def _largest_difference(commands, recorded, subsystem):
+    """"largest difference to the recorded nominal command: 161.8 N (tick 42, axis 1)",
+    over the valid commands with a recorded counterpart."""
+    best = None
+    for c in commands:
+        if not c.valid or c.tick not in recorded:
+            continue
+        d = np.abs(c.values - recorded[c.tick])
+        if not np.all(np.isfinite(d)):
+            continue
+        k = int(np.argmax(d))
+        if best is None or d[k] > best[0]:
+            best = (float(d[k]), c.tick, k)
+    if best is None:
+        return "no valid command to compare with the recorded nominal command"
+    diff, tick, axis = best
+    return f"largest difference to the recorded nominal command: {diff:.6g} {_UNIT[subsystem]} (tick {tick}, axis {axis})"
+
+
+def _controller(spec):
+    """An instance of the class `spec` names, or an InputError naming what is wrong."""
+    try:
+        cls = load_controller(spec)
+    except FileNotFoundError as e:
+        raise InputError(f"{spec}: no such file ({e.filename})") from None
+    except ModuleNotFoundError as e:
+        raise InputError(f"{spec}: no module {e.name!r} (give package.module:Class or path/to/file.py:Class)") from None
+    except AttributeError as e:
+        raise InputError(f"{spec}: {_one_line(e)} (give the class's name after the colon)") from None
+    except ValueError as e:
+        raise InputError(_one_line(e)) from None
+    if not (inspect.isclass(cls) and issubclass(cls, (NominalController, Navigation))):
+        raise InputError(f"{spec}: not a NominalController or Navigation subclass")
+    return cls()
+
+
+def _check_text(path):
+    """A telemetry.csv given with --telemetry: readable text, not an MCAP recording."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(len(_MCAP_MAGIC))
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such file (--telemetry)") from None
+    if head == _MCAP_MAGIC:
+        raise InputError(f"{path} is an MCAP recording: give it with --mcap, not --telemetry")
+
+
+def _read_toml(path, flag):
+    try:
+        return sc_config.read_toml(path)
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such file ({flag})") from None
+    except Exception as e:  # tomllib's own error, or bytes that are no text
+        raise InputError(f"{path}: not a TOML file ({flag}: {_one_line(e)})") from None
 
 
 def _sources(args, subsystem):
@@ -459,10 +543,18 @@ def _sources(args, subsystem):
     the period of `subsystem`'s rate group, or (None) the base period; a scenario alone
     runs every subsystem at its control period."""
     if not args.config:
-        scenario = sc_config.read_toml(args.scenario)
+        scenario = _read_toml(args.scenario, "--scenario")
+        if "mission" not in scenario:
+            if "roles" in scenario or "rate_groups" in scenario:
+                raise InputError(f"{args.scenario} is a partition config, not a scenario: give it with --config")
+            raise InputError(f"{args.scenario}: not a scenario (no [mission]; --scenario)")
         return None, scenario, float(scenario["mission"]["control_period_s"])
-    partition = sc_config.read_toml(args.config)
-    scenario = sc_config.read_toml(sc_config.scenario_path(args.config, partition))
+    partition = _read_toml(args.config, "--config")
+    if "rate_groups" not in partition:
+        if "mission" in partition:
+            raise InputError(f"{args.config} is a scenario, not a partition config: give it with --scenario")
+        raise InputError(f"{args.config}: not a partition config (no rate_groups; --config)")
+    scenario = _read_toml(sc_config.scenario_path(args.config, partition), "the config's scenario")
     if subsystem is None:
         return partition, scenario, sc_config.base_period(partition)
     return partition, scenario, sc_config.group_periods(partition, subsystem)[0]

@@ -218,3 +218,50 @@ class OfflineNavigation(unittest.TestCase):
         self.assertEqual([e.valid for e in out], [1, 0, 1, 0])
         self.assertIsNone(out[1].estimate)
         self.assertIn("no estimate", out[1].reason)
+
+
+class HarnessInputs(unittest.TestCase):
+    """Every input error of the harness's command line is one line on stderr naming the
+    file and the fix, exit 2 (it used to be a 12-15-line traceback)."""
+
+    def run_harness(self, *argv):
+        import contextlib
+        import io
+
+        from sc_partner import harness
+
+        err = io.StringIO()
+        with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+            code = harness.main(list(argv))
+        return code, err.getvalue()
+
+    def test_every_input_error_is_one_line(self):
+        import os
+        import tempfile
+
+        ctl = "sc_partner.examples.nominal_translational"
+        scenario = os.path.join(os.path.dirname(__file__), "..", "..", "..", "config", "scenario.toml")
+        with tempfile.TemporaryDirectory() as d:
+            rec = os.path.join(d, "recording.mcap")
+            with open(rec, "wb") as f:
+                f.write(b"\x89MCAP0\r\n")
+            part = os.path.join(d, "partition.toml")
+            with open(part, "w") as f:
+                f.write('scenario = "scenario.toml"\n[[rate_groups]]\nname = "c"\nperiod_s = 0.1\nmembers = []\n')
+            text = os.path.join(d, "notes.csv")
+            with open(text, "w") as f:
+                f.write("a,b\n1,2\n")
+            cases = [
+                ((ctl, "--telemetry", rec, "--scenario", scenario), "is an MCAP recording: give it with --mcap"),
+                ((ctl, "--telemetry", text, "--scenario", part), "is a partition config, not a scenario"),
+                ((ctl, "--telemetry", text, "--scenario", scenario), "notes.csv: not a safe-capture telemetry.csv"),
+                ((ctl, "--telemetry", os.path.join(d, "none.csv"), "--scenario", scenario), "none.csv: no such file"),
+                ((ctl + ":Nope", "--telemetry", text, "--config", part), "has no attribute 'Nope'"),
+                (("no_such_module:X", "--telemetry", text, "--config", part), "no module 'no_such_module'"),
+            ]
+            for argv, why in cases:
+                code, err = self.run_harness(*argv)
+                self.assertEqual(code, 2, (argv, err))
+                self.assertEqual(len(err.strip().splitlines()), 1, (argv, err))
+                self.assertTrue(err.startswith("harness: "), err)
+                self.assertIn(why, err)
