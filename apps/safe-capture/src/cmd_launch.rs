@@ -11,8 +11,10 @@ use std::process::ExitCode;
 
 /// Runs the mission with every module in its own process (iceoryx2), from
 /// config/partition.toml: starts every process, waits for all to be ready, runs
-/// the mission, tears everything down. Writes the same telemetry.csv, timing.csv and
-/// summary.json as `run`, plus recording.mcap, latency.csv, logs/<role>.log.
+/// the mission, tears everything down. Writes the same telemetry.csv, timing.csv,
+/// summary.json and figures (of its own closed loop; no nominal-only comparison: the
+/// partition runs the mission once) as `run`, plus recording.mcap, latency.csv,
+/// logs/<role>.log.
 ///
 /// Before anything starts, the config, the scenario it names, every role's program,
 /// partner scripts and the simulator's plant program are checked as `safe-capture
@@ -33,6 +35,11 @@ pub struct Args {
     out: PathBuf,
     #[arg(long, help = crate::out_folder::FORCE_HELP)]
     force: bool,
+    /// Skip the figures.
+    #[arg(long)]
+    no_figures: bool,
+    #[command(flatten)]
+    figures: crate::figure_format::FigureFormatArg,
     /// Pace ticks on the wall clock instead of lock-step.
     #[arg(long)]
     real_time: bool,
@@ -98,6 +105,21 @@ fn first_invalid(logs: &std::path::Path, role: &str) -> Option<String> {
     let line = log.lines().find(|l| l.contains(MARK))?;
     let reason = &line[line.find(MARK)? + MARK.len()..];
     Some(reason.trim().to_string())
+}
+
+/// The figures of `run` from the partition's own telemetry (its closed loop), into
+/// `out/figures`; without a nominal-only comparison (the partition ran the mission
+/// once — `run --replay-nominals` would draw an open-loop replay, not the partners').
+fn write_figures(out: &std::path::Path, scenario: &std::path::Path) -> anyhow::Result<()> {
+    let read = |f: &str| {
+        std::fs::read_to_string(out.join(f))
+            .map_err(|e| anyhow::anyhow!("{}: {e}", out.join(f).display()))
+    };
+    let records = sc_mission::parse_telemetry(&read("telemetry.csv")?, &read("timing.csv")?, true)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", out.join("telemetry.csv").display()))?;
+    let scenario = sc_scenario::Scenario::load(scenario)?;
+    sc_plots::run_figures(&out.join("figures"), &scenario, &records, None)?;
+    Ok(())
 }
 
 /// The launcher's codes from this one on are the infrastructure's (a process failed,
@@ -168,6 +190,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     if let Some((p, case)) = &partners {
         crate::redteam_partition::check_case(p, &a.config, case)?;
     }
+    a.figures.check()?;
     // the processes write into the staging folder; it replaces --out once they are done
     let staged = crate::out_folder::stage(&a.out, "launch", a.force)?;
     let out = staged.path().to_path_buf();
@@ -184,6 +207,10 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         .map(|e| e.role.clone())
         .collect();
     let summary = read_json(&out.join("summary.json"));
+    if !a.no_figures {
+        write_figures(&out, &cfg.scenario_path())?;
+        a.figures.export_dir(&out.join("figures"))?;
+    }
     staged.commit()?;
     // a declared uncertainty: the realised errors against the declared bounds, and what
     // the margins do not cover (as `run` says it)

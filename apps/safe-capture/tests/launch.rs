@@ -615,3 +615,57 @@ fn an_interrupted_latency_bench_says_so_and_keeps_no_report() {
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(!out.exists());
 }
+
+/// `launch` writes `run`'s figures from its own closed-loop telemetry (issue #27: a
+/// partition run had none, and the workaround drew an open-loop replay as "nominal"):
+/// in lock-step they are byte-identical to `run --no-compare`'s.
+#[test]
+fn a_launch_draws_the_figures_of_run() {
+    let _cpu = exclusive();
+    let d = tmp("launch-figures");
+    let cfg = d.join("partition.toml");
+    std::fs::write(&cfg, partition_toml_absolute_scenario()).unwrap();
+    let (o, _) = cli_partition(
+        &[
+            "launch",
+            "--config",
+            cfg.to_str().unwrap(),
+            "--out",
+            d.join("p").to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let scenario = root().join("config/scenario.toml");
+    let o = cli(
+        &[
+            "run",
+            "-q",
+            "--no-compare",
+            "--scenario",
+            scenario.to_str().unwrap(),
+            "--out",
+            d.join("r").to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let names = |dir: &std::path::Path| {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    };
+    let (pf, rf) = (d.join("p/figures"), d.join("r/figures"));
+    assert_eq!(names(&pf), names(&rf));
+    assert!(names(&pf).len() >= 6, "{:?}", names(&pf));
+    for f in names(&pf) {
+        assert!(
+            std::fs::read(pf.join(&f)).unwrap() == std::fs::read(rf.join(&f)).unwrap(),
+            "{f} differs between launch and run"
+        );
+    }
+}
