@@ -141,16 +141,18 @@ fn create(p: &Path) -> anyhow::Result<std::io::BufWriter<std::fs::File>> {
 const PROGRESS_EVERY_S: f64 = 10.0;
 
 /// The progress line every [`PROGRESS_EVERY_S`] of mission time: on a terminal one line
-/// redrawn in place, in a log one line per report.
-fn progress_printer(duration: f64, tty: bool) -> impl FnMut(&StepRecord) {
+/// redrawn in place, in a log one line per report. The phase is named, with its index
+/// as telemetry's `phase` column counts (from 0).
+fn progress_printer(duration: f64, phases: Vec<String>, tty: bool) -> impl FnMut(&StepRecord) {
     let mut last_print = 0.0;
     move |r: &StepRecord| {
         if r.t - last_print >= PROGRESS_EVERY_S {
             last_print = r.t;
             let line = format!(
-                "  t = {:6.1} / {duration:.0} s  phase {}  grasp distance {:7.3} m",
+                "  t = {:6.1} / {duration:.0} s  phase {} {:<20}  grasp distance {:7.3} m",
                 r.t,
-                r.phase + 1,
+                r.phase,
+                phases.get(r.phase).map(String::as_str).unwrap_or(""),
                 r.obs.grasp_distance()
             );
             if tty {
@@ -172,7 +174,11 @@ fn run_mission(m: MissionRun<'_>) -> anyhow::Result<Executed> {
     )?;
     let mut qp_file = m.dump_qp.map(create).transpose()?;
     let tty = std::io::IsTerminal::is_terminal(&std::io::stderr());
-    let mut progress = progress_printer(m.setup.scenario.mission.duration_s, tty);
+    let mut progress = progress_printer(
+        m.setup.scenario.mission.duration_s,
+        phase_names(&m.setup.scenario),
+        tty,
+    );
     let mut job = Job::new(m.setup);
     job.options = m.options;
     job.nominals = m.nominals;

@@ -65,9 +65,26 @@ pub type AttitudeOutput = FilterOutput<3, { attitude::N }>;
 /// Output of the robotic filter: `τ_M` (42 constraints).
 pub type RoboticOutput = FilterOutput<7, { robotic::N }>;
 
-/// Stable constraint names of the three filters, in report order.
+/// Stable constraint names of the three filters, in report order, and their units.
 pub mod names {
     pub use crate::attitude::NAMES as ATTITUDE;
     pub use crate::robotic::NAMES as ROBOTIC;
     pub use crate::translational::NAMES as TRANSLATIONAL;
+
+    /// The unit of a barrier `h` by its name, as the filters and the safety monitor
+    /// compute it: the corridor `d·r − ‖r‖ cos ψ` [m], the zone `‖r‖² − R²` [m²], the line
+    /// of sight `d_B·ρ̂ − cos β` [-], the rate limits [rad/s], the joint-angle limits
+    /// `(θ − θ_min)(θ_max − θ)` [rad²], the link–base spheres `‖d‖² − (ρ_i + ρ_B)²` [m²].
+    /// `None` for a name it does not know.
+    pub fn unit(name: &str) -> Option<&'static str> {
+        Some(match name {
+            "approach_corridor" => "m",
+            "collision_avoidance_zone" => "m²",
+            "line_of_sight" => "-",
+            n if n.starts_with("omega_") || n.starts_with("theta_dot_") => "rad/s",
+            n if n.starts_with("theta_") => "rad²",
+            n if n.starts_with("link_base_") => "m²",
+            _ => return None,
+        })
+    }
 }

@@ -5,22 +5,9 @@
 use sc_core::Subsystem;
 use sc_icd::spec::Components;
 
-/// The unit of a barrier `h` by its name (`sc_mission::constraint_names()`), as the
-/// filters and the simulator's monitor compute it: the corridor `d·r − ‖r‖ cos ψ` [m],
-/// the zone `‖r‖² − R²` [m²], the line of sight `d_B·ρ̂ − cos β` [-], the rate limits
-/// [rad/s], the joint-angle limits `(θ − θ_min)(θ_max − θ)` [rad²], the link–base
-/// spheres `‖d‖² − (ρ_i + ρ_B)²` [m²]. `None` for a name it does not know.
-pub fn barrier_unit(name: &str) -> Option<&'static str> {
-    Some(match name {
-        "approach_corridor" => "m",
-        "collision_avoidance_zone" => "m²",
-        "line_of_sight" => "-",
-        n if n.starts_with("omega_") || n.starts_with("theta_dot_") => "rad/s",
-        n if n.starts_with("theta_") => "rad²",
-        n if n.starts_with("link_base_") => "m²",
-        _ => return None,
-    })
-}
+/// The unit of a barrier `h` by its name (`sc_mission::constraint_names()`): one
+/// definition, with the names (`sc_cbf::names::unit`).
+pub use sc_cbf::names::unit as barrier_unit;
 
 /// The constraints of `s`'s safety filter, in its report's order (`h`, `phi`, bits of
 /// `active_mask`).

@@ -475,7 +475,10 @@ fn minima(area: &Area, f: &CampaignFigures) -> DrawResult {
         chart
             .configure_mesh()
             .disable_mesh()
-            .x_desc("minimum of h")
+            .x_desc(format!(
+                "minimum of h [{}]",
+                sc_cbf::names::unit(&m.name).unwrap_or("?")
+            ))
             .y_desc("runs")
             .x_label_formatter(&|v| xa.label(*v))
             .y_label_formatter(&|v| ya.label(*v))

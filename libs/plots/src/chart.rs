@@ -552,6 +552,9 @@ pub struct Panel {
     /// Log axes: ticks at powers of ten; non-positive values are not drawn.
     pub x_log: bool,
     pub y_log: bool,
+    /// Room above the data for the legend, as a fraction of the data's span (0: none),
+    /// so that the legend in the upper right corner covers no curve.
+    pub legend_headroom: f64,
 }
 
 impl Panel {
@@ -593,7 +596,10 @@ impl Panel {
         let y = self
             .y_range
             .map(|r| map_range(r, self.y_log))
-            .unwrap_or_else(|| range(ys, 0.05));
+            .unwrap_or_else(|| {
+                let (lo, hi) = range(ys, 0.05);
+                (lo, hi + self.legend_headroom * (hi - lo))
+            });
         let axis = |r, log| {
             if log {
                 Axis::log10(r, LOG_TICKS)

@@ -208,12 +208,16 @@ fn trajectory(area: &Area, runs: &Runs, g: &Geometry) -> DrawResult {
     Ok(())
 }
 
+/// Room above the barrier curves for a panel's legend (a fraction of the curves' span).
+const BARRIER_LEGEND_HEADROOM: f64 = 0.45;
+
 fn barriers(area: &Area, runs: &Runs, s: &Scenario) -> DrawResult {
     let rows = area.split_evenly((3, 1));
     for (row, fams) in rows.iter().zip(FAMILIES.iter()) {
         let cols = row.split_evenly((1, fams.len()));
         for (col, (title, ylabel, select)) in cols.iter().zip(fams.iter()) {
             let mut p = Panel::new(title, "t [s]", ylabel);
+            p.legend_headroom = BARRIER_LEGEND_HEADROOM;
             p.hlines.push(zero_line());
             p.vlines = phase_lines(s);
             for (recs, label, c, dashed) in &runs.runs {
@@ -272,6 +276,12 @@ fn sync_error(area: &Area, runs: &Runs, s: &Scenario) -> DrawResult {
     p.draw(area)
 }
 
+/// Radius of the line-of-sight figure's start and end markers [px].
+const LOS_MARKER_PX: u32 = 6;
+
+/// The joint-torque figure starts this long before the grasping phase [s].
+const BEFORE_GRASP_S: f64 = 5.0;
+
 fn joint_torques(area: &Area, runs: &Runs, s: &Scenario, g: &Geometry) -> DrawResult {
     let grasp_start = s
         .mission
@@ -279,41 +289,50 @@ fn joint_torques(area: &Area, runs: &Runs, s: &Scenario, g: &Geometry) -> DrawRe
         .iter()
         .find(|p| p.robotic == sc_scenario::RoboticMode::Grasp)
         .map(|p| p.start_s);
-    let mut p = Panel::new(
-        "Applied joint torques τ_M (filtered solid, nominal dashed)",
-        "t [s]",
-        "τ_M [N m]",
-    );
+    let t_end = runs
+        .runs
+        .iter()
+        .flat_map(|(r, ..)| r.last().map(|x| x.t))
+        .fold(f64::NEG_INFINITY, f64::max);
+    // the window around the grasp (the arm rests before it), said in the title; a run
+    // that ended before it is shown whole
+    let window = grasp_start
+        .map(|t0| (t0 - BEFORE_GRASP_S, t_end.max(t0 + 1.0)))
+        .filter(|(a, _)| t_end > *a);
+    let title = match window {
+        Some((a, b)) => format!(
+            "Applied joint torques τ_M around the grasp, t = {a:.1}–{b:.1} s (filtered solid, nominal dashed)"
+        ),
+        None => "Applied joint torques τ_M (filtered solid, nominal dashed)".to_string(),
+    };
+    let mut p = Panel::new(&title, "t [s]", "τ_M [N m]");
     let max = g.joint_torque_max_nm;
     p.hlines = vec![
         RefLine::new(max, ZERO, format!("+|τ_M|max = {max} N m")),
         RefLine::new(-max, ZERO, format!("−|τ_M|max = −{max} N m")),
     ];
     p.vlines = phase_lines(s);
-    for (recs, label, _, dashed) in &runs.runs {
+    let shown = |t: f64| window.is_none_or(|(a, b)| t >= a && t <= b);
+    for (recs, _, _, dashed) in &runs.runs {
         for jn in 0..7 {
+            // only the window's points: a line clipped at its edge drew a spike there
             let mut l = Line::new(
-                recs.iter().map(|r| (r.t, r.applied.tau[jn])).collect(),
+                recs.iter()
+                    .filter(|r| shown(r.t))
+                    .map(|r| (r.t, r.applied.tau[jn]))
+                    .collect(),
                 palette(jn),
                 *dashed,
             );
             l.width = 1;
+            // one legend entry per joint, in its colour; the title says what dashed is
             if !*dashed {
                 l = l.label(format!("joint {}", jn + 1));
-            } else if jn == 0 {
-                l = l.label(format!("{label} (all joints)"));
             }
             p.lines.push(l);
         }
     }
-    if let Some(t0) = grasp_start {
-        let t_end = runs
-            .runs
-            .iter()
-            .flat_map(|(r, ..)| r.last().map(|x| x.t))
-            .fold(t0 + 1.0, f64::max);
-        p.x_range = Some((t0 - 5.0, t_end));
-    }
+    p.x_range = window;
     p.draw(area)
 }
 
@@ -332,11 +351,24 @@ fn los(area: &Area, runs: &Runs, g: &Geometry) -> DrawResult {
         .collect();
     p.lines
         .push(Line::new(circle, CORRIDOR, false).label("LOS cone"));
-    p.lines.extend(runs.lines(|r| {
+    let angles = |r: &StepRecord| {
         los_angles_deg(&r.obs.grasp_b, &g.boresight_b)
             .map(|a| (a[0], a[1]))
             .unwrap_or((f64::NAN, f64::NAN))
-    }));
+    };
+    p.lines.extend(runs.lines(angles));
+    // where the (first) run's line of sight starts and ends: the curve has no direction
+    if let Some((recs, ..)) = runs.runs.iter().find(|(_, _, _, dashed)| !*dashed) {
+        for (r, colour, what) in [(recs.first(), PHASE, "start"), (recs.last(), ZERO, "end")] {
+            if let Some(r) = r {
+                let mut m = Line::new(vec![angles(r)], colour, false)
+                    .label(format!("{what}, t = {:.1} s", r.t));
+                m.markers = true;
+                m.width = LOS_MARKER_PX;
+                p.lines.push(m);
+            }
+        }
+    }
     let lim = b * 1.6;
     p.x_range = Some((-lim, lim));
     p.y_range = Some((-lim, lim));
