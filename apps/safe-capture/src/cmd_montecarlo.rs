@@ -417,6 +417,12 @@ fn report(s: &CampaignSummary, out: &std::path::Path) -> ExitCode {
     if !s.not_captured_runs.is_empty() {
         outln!("  runs without capture: {:?}", s.not_captured_runs);
     }
+    if !s.faulted.is_empty() {
+        outln!(
+            "  runs with faults: {:?} (`montecarlo rerun DIR --run K` writes their telemetry)",
+            s.faulted
+        );
+    }
     if let Some(i) = &s.interrupted {
         outln!(
             "  interrupted after {} of {} runs: only those are aggregated; `safe-capture montecarlo --resume --out {}` runs the rest",

@@ -122,21 +122,24 @@ impl Setup {
         self.check_start()
     }
 
-    /// Refuses a start outside the certified set: a barrier already negative in the
-    /// scenario's initial state (the declared model's; a Monte Carlo draws its own
-    /// starts). From there the filters could only run the relaxed problem (docs/SAFETY.md,
+    /// Refuses a start outside the certified set (the scenario's initial state, the
+    /// declared model's; a Monte Carlo draws its own starts): a barrier already negative,
+    /// or — the filters' own test — a state where a filter's rows cannot all hold within
+    /// its input bounds at t = 0 (e.g. moving towards a barrier too fast to brake, `H <
+    /// 0`). From there the filters could only run the relaxed problem (docs/SAFETY.md,
     /// "What is outside the promise"); a run would end unsafe or time out with faults.
     pub fn check_start(&self) -> Result<(), SetupError> {
         let sim = sc_sim::Simulator::new(&self.scenario, self.robot.clone())
             .map_err(|e| SetupError::Other(e.to_string()))?;
         let monitor = sc_cbf::monitor::Monitor::from_scenario(&self.scenario, self.robot.clone());
-        let h = monitor.evaluate(&sim.observe().barrier_state());
+        let o = sim.observe();
+        let h = monitor.evaluate(&o.barrier_state());
         let Some((name, v)) = crate::constraint_names()
             .into_iter()
             .zip(h)
             .find(|(_, v)| v.is_nan() || *v < 0.0)
         else {
-            return Ok(());
+            return self.check_start_certified(&o);
         };
         let s = &self.scenario.servicer;
         let (key, value) = start_key(name, s);
@@ -147,6 +150,45 @@ impl Setup {
                 "the start is outside the certified set: the barrier `{name}` is {v:.4e} < 0 at t = 0 (docs/SAFETY.md, \"The certified set\"); start where every barrier holds"
             ),
         })
+    }
+
+    /// The filters at the start `o` (on their substitute nominals: whether the rows can
+    /// all hold does not depend on the nominal): every one certified, or the first that
+    /// is not, named with the initial state it rests on.
+    fn check_start_certified(&self, o: &sc_core::Observation) -> Result<(), SetupError> {
+        let mut layer = sc_cbf::SafetyLayer::from_scenario(&self.scenario, self.robot.clone());
+        let out = layer.step(o, &sc_cbf::Nominals::default(), sc_cbf::Actuation::Safe);
+        let s = &self.scenario.servicer;
+        let verdicts = [
+            (
+                "translational",
+                sc_cbf::common::certified(&out.translational.report),
+                "servicer.initial_position_m/initial_velocity_m_s",
+                format!("{:?}/{:?}", s.initial_position_m, s.initial_velocity_m_s),
+            ),
+            (
+                "attitude",
+                sc_cbf::common::certified(&out.attitude.report),
+                "servicer.initial_omega_rad_s",
+                format!("{:?}", s.initial_omega_rad_s),
+            ),
+            (
+                "robotic",
+                sc_cbf::common::certified(&out.robotic.report),
+                "servicer.initial_theta_rad/initial_theta_dot_rad_s",
+                format!("{:?}/{:?}", s.initial_theta_rad, s.initial_theta_dot_rad_s),
+            ),
+        ];
+        match verdicts.into_iter().find(|v| !v.1) {
+            None => Ok(()),
+            Some((filter, _, key, value)) => Err(SetupError::Inconsistent {
+                key: key.into(),
+                value,
+                rule: format!(
+                    "the start is outside the certified set: at t = 0 the {filter} filter's rows cannot all hold within its input bounds (e.g. moving towards a barrier faster than it can brake; docs/SAFETY.md, \"The certified set\"); start slower or farther from the barriers"
+                ),
+            }),
+        }
     }
 
     /// Total servicer mass [kg] (base + arm), the `m` of the CW model.

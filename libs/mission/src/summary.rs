@@ -128,12 +128,17 @@ pub struct Summary {
 
 /// Steps on which a nominal controller gave no valid command (its filter flagged
 /// `nominal_missing` or `invalid_nominal` and filtered the substitute nominal instead).
+/// Counted in the run's steps (the base rate: in a multi-rate partition a command held
+/// over k steps counts k times), and not on steps where an upstream input was missing
+/// too (the backup of a late or dead filter process runs on the substitute nominal
+/// whatever the partner sent). A partner that marks its command invalid (`valid = 0`)
+/// shows as `missing` (the filter does not take it).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PartnerFaults {
     /// Steps without a valid command.
     pub steps: usize,
-    /// Of them, steps with no command at all (silent, late, dead) and with an invalid
-    /// one (non-finite, out of range, flagged invalid by the partner).
+    /// Of them, steps with no command taken (silent, late, dead, or marked invalid by the
+    /// partner) and with an invalid one (non-finite, out of range).
     pub missing: usize,
     pub invalid: usize,
     /// Time of the first [s].
@@ -175,19 +180,19 @@ impl Summary {
     }
 
     /// Passed, the exit code 0 of `run`, `launch` and every run of `montecarlo`:
-    /// captured and [`Self::safe`].
+    /// captured, [`Self::safe`] and without a fault.
     pub fn passed(&self) -> bool {
-        self.captured && self.safe()
+        self.captured && self.safe() && self.fault_count == 0
     }
 
-    /// Safe as `run` and `launch` judge a run: every barrier held, no fault, and (with a
-    /// declared uncertainty) the realised errors within the declared bounds.
+    /// Safe (README, "Verdicts and exit codes"): every barrier held on the true state
+    /// and (with a declared uncertainty) the realised errors within the declared bounds.
     pub fn safe(&self) -> bool {
         let within = self
             .uncertainty
             .as_ref()
             .is_none_or(|u| u.outside_bounds.is_empty());
-        self.violated_constraints.is_empty() && self.fault_count == 0 && within
+        self.violated_constraints.is_empty() && within
     }
 }
 
@@ -502,7 +507,10 @@ impl Tally {
     fn partner(&mut self, r: &StepRecord, filter: &str, f: u32) {
         let missing = f & faults::NOMINAL_MISSING != 0;
         let invalid = f & faults::INVALID_NOMINAL != 0;
-        if !(missing || invalid) {
+        // a step on which an upstream input was missing — the partition's backup of a
+        // late or dead filter process carries the flag too, and runs on the substitute
+        // nominal whatever the partner sent — is no evidence against the partner
+        if !(missing || invalid) || f & faults::UPSTREAM_MISSING != 0 {
             return;
         }
         let p = self

@@ -95,8 +95,10 @@ pub struct CampaignSummary {
     pub safe_runs: usize,
     pub captured_runs: usize,
     pub failed_runs: usize,
-    /// Completed runs with at least one filter fault flag.
+    /// Completed runs with at least one filter fault flag, and which.
     pub faulted_runs: usize,
+    #[serde(default)]
+    pub faulted: Vec<usize>,
     pub unsafe_runs: Vec<usize>,
     pub not_captured_runs: Vec<usize>,
     pub failed: Vec<Failure>,
@@ -383,6 +385,7 @@ fn empty_summary(info: &CampaignInfo, sessions: &Sessions, runs: usize) -> Campa
         captured_runs: 0,
         failed_runs: 0,
         faulted_runs: 0,
+        faulted: Vec::new(),
         unsafe_runs: Vec::new(),
         not_captured_runs: Vec::new(),
         failed: Vec::new(),
@@ -429,6 +432,7 @@ fn count_outcomes(s: &mut CampaignSummary, loaded: &[Loaded]) {
         }
         if m.fault_count > 0 {
             s.faulted_runs += 1;
+            s.faulted.push(r.run);
         }
     }
 }

@@ -255,6 +255,9 @@ fn bad_run_row(o: &mut String, r: &RunResult) {
             if !m.captured {
                 v.push(format!("not captured ({})", m.end));
             }
+            if m.fault_count > 0 {
+                v.push(format!("{} faults", m.fault_count));
+            }
             v.join("; ")
         }
     };
@@ -265,19 +268,21 @@ fn bad_run_row(o: &mut String, r: &RunResult) {
     );
 }
 
-/// The runs that failed, were unsafe or did not capture, or that there are none.
+/// The runs that did not pass — failed, unsafe, not captured or with faults — or that
+/// there are none.
 fn bad_runs(o: &mut String, results: &[RunResult]) {
+    let faulted = |r: &RunResult| r.metrics.as_ref().is_some_and(|m| m.fault_count > 0);
     let bad: Vec<&RunResult> = results
         .iter()
-        .filter(|r| r.failed() || !r.safe() || !r.captured())
+        .filter(|r| r.failed() || !r.safe() || !r.captured() || faulted(r))
         .collect();
     if bad.is_empty() {
-        let _ = writeln!(o, "Every run completed safe and captured.");
+        let _ = writeln!(o, "Every run completed safe, captured and without a fault.");
         return;
     }
     let _ = writeln!(
         o,
-        "## Runs that failed, were unsafe or did not capture\n\n| run | seed | distance [m] | off-axis [deg] | azimuth [deg] | tumble rate [rad/s] | outcome |\n|---|---|---|---|---|---|---|"
+        "## Runs that did not pass: failed, unsafe, not captured or with faults\n\n| run | seed | distance [m] | off-axis [deg] | azimuth [deg] | tumble rate [rad/s] | outcome |\n|---|---|---|---|---|---|---|"
     );
     for r in bad {
         bad_run_row(o, r);

@@ -187,7 +187,7 @@ pub fn measure(
         capture_time_s: finite(sum.capture_time_s),
         final_time_s: sum.final_time_s,
         steps: sum.steps,
-        safe: sum.violated_constraints.is_empty(),
+        safe: sum.safe(),
         violated: sum.violated_constraints.clone(),
         min_h,
         sync_error_peak_rad_s: finite_map(&sum.sync_error_peak_rad_s),

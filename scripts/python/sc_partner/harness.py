@@ -383,17 +383,14 @@ def load_controller(spec):
     ``path/to/file.py:Class``; without ``:Class`` the module's one subclass of
     :class:`NominalController` or :class:`Navigation`."""
     target, _, cls_name = spec.partition(":")
-    if target.endswith(".py") or os.sep in target:
-        name = os.path.splitext(os.path.basename(target))[0]
-        loader_spec = importlib.util.spec_from_file_location(name, target)
-        if loader_spec is None:
-            raise ValueError(f"{target}: cannot load")
-        module = importlib.util.module_from_spec(loader_spec)
-        loader_spec.loader.exec_module(module)
-    else:
-        module = importlib.import_module(target)
+    module = _load_module(target)
     if cls_name:
         return getattr(module, cls_name)
+    return _only_class(module, spec)
+
+
+def _only_class(module, spec):
+    """The one NominalController or Navigation subclass `module` defines."""
     found = [
         c
         for c in vars(module).values()
@@ -408,6 +405,23 @@ def load_controller(spec):
             f"{spec}: name the class (module:Class); NominalController and Navigation subclasses found: {names}"
         )
     return found[0]
+
+
+def _is_file(target):
+    return target.endswith(".py") or os.sep in target
+
+
+def _load_module(target):
+    """The module `target` names: a file path or a dotted module name."""
+    if _is_file(target):
+        name = os.path.splitext(os.path.basename(target))[0]
+        loader_spec = importlib.util.spec_from_file_location(name, target)
+        if loader_spec is None:
+            raise ValueError(f"{target}: cannot load")
+        module = importlib.util.module_from_spec(loader_spec)
+        loader_spec.loader.exec_module(module)
+        return module
+    return importlib.import_module(target)
 
 
 def main(argv=None):
@@ -427,30 +441,25 @@ def main(argv=None):
     p.add_argument("--out", help="write the commands to this CSV")
     p.add_argument("--strict", action="store_true", help="exit 1 if any due step has no valid command")
     args = p.parse_args(argv)
-    recording = args.mcap or args.telemetry
     try:
-        controller = _controller(args.controller)
-        if isinstance(controller, Navigation):
-            return _main_navigation(p, args, controller)
-        partition, scenario, period_s = _sources(args, controller.subsystem)
-        if args.mcap:
-            states = states_from_mcap(args.mcap, scenario)
-        else:
-            _check_text(args.telemetry)
-            states = states_from_telemetry(args.telemetry, partition)
-        recorded = recorded_nominal(recording, controller.subsystem)
+        # the inputs only: the partner's own code (its module, class, setup and step)
+        # runs outside, so that its errors keep their traceback
+        cls = _controller_class(args.controller)
     except InputError as e:
         print(f"harness: {e}", file=sys.stderr)
         return 2
-    except KeyError as e:
-        print(f"harness: {recording}: not a recording of safe-capture (no {e})", file=sys.stderr)
+    controller = cls()
+    try:
+        if isinstance(controller, Navigation):
+            inputs = _navigation_inputs(p, args)
+        else:
+            inputs = _controller_inputs(args, controller.subsystem)
+    except InputError as e:
+        print(f"harness: {e}", file=sys.stderr)
         return 2
-    except (OSError, ValueError) as e:
-        msg = _one_line(e)
-        if not msg.startswith(str(recording)):
-            msg = f"{recording}: not a recording of safe-capture ({msg})"
-        print(f"harness: {msg}", file=sys.stderr)
-        return 2
+    if isinstance(controller, Navigation):
+        return _main_navigation(args, controller, *inputs)
+    partition, scenario, period_s, states, recorded = inputs
     commands = run_offline(controller, states, scenario, period_s)
     if args.out:
         write_commands(args.out, controller, commands)
@@ -483,7 +492,7 @@ _MCAP_MAGIC = b"\x89MCAP"
 
 
 def _largest_difference(commands, recorded, subsystem):
-    """"largest difference to the recorded nominal command: 161.8 N (tick 42, axis 1)",
+    """"largest difference to the recorded nominal command: 161.8 N (tick 42, f_h_nom_y_n)",
     over the valid commands with a recorded counterpart."""
     best = None
     for c in commands:
@@ -498,24 +507,65 @@ def _largest_difference(commands, recorded, subsystem):
     if best is None:
         return "no valid command to compare with the recorded nominal command"
     diff, tick, axis = best
-    return f"largest difference to the recorded nominal command: {diff:.6g} {_UNIT[subsystem]} (tick {tick}, axis {axis})"
+    column = NOMINAL_COLUMNS[subsystem][axis]
+    return f"largest difference to the recorded nominal command: {diff:.6g} {_UNIT[subsystem]} (tick {tick}, {column})"
 
 
-def _controller(spec):
-    """An instance of the class `spec` names, or an InputError naming what is wrong."""
-    try:
-        cls = load_controller(spec)
-    except FileNotFoundError as e:
-        raise InputError(f"{spec}: no such file ({e.filename})") from None
-    except ModuleNotFoundError as e:
-        raise InputError(f"{spec}: no module {e.name!r} (give package.module:Class or path/to/file.py:Class)") from None
-    except AttributeError as e:
-        raise InputError(f"{spec}: {_one_line(e)} (give the class's name after the colon)") from None
-    except ValueError as e:
-        raise InputError(_one_line(e)) from None
+def _controller_class(spec):
+    """The class `spec` names, or an InputError when the spec names no file, module or
+    class; an error inside the partner's module propagates with its traceback."""
+    target, _, cls_name = spec.partition(":")
+    if _is_file(target):
+        if not os.path.isfile(target):
+            raise InputError(f"{spec}: no such file ({target})")
+    else:
+        try:
+            found = importlib.util.find_spec(target)
+        except ModuleNotFoundError:
+            found = None
+        if found is None:
+            raise InputError(f"{spec}: no module {target!r} (give package.module:Class or path/to/file.py:Class)")
+    module = _load_module(target)
+    if cls_name:
+        if not hasattr(module, cls_name):
+            raise InputError(
+                f"{spec}: module {module.__name__!r} has no attribute {cls_name!r} (give the class's name after the colon)"
+            )
+        cls = getattr(module, cls_name)
+    else:
+        try:
+            cls = _only_class(module, spec)
+        except ValueError as e:
+            raise InputError(_one_line(e)) from None
     if not (inspect.isclass(cls) and issubclass(cls, (NominalController, Navigation))):
         raise InputError(f"{spec}: not a NominalController or Navigation subclass")
-    return cls()
+    return cls
+
+
+def _read_recording(recording, read):
+    """`read()` of a recording, its errors as one InputError naming the file."""
+    try:
+        return read()
+    except KeyError as e:
+        raise InputError(f"{recording}: not a recording of safe-capture (no {e})") from None
+    except (OSError, ValueError) as e:
+        msg = _one_line(e)
+        if not msg.startswith(str(recording)):
+            msg = f"{recording}: not a recording of safe-capture ({msg})"
+        raise InputError(msg) from None
+
+
+def _controller_inputs(args, subsystem):
+    """(partition, scenario, period, the recorded states, the recorded nominal commands)."""
+    partition, scenario, period_s = _sources(args, subsystem)
+    recording = args.mcap or args.telemetry
+    if args.mcap:
+        states = _read_recording(recording, lambda: states_from_mcap(args.mcap, scenario))
+    else:
+        _check_text(args.telemetry)
+        states = _read_recording(recording, lambda: states_from_telemetry(args.telemetry, partition))
+    recorded = _read_recording(recording, lambda: recorded_nominal(recording, subsystem))
+    return partition, scenario, period_s, states, recorded
 
 
 def _check_text(path):
@@ -560,16 +610,23 @@ def _sources(args, subsystem):
     return partition, scenario, sc_config.group_periods(partition, subsystem)[0]
 
 
-def _main_navigation(parser, args, navigation):
-    """`main` for a navigation: its estimates of a partition run's recorded measurements."""
+def _navigation_inputs(parser, args):
+    """(scenario, period, the recorded measurements, the recorded estimates by tick)."""
     if not args.mcap:
         parser.error("a navigation runs on the measurements of a partition run: give its --mcap recording.mcap")
     _, scenario, period_s = _sources(args, None)
-    measurements = nav_states_from_mcap(args.mcap)
+    measurements = _read_recording(args.mcap, lambda: nav_states_from_mcap(args.mcap))
+    recorded = _read_recording(
+        args.mcap, lambda: {e.tick: e for e in nav_states_from_mcap(args.mcap, icd.SERVICE_ESTIMATE)}
+    )
+    return scenario, period_s, measurements, recorded
+
+
+def _main_navigation(args, navigation, scenario, period_s, measurements, recorded):
+    """`main` for a navigation: its estimates of a partition run's recorded measurements."""
     estimates = run_offline_navigation(navigation, measurements, scenario, period_s)
     if args.out:
         write_estimates(args.out, estimates)
-    recorded = {e.tick: e for e in nav_states_from_mcap(args.mcap, icd.SERVICE_ESTIMATE)}
     diff, tick, col = largest_estimate_difference(estimates, recorded)
     where = f" (tick {tick}, {col}; units of the ICD's NavState)" if diff > 0 else ""
     invalid = [e for e in estimates if not e.valid]

@@ -206,6 +206,8 @@ impl<'a> Supervisor<'a> {
     ) {
         if signal.load(Ordering::SeqCst) && !self.interrupted {
             self.interrupted = true;
+            // the scheduler may have ended on the same signal: not the mission's end
+            self.normal_end = false;
             if !self.quiet {
                 note!("launch: interrupted, tearing down");
             }
@@ -216,6 +218,7 @@ impl<'a> Supervisor<'a> {
                 note!("launch: run timed out after {timeout:?}, tearing down");
             }
             self.failed = true;
+            self.normal_end = false;
             self.teardown_at = Some(Instant::now());
         }
     }

@@ -1,0 +1,61 @@
+//! The verdict of a run (README, "Verdicts and exit codes"): partner faults are counted
+//! per nominal controller from the filters' flags — not on steps where an upstream input
+//! was missing too (the partition's backup of a late or dead filter process runs on the
+//! substitute nominal whatever the partner sent) — and a run with faults is safe but does
+//! not pass.
+
+use sc_cbf::faults;
+use sc_mission::{Mission, RunOptions, Setup, StepRecord, summarize};
+use std::path::Path;
+
+fn records(duration_s: f64) -> (Vec<StepRecord>, sc_mission::MissionEnd, Vec<String>) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/scenario.toml");
+    let mut setup = Setup::load(&path).unwrap();
+    setup.scenario.mission.duration_s = duration_s;
+    let phases = setup
+        .scenario
+        .mission
+        .phases
+        .iter()
+        .map(|p| p.name.clone())
+        .collect();
+    let mut m = Mission::new(setup, RunOptions { no_filter: false }).unwrap();
+    let mut v = Vec::new();
+    let end = m.run(|_, r| v.push(*r));
+    (v, end, phases)
+}
+
+#[test]
+fn partner_faults_are_the_partners_and_a_run_with_faults_does_not_pass() {
+    let (mut recs, end, phases) = records(3.0);
+    let clean = summarize(&recs, &end, &phases, true);
+    assert!(clean.partner_faults.is_empty());
+    assert!(clean.safe());
+    // the attitude partner's command missing at steps 10..15, invalid at 20; at 25 the
+    // attitude filter process was late (the backup: its flags carry upstream_missing)
+    for r in &mut recs[10..15] {
+        r.attitude.report.faults |= faults::NOMINAL_MISSING;
+    }
+    recs[20].attitude.report.faults |= faults::INVALID_NOMINAL;
+    recs[25].attitude.report.faults |= faults::NOMINAL_MISSING | faults::UPSTREAM_MISSING;
+    let s = summarize(&recs, &end, &phases, true);
+    let p = &s.partner_faults["nominal_attitude"];
+    assert_eq!((p.steps, p.missing, p.invalid), (6, 5, 1), "{p:?}");
+    assert_eq!(p.first_t_s, recs[10].t);
+    assert_eq!(s.partner_faults.len(), 1);
+    assert_eq!(s.fault_count, 7);
+    assert!(s.safe(), "faults do not make a run unsafe");
+    // (a 3 s mission does not capture: as if it had, to see what the faults do)
+    let (mut clean, mut s) = (clean, s);
+    (clean.captured, s.captured) = (true, true);
+    assert!(clean.passed());
+    assert!(!s.passed(), "a run with faults does not pass");
+    assert!(
+        s.verdict().contains(&format!(
+            "; nominal_attitude: 6 of {} steps without a valid command (first at t = 1.0 s)",
+            recs.len()
+        )),
+        "{}",
+        s.verdict()
+    );
+}
