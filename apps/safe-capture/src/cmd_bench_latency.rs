@@ -14,6 +14,8 @@ const EXIT_INTERRUPTED: u8 = 3;
 /// latency_timeline.svg per tick with the host's steal; both with the 1 ms p99 target and
 /// the paper's 3.75 ms maximum as labelled lines) and the machine's facts. Writes latency_report.{json,md} into OUT.
 ///
+/// While it runs, one line every 10 s on stderr says how many steps were recorded.
+///
 /// Exit codes: 0 measured, 2 bad arguments or configuration, or the partition did not
 /// run, 3 interrupted (SIGINT/SIGTERM: no report; what was written stays in
 /// OUT.incomplete, OUT is not replaced).

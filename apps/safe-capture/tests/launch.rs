@@ -669,3 +669,35 @@ fn a_launch_draws_the_figures_of_run() {
         );
     }
 }
+
+/// A real-time launch says how far it got while it runs (issue #27: `launch
+/// --real-time` and `bench latency` showed no progress for minutes); the interval is
+/// shortened for the test (`SC_LAUNCH_PROGRESS_S`, 10 s by default).
+#[test]
+fn a_real_time_launch_shows_its_progress() {
+    let _cpu = exclusive();
+    let d = tmp("progress");
+    let cfg = d.join("partition.toml");
+    std::fs::write(&cfg, partition_toml_absolute_scenario()).unwrap();
+    let (o, _) = cli_partition(
+        &[
+            "launch",
+            "--real-time",
+            "--max-ticks",
+            "30",
+            "--config",
+            cfg.to_str().unwrap(),
+            "--out",
+            d.join("out").to_str().unwrap(),
+        ],
+        &[("SC_LAUNCH_PROGRESS_S", "1")],
+    );
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{t}");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.lines()
+            .any(|l| l.starts_with("launch: ") && l.contains(" steps recorded after ")),
+        "{t}"
+    );
+}

@@ -22,6 +22,21 @@ const AFTER_ESSENTIAL_DEATH: Duration = Duration::from_secs(20);
 const TERM_TO_KILL: Duration = Duration::from_secs(3);
 /// How often the launcher looks at its processes.
 const POLL: Duration = Duration::from_millis(20);
+/// How often a running mission's progress is said (wall time) [s]; the environment
+/// variable [`PROGRESS_ENV`] overrides it (tests).
+const PROGRESS_EVERY_S: f64 = 10.0;
+/// Environment variable with the progress interval [s].
+pub const PROGRESS_ENV: &str = "SC_LAUNCH_PROGRESS_S";
+
+/// The progress interval: [`PROGRESS_ENV`] if it is a positive number, else the default.
+fn progress_every() -> Duration {
+    let s = std::env::var(PROGRESS_ENV)
+        .ok()
+        .and_then(|v| v.parse::<f64>().ok())
+        .filter(|s| s.is_finite() && *s > 0.0)
+        .unwrap_or(PROGRESS_EVERY_S);
+    Duration::from_secs_f64(s)
+}
 
 /// What the watch found.
 pub(super) struct Supervised {
@@ -52,6 +67,9 @@ pub(super) struct Supervisor<'a> {
     /// The scheduler ended well: every process got the stop tick, and one still running
     /// at the teardown is hung.
     normal_end: bool,
+    /// When the progress was last said, and how often it is.
+    progress_at: Instant,
+    progress_every: Duration,
 }
 
 /// How a process ended, in words.
@@ -84,6 +102,8 @@ impl<'a> Supervisor<'a> {
             killed: false,
             early_err: None,
             normal_end: false,
+            progress_at: Instant::now(),
+            progress_every: progress_every(),
         }
     }
 
@@ -95,6 +115,7 @@ impl<'a> Supervisor<'a> {
                 break;
             }
             self.watch_signal_and_timeout(started, timeout, signal);
+            self.say_progress(started);
             self.tear_down();
             std::thread::sleep(POLL);
         }
@@ -189,6 +210,28 @@ impl<'a> Supervisor<'a> {
             )
         });
         self.teardown_at = Some(Instant::now());
+    }
+
+    /// Every [`PROGRESS_EVERY_S`] while the mission runs, one line on stderr: the steps the
+    /// recorder has written so far (telemetry.csv's rows) — a real-time run of 240 s, or
+    /// a latency bench of minutes, otherwise says nothing until it ends.
+    fn say_progress(&mut self, started: Instant) {
+        if self.quiet
+            || self.teardown_at.is_some()
+            || self.progress_at.elapsed() < self.progress_every
+            || !self.out.join(ALL_READY).exists()
+        {
+            return;
+        }
+        self.progress_at = Instant::now();
+        let rows = std::fs::read(self.out.join("telemetry.csv"))
+            .map(|b| b.iter().filter(|c| **c == b'\n').count())
+            .unwrap_or(0);
+        note!(
+            "launch: {} steps recorded after {:.0} s",
+            rows.saturating_sub(1),
+            started.elapsed().as_secs_f64()
+        );
     }
 
     /// Sets the teardown `after` from now, unless one is set already.
