@@ -345,7 +345,7 @@ fn every_file_gets_its_line_and_the_kind_can_be_given() {
 #[test]
 fn implausible_scenarios_are_one_line_each_from_check_and_run() {
     let d = tmp("check-implausible");
-    let cases: [(&str, &str, &[&str]); 3] = [
+    let cases: [(&str, &str, &[&str]); 4] = [
         (
             "altitude_m = 600000.0",
             "altitude_m = 600.0",
@@ -363,6 +363,16 @@ fn implausible_scenarios_are_one_line_each_from_check_and_run() {
                 "`servicer.initial_position_m` = [9.0, 0.45, -0.35]",
                 "the start is outside the certified set",
                 "approach_corridor",
+            ],
+        ),
+        // every barrier holds, but towards the target faster than the thrusters brake:
+        // the translational filter's rows cannot all hold at t = 0
+        (
+            "initial_velocity_m_s = [0.0, 0.004, 0.0]",
+            "initial_velocity_m_s = [0.6, 0.004, 0.0]",
+            &[
+                "`servicer.initial_position_m/initial_velocity_m_s`",
+                "the start is outside the certified set: at t = 0 the translational filter's rows cannot all hold",
             ],
         ),
     ];

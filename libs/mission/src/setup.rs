@@ -153,28 +153,36 @@ impl Setup {
     }
 
     /// The filters at the start `o` (on their substitute nominals: whether the rows can
-    /// all hold does not depend on the nominal): every one certified, or the first that
-    /// is not, named with the initial state it rests on.
+    /// all hold does not depend on the nominal): none on the relaxed problem or its
+    /// fallback, or the first that is, named with the initial state it rests on. A
+    /// translational step on degraded margins under a declared uncertainty is the
+    /// documented degraded mode, not a refusal (`check` says so in its note).
     fn check_start_certified(&self, o: &sc_core::Observation) -> Result<(), SetupError> {
         let mut layer = sc_cbf::SafetyLayer::from_scenario(&self.scenario, self.robot.clone());
         let out = layer.step(o, &sc_cbf::Nominals::default(), sc_cbf::Actuation::Safe);
+        let held = |status| {
+            matches!(
+                status,
+                sc_cbf::FilterStatus::Solved | sc_cbf::FilterStatus::Skipped
+            )
+        };
         let s = &self.scenario.servicer;
         let verdicts = [
             (
                 "translational",
-                sc_cbf::common::certified(&out.translational.report),
+                held(out.translational.report.status),
                 "servicer.initial_position_m/initial_velocity_m_s",
                 format!("{:?}/{:?}", s.initial_position_m, s.initial_velocity_m_s),
             ),
             (
                 "attitude",
-                sc_cbf::common::certified(&out.attitude.report),
-                "servicer.initial_omega_rad_s",
-                format!("{:?}", s.initial_omega_rad_s),
+                held(out.attitude.report.status),
+                "servicer.initial_position_m/initial_omega_rad_s",
+                format!("{:?}/{:?}", s.initial_position_m, s.initial_omega_rad_s),
             ),
             (
                 "robotic",
-                sc_cbf::common::certified(&out.robotic.report),
+                held(out.robotic.report.status),
                 "servicer.initial_theta_rad/initial_theta_dot_rad_s",
                 format!("{:?}/{:?}", s.initial_theta_rad, s.initial_theta_dot_rad_s),
             ),

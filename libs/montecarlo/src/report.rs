@@ -256,7 +256,11 @@ fn bad_run_row(o: &mut String, r: &RunResult) {
                 v.push(format!("not captured ({})", m.end));
             }
             if m.fault_count > 0 {
-                v.push(format!("{} faults", m.fault_count));
+                v.push(format!(
+                    "faults on {} step{}",
+                    m.fault_count,
+                    if m.fault_count == 1 { "" } else { "s" }
+                ));
             }
             v.join("; ")
         }

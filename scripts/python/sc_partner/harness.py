@@ -518,10 +518,16 @@ def _controller_class(spec):
     if _is_file(target):
         if not os.path.isfile(target):
             raise InputError(f"{spec}: no such file ({target})")
+        if not target.endswith(".py"):
+            raise InputError(f"{spec}: not a Python file ({target}; give path/to/file.py:Class)")
     else:
         try:
             found = importlib.util.find_spec(target)
-        except ModuleNotFoundError:
+        except ModuleNotFoundError as e:
+            # the spec's own package missing; a module the partner's package imports
+            # that is missing is the partner's error (its traceback follows)
+            if not (e.name == target or target.startswith(f"{e.name}.")):
+                raise
             found = None
         if found is None:
             raise InputError(f"{spec}: no module {target!r} (give package.module:Class or path/to/file.py:Class)")
@@ -575,6 +581,8 @@ def _check_text(path):
             head = f.read(len(_MCAP_MAGIC))
     except FileNotFoundError:
         raise InputError(f"{path}: no such file (--telemetry)") from None
+    except OSError as e:
+        raise InputError(f"{path}: cannot read ({e.strerror or e}; --telemetry)") from None
     if head == _MCAP_MAGIC:
         raise InputError(f"{path} is an MCAP recording: give it with --mcap, not --telemetry")
 
@@ -598,16 +606,26 @@ def _sources(args, subsystem):
             if "roles" in scenario or "rate_groups" in scenario:
                 raise InputError(f"{args.scenario} is a partition config, not a scenario: give it with --config")
             raise InputError(f"{args.scenario}: not a scenario (no [mission]; --scenario)")
-        return None, scenario, float(scenario["mission"]["control_period_s"])
+        try:
+            return None, scenario, float(scenario["mission"]["control_period_s"])
+        except (KeyError, TypeError, ValueError) as e:
+            raise InputError(f"{args.scenario}: no valid mission.control_period_s ({_one_line(e)}; --scenario)") from None
     partition = _read_toml(args.config, "--config")
     if "rate_groups" not in partition:
         if "mission" in partition:
             raise InputError(f"{args.config} is a scenario, not a partition config: give it with --scenario")
         raise InputError(f"{args.config}: not a partition config (no rate_groups; --config)")
-    scenario = _read_toml(sc_config.scenario_path(args.config, partition), "the config's scenario")
-    if subsystem is None:
-        return partition, scenario, sc_config.base_period(partition)
-    return partition, scenario, sc_config.group_periods(partition, subsystem)[0]
+    try:
+        scenario_path = sc_config.scenario_path(args.config, partition)
+    except (KeyError, TypeError) as e:
+        raise InputError(f"{args.config}: names no scenario ({_one_line(e)}; --config)") from None
+    scenario = _read_toml(scenario_path, "the config's scenario")
+    try:
+        if subsystem is None:
+            return partition, scenario, sc_config.base_period(partition)
+        return partition, scenario, sc_config.group_periods(partition, subsystem)[0]
+    except (KeyError, TypeError, ValueError) as e:
+        raise InputError(f"{args.config}: {_one_line(e)} (--config)") from None
 
 
 def _navigation_inputs(parser, args):

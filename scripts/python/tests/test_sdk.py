@@ -265,3 +265,35 @@ class HarnessInputs(unittest.TestCase):
                 self.assertEqual(len(err.strip().splitlines()), 1, (argv, err))
                 self.assertTrue(err.startswith("harness: "), err)
                 self.assertIn(why, err)
+
+    def test_the_partners_own_errors_keep_their_traceback(self):
+        import os
+        import tempfile
+
+        scenario = os.path.join(os.path.dirname(__file__), "..", "..", "..", "config", "scenario.toml")
+        with tempfile.TemporaryDirectory() as d:
+            ctl = os.path.join(d, "ctl.py")
+            with open(ctl, "w") as f:
+                f.write(
+                    "from sc_partner import NominalController\n\n\n"
+                    "class C(NominalController):\n"
+                    "    subsystem = 'translational'\n\n"
+                    "    def __init__(self):\n"
+                    "        raise KeyError('kp')\n"
+                )
+            text = os.path.join(d, "notes.csv")
+            with open(text, "w") as f:
+                f.write("a\n1\n")
+            # not "not a recording": the partner's KeyError itself
+            with self.assertRaises(KeyError):
+                self.run_harness(ctl + ":C", "--telemetry", text, "--scenario", scenario)
+            # a config without the subsystem's rate group is an input error: one line
+            part = os.path.join(d, "partition.toml")
+            with open(part, "w") as f:
+                f.write(f'scenario = "{scenario}"\n[[rate_groups]]\nname = "c"\nperiod_s = 0.1\nmembers = ["attitude"]\n')
+            code, err = self.run_harness(
+                "sc_partner.examples.nominal_translational", "--telemetry", text, "--config", part
+            )
+            self.assertEqual(code, 2, err)
+            self.assertEqual(len(err.strip().splitlines()), 1, err)
+            self.assertIn("(--config)", err)

@@ -30,12 +30,12 @@ pub const PROGRESS_ENV: &str = "SC_LAUNCH_PROGRESS_S";
 
 /// The progress interval: [`PROGRESS_ENV`] if it is a positive number, else the default.
 fn progress_every() -> Duration {
-    let s = std::env::var(PROGRESS_ENV)
+    std::env::var(PROGRESS_ENV)
         .ok()
         .and_then(|v| v.parse::<f64>().ok())
-        .filter(|s| s.is_finite() && *s > 0.0)
-        .unwrap_or(PROGRESS_EVERY_S);
-    Duration::from_secs_f64(s)
+        .filter(|s| *s > 0.0)
+        .and_then(|s| Duration::try_from_secs_f64(s).ok())
+        .unwrap_or(Duration::from_secs_f64(PROGRESS_EVERY_S))
 }
 
 /// What the watch found.
@@ -70,6 +70,9 @@ pub(super) struct Supervisor<'a> {
     /// When the progress was last said, and how often it is.
     progress_at: Instant,
     progress_every: Duration,
+    /// telemetry.csv's rows counted so far and the bytes they were counted in.
+    progress_rows: usize,
+    progress_bytes: u64,
 }
 
 /// How a process ended, in words.
@@ -104,6 +107,8 @@ impl<'a> Supervisor<'a> {
             normal_end: false,
             progress_at: Instant::now(),
             progress_every: progress_every(),
+            progress_rows: 0,
+            progress_bytes: 0,
         }
     }
 
@@ -224,14 +229,29 @@ impl<'a> Supervisor<'a> {
             return;
         }
         self.progress_at = Instant::now();
-        let rows = std::fs::read(self.out.join("telemetry.csv"))
-            .map(|b| b.iter().filter(|c| **c == b'\n').count())
-            .unwrap_or(0);
+        self.count_new_rows();
         note!(
             "launch: {} steps recorded after {:.0} s",
-            rows.saturating_sub(1),
+            self.progress_rows.saturating_sub(1),
             started.elapsed().as_secs_f64()
         );
+    }
+
+    /// Counts the rows appended to telemetry.csv since the last look (only the new bytes
+    /// are read: the latency bench measures while this runs).
+    fn count_new_rows(&mut self) {
+        use std::io::{Read, Seek, SeekFrom};
+        let Ok(mut f) = std::fs::File::open(self.out.join("telemetry.csv")) else {
+            return;
+        };
+        if f.seek(SeekFrom::Start(self.progress_bytes)).is_err() {
+            return;
+        }
+        let mut new = Vec::new();
+        if f.read_to_end(&mut new).is_ok() {
+            self.progress_bytes += new.len() as u64;
+            self.progress_rows += new.iter().filter(|c| **c == b'\n').count();
+        }
     }
 
     /// Sets the teardown `after` from now, unless one is set already.
