@@ -305,12 +305,29 @@ fn a_launch_stopped_by_max_ticks_says_so() {
     assert_eq!(recorder["code"], 0, "{launch}");
 }
 
-/// A partner's controller that fails — here one whose `step` raises from t = 3 s — is
-/// named in the verdict line with how many steps it gave no valid command and the
-/// reason for the first, quoted from its log; the run is not a pass (exit 1) (issue #27,
-/// "a failing partner controller looks like success").
+/// A partner's controller that fails from t = 3 s — its `step` raises, returns two
+/// values instead of three, or a non-finite command — is named in the verdict line with
+/// how many steps it gave no valid command and the reason for the first, quoted from its
+/// log; the run is not a pass (exit 1) (issue #27, "a failing partner controller looks
+/// like success").
 #[test]
 fn a_failing_partner_is_named_in_the_verdict() {
+    for (bad, reason) in [
+        ("raise ValueError('boom')", "step raised ValueError: boom"),
+        (
+            "return [0.0, 0.0]",
+            "step returned shape (2,), the attitude command is 3 values",
+        ),
+        (
+            "return [float('nan'), 0.0, float('inf')]",
+            "step returned a non-finite command [nan, 0.0, inf]",
+        ),
+    ] {
+        failing_partner_is_named(bad, reason);
+    }
+}
+
+fn failing_partner_is_named(bad: &str, reason: &str) {
     let _cpu = exclusive();
     let Some(py) = python() else {
         return;
@@ -319,7 +336,7 @@ fn a_failing_partner_is_named_in_the_verdict() {
     let script = d.join("bad_attitude.py");
     std::fs::write(
         &script,
-        "import sys\nfrom sc_partner import NominalController\n\n\nclass Bad(NominalController):\n    subsystem = 'attitude'\n\n    def step(self, state):\n        if state.t > 2.95:\n            raise ValueError('boom')\n        return [0.0, 0.0, 0.0]\n\n\nsys.exit(Bad.main())\n",
+        format!("import sys\nfrom sc_partner import NominalController\n\n\nclass Bad(NominalController):\n    subsystem = 'attitude'\n\n    def step(self, state):\n        if state.t > 2.95:\n            {bad}\n        return [0.0, 0.0, 0.0]\n\n\nsys.exit(Bad.main())\n"),
     )
     .unwrap();
     let cfg = partition_with(
@@ -346,7 +363,7 @@ fn a_failing_partner_is_named_in_the_verdict() {
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(
         stdout.contains(&format!(
-            "; nominal_attitude: 20 of {SHORT_TICKS} steps without a valid command (first at t = 3.0 s: step raised ValueError: boom); "
+            "; nominal_attitude: 20 of {SHORT_TICKS} steps without a valid command (first at t = 3.0 s: {reason}"
         )),
         "{t}"
     );

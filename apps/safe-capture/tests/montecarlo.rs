@@ -704,3 +704,35 @@ fn zero_runs_are_refused() {
     );
     assert!(!out.exists());
 }
+
+/// A run with a filter fault is not a pass (issue #27: the campaign counted it safe and
+/// exited 0 while `run` exited 1 on it): seed 1's run 6 has one relaxed attitude step —
+/// every barrier held, so it is safe, and the campaign names it and exits 1.
+#[test]
+fn a_run_with_faults_is_named_and_fails_the_campaign() {
+    let _cpu = exclusive();
+    let d = tmp("faulted");
+    let out = d.join("mc");
+    let o = cli(
+        &[
+            "montecarlo",
+            "--runs",
+            "7",
+            "--seed",
+            "1",
+            "-q",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{t}");
+    assert!(
+        t.contains("7 runs (seed 1): 7 safe, 7 captured, 1 with faults, 0 failed")
+            && t.contains("runs with faults: [6]"),
+        "{t}"
+    );
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("faults on 1 step"), "{report}");
+}
