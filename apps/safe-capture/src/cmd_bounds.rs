@@ -60,7 +60,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     } else {
         "sampled max"
     };
-    if m.samples * 10 < a.samples * 9 || a.samples == 0 {
+    if !envelope::enough_samples(m.samples, a.samples) {
         errln!(
             "bounds: only {} of {} samples usable: no evidence for the bounds (--samples)",
             m.samples,
@@ -69,33 +69,9 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::from(2));
     }
     let checks = envelope::checks(&setup.scenario, &m);
-    let certificate = |c: &envelope::BoundCheck| c.reliance == envelope::Reliance::Certificate;
-    outln!(
-        "{:<52} {:>12} {:>12} {:>8}  {}",
-        "bound",
-        found,
-        "configured",
-        "ratio",
-        "rests on it"
-    );
-    for c in &checks {
-        let ratio = if c.sampled > 0.0 {
-            format!("{:.2}", c.configured / c.sampled)
-        } else {
-            "-".into() // nothing moves there (link 1's spheres lie on joint 1's axis)
-        };
-        let short = certificate(c) && !c.holds();
-        outln!(
-            "{:<52} {:>12.4} {:>12.4} {:>8}  {:<18}{}",
-            c.key,
-            c.sampled,
-            c.configured,
-            ratio,
-            c.reliance.name(),
-            if short { "  < 1.5" } else { "" }
-        );
-    }
-    let load_bearing: Vec<_> = checks.iter().filter(|c| certificate(c)).collect();
+    print_table(&checks, found);
+    let certificate = |c: &&envelope::BoundCheck| c.reliance == envelope::Reliance::Certificate;
+    let load_bearing: Vec<_> = checks.iter().filter(certificate).collect();
     let short = load_bearing.iter().filter(|c| !c.holds()).count();
     // the verified ones whose quantity moves at all (link 1's spheres lie on joint 1's axis)
     let verified: Vec<_> = checks
@@ -122,4 +98,34 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     } else {
         ExitCode::FAILURE
     })
+}
+
+/// One line per bound: its maximum (`found`: sampled or searched), the configured value,
+/// their ratio, what rests on it, and `< 1.5` for a load-bearing one short of the factor.
+fn print_table(checks: &[envelope::BoundCheck], found: &str) {
+    outln!(
+        "{:<52} {:>12} {:>12} {:>8}  {}",
+        "bound",
+        found,
+        "configured",
+        "ratio",
+        "rests on it"
+    );
+    for c in checks {
+        let ratio = if c.sampled > 0.0 {
+            format!("{:.2}", c.configured / c.sampled)
+        } else {
+            "-".into() // nothing moves there (link 1's spheres lie on joint 1's axis)
+        };
+        let short = c.reliance == envelope::Reliance::Certificate && !c.holds();
+        outln!(
+            "{:<52} {:>12.4} {:>12.4} {:>8}  {:<18}{}",
+            c.key,
+            c.sampled,
+            c.configured,
+            ratio,
+            c.reliance.name(),
+            if short { "  < 1.5" } else { "" }
+        );
+    }
 }

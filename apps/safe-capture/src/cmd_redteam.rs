@@ -318,7 +318,9 @@ fn verdict_line(a: &Args, s: &report::CampaignSummary, wall: f64, under: &str) {
     );
 }
 
-pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+/// The scenario with its model, checked before any case runs, under the campaign's
+/// declared uncertainty (a partition campaign only under the file's own).
+fn load(a: &Args) -> anyhow::Result<Setup> {
     let mut setup = Setup::load(&a.scenario)?;
     setup
         .check_before_run(&a.scenario)
@@ -333,6 +335,11 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             "--partition: the processes read the scenario file, so --uncertainty cannot change its profile; declare it in the scenario's [uncertainty] section (docs/UNCERTAINTY.md), or drop --partition to run the cases in process"
         );
     }
+    Ok(setup)
+}
+
+pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    let setup = load(&a)?;
     let cases = selected(&a, run_ticks(&a, &setup))?;
     if a.list {
         for c in &cases {

@@ -515,28 +515,8 @@ fn an_interrupted_launch_says_so() {
     std::fs::write(&cfg, partition_toml_absolute_scenario()).unwrap();
     for signal in ["-INT", "-TERM"] {
         let out = d.join("out");
-        let child = std::process::Command::new(env!("CARGO_BIN_EXE_safe-capture"))
-            .current_dir(root())
-            .args(["launch", "--real-time", "--config", cfg.to_str().unwrap()])
-            .args(["--out", out.to_str().unwrap()])
-            .env("SC_PARTITION_BIN_DIR", partition_bin_dir())
-            .stdout(std::process::Stdio::piped())
-            .stderr(std::process::Stdio::piped())
-            .spawn()
-            .unwrap();
-        let pid = child.id();
-        let started = std::time::Instant::now();
-        while !d.join("out.incomplete/all_ready").exists() {
-            assert!(started.elapsed() < READY_TIMEOUT, "never ready");
-            std::thread::sleep(std::time::Duration::from_millis(50));
-        }
-        std::thread::sleep(std::time::Duration::from_millis(500));
-        let kill = std::process::Command::new("kill")
-            .args([signal, &pid.to_string()])
-            .status()
-            .unwrap();
-        assert!(kill.success());
-        let o = child.wait_with_output().unwrap();
+        let a = ["launch", "--real-time", "--config", cfg.to_str().unwrap()];
+        let (o, pid) = interrupt_once_ready(&a, &out, signal);
         let t = text(&o);
         assert_eq!(o.status.code(), Some(3), "{signal}: {t}");
         let stdout = String::from_utf8_lossy(&o.stdout);
@@ -554,6 +534,39 @@ fn an_interrupted_launch_says_so() {
         }
         assert_eq!(shm_files_of(pid), Vec::<String>::new());
     }
+}
+
+/// Runs the CLI with `args --out out`, sends `signal` (`-INT`, `-TERM`) half a second
+/// after every process of its partition is ready, and returns its output and pid.
+fn interrupt_once_ready(
+    args: &[&str],
+    out: &std::path::Path,
+    signal: &str,
+) -> (std::process::Output, u32) {
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_safe-capture"))
+        .current_dir(root())
+        .args(args)
+        .arg("--out")
+        .arg(out)
+        .env("SC_PARTITION_BIN_DIR", partition_bin_dir())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let pid = child.id();
+    let ready = out.with_extension("incomplete").join("all_ready");
+    let started = std::time::Instant::now();
+    while !ready.exists() {
+        assert!(started.elapsed() < READY_TIMEOUT, "never ready");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    let kill = std::process::Command::new("kill")
+        .args([signal, &pid.to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    (child.wait_with_output().unwrap(), pid)
 }
 
 /// The launch script's usage errors exit 2 with one line, before it builds anything
@@ -585,30 +598,15 @@ fn an_interrupted_latency_bench_says_so_and_keeps_no_report() {
     let cfg = d.join("partition.toml");
     std::fs::write(&cfg, partition_toml_absolute_scenario()).unwrap();
     let out = d.join("out");
-    let child = std::process::Command::new(env!("CARGO_BIN_EXE_safe-capture"))
-        .current_dir(root())
-        .args(["bench", "latency", "--ticks", "3000", "--config"])
-        .arg(&cfg)
-        .arg("--out")
-        .arg(&out)
-        .env("SC_PARTITION_BIN_DIR", partition_bin_dir())
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let pid = child.id();
-    let started = std::time::Instant::now();
-    while !d.join("out.incomplete/all_ready").exists() {
-        assert!(started.elapsed() < READY_TIMEOUT, "never ready");
-        std::thread::sleep(std::time::Duration::from_millis(50));
-    }
-    std::thread::sleep(std::time::Duration::from_millis(500));
-    let kill = std::process::Command::new("kill")
-        .args(["-INT", &pid.to_string()])
-        .status()
-        .unwrap();
-    assert!(kill.success());
-    let o = child.wait_with_output().unwrap();
+    let a = [
+        "bench",
+        "latency",
+        "--ticks",
+        "3000",
+        "--config",
+        cfg.to_str().unwrap(),
+    ];
+    let (o, pid) = interrupt_once_ready(&a, &out, "-INT");
     let t = text(&o);
     assert_eq!(o.status.code(), Some(3), "{t}");
     assert!(

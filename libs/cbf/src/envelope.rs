@@ -296,10 +296,16 @@ pub struct Witnesses {
     pub samples: usize,
 }
 
+/// At least 90 % of `samples` could be evaluated (`usable`): nothing measured is no
+/// evidence for a bound.
+pub fn enough_samples(usable: usize, samples: usize) -> bool {
+    samples > 0 && usable * 10 >= samples * 9
+}
+
 impl Witnesses {
-    /// At least 90 % of the samples could be evaluated: nothing measured is no evidence.
+    /// Enough of the search's samples were usable ([`enough_samples`]).
     pub fn evidence(&self) -> bool {
-        self.samples > 0 && self.usable * 10 >= self.samples * 9
+        enough_samples(self.usable, self.samples)
     }
 
     /// The first bound the model exceeds at a witness state (not a bound).

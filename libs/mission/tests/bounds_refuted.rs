@@ -5,14 +5,13 @@
 //! hundredth, the cheap certificate is refuted again and again — and the mission is still
 //! safe on the true state and captures.
 
-use sc_mission::{Mission, RunOptions, Setup, summarize};
-use std::path::Path;
+mod common;
+use sc_mission::summarize;
 
 /// Runs the default mission with the robotic jerk bounds scaled by `scale`; returns the
 /// robotic filter's refuted certificates and the run's summary.
 fn run(scale: f64) -> (u64, sc_mission::Summary) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/scenario.toml");
-    let mut setup = Setup::load(&path).unwrap();
+    let mut setup = common::default_setup();
     let rb = &mut setup.scenario.safety.robotic;
     for j in rb.joint_jerk_bound_rad_s3.iter_mut() {
         *j *= scale;
@@ -20,16 +19,7 @@ fn run(scale: f64) -> (u64, sc_mission::Summary) {
     for j in rb.link_sphere_jerk_bound_m_s3.iter_mut() {
         *j *= scale;
     }
-    let phases: Vec<String> = setup
-        .scenario
-        .mission
-        .phases
-        .iter()
-        .map(|p| p.name.clone())
-        .collect();
-    let mut m = Mission::new(setup, RunOptions { no_filter: false }).unwrap();
-    let mut records = Vec::new();
-    let end = m.run(|_, r| records.push(*r));
+    let (m, records, end, phases) = common::run_mission(setup);
     let summary = summarize(&records, &end, &phases, true);
     (m.safety.robotic.bounds_refuted(), summary)
 }

@@ -4,25 +4,15 @@
 //! substitute nominal whatever the partner sent) — and a run with faults is safe but does
 //! not pass.
 
+mod common;
 use sc_cbf::faults;
-use sc_mission::{Mission, RunOptions, Setup, StepRecord, summarize};
-use std::path::Path;
+use sc_mission::{StepRecord, summarize};
 
 fn records(duration_s: f64) -> (Vec<StepRecord>, sc_mission::MissionEnd, Vec<String>) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/scenario.toml");
-    let mut setup = Setup::load(&path).unwrap();
+    let mut setup = common::default_setup();
     setup.scenario.mission.duration_s = duration_s;
-    let phases = setup
-        .scenario
-        .mission
-        .phases
-        .iter()
-        .map(|p| p.name.clone())
-        .collect();
-    let mut m = Mission::new(setup, RunOptions { no_filter: false }).unwrap();
-    let mut v = Vec::new();
-    let end = m.run(|_, r| v.push(*r));
-    (v, end, phases)
+    let (_, records, end, phases) = common::run_mission(setup);
+    (records, end, phases)
 }
 
 #[test]
