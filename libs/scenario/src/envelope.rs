@@ -101,10 +101,7 @@ impl LineOfSightEnvelope {
     /// Every rule of the envelope on the tumble and the geometry (what the validation
     /// checks for the scenario's own tumble, for any `ω_T(0)`: a Monte Carlo's draws).
     pub fn contains(&self) -> bool {
-        self.geometry_is_certifiable()
-            && self.limit_rad_s() > 0.0
-            && self.base_can_hold_the_rate()
-            && self.target_rate_rad_s() <= self.limit_rad_s()
+        self.limit_rad_s() > 0.0 && self.broken_tumble_rule().is_none()
     }
 
     /// What the target may take of the boresight's rate [rad/s].
@@ -364,59 +361,143 @@ impl Scenario {
 
     /// (E2), then (E1): the tumble the base and the boresight can follow.
     fn validate_tumble(&self, env: &LineOfSightEnvelope) -> Result<(), ScenarioError> {
-        let key = "target.initial_omega_rad_s";
-        let omega = self.target.initial_omega_rad_s;
-        let peak = env.peak_spin_rad_s();
-        if env.amplification > MAX_OFF_PRINCIPAL_AMPLIFICATION {
-            return Err(outside(
-                key,
-                omega,
-                format!(
-                    "a tumble off the target's principal axes with the inertia ratio {:.2} (target.inertia_kg_m2 with its declared error) can speed up beyond what the attitude filter's in-sample bounds cover (ratio at most {MAX_OFF_PRINCIPAL_AMPLIFICATION}); spin about a principal axis",
-                    env.amplification
-                ),
-            ));
+        match env.broken_tumble_rule() {
+            Some(rule) => Err(outside(
+                "target.initial_omega_rad_s",
+                self.target.initial_omega_rad_s,
+                env.explain(rule),
+            )),
+            None => Ok(()),
         }
-        if peak > env.sync_limit_rad_s {
-            return Err(outside(
-                key,
-                omega,
-                format!(
-                    "the target turns at up to {peak:.4} rad/s, faster than the {:.4} rad/s the base can hold within its rate limits (safety.attitude.omega_max_rad_s/omega_min_rad_s less the rate rows' margins), so the rate synchronisation cannot be certified; the tumble may be at most {:.4} rad/s",
-                    env.sync_limit_rad_s,
-                    env.max_spin_rad_s()
-                ),
-            ));
+    }
+
+    /// The declared tumble's principal axis (unit, F_T), if it spins about one
+    /// ([`Self::line_of_sight_envelope`] takes the spin as constant then).
+    pub fn declared_spin_axis(&self) -> Option<V3> {
+        self.principal_axis(&self.target.initial_omega_rad_s)
+    }
+
+    /// The fastest tumble (F_T) consistent with the knowledge `omega_hat` of the target's
+    /// body rate, whose error is at most `error` [rad/s]: about the declared principal axis
+    /// when `omega_hat` is within `error` of it, `|â·ω̂| + error` along it (a principal spin
+    /// is constant); otherwise `omega_hat` stretched to `‖ω̂‖ + error`, which
+    /// [`Self::line_of_sight_envelope_for`] treats as off the principal axes
+    /// (amplification `κ`, conservative).
+    pub fn tumble_from_knowledge(&self, omega_hat: &V3, error: f64) -> V3 {
+        let spin = norm(omega_hat);
+        if let Some(a) = self.declared_spin_axis() {
+            let along = dot(&a, omega_hat);
+            if norm(&sub(omega_hat, &scale(&a, along))) <= error {
+                let sign = if along < 0.0 { -1.0 } else { 1.0 };
+                return scale(&a, sign * (along.abs() + error));
+            }
         }
-        if peak * env.spin_across_axis > env.boresight_follow_rad_s {
-            return Err(outside(
-                key,
-                omega,
-                format!(
-                    "the rate synchronisation would turn the boresight at up to {:.4} rad/s (the tumble's part across the corridor axis), faster than the {:.4} rad/s it may turn (safety.attitude.boresight_rate_max_rad_s less its margins); the tumble may be at most {:.4} rad/s",
-                    peak * env.spin_across_axis,
-                    env.boresight_follow_rad_s,
-                    env.max_spin_rad_s()
-                ),
-            ));
+        if spin == 0.0 {
+            return [error, 0.0, 0.0];
         }
-        if env.target_rate_rad_s() > env.limit_rad_s() {
-            return Err(outside(
-                key,
-                omega,
-                format!(
-                    "the grasping point moves at up to {:.4} m/s and the servicer may come to {:.3} m of it, so the tumble turns the line of sight at up to {:.4} rad/s, more than the {:.4} rad/s left for it (the boresight follows at {:.4} rad/s, the translational filter's contract takes {:.4}); this geometry allows a tumble of at most {:.4} rad/s",
-                    env.grasp_speed_m_s(),
-                    env.los_min_m,
-                    env.target_rate_rad_s(),
-                    env.limit_rad_s(),
-                    env.boresight_follow_rad_s,
-                    env.translational_rad_s,
-                    env.max_spin_rad_s()
-                ),
-            ));
+        scale(omega_hat, (spin + error) / spin)
+    }
+}
+
+/// A rule of the envelope on the tumble ((E1), (E2)) that a tumble breaks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TumbleRule {
+    /// Off the principal axes with an inertia ratio beyond what the rows' bounds cover.
+    OffPrincipal,
+    /// (E2): faster than the base can hold within its rate rows.
+    Sync,
+    /// (E2): the synchronisation would turn the boresight faster than it may turn.
+    AcrossAxis,
+    /// (E1): the grasping point turns the line of sight faster than the boresight follows.
+    LineOfSight,
+    /// The geometry the rows are defined for: the fixture within reach, the line of sight
+    /// outside the contract's domain.
+    Geometry,
+    /// Nothing is known of the tumble (a non-finite estimate).
+    Unknown,
+}
+
+impl TumbleRule {
+    /// Stable name (summary, logs).
+    pub fn name(&self) -> &'static str {
+        match self {
+            TumbleRule::OffPrincipal => "off_principal",
+            TumbleRule::Sync => "rate_synchronisation",
+            TumbleRule::AcrossAxis => "boresight_rate",
+            TumbleRule::LineOfSight => "line_of_sight_rate",
+            TumbleRule::Geometry => "geometry",
+            TumbleRule::Unknown => "unknown",
         }
-        Ok(())
+    }
+}
+
+impl LineOfSightEnvelope {
+    /// The first rule the tumble breaks, (E2) before (E1); `None` inside the envelope
+    /// ([`Self::contains`] is `broken_tumble_rule().is_none()` with a positive limit).
+    pub fn broken_tumble_rule(&self) -> Option<TumbleRule> {
+        if !self.geometry_is_certifiable() && self.amplification <= MAX_OFF_PRINCIPAL_AMPLIFICATION
+        {
+            return Some(TumbleRule::Geometry);
+        }
+        let peak = self.peak_spin_rad_s();
+        if self.amplification > MAX_OFF_PRINCIPAL_AMPLIFICATION {
+            Some(TumbleRule::OffPrincipal)
+        } else if peak > self.sync_limit_rad_s {
+            Some(TumbleRule::Sync)
+        } else if peak * self.spin_across_axis > self.boresight_follow_rad_s {
+            Some(TumbleRule::AcrossAxis)
+        } else if self.target_rate_rad_s() > self.limit_rad_s() {
+            Some(TumbleRule::LineOfSight)
+        } else {
+            None
+        }
+    }
+
+    /// The line of sight's least length at which the boresight can follow this tumble's
+    /// grasping point: `v̄_G / (w_follow − √2 w_tr)` [m] (infinite when nothing is left).
+    pub fn range_needed_m(&self) -> f64 {
+        let left = self.limit_rad_s();
+        if left <= 0.0 {
+            return f64::INFINITY;
+        }
+        self.grasp_speed_m_s() / left
+    }
+
+    /// One line: what `rule` says about this tumble, with its numbers and the limit.
+    pub fn explain(&self, rule: TumbleRule) -> String {
+        let peak = self.peak_spin_rad_s();
+        match rule {
+            TumbleRule::OffPrincipal => format!(
+                "a tumble off the target's principal axes with the inertia ratio {:.2} (target.inertia_kg_m2 with its declared error) can speed up beyond what the attitude filter's in-sample bounds cover (ratio at most {MAX_OFF_PRINCIPAL_AMPLIFICATION}); spin about a principal axis",
+                self.amplification
+            ),
+            TumbleRule::Sync => format!(
+                "the target turns at up to {peak:.4} rad/s, faster than the {:.4} rad/s the base can hold within its rate limits (safety.attitude.omega_max_rad_s/omega_min_rad_s less the rate rows' margins), so the rate synchronisation cannot be certified; the tumble may be at most {:.4} rad/s",
+                self.sync_limit_rad_s,
+                self.max_spin_rad_s()
+            ),
+            TumbleRule::AcrossAxis => format!(
+                "the rate synchronisation would turn the boresight at up to {:.4} rad/s (the tumble's part across the corridor axis), faster than the {:.4} rad/s it may turn (safety.attitude.boresight_rate_max_rad_s less its margins); the tumble may be at most {:.4} rad/s",
+                peak * self.spin_across_axis,
+                self.boresight_follow_rad_s,
+                self.max_spin_rad_s()
+            ),
+            TumbleRule::LineOfSight => format!(
+                "the grasping point moves at up to {:.4} m/s and the servicer may come to {:.3} m of it, so the tumble turns the line of sight at up to {:.4} rad/s, more than the {:.4} rad/s left for it (the boresight follows at {:.4} rad/s, the translational filter's contract takes {:.4}); this geometry allows a tumble of at most {:.4} rad/s",
+                self.grasp_speed_m_s(),
+                self.los_min_m,
+                self.target_rate_rad_s(),
+                self.limit_rad_s(),
+                self.boresight_follow_rad_s,
+                self.translational_rad_s,
+                self.max_spin_rad_s()
+            ),
+            TumbleRule::Unknown => "the target's rate is not known (a non-finite estimate)".into(),
+            TumbleRule::Geometry => format!(
+                "the grasping point's geometry leaves no certified line of sight (least length {:.3} m, the contract's least σ {:.3})",
+                self.los_min_m, self.contract_sigma_min
+            ),
+        }
     }
 }
 

@@ -12,7 +12,7 @@ pub mod envelope;
 pub mod uncertainty;
 mod validate;
 
-pub use envelope::LineOfSightEnvelope;
+pub use envelope::{LineOfSightEnvelope, TumbleRule};
 pub use uncertainty::{Uncertainty, UncertaintySpec};
 pub use validate::ScenarioError;
 
@@ -38,6 +38,12 @@ pub struct Scenario {
     /// written back (a Monte Carlo run's file) reproduces the run on its own.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub uncertainty: Option<UncertaintySpec>,
+    /// What the world does that the mission does not declare (absent: nothing). Only the
+    /// simulator reads it, as the truth; the controllers and filters never do — it tests
+    /// that leaving the certified envelope during a run is detected (docs/SAFETY.md, "Safe
+    /// mode").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub world: Option<World>,
     /// Directory the scenario was loaded from; relative paths resolve against it.
     #[serde(skip)]
     pub base_dir: PathBuf,
@@ -208,6 +214,41 @@ pub struct Safety {
     pub robotic: SafetyRobotic,
     pub solver: Solver,
     pub fallback: Fallback,
+    /// What the layer does once the run has left the certified envelope.
+    pub safe_mode: SafeMode,
+}
+
+/// The safe mode the layer switches to when the run leaves the certified envelope
+/// (docs/SAFETY.md, "Safe mode"): the servicer retreats radially from the target, the arm
+/// brakes; every command still goes through the filters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SafeMode {
+    /// Speed of the radial retreat from the target's CoM [m/s]: the translational nominal
+    /// becomes `f_H = sat(m (v_s r̂_H − v_H) / T_t)` (`T_t` the translational brake time).
+    pub retreat_speed_m_s: f64,
+    /// Distance from the target's CoM at which the retreat stops and the servicer holds
+    /// (`v_s` = 0 beyond it) [m].
+    pub hold_range_m: f64,
+}
+
+/// Events of the world the mission does not declare (`[world]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct World {
+    /// The target's body rate jumps (a collision, an outgassing burst) at `t_s`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target_spin_change: Option<SpinChange>,
+}
+
+/// The target's body rate set to `omega_rad_s` at `t_s`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpinChange {
+    /// Mission time of the change [s] (applied at the first control step at or after it).
+    pub t_s: f64,
+    /// ω_T after the change, in F_T [rad/s].
+    pub omega_rad_s: V3,
 }
 
 /// Time constants of the bounded fallback commands (saturated brakes).

@@ -210,7 +210,26 @@ impl Scenario {
         self.validate_safety()?;
         self.validate_nominal()?;
         self.validate_uncertainty()?;
+        self.validate_world()?;
         self.validate_envelope()
+    }
+
+    fn validate_world(&self) -> Result<(), ScenarioError> {
+        let sm = &self.safety.safe_mode;
+        positive("safety.safe_mode.retreat_speed_m_s", sm.retreat_speed_m_s)?;
+        positive("safety.safe_mode.hold_range_m", sm.hold_range_m)?;
+        let Some(c) = self.world.as_ref().and_then(|w| w.target_spin_change) else {
+            return Ok(());
+        };
+        finite("world.target_spin_change.t_s", c.t_s)?;
+        if c.t_s < 0.0 {
+            return Err(invalid(
+                "world.target_spin_change.t_s",
+                c.t_s,
+                "must not be negative (the change happens during the run)",
+            ));
+        }
+        finite_all("world.target_spin_change.omega_rad_s", &c.omega_rad_s)
     }
 
     fn validate_uncertainty(&self) -> Result<(), ScenarioError> {
