@@ -89,6 +89,12 @@ impl Simulator {
         }
         let (h, n) = (self.p.physics_step, self.p.substeps);
         let t0 = self.state.t;
+        if self.world_due().is_some() {
+            return Err(SimError::Plant {
+                t: t0,
+                message: "the world's change of the target's rate ([world]) needs the simulator's own propagation, not an external plant".into(),
+            });
+        }
         let states = plant.propagate(cmd, h, n).map_err(|e| SimError::Plant {
             t: t0,
             message: e.0,

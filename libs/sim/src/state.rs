@@ -98,6 +98,9 @@ pub(crate) struct Params {
     pub grasp_point_t: Vector3<f64>,
     pub physics_step: f64,
     pub substeps: usize,
+    /// The world's undeclared change of the target's rate (`[world]`): at `t` [s], ω_T
+    /// [rad/s, F_T] becomes the given one.
+    pub spin_change: Option<(f64, Vector3<f64>)>,
 }
 
 /// The simulator: state + models + integrator.
@@ -167,6 +170,11 @@ impl Simulator {
             grasp_point_t: v3(tg.grasp_point_m),
             physics_step: scenario.mission.physics_step_s,
             substeps: scenario.physics_substeps(),
+            spin_change: scenario
+                .world
+                .as_ref()
+                .and_then(|w| w.target_spin_change)
+                .map(|c| (c.t_s, v3(c.omega_rad_s))),
         };
         Ok(Self {
             robot,
@@ -274,6 +282,7 @@ impl Simulator {
         if !cmd.is_finite() {
             return Err(SimError::NonFiniteCommand { t: self.state.t });
         }
+        self.apply_world();
         let u = cmd.as_vector();
         let mut x = self.state.pack();
         let h = self.p.physics_step;
@@ -293,6 +302,22 @@ impl Simulator {
         let period = h * self.p.substeps as f64;
         self.state = SimState::unpack(self.step as f64 * period, &x);
         Ok(())
+    }
+
+    /// The world's change of the target's rate, once it is due (at the start of the first
+    /// control period that begins at or after its time).
+    fn apply_world(&mut self) {
+        if let Some((_, w)) = self.world_due() {
+            self.state.w_t = w;
+            self.p.spin_change = None;
+        }
+    }
+
+    /// The world's change of the target's rate if it is due now.
+    pub(crate) fn world_due(&self) -> Option<(f64, Vector3<f64>)> {
+        let (t, w) = self.p.spin_change?;
+        // (within a rounding of the step count's time)
+        (self.state.t + 1e-9 * t.abs().max(1.0) >= t).then_some((t, w))
     }
 
     /// The true state `k` physics steps ago (`k` ≤ the steps of a period); before the
