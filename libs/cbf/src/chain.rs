@@ -11,6 +11,7 @@
 
 use crate::common::{FilterOutput, faults};
 use crate::filter::{Coupling, SafetyFilter};
+use crate::safe_mode::EnvelopeWatch;
 use crate::translational::TranslationalParams;
 use crate::{
     AttitudeFilter, AttitudeOutput, RoboticFilter, RoboticOutput, TranslationalFilter,
@@ -76,11 +77,14 @@ pub struct ChainOutput {
     pub applied: Command,
 }
 
-/// The three filters of the modular safety layer with the servicer model they evaluate.
+/// The three filters of the modular safety layer with the servicer model they evaluate,
+/// and the watch on the certified envelope that puts every stage in safe mode
+/// ([`crate::safe_mode`]).
 pub struct SafetyLayer {
     pub translational: TranslationalFilter,
     pub attitude: AttitudeFilter,
     pub robotic: RoboticFilter,
+    pub watch: EnvelopeWatch,
     model: Arc<Robot>,
 }
 
@@ -92,6 +96,7 @@ impl SafetyLayer {
             translational: TranslationalFilter::new(TranslationalParams::from_model(s, &robot)),
             attitude: AttitudeFilter::from_scenario(s, mass),
             robotic: RoboticFilter::from_scenario(s, robot.clone()),
+            watch: EnvelopeWatch::from_scenario(s),
             model: robot,
         }
     }
@@ -121,6 +126,7 @@ impl SafetyLayer {
             translational: TranslationalFilter::new(TranslationalParams::from_model(&t, &robot)),
             attitude: AttitudeFilter::from_scenario(&a, mass),
             robotic: RoboticFilter::from_scenario(&r, robot.clone()),
+            watch: EnvelopeWatch::from_scenario(s),
             model: robot,
         }
     }
@@ -172,31 +178,42 @@ impl SafetyLayer {
         }
     }
 
-    /// The translational stage (first in the causal order: ξ_tr = 0).
+    /// The translational stage (first in the causal order: ξ_tr = 0); in safe mode on the
+    /// retreat instead of `nominal`.
     pub fn translational_stage(
         &mut self,
         o: &Observation,
         nominal: Option<&Vector3<f64>>,
     ) -> TranslationalOutput {
-        self.translational
-            .stage(&self.model, o, &Coupling::default(), nominal)
+        let safe = self.watch.check(o).is_some();
+        let f = &mut self.translational;
+        let Some(x) = f.input(&self.model, o, &Coupling::default()) else {
+            return flag_safe_mode(f.invalid_state(), safe);
+        };
+        let retreat =
+            safe.then(|| f.toward_velocity(&x, &self.watch.retreat_velocity(&x.r_h, &x.omega_h)));
+        let nominal = if safe { retreat.as_ref() } else { nominal };
+        flag_safe_mode(f.filter_with(&x, nominal), safe)
     }
 
-    /// The attitude stage with the actuated safe force `force_b` [N, F_B] as ξ_att.
+    /// The attitude stage with the actuated safe force `force_b` [N, F_B] as ξ_att (its
+    /// nominal kept in safe mode).
     pub fn attitude_stage(
         &mut self,
         o: &Observation,
         force_b: &Vector3<f64>,
         nominal: Option<&Vector3<f64>>,
     ) -> AttitudeOutput {
+        let safe = self.watch.check(o).is_some();
         let xi = Coupling {
             force_b: *force_b,
             torque_b: Vector3::zeros(),
         };
-        self.attitude.stage(&self.model, o, &xi, nominal)
+        flag_safe_mode(self.attitude.stage(&self.model, o, &xi, nominal), safe)
     }
 
-    /// The robotic stage with the safe base force and torque [F_B] as ξ_rob.
+    /// The robotic stage with the safe base force and torque [F_B] as ξ_rob; in safe mode
+    /// on the arm's brake instead of `nominal`.
     pub fn robotic_stage(
         &mut self,
         o: &Observation,
@@ -204,11 +221,18 @@ impl SafetyLayer {
         torque_b: &Vector3<f64>,
         nominal: Option<&Vector7>,
     ) -> RoboticOutput {
+        let safe = self.watch.check(o).is_some();
         let xi = Coupling {
             force_b: *force_b,
             torque_b: *torque_b,
         };
-        self.robotic.stage(&self.model, o, &xi, nominal)
+        let f = &mut self.robotic;
+        let Some(x) = f.input(&self.model, o, &xi) else {
+            return flag_safe_mode(f.invalid_state(), safe);
+        };
+        let brake = safe.then(|| f.brake(&x));
+        let nominal = if safe { brake.as_ref() } else { nominal };
+        flag_safe_mode(f.filter_with(&x, nominal), safe)
     }
 
     /// The translational backup, as the partition applies it when the safe command is
@@ -232,6 +256,17 @@ impl SafetyLayer {
     ) -> RoboticOutput {
         flag_missing(self.robotic_stage(o, force_b, torque_b, None))
     }
+}
+
+/// Marks an output of a stage in safe mode (when `safe`).
+fn flag_safe_mode<const M: usize, const N: usize>(
+    mut out: FilterOutput<M, N>,
+    safe: bool,
+) -> FilterOutput<M, N> {
+    if safe {
+        out.report.faults |= faults::SAFE_MODE;
+    }
+    out
 }
 
 /// Marks an output computed with an input missing.

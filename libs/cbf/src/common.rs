@@ -42,11 +42,15 @@ pub mod faults {
     /// declared margins, `FilterReport::violation = 1 − λ` (`λ = 0`: the nominal model's
     /// rows). Only the translational filter degrades so (docs/SAFETY.md).
     pub const MARGINS_DEGRADED: u32 = 1 << 9;
+    /// The run has left the certified envelope (the tumble known at this step breaks a
+    /// rule of it, `crate::safe_mode`): the layer is in safe mode — the translational
+    /// nominal is the retreat, the robotic nominal the arm's brake, each still filtered.
+    pub const SAFE_MODE: u32 = 1 << 10;
     /// All flags, for masks.
-    pub const ALL: u32 = (1 << 10) - 1;
+    pub const ALL: u32 = (1 << 11) - 1;
 
     /// Names of the flags in bit order.
-    pub const NAMES: [&str; 10] = [
+    pub const NAMES: [&str; 11] = [
         "invalid_state",
         "invalid_nominal",
         "invalid_coupling",
@@ -57,6 +61,7 @@ pub mod faults {
         "nominal_missing",
         "qp_second_opinion",
         "margins_degraded",
+        "safe_mode",
     ];
 }
 

@@ -15,7 +15,8 @@
 //! * [`engine`]: the filters' QP on the exact dual active-set solver of `sc-qp`, with the
 //!   lexicographic relaxation; [`qp`]: the Clarabel engine, the independent reference.
 //! * [`monitor`]: every barrier from the true state; [`envelope`]: the model's bounds over
-//!   the certified envelope.
+//!   the certified envelope; [`safe_mode`]: leaving the envelope during a run, and what the
+//!   chain does then.
 //! * [`common`]: outputs, reports, [`faults`] flags; `step`: the one filter step the three
 //!   filters share (resolve the nominal, solve, report, brake, clamp), each adding its own
 //!   rows, certificate and braking law.
@@ -39,6 +40,7 @@ pub mod los_contract;
 pub mod monitor;
 pub mod qp;
 pub mod robotic;
+pub mod safe_mode;
 pub mod sampled;
 mod step;
 #[cfg(test)]

@@ -955,7 +955,22 @@ impl TranslationalFilter {
     }
 
     fn brake_prepared(&self, x: &TranslationalInput, p: &Prepared) -> (Vector3<f64>, Vector3<f64>) {
-        let f_b = p.r_bh * (-self.params.mass * x.v_h / self.params.brake_time);
+        self.toward_prepared(p, &-x.v_h)
+    }
+
+    /// `f_H = sat(m (v_ref − v_H)/T)` in the force box (the braking law with a reference
+    /// velocity `v_ref` [m/s, F_H]: the safe mode's retreat, [`crate::safe_mode`]); zero
+    /// when the input cannot be prepared.
+    pub fn toward_velocity(&self, x: &TranslationalInput, v_ref: &Vector3<f64>) -> Vector3<f64> {
+        match self.prepare(x) {
+            Ok(p) => self.toward_prepared(&p, &(v_ref - x.v_h)).0,
+            Err(_) => Vector3::zeros(),
+        }
+    }
+
+    /// `sat(m Δv/T)` in the force box for the velocity error `Δv` [m/s, F_H].
+    fn toward_prepared(&self, p: &Prepared, dv: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+        let f_b = p.r_bh * (self.params.mass * dv / self.params.brake_time);
         let f_b = common::sat_inf(&f_b, self.params.force_max * (1.0 - BOX_MARGIN));
         (p.r_bh.transpose() * f_b, f_b)
     }

@@ -236,10 +236,11 @@ fn fault_flags_are_stable_and_the_layer_is_built_from_the_model() {
     assert_eq!(sc_cbf::names::TRANSLATIONAL.len(), 2);
     assert_eq!(sc_cbf::names::ATTITUDE.len(), 7);
     assert_eq!(sc_cbf::names::ROBOTIC.len(), 42);
-    assert_eq!(faults::NAMES.len(), 10);
+    assert_eq!(faults::NAMES.len(), 11);
     assert_eq!(faults::NOMINAL_MISSING, 1 << 7);
     assert_eq!(faults::QP_SECOND_OPINION, 1 << 8);
     assert_eq!(faults::MARGINS_DEGRADED, 1 << 9);
+    assert_eq!(faults::SAFE_MODE, 1 << 10);
     assert_eq!(faults::ALL, (1 << faults::NAMES.len()) - 1);
     let s = scenario();
     // the safety layer: the servicer's mass, the robotic filter with the model

@@ -320,7 +320,7 @@ typedef struct ScSafeTranslational {
     uint64_t solve_ns; /* Wall time of the filter call [ns] */
     uint32_t solver_status; /* `sc_cbf::FilterStatus`: 0 skipped, 1 solved, 2 relaxed, 3 fallback [-] */
     uint32_t iterations; /* QP solver iterations [-] */
-    uint32_t fault_flags; /* `sc_cbf::faults` bits (5 upstream_missing, 7 nominal_missing, 9 margins_degraded: docs/ICD.md) [-] */
+    uint32_t fault_flags; /* `sc_cbf::faults` bits (5 upstream_missing, 7 nominal_missing, 9 margins_degraded, 10 safe_mode: docs/ICD.md) [-] */
     uint32_t n_constraints; /* Number of constraints in `h` and `phi` [-] */
     uint32_t phase; /* Mission phase of the nominal command filtered (0-based) [-] */
     uint32_t solve_cpu_ns; /* CPU time of the filter call on its thread, saturating at u32::MAX [ns] */
@@ -368,7 +368,7 @@ typedef struct ScSafeAttitude {
     uint64_t solve_ns; /* Wall time of the filter call [ns] */
     uint32_t solver_status; /* `sc_cbf::FilterStatus`: 0 skipped, 1 solved, 2 relaxed, 3 fallback [-] */
     uint32_t iterations; /* QP solver iterations [-] */
-    uint32_t fault_flags; /* `sc_cbf::faults` bits (5 upstream_missing, 7 nominal_missing, 9 margins_degraded: docs/ICD.md) [-] */
+    uint32_t fault_flags; /* `sc_cbf::faults` bits (5 upstream_missing, 7 nominal_missing, 9 margins_degraded, 10 safe_mode: docs/ICD.md) [-] */
     uint32_t n_constraints; /* Number of constraints in `h` and `phi` [-] */
     uint32_t phase; /* Mission phase of the nominal command filtered (0-based) [-] */
     uint32_t solve_cpu_ns; /* CPU time of the filter call on its thread, saturating at u32::MAX [ns] */
@@ -416,7 +416,7 @@ typedef struct ScSafeRobotic {
     uint64_t solve_ns; /* Wall time of the filter call [ns] */
     uint32_t solver_status; /* `sc_cbf::FilterStatus`: 0 skipped, 1 solved, 2 relaxed, 3 fallback [-] */
     uint32_t iterations; /* QP solver iterations [-] */
-    uint32_t fault_flags; /* `sc_cbf::faults` bits (5 upstream_missing, 7 nominal_missing, 9 margins_degraded: docs/ICD.md) [-] */
+    uint32_t fault_flags; /* `sc_cbf::faults` bits (5 upstream_missing, 7 nominal_missing, 9 margins_degraded, 10 safe_mode: docs/ICD.md) [-] */
     uint32_t n_constraints; /* Number of constraints in `h` and `phi` [-] */
     uint32_t phase; /* Mission phase of the nominal command filtered (0-based) [-] */
     uint32_t solve_cpu_ns; /* CPU time of the filter call on its thread, saturating at u32::MAX [ns] */

@@ -417,7 +417,7 @@ macro_rules! safe_msg {
                 pub solver_status: u32 = ["-"],
                 /// QP solver iterations
                 pub iterations: u32 = ["-"],
-                /// `sc_cbf::faults` bits (5 upstream_missing, 7 nominal_missing, 9 margins_degraded: docs/ICD.md)
+                /// `sc_cbf::faults` bits (5 upstream_missing, 7 nominal_missing, 9 margins_degraded, 10 safe_mode: docs/ICD.md)
                 pub fault_flags: u32 = ["-"],
                 /// Number of constraints in `h` and `phi`
                 pub n_constraints: u32 = ["-"],
