@@ -543,6 +543,37 @@ impl AttitudeFilter {
         })
     }
 
+    /// The emergency brake (no solver produced a command): the braking law scaled,
+    /// `τ_B = s τ_brake` with the largest `s ∈ [0, 1]` that keeps every joint-coupling
+    /// contract row ([`Self::hard_rows`]) — the robotic filter's certificate assumes the
+    /// base wrench stays within `joint_coupling_budget_nm` whatever the attitude filter
+    /// does, its emergencies included. The base then brakes at `s` times the braking
+    /// law's rate. Where the rows fail even at zero torque (the upstream force's share
+    /// beyond the budget), `s = 0`: no torque of ours adds to it. `s τ_brake` stays in the
+    /// torque box with `τ_brake`.
+    pub fn emergency_brake(&self, x: &AttitudeInput) -> Vector3<f64> {
+        self.within_contract(x, self.brake(x))
+    }
+
+    /// `s brake` with the largest `s ∈ [0, 1]` that keeps every contract row at `x`.
+    fn within_contract(&self, x: &AttitudeInput, brake: Vector3<f64>) -> Vector3<f64> {
+        let rows = self.hard_rows(x);
+        // along the segment from zero every contract row is `at_zero + s slope ≥ 0`
+        let s = rows[6..].iter().fold(1.0f64, |s, r| {
+            let (at_zero, slope) = (r.c, r.a.dot(&brake));
+            if !(at_zero.is_finite() && slope.is_finite()) {
+                0.0
+            } else if slope < 0.0 {
+                s.min((at_zero / -slope).max(0.0))
+            } else if at_zero < 0.0 {
+                0.0
+            } else {
+                s
+            }
+        });
+        if s >= 1.0 { brake } else { brake * s }
+    }
+
     fn brake_with(&self, inertia: &Matrix3<f64>, x: &AttitudeInput) -> Vector3<f64> {
         let t = -(inertia * (x.omega_b - x.omega_target_b)) / self.params.brake_time;
         common::sat_inf(&t, self.params.torque_max * (1.0 - BOX_MARGIN))
@@ -827,6 +858,10 @@ impl FilterStep<3, N> for AttitudeFilter {
 
     fn braking_law(&self, x: &AttitudeInput, p: &Prepared) -> Vector3<f64> {
         self.brake_with(&p.inertia, x)
+    }
+
+    fn emergency(&self, x: &AttitudeInput, p: &Prepared) -> Vector3<f64> {
+        self.within_contract(x, self.braking_law(x, p))
     }
 
     /// The acceleration-cap certificate (sampled-data rows); without one, the rows valid

@@ -1516,3 +1516,109 @@ mod lexicographic {
         relaxed_command_is_the_lexicographic_least_violation::<AttitudeFilter, 3, 7>();
     }
 }
+
+// ================================================================== the chain in safe mode
+
+/// The chain's stages in safe mode (a tumble beyond the certified envelope known at the
+/// observation, `sc_cbf::safe_mode`): every stage flagged; the translational stage is its
+/// filter on the retreat and the robotic stage its filter on the arm's brake, whatever
+/// their nominals; the attitude stage its filter on its own nominal. At any observation —
+/// a non-finite or huge tumble among them — every stage's command is finite and bounded.
+#[test]
+fn the_chain_in_safe_mode_filters_the_retreat_and_the_arm_brake() {
+    let s = scenario();
+    let model = robot();
+    let mut layer = sc_cbf::SafetyLayer::from_scenario(&s, model.clone());
+    let mut o = observation();
+    assert!(
+        layer.watch.check(&o).is_none(),
+        "the declared tumble is inside"
+    );
+    o.omega_t = Vector3::new(-0.3, 0.0, 0.0);
+    assert!(layer.watch.check(&o).is_some(), "0.3 rad/s is outside");
+    let f_nom = Vector3::new(5.0, -5.0, 5.0);
+    let tr = layer.translational_stage(&o, Some(&f_nom));
+    let x = layer
+        .translational
+        .input(&model, &o, &Coupling::default())
+        .unwrap();
+    let retreat = layer
+        .translational
+        .toward_velocity(&x, &layer.watch.retreat_velocity(&x.r_h, &x.omega_h));
+    let mut alone = TranslationalFilter::new(layer.translational.params.clone());
+    let mut expected = alone.filter_with(&x, Some(&retreat));
+    expected.report.faults |= faults::SAFE_MODE;
+    assert_eq!(bits(&tr), bits(&expected));
+    // the retreat points away from the target (in F_H, against the relative position)
+    assert!(retreat.dot(&x.r_h) > 0.0, "{retreat:?}");
+    let tau_nom = Vector3::new(0.5, 0.5, 0.5);
+    let at = layer.attitude_stage(&o, &tr.actuated, Some(&tau_nom));
+    assert_ne!(at.report.faults & faults::SAFE_MODE, 0);
+    let tau_m_nom = Vector7::from_element(0.5);
+    let rb = layer.robotic_stage(&o, &tr.actuated, &at.u, Some(&tau_m_nom));
+    let xr = layer
+        .robotic
+        .input(
+            &model,
+            &o,
+            &Coupling {
+                force_b: tr.actuated,
+                torque_b: at.u,
+            },
+        )
+        .unwrap();
+    let brake = layer.robotic.brake(&xr);
+    let mut expected =
+        RoboticFilter::from_scenario(&s, model.clone()).filter_with(&xr, Some(&brake));
+    expected.report.faults |= faults::SAFE_MODE;
+    assert_eq!(bits(&rb), bits(&expected));
+    for v in [f64::NAN, f64::INFINITY, -1e300, 1e3] {
+        for k in 0..OBSERVED {
+            let o = perturbed(&o, k, v);
+            let tr = layer.translational_stage(&o, Some(&f_nom));
+            let at = layer.attitude_stage(&o, &tr.actuated, Some(&tau_nom));
+            let rb = layer.robotic_stage(&o, &tr.actuated, &at.u, Some(&tau_m_nom));
+            assert!(
+                finite(&tr.actuated) && tr.actuated.amax() <= layer.translational.input_bound()
+            );
+            assert!(finite(&at.actuated) && at.actuated.amax() <= layer.attitude.input_bound());
+            assert!(finite(&rb.actuated) && rb.actuated.amax() <= layer.robotic.input_bound());
+        }
+    }
+}
+
+/// The attitude filter's emergency brake (no solver produced a command) keeps the
+/// joint-coupling contract the robotic filter's certificate rests on: with the arm
+/// extended and the base turning at 0.5 rad/s, the plain braking law's (saturated) torque
+/// breaks it; the emergency brake is gentler, within it, and still against the rate
+/// error; a slow base gets the plain braking law.
+#[test]
+fn the_attitude_emergency_brake_keeps_the_joint_coupling_contract() {
+    let s = scenario();
+    let model = robot();
+    let f = AttitudeFilter::from_scenario(&s, model.total_mass());
+    let at = |w: f64| {
+        let mut o = observation();
+        o.omega_b = Vector3::new(w, -w, w);
+        o.theta = Vector7::from_row_slice(&[0.0, -0.6, 0.0, 0.6, 0.0, -0.6, 0.0]);
+        f.input(&model, &o, &Coupling::default()).unwrap()
+    };
+    let holds = |x: &AttitudeInput, u: &Vector3<f64>| {
+        let hard = f.rows(x).unwrap().2;
+        hard[6..].iter().all(|r| r.a.dot(u) + r.c >= -1e-12)
+    };
+    let fast = at(0.5);
+    assert!(
+        !holds(&fast, &f.brake(&fast)),
+        "the plain brake breaks the contract"
+    );
+    let u = f.emergency_brake(&fast);
+    assert!(holds(&fast, &u) && u.amax() <= f.input_bound(), "{u}");
+    assert!(
+        u.dot(&(fast.omega_b - fast.omega_target_b)) < 0.0,
+        "still a brake: {u}"
+    );
+    let slow = at(1e-4);
+    assert!(holds(&slow, &f.brake(&slow)));
+    assert_eq!(f.emergency_brake(&slow), f.brake(&slow));
+}
