@@ -17,39 +17,7 @@ fn lock_step_telemetry_is_identical_to_in_process_run() {
     assert_clean(&rep, &out);
     assert_no_lost_wakeups(&out);
 
-    let setup = Setup::load(&repo().join("config/scenario.toml")).unwrap();
-    let names: Vec<String> = setup
-        .scenario
-        .mission
-        .phases
-        .iter()
-        .map(|p| p.name.clone())
-        .collect();
-    let mut tel = Vec::new();
-    let mut tim = Vec::new();
-    let mut records = Vec::new();
-    let end = {
-        let mut w = TelemetryWriter::new(&mut tel, &mut tim).unwrap();
-        let mut m = Mission::new(setup, RunOptions::default()).unwrap();
-        let end = m.run(|_, r| {
-            w.write(r).unwrap();
-            records.push(*r);
-        });
-        w.flush().unwrap();
-        end
-    };
-    let part = std::fs::read(out.join("telemetry.csv")).unwrap();
-    assert!(part == tel, "telemetry.csv differs from the in-process run");
-    // this process stands for the same build as the recorder: the summaries name it alike
-    sc_mission::build::register(env!("CARGO_PKG_VERSION"), env!("SC_GIT_COMMIT"));
-    let mut a = serde_json::to_value(summarize(&records, &end, &names, true)).unwrap();
-    let mut b = summary(&out);
-    // wall and CPU time are measurements, not results
-    for k in ["solve_time_us", "solve_cpu_us"] {
-        a.as_object_mut().unwrap().remove(k);
-        b.as_object_mut().unwrap().remove(k);
-    }
-    assert_eq!(a, b);
+    let b = assert_as_in_process(&repo().join("config/scenario.toml"), &out);
     assert_eq!(b["end"], "captured");
     // MCAP and counts; the MCAP's log time is mission time (Foxglove's timeline shows the
     // mission, not the host's uptime), the host's clock stays in publish_time
@@ -112,6 +80,78 @@ fn lock_step_telemetry_is_identical_to_in_process_run() {
             .sum::<u64>(),
         0,
         "{r}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The partition's telemetry.csv and summary.json (except solve times) in `out` equal
+/// those of the scenario `scenario` run in this process; returns the summary.
+fn assert_as_in_process(scenario: &std::path::Path, out: &std::path::Path) -> serde_json::Value {
+    let setup = Setup::load(scenario).unwrap();
+    let names: Vec<String> = setup
+        .scenario
+        .mission
+        .phases
+        .iter()
+        .map(|p| p.name.clone())
+        .collect();
+    let declared = setup.scenario.clone();
+    let mut tel = Vec::new();
+    let mut tim = Vec::new();
+    let mut records = Vec::new();
+    let end = {
+        let mut w = TelemetryWriter::new(&mut tel, &mut tim).unwrap();
+        let mut m = Mission::new(setup, RunOptions::default()).unwrap();
+        let end = m.run(|_, r| {
+            w.write(r).unwrap();
+            records.push(*r);
+        });
+        w.flush().unwrap();
+        end
+    };
+    let part = std::fs::read(out.join("telemetry.csv")).unwrap();
+    assert!(part == tel, "telemetry.csv differs from the in-process run");
+    // this process stands for the same build as the recorder: the summaries name it alike
+    sc_mission::build::register(env!("CARGO_PKG_VERSION"), env!("SC_GIT_COMMIT"));
+    let mut local = summarize(&records, &end, &names, true);
+    local.safe_mode = sc_mission::SafeModeSummary::of(&records, &declared);
+    let mut a = serde_json::to_value(local).unwrap();
+    let mut b = summary(out);
+    // wall and CPU time are measurements, not results
+    for k in ["solve_time_us", "solve_cpu_us"] {
+        a.as_object_mut().unwrap().remove(k);
+        b.as_object_mut().unwrap().remove(k);
+    }
+    assert_eq!(a, b);
+    b
+}
+
+/// The world spins the target up beyond the certified envelope (undeclared to the
+/// filters): the three filter processes go to safe mode on the same tick as the mission
+/// in one process, and the lock-step telemetry stays byte-identical to it.
+#[test]
+fn a_spin_up_puts_the_partition_in_safe_mode_as_in_process() {
+    let dir = tmp("spinup");
+    let out = dir.join("out");
+    let config = write_config(&dir, Some(40.0), None, 20.0);
+    let scenario = dir.join("scenario.toml");
+    let mut text = std::fs::read_to_string(&scenario).unwrap();
+    text.push_str("\n[world.target_spin_change]\nt_s = 20.0\nomega_rad_s = [-0.3, 0.0, 0.0]\n");
+    std::fs::write(&scenario, text).unwrap();
+    let rep = sc_ground::launch(&options(&config, &out, "spinup")).unwrap();
+    // no capture: the run does not pass
+    assert_eq!(rep.code, 1, "{rep:?}");
+    assert_clean(&rep, &out);
+    let b = assert_as_in_process(&scenario, &out);
+    let m = &b["safe_mode"];
+    assert!(
+        (m["entered_t_s"].as_f64().unwrap() - 20.1).abs() < 1e-9,
+        "{b}"
+    );
+    assert_eq!(m["undetected_t_s"], serde_json::Value::Null);
+    assert!(
+        b["violated_constraints"].as_array().unwrap().is_empty(),
+        "{b}"
     );
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -96,7 +96,7 @@ fn check_file(path: &Path, kind: Option<Kind>, mc_scenario: &Path) -> Result<Str
                 s.mission.control_period_s,
                 env.spin_rad_s,
                 env.max_spin_rad_s(),
-                uncertified_note(s, robot)
+                uncertified_note(s, robot) + &world_note(s)
             ))
         }
         Kind::Partition => {
@@ -152,6 +152,26 @@ fn uncertified_note(s: &Scenario, robot: &sc_multibody::Robot) -> String {
         ),
         None => String::new(),
     }
+}
+
+/// What the scenario's `[world]` does to the certified envelope (the filters never read
+/// it; the run then tests the safe mode, docs/SAFETY.md "Safe mode"); empty without one.
+fn world_note(s: &Scenario) -> String {
+    let Some(c) = s.world.as_ref().and_then(|w| w.target_spin_change) else {
+        return String::new();
+    };
+    let watch = sc_cbf::safe_mode::EnvelopeWatch::from_scenario(s);
+    let after = match watch.check_rate(&c.omega_rad_s, 0.0) {
+        Some(rule) => format!(
+            "outside the certified envelope ({}): the run tests the safe mode",
+            rule.name()
+        ),
+        None => "inside the certified envelope".into(),
+    };
+    format!(
+        "; NOTE: [world] changes the target's rate to {:?} rad/s at t = {} s, undeclared to the filters: {after}",
+        c.omega_rad_s, c.t_s
+    )
 }
 
 /// A scenario error without the file's name (the line starts with it).

@@ -143,9 +143,27 @@ const PROGRESS_EVERY_S: f64 = 10.0;
 /// The progress line every [`PROGRESS_EVERY_S`] of mission time: on a terminal one line
 /// redrawn in place, in a log one line per report. The phase is named, with its index
 /// as telemetry's `phase` column counts (from 0).
-fn progress_printer(duration: f64, phases: Vec<String>, tty: bool) -> impl FnMut(&StepRecord) {
+/// The first step in safe mode (or outside the envelope undetected) gets a line of its
+/// own, at once.
+fn progress_printer(
+    scenario: &sc_scenario::Scenario,
+    phases: Vec<String>,
+    tty: bool,
+) -> impl FnMut(&StepRecord) + use<> {
+    let duration = scenario.mission.duration_s;
+    let watch = sc_cbf::safe_mode::EnvelopeWatch::from_scenario(scenario);
     let mut last_print = 0.0;
+    let mut safe_mode_said = false;
     move |r: &StepRecord| {
+        if !safe_mode_said {
+            let entered = sc_mission::SafeModeSummary::with_watch(std::slice::from_ref(r), &watch)
+                .filter(|m| m.entered_t_s.is_some() || m.undetected_t_s.is_some());
+            if let Some(m) = entered {
+                safe_mode_said = true;
+                let nl = if tty { "\n" } else { "" };
+                errln!("{nl}  t = {:6.1} s  SAFE MODE: {}", r.t, m.line());
+            }
+        }
         if r.t - last_print >= PROGRESS_EVERY_S {
             last_print = r.t;
             let line = format!(
@@ -174,11 +192,7 @@ fn run_mission(m: MissionRun<'_>) -> anyhow::Result<Executed> {
     )?;
     let mut qp_file = m.dump_qp.map(create).transpose()?;
     let tty = std::io::IsTerminal::is_terminal(&std::io::stderr());
-    let mut progress = progress_printer(
-        m.setup.scenario.mission.duration_s,
-        phase_names(&m.setup.scenario),
-        tty,
-    );
+    let mut progress = progress_printer(&m.setup.scenario, phase_names(&m.setup.scenario), tty);
     let mut job = Job::new(m.setup);
     job.options = m.options;
     job.nominals = m.nominals;
@@ -292,6 +306,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let mut summary = summarize(&records, &end, &phase_names(&scenario), !a.no_filter);
     summary.uncertainty =
         sc_mission::UncertaintySummary::of(&records, &scenario, &robot, !a.no_filter);
+    summary.safe_mode = sc_mission::SafeModeSummary::of(&records, &scenario);
     write_summary(&out.join("summary.json"), &summary)?;
     if !a.no_figures {
         let alone = a.no_filter || a.no_compare || a.basilisk;

@@ -110,6 +110,39 @@ fn a_declared_uncertainty_the_rows_cannot_certify_is_named_before_the_run() {
     );
 }
 
+/// A `[world]` event (undeclared to the filters) is named by `check`, with what it does to
+/// the certified envelope; a negative time is refused on one line (docs/SCENARIO.md).
+#[test]
+fn a_world_event_is_named_and_checked() {
+    let d = tmp("check-world");
+    let world =
+        "[world.target_spin_change]\nt_s = 100.0\nomega_rad_s = [-0.3, 0.0, 0.0]\n\n[mission]";
+    let s = shipped_with(&d, "scenario.toml", "[mission]", world);
+    let o = check(&[s.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("NOTE: [world] changes the target's rate to [-0.3, 0.0, 0.0] rad/s at t = 100 s, undeclared to the filters: outside the certified envelope (rate_synchronisation): the run tests the safe mode"),
+        "{}",
+        text(&o)
+    );
+    let s = shipped_with(
+        &d,
+        "scenario.toml",
+        "[mission]",
+        &world.replace("t_s = 100.0", "t_s = -1.0"),
+    );
+    let o = check(&[s.to_str().unwrap()]);
+    assert_invalid(
+        &o,
+        &s,
+        &[
+            "`world.target_spin_change.t_s` = -1.0",
+            "must not be negative",
+        ],
+    );
+}
+
 #[test]
 fn a_scenario_with_a_bad_value_names_the_key_and_the_rule() {
     let d = tmp("check-bad-value");

@@ -16,6 +16,7 @@ pub mod nominal_source;
 pub mod out_dir;
 pub mod record;
 pub mod replay;
+pub mod safe_mode_summary;
 pub mod setup;
 pub mod stages;
 pub mod summary;
@@ -33,7 +34,7 @@ pub use record::{
 };
 pub use replay::ReplayNominals;
 pub use setup::{Setup, SetupError};
-pub use summary::{Summary, UncertaintySummary, summarize};
+pub use summary::{SafeModeSummary, Summary, UncertaintySummary, summarize};
 
 /// Names of all 51 constraints in telemetry order (translational, attitude, robotic).
 pub fn constraint_names() -> Vec<&'static str> {

@@ -2,6 +2,7 @@
 
 use crate::mission::MissionEnd;
 use crate::record::StepRecord;
+pub use crate::safe_mode_summary::SafeModeSummary;
 use sc_cbf::faults;
 use sc_sim::uncertainty::{NAVIGATION_ERROR_NAMES, NavigationError};
 use serde::{Deserialize, Serialize};
@@ -124,6 +125,11 @@ pub struct Summary {
     /// give a valid command: how often and from when (absent when every one did).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub partner_faults: BTreeMap<String, PartnerFaults>,
+    /// The safe mode and the certified envelope during the run (absent when the layer never
+    /// went to safe mode and the true tumble never left the envelope); see
+    /// [`SafeModeSummary::of`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub safe_mode: Option<SafeModeSummary>,
 }
 
 /// Steps on which a nominal controller gave no valid command (its filter flagged
@@ -176,6 +182,9 @@ impl Summary {
                 f.line(role, self.steps, reason(role).as_deref())
             ));
         }
+        if let Some(m) = &self.safe_mode {
+            line.push_str(&format!("; {}", m.line()));
+        }
         line
     }
 
@@ -185,14 +194,19 @@ impl Summary {
         self.captured && self.safe() && self.fault_count == 0
     }
 
-    /// Safe (README, "Verdicts and exit codes"): every barrier held on the true state
-    /// and (with a declared uncertainty) the realised errors within the declared bounds.
+    /// Safe (README, "Verdicts and exit codes"): every barrier held on the true state,
+    /// (with a declared uncertainty) the realised errors within the declared bounds, and
+    /// the true tumble never outside the certified envelope without the layer in safe mode.
     pub fn safe(&self) -> bool {
         let within = self
             .uncertainty
             .as_ref()
             .is_none_or(|u| u.outside_bounds.is_empty());
-        self.violated_constraints.is_empty() && within
+        let detected = self
+            .safe_mode
+            .as_ref()
+            .is_none_or(|m| m.undetected_t_s.is_none());
+        self.violated_constraints.is_empty() && within && detected
     }
 }
 
@@ -492,7 +506,9 @@ impl Tally {
             r.robotic.report.faults,
         ];
         for (name, f) in FILTERS.into_iter().zip(reported) {
-            if f != 0 {
+            // the safe mode is the defined reaction to leaving the envelope, reported on
+            // its own (`Summary::safe_mode`), not a fault of the step
+            if f & !faults::SAFE_MODE != 0 {
                 self.fault(r, name, flag_names(f));
             }
             self.partner(r, name, f);
@@ -595,6 +611,7 @@ impl Tally {
             faults: self.fault_events,
             uncertainty: None,
             partner_faults: self.partner_faults,
+            safe_mode: None,
         }
     }
 }

@@ -162,7 +162,9 @@ pub fn measure(
     trace_every: u32,
 ) -> (RunMetrics, Vec<TracePoint>, RunTiming) {
     let phase_names: Vec<String> = s.mission.phases.iter().map(|p| p.name.clone()).collect();
-    let sum = summarize(records, end, &phase_names, true);
+    let mut sum = summarize(records, end, &phase_names, true);
+    // a run whose true tumble left the envelope undetected is not safe
+    sum.safe_mode = sc_mission::SafeModeSummary::of(records, s);
     let min_h = sum
         .constraints
         .iter()
