@@ -7,11 +7,17 @@
 # partition). One line per scenario in OUT/sweep.csv:
 #   spin_rad_s,offset_m,verdict,cases,unsafe,detail
 # verdict: refused (check refused it, its line in detail), safe (every case safe on the
-# true state), unsafe (a case unsafe: the envelope is wrong; exit 1), failed (the red team
-# could not run; exit 1).
+# true state), announced (unsafe cases, each only after the layer had said, entering the
+# safe mode, that the line of sight was at risk; exit 1), unsafe (a case unsafe without
+# that: the envelope is wrong; exit 1), failed (the red team could not run; exit 1).
+#
+# With --spin-up-at T the tumble starts as in config/scenario.toml and the world spins the
+# target up to the swept rate at T s ([world.target_spin_change], undeclared to the
+# filters): the sweep of leaving the envelope during a run (docs/SAFETY.md, "Safe mode").
 #
 # Usage: scripts/envelope_sweep.sh [--out DIR] [--spins "0.05 0.08 …"]
 #                                  [--offsets "0.1 0.35 0.6"] [--cases LIST] [--partition]
+#                                  [--spin-up-at T]
 # Defaults: the acceptance grid, spins 0.05–0.30 rad/s, offsets 0.1–0.6 m (measured on two
 # cores: ≈ 4 min in process, ≈ 7 min and ≈ 1.5 GB of telemetry per accepted cell with
 # --partition; --cases narrows the red team).
@@ -22,6 +28,7 @@ spins="0.05 0.08 0.10 0.12 0.15 0.17 0.20 0.25 0.30"
 offsets="0.1 0.35 0.6"
 cases=""
 partition=
+spin_up=
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --out) out="${2:?--out needs a directory}"; shift 2 ;;
@@ -29,7 +36,8 @@ while [[ $# -gt 0 ]]; do
     --offsets) offsets="${2:?--offsets needs a list}"; shift 2 ;;
     --cases) cases="${2:?--cases needs a list}"; shift 2 ;;
     --partition) partition="--partition"; shift ;;
-    -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --spin-up-at) spin_up="${2:?--spin-up-at needs a time in s}"; shift 2 ;;
+    -h|--help) sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "envelope_sweep.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -45,10 +53,16 @@ for w in $spins; do
   for o in $offsets; do
     dir="$out/spin${w}_offset${o}"
     mkdir -p "$dir"
+    initial="[-$w, 0.0, 0.0]"
+    [[ -n "$spin_up" ]] && initial="$(sed -n '/^\[target\]/,/^\[/ s|^initial_omega_rad_s = \(\[[^]]*\]\).*|\1|p' "$here/config/scenario.toml")"
     sed -e "s|^urdf = \"servicer.urdf\"|urdf = \"$here/config/servicer.urdf\"|" \
-        -e "/^\[target\]/,/^\[/ s|^initial_omega_rad_s = .*|initial_omega_rad_s = [-$w, 0.0, 0.0]|" \
+        -e "/^\[target\]/,/^\[/ s|^initial_omega_rad_s = .*|initial_omega_rad_s = $initial|" \
         -e "s|^grasp_point_m = .*|grasp_point_m = [-0.55, $o, 0.0]|" \
         "$here/config/scenario.toml" > "$dir/scenario.toml"
+    if [[ -n "$spin_up" ]]; then
+      printf '\n[world.target_spin_change]\nt_s = %s\nomega_rad_s = [-%s, 0.0, 0.0]\n' \
+        "$spin_up" "$w" >> "$dir/scenario.toml"
+    fi
     if ! line="$("$sc" check "$dir/scenario.toml" 2>&1)"; then
       echo "$w,$o,refused,0,0,\"${line//\"/\'}\"" >> "$csv"
       echo "envelope_sweep: spin $w rad/s, offset $o m: refused by check" >&2
@@ -61,9 +75,11 @@ for w in $spins; do
     last="$(tail -1 "$dir/redteam.log")"
     n="$(sed -n 's/.*: \([0-9]*\) of \([0-9]*\) cases safe.*/\2/p' <<< "$last")"
     ok="$(sed -n 's/.*: \([0-9]*\) of \([0-9]*\) cases safe.*/\1/p' <<< "$last")"
+    announced="$(sed -n 's/.*(\([0-9]*\) of the unsafe announced.*/\1/p' <<< "$last")"
     case $rc in
       0) verdict=safe ;;
-      1) verdict=unsafe; status=1 ;;
+      1) if [[ "${announced:-0}" -eq $(( ${n:-0} - ${ok:-0} )) ]]; then verdict=announced; else verdict=unsafe; fi
+         status=1 ;;
       *) verdict=failed; status=1 ;; # the red team could not run (its log says why)
     esac
     echo "$w,$o,$verdict,${n:-0},$(( ${n:-0} - ${ok:-0} )),\"${last//\"/\'}\"" >> "$csv"
@@ -71,5 +87,5 @@ for w in $spins; do
   done
 done
 count() { grep -c "^[^,]*,[^,]*,$1," "$csv" || true; }
-echo "envelope_sweep: $(count safe) safe, $(count refused) refused, $(count unsafe) unsafe, $(count failed) failed -> $csv" >&2
+echo "envelope_sweep: $(count safe) safe, $(count refused) refused, $(count announced) announced, $(count unsafe) unsafe, $(count failed) failed -> $csv" >&2
 exit $status

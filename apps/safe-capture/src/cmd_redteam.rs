@@ -290,10 +290,22 @@ fn listed(items: &[String], before: &str, sep: &str, after: &str) -> String {
     }
 }
 
+/// `; safe mode in N cases (M of the unsafe announced at risk when it began)`, or nothing.
+fn safe_mode_part(s: &report::CampaignSummary) -> String {
+    if s.safe_mode_cases.is_empty() {
+        return String::new();
+    }
+    format!(
+        "; safe mode in {} cases ({} of the unsafe announced the line of sight at risk when it began)",
+        s.safe_mode_cases.len(),
+        s.announced_unsafe.len()
+    )
+}
+
 /// The final line.
 fn verdict_line(a: &Args, s: &report::CampaignSummary, wall: f64, under: &str) {
     outln!(
-        "redteam{}{under}: {} of {} cases safe{}{}; non-finite applied {}, out-of-bound applied {}; bystanders disturbed in {} cases{}; solve time geomean (worst case) {:.1} us, max {:.0} us; wall {:.1} s -> {}",
+        "redteam{}{under}: {} of {} cases safe{}{}{}; non-finite applied {}, out-of-bound applied {}; bystanders disturbed in {} cases{}; solve time geomean (worst case) {:.1} us, max {:.0} us; wall {:.1} s -> {}",
         match (a.partition, a.real_time) {
             (true, true) => " (partition, real time)",
             (true, false) => " (partition)",
@@ -307,6 +319,7 @@ fn verdict_line(a: &Args, s: &report::CampaignSummary, wall: f64, under: &str) {
         } else {
             format!(", {} could not run", s.errors.len())
         },
+        safe_mode_part(s),
         s.nonfinite_applied,
         s.out_of_bounds_applied,
         s.bystanders_disturbed.len(),

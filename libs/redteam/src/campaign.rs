@@ -73,13 +73,45 @@ pub struct CaseResult {
     pub disturbed_steps: PerSubsystem<usize>,
     /// Safety-layer time per step (wall clock) [µs].
     pub solve_time_us: TimeStats,
+    /// When the layer went to safe mode (the tumble left the certified envelope), and
+    /// what it said then (absent: never; docs/SAFETY.md, "Safe mode").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub safe_mode: Option<CaseSafeMode>,
+}
+
+/// A case's safe mode: when it began, whether the line of sight was certifiable at that
+/// range (the layer said "at risk" otherwise), when the true tumble was outside the
+/// envelope with no filter in safe mode (a silent exit), and the first step with a
+/// barrier below zero, if any (the true state).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CaseSafeMode {
+    pub entered_t_s: Option<f64>,
+    pub certifiable: bool,
+    pub undetected_t_s: Option<f64>,
+    pub first_violation_t_s: Option<f64>,
+}
+
+impl CaseSafeMode {
+    /// A barrier went below zero only after the layer had said, entering the safe mode,
+    /// that the line of sight was at risk: announced, not silent.
+    pub fn announced(&self) -> bool {
+        match (self.entered_t_s, self.first_violation_t_s) {
+            (Some(entered), Some(violated)) => !self.certifiable && violated >= entered,
+            _ => false,
+        }
+    }
 }
 
 impl CaseResult {
-    /// True if every barrier held at every physics step and every applied command was
-    /// finite and inside its bounds.
+    /// True if every barrier held at every physics step, every applied command was finite
+    /// and inside its bounds, and the true tumble never left the certified envelope
+    /// without the layer in safe mode.
     pub fn safe(&self) -> bool {
-        self.violated.is_empty() && self.nonfinite_applied == 0 && self.out_of_bounds_applied == 0
+        let detected = self.safe_mode.is_none_or(|m| m.undetected_t_s.is_none());
+        self.violated.is_empty()
+            && self.nonfinite_applied == 0
+            && self.out_of_bounds_applied == 0
+            && detected
     }
 
     /// Disturbed steps summed over the subsystems the case does not attack.
@@ -312,9 +344,25 @@ pub fn measure(
             .get("total")
             .copied()
             .unwrap_or_default(),
+        safe_mode: None,
     };
     count_steps(&mut r, records, &setup.scenario.limits);
+    r.safe_mode = sc_mission::SafeModeSummary::of(records, &setup.scenario).map(|m| CaseSafeMode {
+        entered_t_s: m.entered_t_s,
+        certifiable: m.line_of_sight_certifiable(),
+        undetected_t_s: m.undetected_t_s,
+        first_violation_t_s: first_violation(records),
+    });
     r
+}
+
+/// The time of the first record with a barrier below zero (or not evaluable) at its
+/// control step or the physics steps before it [s].
+fn first_violation(records: &[StepRecord]) -> Option<f64> {
+    records
+        .iter()
+        .find(|r| !(sc_mission::all_hold(&r.barriers) && sc_mission::all_hold(&r.barriers_between)))
+        .map(|r| r.t)
 }
 
 /// Called as cases finish: `(done, total, result)`.
@@ -341,6 +389,7 @@ mod tests {
             backup_steps: PerSubsystem::default(),
             disturbed_steps: PerSubsystem(disturbed),
             solve_time_us: TimeStats::default(),
+            safe_mode: None,
         }
     }
 

@@ -29,6 +29,14 @@ pub struct CampaignSummary {
     /// its own subsystem.
     #[serde(default)]
     pub bystanders_disturbed: Vec<String>,
+    /// Cases in which the layer went to safe mode (the tumble left the certified envelope),
+    /// and of the unsafe ones those whose first barrier below zero came after the layer
+    /// had said, entering it, that the line of sight was at risk (docs/SAFETY.md, "Safe
+    /// mode"); absent when none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub safe_mode_cases: Vec<String>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub announced_unsafe: Vec<String>,
     /// Per barrier: the smallest value over all cases and the case it came from.
     pub worst: BTreeMap<String, (f64, String)>,
     /// Safety-layer time per step over all cases [µs]: the largest geometric mean of a
@@ -56,7 +64,8 @@ pub enum ReportError {
 /// The header of `cases.csv`.
 const CASES_COLUMNS: &str = "case,target,strategy,end,final_time_s,steps,safe,violated,nonfinite_applied,out_of_bounds_applied,\
 substituted_translational,substituted_attitude,substituted_robotic,relaxed_translational,relaxed_attitude,relaxed_robotic,\
-backup_translational,backup_attitude,backup_robotic,bystander_disturbed_steps,worst_barrier,worst_normalised_margin,solve_geomean_us,solve_max_us\n";
+backup_translational,backup_attitude,backup_robotic,bystander_disturbed_steps,worst_barrier,worst_normalised_margin,solve_geomean_us,solve_max_us,\
+safe_mode_t_s,safe_mode_at_risk\n";
 
 /// The campaign's verdict before any case.
 fn empty_summary(cases: usize, wall_s: f64) -> CampaignSummary {
@@ -68,6 +77,8 @@ fn empty_summary(cases: usize, wall_s: f64) -> CampaignSummary {
         nonfinite_applied: 0,
         out_of_bounds_applied: 0,
         bystanders_disturbed: Vec::new(),
+        safe_mode_cases: Vec::new(),
+        announced_unsafe: Vec::new(),
         worst: BTreeMap::new(),
         solve_time_geomean_max_us: 0.0,
         solve_time_max_us: 0.0,
@@ -84,6 +95,12 @@ fn tally(summary: &mut CampaignSummary, r: &CaseResult) {
     }
     if r.bystander_disturbed_steps() > 0 {
         summary.bystanders_disturbed.push(r.case.clone());
+    }
+    if let Some(m) = r.safe_mode.filter(|m| m.entered_t_s.is_some()) {
+        summary.safe_mode_cases.push(r.case.clone());
+        if !r.safe() && m.announced() {
+            summary.announced_unsafe.push(r.case.clone());
+        }
     }
     summary.nonfinite_applied += r.nonfinite_applied;
     summary.out_of_bounds_applied += r.out_of_bounds_applied;
@@ -137,7 +154,7 @@ fn cases_line(r: &CaseResult, normalised: &[f64]) -> String {
         format!("{t},{a},{ro}")
     };
     format!(
-        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
         r.case,
         r.target,
         r.strategy,
@@ -156,6 +173,14 @@ fn cases_line(r: &CaseResult, normalised: &[f64]) -> String {
         wv,
         r.solve_time_us.geomean,
         r.solve_time_us.max,
+        r.safe_mode
+            .and_then(|m| m.entered_t_s)
+            .map(|t| t.to_string())
+            .unwrap_or_default(),
+        r.safe_mode
+            .filter(|m| m.entered_t_s.is_some())
+            .map(|m| (!m.certifiable).to_string())
+            .unwrap_or_default(),
     )
 }
 
@@ -257,6 +282,19 @@ fn markdown_header(m: &mut String, s: &CampaignSummary, how: &str) {
     }
     if !s.errors.is_empty() {
         let _ = writeln!(m, "Could not run: {}\n", s.errors.join("; "));
+    }
+    if !s.safe_mode_cases.is_empty() {
+        let _ = writeln!(
+            m,
+            "Safe mode (the tumble left the certified envelope; docs/SAFETY.md, \"Safe mode\") in {} cases: {}. Unsafe after the layer had said, entering it, that the line of sight was at risk: {}.\n",
+            s.safe_mode_cases.len(),
+            s.safe_mode_cases.join(", "),
+            if s.announced_unsafe.is_empty() {
+                "none".to_string()
+            } else {
+                s.announced_unsafe.join(", ")
+            }
+        );
     }
     let _ = writeln!(
         m,
