@@ -9,7 +9,8 @@
 # verdict: refused (check refused it, its line in detail), safe (every case safe on the
 # true state), announced (unsafe cases, each only after the layer had said, entering the
 # safe mode, that the line of sight was at risk; exit 1), unsafe (a case unsafe without
-# that: the envelope is wrong; exit 1), failed (the red team could not run; exit 1).
+# that: the envelope is wrong; exit 1), disturbed (every case safe, but an attack reached
+# a subsystem it does not attack; exit 1), failed (the red team could not run; exit 1).
 #
 # With --spin-up-at T the tumble starts as in config/scenario.toml and the world spins the
 # target up to the swept rate at T s ([world.target_spin_change], undeclared to the
@@ -37,7 +38,7 @@ while [[ $# -gt 0 ]]; do
     --cases) cases="${2:?--cases needs a list}"; shift 2 ;;
     --partition) partition="--partition"; shift ;;
     --spin-up-at) spin_up="${2:?--spin-up-at needs a time in s}"; shift 2 ;;
-    -h|--help) sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,24p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "envelope_sweep.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -76,9 +77,13 @@ for w in $spins; do
     n="$(sed -n 's/.*: \([0-9]*\) of \([0-9]*\) cases safe.*/\2/p' <<< "$last")"
     ok="$(sed -n 's/.*: \([0-9]*\) of \([0-9]*\) cases safe.*/\1/p' <<< "$last")"
     announced="$(sed -n 's/.*(\([0-9]*\) of the unsafe announced.*/\1/p' <<< "$last")"
+    unsafe=$(( ${n:-0} - ${ok:-0} ))
     case $rc in
       0) verdict=safe ;;
-      1) if [[ "${announced:-0}" -eq $(( ${n:-0} - ${ok:-0} )) ]]; then verdict=announced; else verdict=unsafe; fi
+      1) if grep -q 'could not run' <<< "$last"; then verdict=failed
+         elif [[ $unsafe -eq 0 ]]; then verdict=disturbed # only bystanders disturbed
+         elif [[ "${announced:-0}" -eq $unsafe ]]; then verdict=announced
+         else verdict=unsafe; fi
          status=1 ;;
       *) verdict=failed; status=1 ;; # the red team could not run (its log says why)
     esac
@@ -87,5 +92,5 @@ for w in $spins; do
   done
 done
 count() { grep -c "^[^,]*,[^,]*,$1," "$csv" || true; }
-echo "envelope_sweep: $(count safe) safe, $(count refused) refused, $(count announced) announced, $(count unsafe) unsafe, $(count failed) failed -> $csv" >&2
+echo "envelope_sweep: $(count safe) safe, $(count refused) refused, $(count announced) announced, $(count unsafe) unsafe, $(count disturbed) disturbed, $(count failed) failed -> $csv" >&2
 exit $status

@@ -472,12 +472,13 @@ fn rerun(a: RerunArgs) -> anyhow::Result<ExitCode> {
         .iter()
         .map(|p| p.name.clone())
         .collect();
-    let summary = summarize(
+    let mut summary = summarize(
         &r.records,
         &r.end,
         &phases,
         !RunOptions::default().no_filter,
     );
+    summary.safe_mode = sc_mission::SafeModeSummary::of(&r.records, &r.scenario);
     std::fs::write(
         out.join("summary.json"),
         serde_json::to_string_pretty(&summary)? + "\n",

@@ -306,7 +306,10 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let mut summary = summarize(&records, &end, &phase_names(&scenario), !a.no_filter);
     summary.uncertainty =
         sc_mission::UncertaintySummary::of(&records, &scenario, &robot, !a.no_filter);
-    summary.safe_mode = sc_mission::SafeModeSummary::of(&records, &scenario);
+    // (without the filters nothing acted on the safe mode: the nominals did)
+    summary.safe_mode = (!a.no_filter)
+        .then(|| sc_mission::SafeModeSummary::of(&records, &scenario))
+        .flatten();
     write_summary(&out.join("summary.json"), &summary)?;
     if !a.no_figures {
         let alone = a.no_filter || a.no_compare || a.basilisk;

@@ -126,7 +126,8 @@ impl SafetyLayer {
             translational: TranslationalFilter::new(TranslationalParams::from_model(&t, &robot)),
             attitude: AttitudeFilter::from_scenario(&a, mass),
             robotic: RoboticFilter::from_scenario(&r, robot.clone()),
-            watch: EnvelopeWatch::from_scenario(s),
+            // the envelope's margins grow with the attitude filter's hold
+            watch: EnvelopeWatch::from_scenario(&a),
             model: robot,
         }
     }
@@ -190,10 +191,12 @@ impl SafetyLayer {
         let Some(x) = f.input(&self.model, o, &Coupling::default()) else {
             return flag_safe_mode(f.invalid_state(), safe);
         };
-        let retreat =
-            safe.then(|| f.toward_velocity(&x, &self.watch.retreat_velocity(&x.r_h, &x.omega_h)));
-        let nominal = if safe { retreat.as_ref() } else { nominal };
-        flag_safe_mode(f.filter_with(&x, nominal), safe)
+        if !safe {
+            return f.filter_with(&x, nominal);
+        }
+        let retreat = f.toward_velocity(&x, &self.watch.retreat_velocity(&x.r_h, &x.omega_h));
+        let out = f.filter_with(&x, Some(&retreat));
+        in_safe_mode(out, nominal, f.input_bound())
     }
 
     /// The attitude stage with the actuated safe force `force_b` [N, F_B] as ξ_att (its
@@ -230,9 +233,11 @@ impl SafetyLayer {
         let Some(x) = f.input(&self.model, o, &xi) else {
             return flag_safe_mode(f.invalid_state(), safe);
         };
-        let brake = safe.then(|| f.brake(&x));
-        let nominal = if safe { brake.as_ref() } else { nominal };
-        flag_safe_mode(f.filter_with(&x, nominal), safe)
+        if !safe {
+            return f.filter_with(&x, nominal);
+        }
+        let out = f.filter_with(&x, Some(&f.brake(&x)));
+        in_safe_mode(out, nominal, f.input_bound())
     }
 
     /// The translational backup, as the partition applies it when the safe command is
@@ -256,6 +261,20 @@ impl SafetyLayer {
     ) -> RoboticOutput {
         flag_missing(self.robotic_stage(o, force_b, torque_b, None))
     }
+}
+
+/// Marks an output of a stage in safe mode, with the flag the partner's nominal `given`
+/// would have raised ([`faults::NOMINAL_MISSING`], [`faults::INVALID_NOMINAL`]): the
+/// partner is still accounted for, and the partition's recorder still knows that no
+/// nominal came (`bound`: the filter's input bound).
+fn in_safe_mode<const M: usize, const N: usize>(
+    mut out: FilterOutput<M, N>,
+    given: Option<&SVector<f64, M>>,
+    bound: f64,
+) -> FilterOutput<M, N> {
+    let (_, partner) = crate::common::resolve_nominal(given, bound, SVector::zeros);
+    out.report.faults |= faults::SAFE_MODE | partner;
+    out
 }
 
 /// Marks an output of a stage in safe mode (when `safe`).

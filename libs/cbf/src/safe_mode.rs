@@ -24,7 +24,7 @@
 
 use nalgebra::Vector3;
 use sc_core::Observation;
-use sc_scenario::{Scenario, TumbleRule};
+use sc_scenario::{LineOfSightEnvelope, Scenario, TumbleRule};
 
 /// What the safe mode does (`[safety.safe_mode]`).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -52,7 +52,7 @@ impl EnvelopeWatch {
         // the watch never reads the world's undeclared events
         scenario.world = None;
         Self {
-            rate_error: s.uncertainty_bounds().navigation.target_rate_rad_s.bound(),
+            rate_error: s.target_rate_error(),
             params: SafeModeParams {
                 retreat_speed: s.safety.safe_mode.retreat_speed_m_s,
                 hold_range: s.safety.safe_mode.hold_range_m,
@@ -66,29 +66,42 @@ impl EnvelopeWatch {
         self.params
     }
 
-    /// The rule of the envelope the tumble known at `o` breaks (`None`: inside). A
-    /// non-finite estimate breaks the envelope too (nothing is known about the tumble).
+    /// The rule of the envelope the tumble known at `o` breaks (`None`: inside): the
+    /// fastest tumble within `ē` of the estimate. A non-finite or overflowing estimate is
+    /// [`TumbleRule::Unknown`] (nothing is known about the tumble).
     pub fn check(&self, o: &Observation) -> Option<TumbleRule> {
         let w = o.omega_t;
-        self.check_rate(&[w.x, w.y, w.z], self.rate_error)
-    }
-
-    /// The rule broken by the fastest tumble within `error` [rad/s] of `omega_t` [rad/s,
-    /// F_T] (the summary checks the true tumble with `error` = 0).
-    pub fn check_rate(&self, omega_t: &[f64; 3], error: f64) -> Option<TumbleRule> {
-        if !(omega_t.iter().all(|x| x.is_finite()) && error.is_finite()) {
-            return Some(TumbleRule::Unknown);
-        }
-        let tumble = self.scenario.tumble_from_knowledge(omega_t, error);
-        self.scenario
-            .line_of_sight_envelope_for(&tumble)
+        self.envelope(&[w.x, w.y, w.z], self.rate_error)
             .broken_tumble_rule()
     }
 
-    /// The envelope of the fastest tumble within `error` of `omega_t` (numbers for
+    /// The rule the true tumble `omega_t` [rad/s, F_T] breaks, judged on the watch's own
+    /// premise: within `3ē` of the declared axis it is that axis's constant spin, nothing
+    /// added. An estimate is within `ē` of the truth, and the watch takes an estimate
+    /// within `2ē` of the axis for the axis's spin at `|â·ω̂| + ē ≥ |â·ω|` and any other
+    /// off the axes at `‖ω̂‖ + ē ≥ ‖ω‖` (amplification `κ`): its worst case is never below
+    /// this one, so a true tumble outside is seen by the watch too (the summary's check
+    /// for a silent exit).
+    pub fn check_truth(&self, omega_t: &[f64; 3]) -> Option<TumbleRule> {
+        self.truth_envelope(omega_t).broken_tumble_rule()
+    }
+
+    /// The envelope of the true tumble `omega_t` on the watch's premise (numbers for
     /// reports).
-    pub fn envelope_of(&self, omega_t: &[f64; 3], error: f64) -> sc_scenario::LineOfSightEnvelope {
-        let tumble = self.scenario.tumble_from_knowledge(omega_t, error);
+    pub fn truth_envelope(&self, omega_t: &[f64; 3]) -> LineOfSightEnvelope {
+        let tolerance = self.scenario.watch_axis_tolerance_rad_s() + self.rate_error;
+        let tumble = self.scenario.tumble_from_knowledge(omega_t, tolerance, 0.0);
+        self.scenario.line_of_sight_envelope_for(&tumble)
+    }
+
+    /// The envelope of the fastest tumble within `error` of the estimate `omega_t`: about
+    /// the declared axis within `2ē` of it (a truth within `ē` of the axis seen through an
+    /// estimate up to `ē` off is not mistaken for a tumble off the axes).
+    fn envelope(&self, omega_t: &[f64; 3], error: f64) -> LineOfSightEnvelope {
+        let tolerance = self.scenario.watch_axis_tolerance_rad_s();
+        let tumble = self
+            .scenario
+            .tumble_from_knowledge(omega_t, tolerance, error);
         self.scenario.line_of_sight_envelope_for(&tumble)
     }
 
@@ -130,19 +143,100 @@ mod tests {
     /// the declared principal axis by more than the error, or one not known at all.
     #[test]
     fn the_envelope_watch_tells_the_campaigns_tumbles_from_faster_ones() {
-        let w = watch();
-        let e = 1e-3;
-        for across in [[0.0, 0.0], [e, 0.0], [0.0, -e], [0.7 * e, 0.7 * e]] {
-            assert_eq!(w.check_rate(&[-0.12, across[0], across[1]], e), None);
+        let mut s = Scenario::load(std::path::Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../config/scenario.toml"
+        )))
+        .unwrap();
+        s.set_uncertainty(sc_scenario::UncertaintySpec {
+            profile: sc_scenario::uncertainty::REALISTIC_NAME.into(),
+            seed: 0,
+            model: None,
+            actuators: None,
+            navigation: None,
+            truth: None,
+        })
+        .unwrap();
+        let e = s.target_rate_error();
+        assert_eq!(e, 1e-3);
+        let w = EnvelopeWatch::from_scenario(&s);
+        let rule = |omega: [f64; 3]| w.envelope(&omega, e).broken_tumble_rule();
+        // estimates of the fastest draw (0.12) within 2ē of the axis (a truth up to ē off
+        // it, seen through an estimate up to ē off; plus the gate's rounding)
+        let r = 2.0 * e + sc_scenario::envelope::KNOWLEDGE_ROUNDING_RAD_S;
+        for d in [
+            [0.0, 0.0, 0.0],
+            [e, 0.0, 0.0],
+            [-e, 0.0, 0.0],
+            [0.0, r, 0.0],
+            [0.0, 0.0, -r],
+            [0.0, 0.7 * e, 0.7 * e],
+        ] {
+            assert_eq!(rule([-0.12 + d[0], d[1], d[2]]), None, "{d:?}");
         }
-        assert_eq!(w.check_rate(&[0.0; 3], e), None);
-        assert_eq!(w.check_rate(&[-0.13, 0.0, 0.0], e), Some(TumbleRule::Sync));
-        assert_eq!(w.check_rate(&[-0.124, 0.0, 0.0], e), Some(TumbleRule::Sync));
-        assert!(w.check_rate(&[-0.08, 0.05, 0.0], e).is_some());
-        for bad in [f64::NAN, f64::INFINITY] {
-            assert_eq!(w.check_rate(&[bad, 0.0, 0.0], e), Some(TumbleRule::Unknown));
-            assert_eq!(w.check_rate(&[0.0; 3], bad), Some(TumbleRule::Unknown));
+        assert_eq!(rule([0.0; 3]), None);
+        assert_eq!(rule([-0.124, 0.0, 0.0]), Some(TumbleRule::Sync));
+        assert_eq!(rule([-0.13, 0.0, 0.0]), Some(TumbleRule::Sync));
+        assert!(rule([-0.08, 0.05, 0.0]).is_some());
+        for bad in [f64::NAN, f64::INFINITY, 1e300] {
+            assert_eq!(rule([bad, bad, 0.0]), Some(TumbleRule::Unknown), "{bad}");
         }
+        // the truth on the watch's premise: near the axis a constant spin, nothing added
+        assert_eq!(w.check_truth(&[-0.12, 5e-4, 0.0]), None);
+        assert_eq!(w.check_truth(&[0.0; 3]), None);
+        assert_eq!(w.check_truth(&[-0.125, 0.0, 0.0]), Some(TumbleRule::Sync));
+    }
+
+    /// Never silent: wherever the true tumble is outside on the watch's premise
+    /// (`check_truth`), every estimate within `ē` of it makes the watch fire — on and off
+    /// the declared axis, below, at and beyond the limits.
+    #[test]
+    fn the_watch_fires_whenever_the_truth_is_outside() {
+        let mut s = Scenario::load(std::path::Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../config/scenario.toml"
+        )))
+        .unwrap();
+        s.set_uncertainty(sc_scenario::UncertaintySpec {
+            profile: sc_scenario::uncertainty::REALISTIC_NAME.into(),
+            seed: 0,
+            model: None,
+            actuators: None,
+            navigation: None,
+            truth: None,
+        })
+        .unwrap();
+        let w = EnvelopeWatch::from_scenario(&s);
+        let e = s.target_rate_error();
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let dirs = [
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+            [h, h, 0.0],
+            [-h, 0.0, h],
+            [0.0, -h, -h],
+        ];
+        let (mut outside, mut fired) = (0, 0);
+        for spin in [0.0, 0.05, 0.1, 0.12, 0.1235, 0.125, 0.13, 0.2, 0.3] {
+            for off in [0.0, 0.5, 1.0, 2.0, 3.0, 3.5, 5.0, 20.0] {
+                let truth = [-spin, off * e, 0.3 * off * e];
+                if w.check_truth(&truth).is_none() {
+                    continue;
+                }
+                outside += 1;
+                for d in dirs {
+                    let est: [f64; 3] = std::array::from_fn(|i| truth[i] + e * d[i]);
+                    let fires = w.envelope(&est, e).broken_tumble_rule().is_some();
+                    assert!(fires, "truth {truth:?} outside, estimate {est:?} not");
+                    fired += 1;
+                }
+            }
+        }
+        assert!(outside > 20 && fired == outside * dirs.len(), "{outside}");
     }
 
     /// The retreat: `v_s` radially in F_R inside the hold range, at rest in F_R beyond it,

@@ -955,24 +955,30 @@ impl TranslationalFilter {
     }
 
     fn brake_prepared(&self, x: &TranslationalInput, p: &Prepared) -> (Vector3<f64>, Vector3<f64>) {
-        self.toward_prepared(p, &-x.v_h)
+        self.toward(&p.r_bh, &-x.v_h)
     }
 
     /// `f_H = sat(m (v_ref − v_H)/T)` in the force box (the braking law with a reference
     /// velocity `v_ref` [m/s, F_H]: the safe mode's retreat, [`crate::safe_mode`]); zero
-    /// when the input cannot be prepared.
+    /// when the attitudes are not unit quaternions (a state the filter refuses anyway, as
+    /// it does non-finite velocities, before it looks at any nominal).
     pub fn toward_velocity(&self, x: &TranslationalInput, v_ref: &Vector3<f64>) -> Vector3<f64> {
-        match self.prepare(x) {
-            Ok(p) => self.toward_prepared(&p, &(v_ref - x.v_h)).0,
-            Err(_) => Vector3::zeros(),
+        // only the attitudes (the filter itself refuses an input it cannot prepare)
+        match (unit_quat(&x.q_hr), unit_quat(&x.q_rb)) {
+            (Some(q_hr), Some(q_rb)) => {
+                let r_bh = (quat::to_matrix(&q_hr) * quat::to_matrix(&q_rb)).transpose();
+                self.toward(&r_bh, &(v_ref - x.v_h)).0
+            }
+            _ => Vector3::zeros(),
         }
     }
 
-    /// `sat(m Δv/T)` in the force box for the velocity error `Δv` [m/s, F_H].
-    fn toward_prepared(&self, p: &Prepared, dv: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
-        let f_b = p.r_bh * (self.params.mass * dv / self.params.brake_time);
+    /// `sat(m Δv/T)` in the force box for the velocity error `Δv` [m/s, F_H], with `R_BH`
+    /// `r_bh`: `(f_H, f_B)`.
+    fn toward(&self, r_bh: &Matrix3<f64>, dv: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+        let f_b = r_bh * (self.params.mass * dv / self.params.brake_time);
         let f_b = common::sat_inf(&f_b, self.params.force_max * (1.0 - BOX_MARGIN));
-        (p.r_bh.transpose() * f_b, f_b)
+        (r_bh.transpose() * f_b, f_b)
     }
 
     /// The filter's command when its nominal is missing: the safety QP on the substitute

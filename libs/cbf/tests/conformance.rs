@@ -1572,6 +1572,20 @@ fn the_chain_in_safe_mode_filters_the_retreat_and_the_arm_brake() {
         RoboticFilter::from_scenario(&s, model.clone()).filter_with(&xr, Some(&brake));
     expected.report.faults |= faults::SAFE_MODE;
     assert_eq!(bits(&rb), bits(&expected));
+    // the partner is still accounted for: a missing or invalid nominal is flagged
+    let silent = layer.translational_stage(&o, None);
+    assert_eq!(
+        silent.report.faults & (faults::SAFE_MODE | faults::NOMINAL_MISSING),
+        faults::SAFE_MODE | faults::NOMINAL_MISSING
+    );
+    assert_eq!(bits(&silent)[..6], bits(&tr)[..6], "the same retreat");
+    let bad = layer.robotic_stage(
+        &o,
+        &tr.actuated,
+        &at.u,
+        Some(&Vector7::from_element(f64::NAN)),
+    );
+    assert_ne!(bad.report.faults & faults::INVALID_NOMINAL, 0);
     for v in [f64::NAN, f64::INFINITY, -1e300, 1e3] {
         for k in 0..OBSERVED {
             let o = perturbed(&o, k, v);

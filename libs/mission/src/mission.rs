@@ -165,6 +165,11 @@ impl Mission {
         &mut self,
         mut plant: Box<dyn Plant + Send>,
     ) -> Result<(), sc_sim::PlantError> {
+        if self.sim.world_event_pending() {
+            return Err(sc_sim::PlantError(
+                "the scenario's [world] event needs the simulator's own propagation: an external plant cannot apply it".into(),
+            ));
+        }
         plant.start(self.sim.state())?;
         self.plant = Some(plant);
         Ok(())

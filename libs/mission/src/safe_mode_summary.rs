@@ -21,8 +21,8 @@ pub struct SafeModeSummary {
     /// The first step on which the true tumble was outside the envelope and no filter in
     /// safe mode [s]: a silent exit (`None`: none).
     pub undetected_t_s: Option<f64>,
-    /// The rule the true tumble broke when the safe mode began (`inside` when the
-    /// knowledge's worst case broke it first), and the rule's numbers in one line.
+    /// The rule the true tumble broke when the safe mode began (`estimate_only` when only
+    /// the estimate's worst case broke one), and the rule's numbers in one line.
     pub rule: String,
     pub reason: String,
     /// The true line of sight's length when the safe mode began, and the least length at
@@ -49,7 +49,7 @@ impl SafeModeSummary {
             .iter()
             .any(|f| f & faults::SAFE_MODE != 0)
         };
-        let outside = |r: &StepRecord| watch.check_rate(&true_rate(r), 0.0).is_some();
+        let outside = |r: &StepRecord| watch.check_truth(&true_rate(r)).is_some();
         let entered = records.iter().find(|r| in_safe_mode(r));
         let truth_left = records.iter().find(|r| outside(r));
         if entered.is_none() && truth_left.is_none() {
@@ -57,16 +57,16 @@ impl SafeModeSummary {
         }
         let undetected = records.iter().find(|r| outside(r) && !in_safe_mode(r));
         let at = entered.or(truth_left)?;
-        let env = watch.envelope_of(&true_rate(at), 0.0);
+        let env = watch.truth_envelope(&true_rate(at));
         let rule = env.broken_tumble_rule();
         Some(Self {
             entered_t_s: entered.map(|r| r.t),
             steps: records.iter().filter(|r| in_safe_mode(r)).count(),
             truth_left_t_s: truth_left.map(|r| r.t),
             undetected_t_s: undetected.map(|r| r.t),
-            rule: rule.map_or("inside", |r| r.name()).into(),
+            rule: rule.map_or(ESTIMATE_ONLY, |r| r.name()).into(),
             reason: rule.map(|r| env.explain(r)).unwrap_or_else(|| {
-                "the true tumble was inside the envelope; the estimate's worst case was not".into()
+                "the true tumble was inside the envelope; the estimate's worst case (ē added) was not".into()
             }),
             line_of_sight_m: (at.obs.grasp_r - at.obs.com_r).norm(),
             range_needed_m: env.range_needed_m(),
@@ -76,14 +76,17 @@ impl SafeModeSummary {
     /// The line of sight was long enough for the boresight to follow the true tumble when
     /// the safe mode began (its certificate, docs/SAFETY.md).
     pub fn line_of_sight_certifiable(&self) -> bool {
-        self.line_of_sight_m >= self.range_needed_m
+        // a tumble off the principal axes beyond the rows' bounds, a geometry the rows are
+        // not defined for or an unknown one: no distance makes it certifiable
+        let by_range = !matches!(self.rule.as_str(), "off_principal" | "geometry" | "unknown");
+        by_range && self.line_of_sight_m >= self.range_needed_m
     }
 
     /// One line for the verdict.
     pub fn line(&self) -> String {
         let mut s = match self.entered_t_s {
             Some(t) => format!(
-                "safe mode from t = {t:.1} s (the tumble left the certified envelope: {}; {})",
+                "safe mode from t = {t:.1} s (the tumble known left the certified envelope: {}; {})",
                 self.rule,
                 self.range_line()
             ),
@@ -115,6 +118,9 @@ impl SafeModeSummary {
         }
     }
 }
+
+/// `rule` when the watch's worst case left the envelope while the true tumble did not.
+const ESTIMATE_ONLY: &str = "estimate_only";
 
 /// The true ω_T [rad/s, F_T] of a record.
 fn true_rate(r: &StepRecord) -> [f64; 3] {

@@ -189,9 +189,15 @@ impl Summary {
     }
 
     /// Passed, the exit code 0 of `run`, `launch` and every run of `montecarlo`:
-    /// captured, [`Self::safe`] and without a fault.
+    /// captured, [`Self::safe`], without a fault and never in safe mode (the safe mode is
+    /// decided step by step: a tumble known inside again hands the commands back to the
+    /// partners, but the run left the certified envelope).
     pub fn passed(&self) -> bool {
-        self.captured && self.safe() && self.fault_count == 0
+        let never_safe_mode = self
+            .safe_mode
+            .as_ref()
+            .is_none_or(|m| m.entered_t_s.is_none());
+        self.captured && self.safe() && self.fault_count == 0 && never_safe_mode
     }
 
     /// Safe (README, "Verdicts and exit codes"): every barrier held on the true state,

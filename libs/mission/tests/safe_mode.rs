@@ -9,21 +9,38 @@ use sc_cbf::faults;
 use sc_mission::{SafeModeSummary, StepRecord, summarize};
 use sc_scenario::{SpinChange, World};
 
-/// The default mission with the target spun up to `rate` [rad/s] about its spin axis at
-/// `t_s`: the summary (with its safe mode) and the records.
-fn spun_up(t_s: f64, rate: f64) -> (sc_mission::Summary, Vec<StepRecord>) {
+/// The default mission with the target's rate set to `omega` [rad/s, F_T] at `t_s`
+/// (under the `realistic` profile if `realistic`): the summary (with its safe mode) and
+/// the records.
+fn changed(t_s: f64, omega: [f64; 3], realistic: bool) -> (sc_mission::Summary, Vec<StepRecord>) {
     let mut setup = common::default_setup();
     setup.scenario.world = Some(World {
         target_spin_change: Some(SpinChange {
             t_s,
-            omega_rad_s: [-rate, 0.0, 0.0],
+            omega_rad_s: omega,
         }),
     });
+    if realistic {
+        let spec = sc_scenario::UncertaintySpec {
+            profile: sc_scenario::uncertainty::REALISTIC_NAME.into(),
+            seed: 3,
+            model: None,
+            actuators: None,
+            navigation: None,
+            truth: None,
+        };
+        setup.scenario.set_uncertainty(spec).unwrap();
+    }
     let scenario = setup.scenario.clone();
     let (_, records, end, phases) = common::run_mission(setup);
     let mut summary = summarize(&records, &end, &phases, true);
     summary.safe_mode = SafeModeSummary::of(&records, &scenario);
     (summary, records)
+}
+
+/// [`changed`] about the declared spin axis to `rate`, exact navigation.
+fn spun_up(t_s: f64, rate: f64) -> (sc_mission::Summary, Vec<StepRecord>) {
+    changed(t_s, [-rate, 0.0, 0.0], false)
 }
 
 fn in_safe_mode(r: &StepRecord) -> [bool; 3] {
@@ -78,4 +95,57 @@ fn a_spin_change_inside_the_envelope_is_no_safe_mode() {
     assert_eq!(s.safe_mode, None);
     assert!(records.iter().all(|r| in_safe_mode(r) == [false; 3]));
     assert!(s.passed(), "{}", s.verdict());
+}
+
+/// Under the `realistic` profile (the target's rate known to 1e-3 rad/s) a spin-up beyond
+/// the envelope is seen on the first step after it too, never silently, and the line of
+/// sight holds (the profile's link-mass errors, which no robotic row covers yet, can break
+/// a joint-rate barrier while the arm brakes: docs/SAFETY.md, "Model error … not in the
+/// rows yet"); a change that stays near the declared axis and inside the envelope (1e-4
+/// rad/s across it) is neither a false alarm nor a silent exit.
+#[test]
+fn under_realistic_navigation_the_watch_is_neither_late_nor_jumpy() {
+    let (s, records) = changed(40.0, [-0.25, 0.0, 0.0], true);
+    let m = s.safe_mode.as_ref().expect("a safe mode");
+    let first = records.iter().position(|r| r.t > 40.0).unwrap();
+    assert_eq!(m.entered_t_s, Some(records[first].t), "{m:?}");
+    assert_eq!(m.undetected_t_s, None, "{m:?}");
+    let los = "line_of_sight".to_string();
+    assert!(!s.violated_constraints.contains(&los), "{}", s.verdict());
+    let (s, records) = changed(40.0, [-0.08, 1e-4, 0.0], true);
+    assert_eq!(s.safe_mode, None, "{}", s.verdict());
+    assert!(records.iter().all(|r| in_safe_mode(r) == [false; 3]));
+}
+
+/// A plant outside the simulator (Basilisk) cannot apply the world's change: refused when
+/// it is set, before the run, not when the change falls due.
+#[test]
+fn an_external_plant_is_refused_with_a_world_event() {
+    struct Never;
+    impl sc_sim::Plant for Never {
+        fn start(&mut self, _: &sc_sim::SimState) -> Result<(), sc_sim::PlantError> {
+            Ok(())
+        }
+        fn propagate(
+            &mut self,
+            _: &sc_sim::Command,
+            _: f64,
+            _: usize,
+        ) -> Result<Vec<sc_sim::SimState>, sc_sim::PlantError> {
+            Err(sc_sim::PlantError("never propagated".into()))
+        }
+    }
+    let mut setup = common::default_setup();
+    setup.scenario.world = Some(World {
+        target_spin_change: Some(SpinChange {
+            t_s: 10.0,
+            omega_rad_s: [-0.2, 0.0, 0.0],
+        }),
+    });
+    let mut m = sc_mission::Mission::new(setup, sc_mission::RunOptions::default()).unwrap();
+    let e = m.set_plant(Box::new(Never)).unwrap_err();
+    assert!(
+        e.0.contains("[world] event needs the simulator's own propagation"),
+        "{e}"
+    );
 }

@@ -49,3 +49,46 @@ fn partner_faults_are_the_partners_and_a_run_with_faults_does_not_pass() {
         s.verdict()
     );
 }
+
+/// A run that entered the safe mode does not pass, even captured, safe and without a
+/// fault (the tumble known came back inside and the partners captured after all); its
+/// verdict says when. A rule no range can fix is never certifiable.
+#[test]
+fn a_run_that_entered_the_safe_mode_does_not_pass() {
+    let (recs, end, phases) = records(3.0);
+    let mut s = summarize(&recs, &end, &phases, true);
+    s.captured = true;
+    assert!(s.passed());
+    let mut m = sc_mission::SafeModeSummary {
+        entered_t_s: Some(1.0),
+        steps: 3,
+        truth_left_t_s: Some(1.0),
+        undetected_t_s: None,
+        rule: "rate_synchronisation".into(),
+        reason: String::new(),
+        line_of_sight_m: 2.0,
+        range_needed_m: 1.5,
+    };
+    assert!(m.line_of_sight_certifiable());
+    s.safe_mode = Some(m.clone());
+    assert!(s.safe() && !s.passed());
+    assert!(
+        s.verdict().contains("safe mode from t = 1.0 s"),
+        "{}",
+        s.verdict()
+    );
+    for rule in ["off_principal", "geometry", "unknown"] {
+        m.rule = rule.into();
+        assert!(!m.line_of_sight_certifiable(), "{rule}");
+    }
+    // the true tumble outside with no filter in safe mode: not safe
+    m.entered_t_s = None;
+    m.undetected_t_s = Some(1.0);
+    s.safe_mode = Some(m);
+    assert!(!s.safe());
+    assert!(
+        s.verdict().contains("UNDETECTED at t = 1.0 s"),
+        "{}",
+        s.verdict()
+    );
+}

@@ -203,7 +203,8 @@ impl MonteCarloConfig {
         let axis = r.axis_t;
         let k =
             r.rate_max_rad_s / (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
-        let env = s.line_of_sight_envelope_for(&axis.map(|a| a * k));
+        // as the start checks a scenario's own tumble: with the run-time watch's margin
+        let env = s.watched_envelope_for(&axis.map(|a| a * k));
         if env.contains() {
             return Ok(());
         }
@@ -221,10 +222,18 @@ impl MonteCarloConfig {
             "target_rate.rate_max_rad_s",
             r.rate_max_rad_s,
             &format!(
-                "outside the scenario's certified envelope (docs/SAFETY.md, \"The certified envelope\"): with the grasping point's lever {:.3} m (from the spin axis, or the CoM off the principal axes), the servicer as close as {:.3} m to it and the base's rate limits, the tumble may be at most {:.4} rad/s",
+                "outside the scenario's certified envelope (docs/SAFETY.md, \"The certified envelope\"): with the grasping point's lever {:.3} m (from the spin axis, or the CoM off the principal axes), the servicer as close as {:.3} m to it and the base's rate limits, the tumble may be at most {:.4} rad/s{}",
                 env.lever_m,
                 env.los_min_m,
-                env.max_spin_rad_s()
+                (env.max_spin_rad_s() - s.watch_margin_rad_s()).max(0.0),
+                if s.watch_margin_rad_s() > 0.0 {
+                    format!(
+                        " (the limit less twice the declared error of the target's rate estimate, {:.4} rad/s, the run-time watch's margin)",
+                        s.watch_margin_rad_s()
+                    )
+                } else {
+                    String::new()
+                }
             ),
         ))
     }

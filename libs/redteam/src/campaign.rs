@@ -89,14 +89,25 @@ pub struct CaseSafeMode {
     pub certifiable: bool,
     pub undetected_t_s: Option<f64>,
     pub first_violation_t_s: Option<f64>,
+    /// The first step after the entry with no filter in safe mode (the tumble known back
+    /// inside) [s].
+    #[serde(default)]
+    pub exited_t_s: Option<f64>,
 }
 
 impl CaseSafeMode {
     /// A barrier went below zero only after the layer had said, entering the safe mode,
-    /// that the line of sight was at risk: announced, not silent.
+    /// that the line of sight was at risk, while it was still in safe mode, and the true
+    /// tumble never left the envelope unseen: announced, not silent. The first violation
+    /// must come at a later control step than the entry (a record's between-samples minima
+    /// cover the physics steps before it, when nothing had been said yet). Which barrier
+    /// broke is the campaign's to check (only the line of sight was announced).
     pub fn announced(&self) -> bool {
         match (self.entered_t_s, self.first_violation_t_s) {
-            (Some(entered), Some(violated)) => !self.certifiable && violated >= entered,
+            (Some(entered), Some(violated)) => {
+                let still_in = self.exited_t_s.is_none_or(|t| violated < t);
+                !self.certifiable && violated > entered && still_in && self.undetected_t_s.is_none()
+            }
             _ => false,
         }
     }
@@ -352,8 +363,22 @@ pub fn measure(
         certifiable: m.line_of_sight_certifiable(),
         undetected_t_s: m.undetected_t_s,
         first_violation_t_s: first_violation(records),
+        exited_t_s: m.entered_t_s.and_then(|t| first_exit(records, t)),
     });
     r
+}
+
+/// The first record after `entered` [s] on which no filter is in safe mode [s].
+fn first_exit(records: &[StepRecord], entered: f64) -> Option<f64> {
+    records
+        .iter()
+        .filter(|r| r.t > entered)
+        .find(|r| {
+            filter_faults(r)
+                .iter()
+                .all(|(_, f)| f & faults::SAFE_MODE == 0)
+        })
+        .map(|r| r.t)
 }
 
 /// The time of the first record with a barrier below zero (or not evaluable) at its
@@ -391,6 +416,55 @@ mod tests {
             solve_time_us: TimeStats::default(),
             safe_mode: None,
         }
+    }
+
+    /// Announced: a violation strictly after the at-risk entry, while still in safe mode,
+    /// with no silent exit; anything else is not.
+    #[test]
+    fn a_violation_is_announced_only_after_an_at_risk_entry_while_in_safe_mode() {
+        let m = CaseSafeMode {
+            entered_t_s: Some(100.1),
+            certifiable: false,
+            undetected_t_s: None,
+            first_violation_t_s: Some(104.0),
+            exited_t_s: None,
+        };
+        assert!(m.announced());
+        for not in [
+            CaseSafeMode {
+                certifiable: true,
+                ..m
+            },
+            CaseSafeMode {
+                first_violation_t_s: Some(100.1),
+                ..m
+            },
+            CaseSafeMode {
+                first_violation_t_s: None,
+                ..m
+            },
+            CaseSafeMode {
+                undetected_t_s: Some(100.0),
+                ..m
+            },
+            CaseSafeMode {
+                exited_t_s: Some(103.0),
+                ..m
+            },
+            CaseSafeMode {
+                entered_t_s: None,
+                ..m
+            },
+        ] {
+            assert!(!not.announced(), "{not:?}");
+        }
+        assert!(
+            CaseSafeMode {
+                exited_t_s: Some(110.0),
+                ..m
+            }
+            .announced()
+        );
     }
 
     /// Only the subsystems a case does not attack count as disturbed bystanders.

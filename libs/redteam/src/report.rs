@@ -98,7 +98,10 @@ fn tally(summary: &mut CampaignSummary, r: &CaseResult) {
     }
     if let Some(m) = r.safe_mode.filter(|m| m.entered_t_s.is_some()) {
         summary.safe_mode_cases.push(r.case.clone());
-        if !r.safe() && m.announced() {
+        let commands_fine = r.nonfinite_applied == 0 && r.out_of_bounds_applied == 0;
+        // the entry announced the line of sight at risk, nothing else
+        let only_los = r.violated.iter().all(|b| b == "line_of_sight");
+        if !r.safe() && m.announced() && commands_fine && only_los {
             summary.announced_unsafe.push(r.case.clone());
         }
     }

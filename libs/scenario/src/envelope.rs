@@ -359,16 +359,21 @@ impl Scenario {
         Ok(())
     }
 
-    /// (E2), then (E1): the tumble the base and the boresight can follow.
+    /// (E2), then (E1): the tumble the base and the boresight can follow — the declared
+    /// one and the fastest the run-time watch may take it for ([`Self::watched_envelope_for`]).
     fn validate_tumble(&self, env: &LineOfSightEnvelope) -> Result<(), ScenarioError> {
-        match env.broken_tumble_rule() {
-            Some(rule) => Err(outside(
-                "target.initial_omega_rad_s",
-                self.target.initial_omega_rad_s,
-                env.explain(rule),
-            )),
-            None => Ok(()),
-        }
+        let omega = self.target.initial_omega_rad_s;
+        let watched = self.watched_envelope_for(&omega);
+        let (env, margin) = match (env.broken_tumble_rule(), watched.broken_tumble_rule()) {
+            (Some(rule), _) => (*env, (rule, String::new())),
+            (None, Some(rule)) => (watched, (rule, self.watch_margin_note())),
+            (None, None) => return Ok(()),
+        };
+        Err(outside(
+            "target.initial_omega_rad_s",
+            omega,
+            format!("{}{}", env.explain(margin.0), margin.1),
+        ))
     }
 
     /// The declared tumble's principal axis (unit, F_T), if it spins about one
@@ -377,27 +382,78 @@ impl Scenario {
         self.principal_axis(&self.target.initial_omega_rad_s)
     }
 
-    /// The fastest tumble (F_T) consistent with the knowledge `omega_hat` of the target's
-    /// body rate, whose error is at most `error` [rad/s]: about the declared principal axis
-    /// when `omega_hat` is within `error` of it, `|â·ω̂| + error` along it (a principal spin
-    /// is constant); otherwise `omega_hat` stretched to `‖ω̂‖ + error`, which
-    /// [`Self::line_of_sight_envelope_for`] treats as off the principal axes
-    /// (amplification `κ`, conservative).
-    pub fn tumble_from_knowledge(&self, omega_hat: &V3, error: f64) -> V3 {
-        let spin = norm(omega_hat);
+    /// The declared bound `ē` on the error of the target's rate estimate [rad/s].
+    pub fn target_rate_error(&self) -> f64 {
+        self.uncertainty_bounds()
+            .navigation
+            .target_rate_rad_s
+            .bound()
+    }
+
+    /// What the run-time watch adds to a true tumble at most: `2ē` [rad/s] (the estimate
+    /// is up to `ē` off, and the watch adds `ē` to it; docs/SAFETY.md, "Safe mode").
+    pub fn watch_margin_rad_s(&self) -> f64 {
+        2.0 * self.target_rate_error()
+    }
+
+    /// The envelope of the fastest tumble the run-time watch may take the true tumble
+    /// `omega_t` (F_T) for: about the declared axis at `|â·ω| + 2ē` (the start and a Monte
+    /// Carlo's fastest draw are checked with it, so that the watch never fires on a
+    /// declared tumble).
+    pub fn watched_envelope_for(&self, omega_t: &V3) -> LineOfSightEnvelope {
+        let e = self.target_rate_error();
+        self.line_of_sight_envelope_for(&self.tumble_from_knowledge(
+            omega_t,
+            self.watch_axis_tolerance_rad_s(),
+            2.0 * e,
+        ))
+    }
+
+    /// How far off the declared axis the run-time watch still takes an estimate for a
+    /// spin about it [rad/s]: `2ē` (a true tumble within `ē` of the axis, seen through an
+    /// estimate up to `ē` off) plus the navigation gate's rounding.
+    pub fn watch_axis_tolerance_rad_s(&self) -> f64 {
+        2.0 * self.target_rate_error() + KNOWLEDGE_ROUNDING_RAD_S
+    }
+
+    /// The suffix of a refusal that only the watch's margin causes.
+    fn watch_margin_note(&self) -> String {
+        let limit = self.line_of_sight_envelope().max_spin_rad_s() - self.watch_margin_rad_s();
+        format!(
+            " (this includes twice the declared error of the target's rate estimate, 2 × {:.4} rad/s, which the run-time watch adds: docs/SAFETY.md, \"Safe mode\"; so the declared tumble may be at most {:.4} rad/s)",
+            self.target_rate_error(),
+            limit.max(0.0)
+        )
+    }
+
+    /// The fastest tumble (F_T) consistent with `omega` known to within `error` [rad/s]:
+    /// about the declared principal axis when `omega` lies within `axis_tolerance` of it,
+    /// at `|â·ω| + error` (a principal spin is constant); otherwise `omega` stretched to
+    /// `‖ω‖ + error`, which [`Self::line_of_sight_envelope_for`] judges by its own
+    /// principal-axis test (off the axes: amplification `κ`, conservative). Non-finite
+    /// when `omega` is.
+    pub fn tumble_from_knowledge(&self, omega: &V3, axis_tolerance: f64, error: f64) -> V3 {
+        let spin = norm(omega);
         if let Some(a) = self.declared_spin_axis() {
-            let along = dot(&a, omega_hat);
-            if norm(&sub(omega_hat, &scale(&a, along))) <= error {
+            let along = dot(&a, omega);
+            if norm(&sub(omega, &scale(&a, along))) <= axis_tolerance {
                 let sign = if along < 0.0 { -1.0 } else { 1.0 };
                 return scale(&a, sign * (along.abs() + error));
             }
         }
         if spin == 0.0 {
-            return [error, 0.0, 0.0];
+            // no direction known: off every frame axis, as a noisy estimate of a still
+            // target would be
+            return scale(&[1.0, 1.0, 1.0], error / 3f64.sqrt());
         }
-        scale(omega_hat, (spin + error) / spin)
+        scale(omega, (spin + error) / spin)
     }
 }
+
+/// The rounding the navigation gate allows beyond a declared error bound [rad/s]
+/// (`sc_sim::navigation::NAVIGATION_ERROR_ROUNDING`): an estimate admitted at its bound
+/// stays on the declared axis for the watch.
+pub const KNOWLEDGE_ROUNDING_RAD_S: f64 = 1e-12;
 
 /// A rule of the envelope on the tumble ((E1), (E2)) that a tumble breaks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -434,19 +490,33 @@ impl TumbleRule {
 impl LineOfSightEnvelope {
     /// The first rule the tumble breaks, (E2) before (E1); `None` inside the envelope
     /// ([`Self::contains`] is `broken_tumble_rule().is_none()` with a positive limit).
+    /// A tumble that is not a finite number is `Unknown`; no tumble at all cannot speed up
+    /// (its amplification does not matter). Every comparison fails safe on a NaN.
     pub fn broken_tumble_rule(&self) -> Option<TumbleRule> {
-        if !self.geometry_is_certifiable() && self.amplification <= MAX_OFF_PRINCIPAL_AMPLIFICATION
-        {
+        // above the limit, or not comparable (a NaN)
+        let exceeds = |x: f64, limit: f64| {
+            !matches!(
+                x.partial_cmp(&limit),
+                Some(std::cmp::Ordering::Less | std::cmp::Ordering::Equal)
+            )
+        };
+        if !(self.spin_rad_s.is_finite() && self.lever_m.is_finite()) {
+            return Some(TumbleRule::Unknown);
+        }
+        let still = self.spin_rad_s == 0.0;
+        let off_principal = !still && exceeds(self.amplification, MAX_OFF_PRINCIPAL_AMPLIFICATION);
+        let geometry = self.los_min_m > 0.0 && self.contract_sigma_min >= MIN_LOS_CONTRACT_SIGMA;
+        if !off_principal && !geometry {
             return Some(TumbleRule::Geometry);
         }
         let peak = self.peak_spin_rad_s();
-        if self.amplification > MAX_OFF_PRINCIPAL_AMPLIFICATION {
+        if off_principal {
             Some(TumbleRule::OffPrincipal)
-        } else if peak > self.sync_limit_rad_s {
+        } else if exceeds(peak, self.sync_limit_rad_s) {
             Some(TumbleRule::Sync)
-        } else if peak * self.spin_across_axis > self.boresight_follow_rad_s {
+        } else if exceeds(peak * self.spin_across_axis, self.boresight_follow_rad_s) {
             Some(TumbleRule::AcrossAxis)
-        } else if self.target_rate_rad_s() > self.limit_rad_s() {
+        } else if exceeds(self.target_rate_rad_s(), self.limit_rad_s()) {
             Some(TumbleRule::LineOfSight)
         } else {
             None

@@ -225,7 +225,8 @@ pub struct Safety {
 #[serde(deny_unknown_fields)]
 pub struct SafeMode {
     /// Speed of the radial retreat from the target's CoM [m/s]: the translational nominal
-    /// becomes `f_H = sat(m (v_s r̂_H − v_H) / T_t)` (`T_t` the translational brake time).
+    /// becomes `f_H = sat(m (v_s r̂_H − ω_H × r_H − v_H) / T_t)` (radial in the inertially
+    /// fixed F_R; `T_t` the translational brake time).
     pub retreat_speed_m_s: f64,
     /// Distance from the target's CoM at which the retreat stops and the servicer holds
     /// (`v_s` = 0 beyond it) [m].

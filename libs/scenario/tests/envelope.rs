@@ -218,3 +218,34 @@ fn an_elongated_target_tumbling_off_its_principal_axes_is_refused() {
     s.target.initial_omega_rad_s = [-0.03, 0.0, 0.0];
     s.validate().expect("a principal spin is accepted");
 }
+
+/// Under a declared error `ē` of the target's rate estimate the start keeps the run-time
+/// watch's margin `2ē` below the limit: 0.123 rad/s, inside the exact profile's 0.1241, is
+/// refused under `realistic` (ē = 1e-3) with the reason and the limit it leaves, 0.1221;
+/// 0.12 is accepted. Without a declared error nothing changes.
+#[test]
+fn the_start_keeps_the_watchs_margin() {
+    let mut s = default();
+    s.target.initial_omega_rad_s = [-0.123, 0.0, 0.0];
+    assert!(s.validate().is_ok());
+    s.set_uncertainty(sc_scenario::UncertaintySpec {
+        profile: sc_scenario::uncertainty::REALISTIC_NAME.into(),
+        seed: 0,
+        model: None,
+        actuators: None,
+        navigation: None,
+        truth: None,
+    })
+    .unwrap();
+    let e = s.validate().unwrap_err().to_string();
+    assert!(e.contains("which the run-time watch adds"), "{e}");
+    assert!(
+        e.contains("the declared tumble may be at most 0.1221 rad/s"),
+        "{e}"
+    );
+    s.target.initial_omega_rad_s = [-0.12, 0.0, 0.0];
+    assert!(s.validate().is_ok());
+    // a still target stays inside, whatever its inertia ratio
+    s.target.initial_omega_rad_s = [0.0; 3];
+    assert!(s.validate().is_ok());
+}

@@ -89,11 +89,8 @@ impl Simulator {
         }
         let (h, n) = (self.p.physics_step, self.p.substeps);
         let t0 = self.state.t;
-        if self.world_due().is_some() {
-            return Err(SimError::Plant {
-                t: t0,
-                message: "the world's change of the target's rate ([world]) needs the simulator's own propagation, not an external plant".into(),
-            });
+        if let Some((t, _)) = self.world_due() {
+            return Err(SimError::WorldNeedsOwnPropagation { t });
         }
         let states = plant.propagate(cmd, h, n).map_err(|e| SimError::Plant {
             t: t0,

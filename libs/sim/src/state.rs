@@ -21,7 +21,16 @@ pub enum SimError {
     Model(String),
     #[error("plant at t = {t} s: {message}")]
     Plant { t: f64, message: String },
+    /// The world's change of the target's rate (`[world]`) fell due with an external plant
+    /// in the loop: only the simulator's own propagation applies it.
+    #[error(
+        "the world's change of the target's rate ([world]) at t = {t} s needs the simulator's own propagation, not an external plant"
+    )]
+    WorldNeedsOwnPropagation { t: f64 },
 }
+
+/// Relative tolerance on the time of a world event against the step count's time [-].
+const WORLD_TIME_TOLERANCE: f64 = 1e-9;
 
 pub use sc_core::BarrierState;
 
@@ -317,7 +326,12 @@ impl Simulator {
     pub(crate) fn world_due(&self) -> Option<(f64, Vector3<f64>)> {
         let (t, w) = self.p.spin_change?;
         // (within a rounding of the step count's time)
-        (self.state.t + 1e-9 * t.abs().max(1.0) >= t).then_some((t, w))
+        (self.state.t + WORLD_TIME_TOLERANCE * t.abs().max(1.0) >= t).then_some((t, w))
+    }
+
+    /// True while a world event (`[world]`) is still to come.
+    pub fn world_event_pending(&self) -> bool {
+        self.p.spin_change.is_some()
     }
 
     /// The true state `k` physics steps ago (`k` ≤ the steps of a period); before the

@@ -682,6 +682,11 @@ fn start_plant(p: &Proc, sim: &Simulator) -> Result<Option<Box<dyn Plant + Send>
     let Some((program, args)) = p.cfg.simulator.plant.split_first() else {
         return Ok(None);
     };
+    if sim.world_event_pending() {
+        return Err(FlightError::Simulator(
+            "the scenario's [world] event needs the simulator's own propagation: an external plant ([simulator] plant) cannot apply it".into(),
+        ));
+    }
     let mut args = args.to_vec();
     args.push("--scenario".into());
     args.push(p.cfg.scenario_path().display().to_string());
