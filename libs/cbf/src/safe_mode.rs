@@ -24,6 +24,7 @@
 
 use nalgebra::Vector3;
 use sc_core::Observation;
+use sc_scenario::envelope::KNOWLEDGE_ROUNDING_RAD_S;
 use sc_scenario::{LineOfSightEnvelope, Scenario, TumbleRule};
 
 /// What the safe mode does (`[safety.safe_mode]`).
@@ -77,11 +78,12 @@ impl EnvelopeWatch {
 
     /// The rule the true tumble `omega_t` [rad/s, F_T] breaks, judged on the watch's own
     /// premise: within `3ē` of the declared axis it is that axis's constant spin, nothing
-    /// added. An estimate is within `ē` of the truth, and the watch takes an estimate
-    /// within `2ē` of the axis for the axis's spin at `|â·ω̂| + ē ≥ |â·ω|` and any other
-    /// off the axes at `‖ω̂‖ + ē ≥ ‖ω‖` (amplification `κ`): its worst case is never below
-    /// this one, so a true tumble outside is seen by the watch too (the summary's check
-    /// for a silent exit).
+    /// added, anywhere else a tumble off the axes (`κ`). An estimate is within `ē` of the
+    /// truth, and the watch takes an estimate within `2ē` of the axis for the axis's spin
+    /// at `|â·ω̂| + ē ≥ |â·ω|` and any other for a tumble off the axes at
+    /// `‖ω̂‖ + ē ≥ ‖ω‖`, never less restrictive than a principal one: its worst case is
+    /// never below this one, so a true tumble outside is seen by the watch too (the
+    /// summary's check for a silent exit).
     pub fn check_truth(&self, omega_t: &[f64; 3]) -> Option<TumbleRule> {
         self.truth_envelope(omega_t).broken_tumble_rule()
     }
@@ -89,9 +91,11 @@ impl EnvelopeWatch {
     /// The envelope of the true tumble `omega_t` on the watch's premise (numbers for
     /// reports).
     pub fn truth_envelope(&self, omega_t: &[f64; 3]) -> LineOfSightEnvelope {
-        let tolerance = self.scenario.watch_axis_tolerance_rad_s() + self.rate_error;
-        let tumble = self.scenario.tumble_from_knowledge(omega_t, tolerance, 0.0);
-        self.scenario.line_of_sight_envelope_for(&tumble)
+        // 3ē and the gate's rounding twice: an estimate admitted at ē plus rounding of a
+        // truth beyond this is beyond the watch's 2ē plus rounding
+        let tolerance =
+            self.scenario.watch_axis_tolerance_rad_s() + self.rate_error + KNOWLEDGE_ROUNDING_RAD_S;
+        self.scenario.knowledge_envelope(omega_t, tolerance, 0.0)
     }
 
     /// The envelope of the fastest tumble within `error` of the estimate `omega_t`: about
@@ -99,10 +103,7 @@ impl EnvelopeWatch {
     /// estimate up to `ē` off is not mistaken for a tumble off the axes).
     fn envelope(&self, omega_t: &[f64; 3], error: f64) -> LineOfSightEnvelope {
         let tolerance = self.scenario.watch_axis_tolerance_rad_s();
-        let tumble = self
-            .scenario
-            .tumble_from_knowledge(omega_t, tolerance, error);
-        self.scenario.line_of_sight_envelope_for(&tumble)
+        self.scenario.knowledge_envelope(omega_t, tolerance, error)
     }
 
     /// The safe mode's reference velocity of the CoM in F_H [m/s] at `r_h` [m, F_H] with
@@ -163,7 +164,7 @@ mod tests {
         let rule = |omega: [f64; 3]| w.envelope(&omega, e).broken_tumble_rule();
         // estimates of the fastest draw (0.12) within 2ē of the axis (a truth up to ē off
         // it, seen through an estimate up to ē off; plus the gate's rounding)
-        let r = 2.0 * e + sc_scenario::envelope::KNOWLEDGE_ROUNDING_RAD_S;
+        let r = 2.0 * e + KNOWLEDGE_ROUNDING_RAD_S;
         for d in [
             [0.0, 0.0, 0.0],
             [e, 0.0, 0.0],
@@ -220,20 +221,28 @@ mod tests {
             [-h, 0.0, h],
             [0.0, -h, -h],
         ];
-        let (mut outside, mut fired) = (0, 0);
-        for spin in [0.0, 0.05, 0.1, 0.12, 0.1235, 0.125, 0.13, 0.2, 0.3] {
+        let mut truths = Vec::new();
+        for spin in [0.0, 0.03, 0.05, 0.1, 0.12, 0.1235, 0.125, 0.13, 0.2, 0.3] {
             for off in [0.0, 0.5, 1.0, 2.0, 3.0, 3.5, 5.0, 20.0] {
-                let truth = [-spin, off * e, 0.3 * off * e];
-                if w.check_truth(&truth).is_none() {
-                    continue;
-                }
-                outside += 1;
-                for d in dirs {
-                    let est: [f64; 3] = std::array::from_fn(|i| truth[i] + e * d[i]);
-                    let fires = w.envelope(&est, e).broken_tumble_rule().is_some();
-                    assert!(fires, "truth {truth:?} outside, estimate {est:?} not");
-                    fired += 1;
-                }
+                truths.push([-spin, off * e, 0.3 * off * e]);
+            }
+            // just off another principal axis, seen exactly on it below
+            truths.push([0.0, spin, 0.5 * e]);
+            truths.push([0.5 * e, 0.0, spin]);
+        }
+        let mut dirs = dirs.to_vec();
+        dirs.extend([[0.0, 0.0, -0.5], [-0.5, 0.0, 0.0]]);
+        let (mut outside, mut fired) = (0, 0);
+        for truth in truths {
+            if w.check_truth(&truth).is_none() {
+                continue;
+            }
+            outside += 1;
+            for d in &dirs {
+                let est: [f64; 3] = std::array::from_fn(|i| truth[i] + e * d[i]);
+                let fires = w.envelope(&est, e).broken_tumble_rule().is_some();
+                assert!(fires, "truth {truth:?} outside, estimate {est:?} not");
+                fired += 1;
             }
         }
         assert!(outside > 20 && fired == outside * dirs.len(), "{outside}");

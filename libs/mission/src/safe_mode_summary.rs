@@ -105,6 +105,9 @@ impl SafeModeSummary {
     }
 
     fn range_line(&self) -> String {
+        if matches!(self.rule.as_str(), "off_principal" | "geometry" | "unknown") {
+            return "no range makes the line of sight certifiable: AT RISK".into();
+        }
         if self.line_of_sight_certifiable() {
             format!(
                 "line of sight {:.2} m, the tumble needs {:.2} m: certifiable",

@@ -145,11 +145,17 @@ impl Scenario {
     /// The line-of-sight envelope for the tumble `ω_T(0)` (in F_T) in this scenario's
     /// geometry (a Monte Carlo checks its fastest draw).
     pub fn line_of_sight_envelope_for(&self, omega_t: &V3) -> LineOfSightEnvelope {
+        self.envelope_about(omega_t, self.principal_axis(omega_t))
+    }
+
+    /// The envelope of a tumble `omega_t` that is a constant spin about `principal`, or
+    /// (`None`) one off the principal axes (amplification `κ`, lever `‖p_G‖`).
+    fn envelope_about(&self, omega_t: &V3, principal: Option<V3>) -> LineOfSightEnvelope {
         let t = &self.target;
         let p = &t.grasp_point_m;
         let spin = norm(omega_t);
         let d = normalize(&self.safety.translational.corridor_axis);
-        let (amplification, lever_m, axial, across) = match self.principal_axis(omega_t) {
+        let (amplification, lever_m, axial, across) = match principal {
             Some(a) => {
                 let a_r = rotate(&t.initial_attitude, &a);
                 let across = norm(&cross(&a_r, &d));
@@ -399,14 +405,15 @@ impl Scenario {
     /// The envelope of the fastest tumble the run-time watch may take the true tumble
     /// `omega_t` (F_T) for: about the declared axis at `|â·ω| + 2ē` (the start and a Monte
     /// Carlo's fastest draw are checked with it, so that the watch never fires on a
-    /// declared tumble).
+    /// declared spin about a principal axis; a declared tumble off the axes is judged as
+    /// the watch judges it, `‖ω‖ + 2ē` with `κ`).
     pub fn watched_envelope_for(&self, omega_t: &V3) -> LineOfSightEnvelope {
         let e = self.target_rate_error();
-        self.line_of_sight_envelope_for(&self.tumble_from_knowledge(
-            omega_t,
-            self.watch_axis_tolerance_rad_s(),
-            2.0 * e,
-        ))
+        if e == 0.0 {
+            // nothing unknown: the declared tumble as the start has always judged it
+            return self.line_of_sight_envelope_for(omega_t);
+        }
+        self.knowledge_envelope(omega_t, self.watch_axis_tolerance_rad_s(), 2.0 * e)
     }
 
     /// How far off the declared axis the run-time watch still takes an estimate for a
@@ -426,27 +433,35 @@ impl Scenario {
         )
     }
 
-    /// The fastest tumble (F_T) consistent with `omega` known to within `error` [rad/s]:
-    /// about the declared principal axis when `omega` lies within `axis_tolerance` of it,
-    /// at `|â·ω| + error` (a principal spin is constant); otherwise `omega` stretched to
-    /// `‖ω‖ + error`, which [`Self::line_of_sight_envelope_for`] judges by its own
-    /// principal-axis test (off the axes: amplification `κ`, conservative). Non-finite
-    /// when `omega` is.
-    pub fn tumble_from_knowledge(&self, omega: &V3, axis_tolerance: f64, error: f64) -> V3 {
+    /// The envelope of the fastest tumble consistent with `omega` (F_T) known to within
+    /// `error` [rad/s]: within `axis_tolerance` of the declared principal axis `â` a
+    /// constant spin about it at `|â·ω| + error`; anywhere else a tumble off the principal
+    /// axes at `‖ω‖ + error` (amplification `κ`, lever `‖p_G‖`) — whatever axis `omega`
+    /// itself lies on, since the truth within `error` of it need not. The off-axes
+    /// envelope is never less restrictive than a principal one: `κ ≥ 1`, `‖p_G‖ ≥ ‖â × p_G‖`,
+    /// the tumble wholly across the corridor axis, the shortest line of sight no longer.
+    /// Non-finite when `omega` is.
+    pub fn knowledge_envelope(
+        &self,
+        omega: &V3,
+        axis_tolerance: f64,
+        error: f64,
+    ) -> LineOfSightEnvelope {
         let spin = norm(omega);
         if let Some(a) = self.declared_spin_axis() {
-            let along = dot(&a, omega);
+            let along = dot(omega, &a);
             if norm(&sub(omega, &scale(&a, along))) <= axis_tolerance {
                 let sign = if along < 0.0 { -1.0 } else { 1.0 };
-                return scale(&a, sign * (along.abs() + error));
+                return self.envelope_about(&scale(&a, sign * (along.abs() + error)), Some(a));
             }
         }
-        if spin == 0.0 {
-            // no direction known: off every frame axis, as a noisy estimate of a still
-            // target would be
-            return scale(&[1.0, 1.0, 1.0], error / 3f64.sqrt());
-        }
-        scale(omega, (spin + error) / spin)
+        let tumble = if spin == 0.0 {
+            // no direction known: off every axis, as a noisy estimate of a still target
+            scale(&[1.0, 1.0, 1.0], error / 3f64.sqrt())
+        } else {
+            scale(omega, (spin + error) / spin)
+        };
+        self.envelope_about(&tumble, None)
     }
 }
 

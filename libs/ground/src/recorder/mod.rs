@@ -444,7 +444,9 @@ impl<S: RecordSink> Component for RecorderRole<S> {
         let mut summary = summarize(&self.records, &end, &phase_names, true);
         summary.uncertainty =
             sc_mission::UncertaintySummary::of(&self.records, &self.scenario, &self.robot, true);
-        summary.safe_mode = sc_mission::SafeModeSummary::of(&self.records, &self.scenario);
+        // judged by the watch the filter processes ran (the attitude group's hold)
+        summary.safe_mode =
+            sc_mission::SafeModeSummary::with_watch(&self.records, &self.layer.watch);
         self.rep.end = summary.end.clone();
         let r = self.sink.finish(&self.records, &summary, &self.rep);
         self.keep(r);
