@@ -56,15 +56,18 @@ pub fn check_scenario(cfg: &PartitionConfig) -> Result<PathBuf, ConfigError> {
         )),
         // the cross-checks with the servicer model, and the envelope bounds every ground
         // command checks (the flight processes trust them)
-        Ok(s) => sc_mission::Setup::from_scenario(s)
-            .and_then(|setup| setup.check_before_run(&path))
-            .map(|()| path.clone())
-            .map_err(|e| {
-                ConfigError(format!(
-                    "scenario = {:?}: {e}; correct the scenario or point `scenario` at another",
-                    cfg.scenario
-                ))
-            }),
+        Ok(s) => {
+            held_envelope(cfg, &s)?;
+            sc_mission::Setup::from_scenario(s)
+                .and_then(|setup| setup.check_before_run(&path))
+                .map(|()| path.clone())
+                .map_err(|e| {
+                    ConfigError(format!(
+                        "scenario = {:?}: {e}; correct the scenario or point `scenario` at another",
+                        cfg.scenario
+                    ))
+                })
+        }
         Err(e @ sc_scenario::ScenarioError::Io { .. }) => err(format!(
             "scenario = {:?}: {e}; point `scenario` at a scenario file (a relative path is relative to the config's directory {})",
             cfg.scenario,
@@ -75,6 +78,29 @@ pub fn check_scenario(cfg: &PartitionConfig) -> Result<PathBuf, ConfigError> {
             cfg.scenario
         )),
     }
+}
+
+/// The certified envelope at the attitude filter's hold: in a multi-rate partition its
+/// rows' margins — and the run-time watch on the tumble (`SafetyLayer::with_holds`) — take
+/// its rate group's period, so the declared tumble must be inside the envelope of the
+/// scenario held that long too (else the watch would put the run in safe mode at once).
+/// A config whose schedule is invalid is refused where the schedule is built.
+fn held_envelope(cfg: &PartitionConfig, s: &sc_scenario::Scenario) -> Result<(), ConfigError> {
+    let Ok(schedule) = cfg.schedule() else {
+        return Ok(());
+    };
+    let hold = schedule.period_s[sc_core::Subsystem::Attitude];
+    if hold == s.mission.control_period_s {
+        return Ok(());
+    }
+    let mut held = s.clone();
+    held.mission.control_period_s = hold;
+    held.validate().map_err(|e| {
+        ConfigError(format!(
+            "scenario = {:?} held for the attitude rate group's period {hold} s (its filter certifies for that hold): {e}; give the attitude group a shorter period or slow the tumble",
+            cfg.scenario
+        ))
+    })
 }
 
 /// Every role's program (and the partner script its arguments name), and the
@@ -275,11 +301,15 @@ mod tests {
     use super::*;
 
     fn config(dir: &Path, roles: &str, extra: &str) -> PartitionConfig {
+        PartitionConfig::from_toml_str(&config_text(roles, extra), dir).unwrap()
+    }
+
+    fn config_text(roles: &str, extra: &str) -> String {
         let mut s = format!(
             "scenario = \"scenario.toml\"\nclock = \"lock_step\"\nhandshake_timeout_s = 30\n{extra}[[rate_groups]]\nname = \"c\"\nperiod_s = 0.1\nmembers = [\"translational\", \"attitude\", \"robotic\"]\n[deadlines]\nsafety_translational_ms = 40\nsafety_attitude_ms = 60\nsafety_robotic_ms = 80\nsimulator_ms = 90\n[lock_step]\ndeadline_scale = 20\nrecorder_window_ticks = 8\n"
         );
         s += roles;
-        PartitionConfig::from_toml_str(&s, dir).unwrap()
+        s
     }
 
     fn roles_all(exec: &str) -> String {
@@ -410,6 +440,49 @@ mod tests {
                 && e.contains("scripts/setup.sh"),
             "{e}"
         );
+    }
+
+    /// An attitude rate group slower than the scenario's control period: the declared
+    /// tumble must be inside the envelope at that hold (0.3 s leaves 0.0764 rad/s of
+    /// synchronisation, below the default 0.08), or the launch is refused before anything
+    /// starts; 0.2 s (limit 0.0977 rad/s) is accepted.
+    #[test]
+    fn the_envelope_is_checked_at_the_attitude_groups_hold() {
+        let d = scratch("held");
+        let repo =
+            std::path::absolute(Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")).unwrap();
+        let sc = std::fs::read_to_string(repo.join("config/scenario.toml"))
+            .unwrap()
+            .replace(
+                "urdf = \"servicer.urdf\"",
+                &format!("urdf = \"{}\"", repo.join("config/servicer.urdf").display()),
+            );
+        std::fs::write(d.0.join("scenario.toml"), sc).unwrap();
+        let groups = |a: f64| {
+            format!(
+                "[[rate_groups]]\nname = \"t\"\nperiod_s = {a}\nmembers = [\"translational\"]\n[[rate_groups]]\nname = \"a\"\nperiod_s = {a}\nmembers = [\"attitude\"]\n[[rate_groups]]\nname = \"r\"\nperiod_s = 0.1\nmembers = [\"robotic\"]\n"
+            )
+        };
+        let with = |a: f64| {
+            let text = config_text(&roles_all("./prog"), "").replace(
+                "[[rate_groups]]\nname = \"c\"\nperiod_s = 0.1\nmembers = [\"translational\", \"attitude\", \"robotic\"]\n",
+                &groups(a),
+            );
+            PartitionConfig::from_toml_str(&text, &d.0).unwrap()
+        };
+        let e = held_envelope(
+            &with(0.3),
+            &sc_scenario::Scenario::load(&d.0.join("scenario.toml")).unwrap(),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("held for the attitude rate group's period 0.3 s")
+                && e.contains("outside the certified envelope"),
+            "{e}"
+        );
+        let s = sc_scenario::Scenario::load(&d.0.join("scenario.toml")).unwrap();
+        assert!(held_envelope(&with(0.2), &s).is_ok());
     }
 
     #[test]
