@@ -93,6 +93,10 @@ impl EnvelopeWatch {
     pub fn truth_envelope(&self, omega_t: &[f64; 3]) -> LineOfSightEnvelope {
         // 3ē and the gate's rounding twice: an estimate admitted at ē plus rounding of a
         // truth beyond this is beyond the watch's 2ē plus rounding
+        if self.rate_error == 0.0 {
+            // nothing unknown: the tumble is judged as the start judges it
+            return self.scenario.line_of_sight_envelope_for(omega_t);
+        }
         let tolerance =
             self.scenario.watch_axis_tolerance_rad_s() + self.rate_error + KNOWLEDGE_ROUNDING_RAD_S;
         self.scenario.knowledge_envelope(omega_t, tolerance, 0.0)
@@ -102,8 +106,14 @@ impl EnvelopeWatch {
     /// the declared axis within `2ē` of it (a truth within `ē` of the axis seen through an
     /// estimate up to `ē` off is not mistaken for a tumble off the axes).
     fn envelope(&self, omega_t: &[f64; 3], error: f64) -> LineOfSightEnvelope {
+        if self.rate_error == 0.0 {
+            // nothing unknown: the estimate is the truth, judged as the start judges it
+            return self.scenario.line_of_sight_envelope_for(omega_t);
+        }
+        // the gate admits an error up to ē plus its rounding
         let tolerance = self.scenario.watch_axis_tolerance_rad_s();
-        self.scenario.knowledge_envelope(omega_t, tolerance, error)
+        self.scenario
+            .knowledge_envelope(omega_t, tolerance, error + KNOWLEDGE_ROUNDING_RAD_S)
     }
 
     /// The safe mode's reference velocity of the CoM in F_H [m/s] at `r_h` [m, F_H] with

@@ -95,7 +95,7 @@ fn held_envelope(cfg: &PartitionConfig, s: &sc_scenario::Scenario) -> Result<(),
     }
     let mut held = s.clone();
     held.mission.control_period_s = hold;
-    held.validate().map_err(|e| {
+    held.validate_envelope().map_err(|e| {
         ConfigError(format!(
             "scenario = {:?} held for the attitude rate group's period {hold} s (its filter certifies for that hold): {e}; give the attitude group a shorter period or slow the tumble",
             cfg.scenario

@@ -203,8 +203,11 @@ impl MonteCarloConfig {
         let axis = r.axis_t;
         let k =
             r.rate_max_rad_s / (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
-        // as the start checks a scenario's own tumble: with the run-time watch's margin
-        let env = s.watched_envelope_for(&axis.map(|a| a * k));
+        // as the start checks a run's own tumble (each run declares its draw): with the
+        // run-time watch's margin about the drawn axis
+        let mut fastest = s.clone();
+        fastest.target.initial_omega_rad_s = axis.map(|a| a * k);
+        let env = fastest.watched_envelope_for(&fastest.target.initial_omega_rad_s);
         if env.contains() {
             return Ok(());
         }

@@ -284,8 +284,9 @@ impl Scenario {
     }
 
     /// The envelope's rules (after every other rule: they combine the sections), each
-    /// naming the key that decides it.
-    pub(crate) fn validate_envelope(&self) -> Result<(), ScenarioError> {
+    /// naming the key that decides it (alone: the partition's check at a rate group's
+    /// hold).
+    pub fn validate_envelope(&self) -> Result<(), ScenarioError> {
         let env = self.line_of_sight_envelope();
         self.validate_target_geometry(&env)?;
         self.validate_rate_rows(&env)?;
@@ -413,7 +414,8 @@ impl Scenario {
             // nothing unknown: the declared tumble as the start has always judged it
             return self.line_of_sight_envelope_for(omega_t);
         }
-        self.knowledge_envelope(omega_t, self.watch_axis_tolerance_rad_s(), 2.0 * e)
+        let margin = 2.0 * (e + KNOWLEDGE_ROUNDING_RAD_S);
+        self.knowledge_envelope(omega_t, self.watch_axis_tolerance_rad_s(), margin)
     }
 
     /// How far off the declared axis the run-time watch still takes an estimate for a
