@@ -139,26 +139,21 @@ impl EnvelopeWatch {
 mod tests {
     use super::*;
 
-    fn watch() -> EnvelopeWatch {
-        let s = Scenario::load(std::path::Path::new(concat!(
+    fn default_scenario() -> Scenario {
+        Scenario::load(std::path::Path::new(concat!(
             env!("CARGO_MANIFEST_DIR"),
             "/../../config/scenario.toml"
         )))
-        .unwrap();
-        EnvelopeWatch::from_scenario(&s)
+        .unwrap()
     }
 
-    /// The Monte Carlo's fastest tumble (0.12 rad/s about the declared axis) known with the
-    /// `realistic` profile's rate error (1e-3 rad/s), in any direction within it, is inside:
-    /// no false alarm; 0.13 rad/s is outside (the limit is 0.1241), and so is a tumble off
-    /// the declared principal axis by more than the error, or one not known at all.
-    #[test]
-    fn the_envelope_watch_tells_the_campaigns_tumbles_from_faster_ones() {
-        let mut s = Scenario::load(std::path::Path::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../config/scenario.toml"
-        )))
-        .unwrap();
+    fn watch() -> EnvelopeWatch {
+        EnvelopeWatch::from_scenario(&default_scenario())
+    }
+
+    /// The default scenario under the `realistic` profile (ē = 1e-3 rad/s).
+    fn realistic() -> Scenario {
+        let mut s = default_scenario();
         s.set_uncertainty(sc_scenario::UncertaintySpec {
             profile: sc_scenario::uncertainty::REALISTIC_NAME.into(),
             seed: 0,
@@ -168,6 +163,16 @@ mod tests {
             truth: None,
         })
         .unwrap();
+        s
+    }
+
+    /// The Monte Carlo's fastest tumble (0.12 rad/s about the declared axis) known with the
+    /// `realistic` profile's rate error (1e-3 rad/s), in any direction within it, is inside:
+    /// no false alarm; 0.13 rad/s is outside (the limit is 0.1241), and so is a tumble off
+    /// the declared principal axis by more than the error, or one not known at all.
+    #[test]
+    fn the_envelope_watch_tells_the_campaigns_tumbles_from_faster_ones() {
+        let s = realistic();
         let e = s.target_rate_error();
         assert_eq!(e, 1e-3);
         let w = EnvelopeWatch::from_scenario(&s);
@@ -203,20 +208,7 @@ mod tests {
     /// the declared axis, below, at and beyond the limits.
     #[test]
     fn the_watch_fires_whenever_the_truth_is_outside() {
-        let mut s = Scenario::load(std::path::Path::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../config/scenario.toml"
-        )))
-        .unwrap();
-        s.set_uncertainty(sc_scenario::UncertaintySpec {
-            profile: sc_scenario::uncertainty::REALISTIC_NAME.into(),
-            seed: 0,
-            model: None,
-            actuators: None,
-            navigation: None,
-            truth: None,
-        })
-        .unwrap();
+        let s = realistic();
         let w = EnvelopeWatch::from_scenario(&s);
         let e = s.target_rate_error();
         let h = std::f64::consts::FRAC_1_SQRT_2;
