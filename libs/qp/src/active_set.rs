@@ -26,7 +26,7 @@ struct Direction<const M: usize> {
 }
 
 /// Dual active-set solver for `min ½‖x − x0‖²  s.t.  a_i·x ≥ b_i` with `x ∈ ℝᴹ` and at most
-/// `N ≤ 64` rows. All workspace is inside the struct: build it once, call
+/// `N ≤ 128` rows. All workspace is inside the struct: build it once, call
 /// [`solve`](Self::solve) every control step; no call allocates.
 #[derive(Debug, Clone)]
 pub struct ActiveSetQp<const M: usize, const N: usize> {
@@ -47,7 +47,7 @@ pub struct ActiveSetQp<const M: usize, const N: usize> {
     /// Right-hand side the core iteration works on (scaled rows).
     pub(crate) rhs: [f64; N],
     /// Bit `i`: row `i` is a zero row (never enters the iteration).
-    pub(crate) zero: u64,
+    pub(crate) zero: u128,
     /// The caller's rows of the last [`prepare`](Self::prepare), for reuse: a row equal
     /// (bit for bit) to the one before keeps its scaling, only `b` and `w` are rescaled.
     raw: [[f64; M]; N],
@@ -67,7 +67,7 @@ pub struct ActiveSetQp<const M: usize, const N: usize> {
     /// Number of active rows.
     q: usize,
     /// Bit `i`: row `i` is active.
-    mask: u64,
+    mask: u128,
     /// Current iterate.
     x: [f64; M],
     /// Certificate in the scaled rows (valid after `Core::Infeasible`).
@@ -77,8 +77,8 @@ pub struct ActiveSetQp<const M: usize, const N: usize> {
 }
 
 impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
-    /// The active set is a bit mask in a `u64`.
-    const SIZE_OK: () = assert!(N <= 64, "ActiveSetQp supports at most 64 rows");
+    /// The active set is a bit mask in a `u128`.
+    const SIZE_OK: () = assert!(N <= 128, "ActiveSetQp supports at most 128 rows");
 
     /// A solver with its workspace for problems of `M` variables and up to `N` rows.
     pub fn new(settings: Settings) -> Self {
@@ -270,7 +270,7 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
         let x0_noise = 64.0 * f64::EPSILON * inf_norm(x0);
         // Rows found to be violated only by rounding (dependent on the active rows, and the
         // data say they hold): not picked again until the active set grows.
-        let mut noise: u64 = 0;
+        let mut noise: u128 = 0;
         // `tight`: the loose test has passed once and x was refined; from then on rows are
         // tested against the refined point's own rounding. `fresh`: refined, no step since.
         let (mut tight, mut fresh) = (false, false);
@@ -312,7 +312,7 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
     /// rounding (`None`, `p` added to `noise`), or the iteration ends (`Some`: the rows are
     /// infeasible, or the iteration limit is reached).
     #[inline(always)]
-    fn satisfy(&mut self, p: usize, max_iter: u32, noise: &mut u64) -> Option<Core> {
+    fn satisfy(&mut self, p: usize, max_iter: u32, noise: &mut u128) -> Option<Core> {
         // the multiplier row p has gathered so far
         let mut up = 0.0;
         loop {
@@ -479,7 +479,7 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
     /// [`refine`](Self::refine)): the refined point's rounding from a far `x0` lies in the
     /// null space of the active rows only, so the `x0` term is scaled by `‖J₂ᵀ â_i‖`, the
     /// row's component in that null space (zero when `M` rows are active).
-    fn most_violated(&mut self, skip: u64, x0_noise: f64, tight: bool) -> usize {
+    fn most_violated(&mut self, skip: u128, x0_noise: f64, tight: bool) -> usize {
         let ptol = self.settings.primal_tol;
         let sx = inf_norm(&self.x);
         let n = self.n;
@@ -556,7 +556,7 @@ impl<const M: usize, const N: usize> ActiveSetQp<M, N> {
     /// Removes the active row at position `l` and restores `R` to triangular form.
     fn drop(&mut self, l: usize) {
         let q = self.q;
-        self.mask &= !(1u64 << self.act[l]);
+        self.mask &= !(1u128 << self.act[l]);
         for k in l..q - 1 {
             self.rc[k] = self.rc[k + 1];
             self.act[k] = self.act[k + 1];

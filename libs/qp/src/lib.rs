@@ -6,7 +6,7 @@
 //! Every safety-filter problem is a Euclidean projection onto a small polytope:
 //!
 //! ```text
-//! minimise ½‖x − x0‖²   subject to   a_i · x ≥ b_i,   i = 0..n      (x ∈ ℝᴹ, n ≤ N ≤ 64)
+//! minimise ½‖x − x0‖²   subject to   a_i · x ≥ b_i,   i = 0..n      (x ∈ ℝᴹ, n ≤ N ≤ 128)
 //! ```
 //!
 //! [`ActiveSetQp::solve`] solves it with a **dual active-set method of the Goldfarb–Idnani
@@ -197,7 +197,7 @@ pub struct Solution<const M: usize, const N: usize> {
     /// inactive rows.
     pub lambda: [f64; N],
     /// Bit `i` is set when row `i` is in the final active set.
-    pub active: u64,
+    pub active: u128,
     /// Active-set changes (adds + drops).
     pub iterations: u32,
     /// When `Infeasible`: a Farkas certificate `y ≥ 0` with `Σ y_i a_i ≈ 0` and

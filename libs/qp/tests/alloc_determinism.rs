@@ -89,7 +89,8 @@ fn sol_bits<const M: usize, const N: usize>(s: &Solution<M, N>, out: &mut Vec<u6
     out.extend(s.x.iter().map(|v| v.to_bits()));
     out.extend(s.lambda.iter().map(|v| v.to_bits()));
     out.extend(s.certificate.iter().map(|v| v.to_bits()));
-    out.push(s.active);
+    out.push(s.active as u64);
+    out.push((s.active >> 64) as u64);
     out.push(s.iterations as u64);
 }
 
