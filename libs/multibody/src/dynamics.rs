@@ -412,6 +412,39 @@ impl Robot {
         }
     }
 
+    /// A bound over every joint state on each body's CoM distance from a point fixed in
+    /// the base frame (m), body 0 the base: `‖q − c_0‖` for the base, and for link `k`
+    /// the chain `‖q − o_1‖ + Σ_{i<k} ‖o_{i+1} − o_i‖ + ‖c_k − o_k‖` (`o_i` the origin of
+    /// link `i`, on joint `i`'s axis: each term is a fixed offset in one body's frame, so
+    /// the triangle inequality bounds the distance at every `θ`). A body without mass
+    /// gets 0.
+    pub fn body_com_distance_bounds(&self, q: &Vector3<f64>) -> [f64; NJ + 1] {
+        let kin = self.kinematics(&Vector7::zeros());
+        let com_of = |k: usize| {
+            let i = &self.inertias[k];
+            (i.mass > 0.0).then(|| i.h / i.mass)
+        };
+        let mut out = [0.0; NJ + 1];
+        if let Some(c0) = com_of(0) {
+            out[0] = (q - (kin.pose[0].trans + kin.pose[0].rot * c0)).norm();
+        }
+        let mut chain = (q - kin.pose[1].trans).norm();
+        for (k, bound) in out.iter_mut().enumerate().skip(1) {
+            if k > 1 {
+                chain += (kin.pose[k].trans - kin.pose[k - 1].trans).norm();
+            }
+            if let Some(ck) = com_of(k) {
+                *bound = chain + ck.norm();
+            }
+        }
+        out
+    }
+
+    /// The mass of body `k` (0 the base) [kg]; 0 beyond the arm.
+    pub fn body_mass(&self, k: usize) -> f64 {
+        self.inertias.get(k).map_or(0.0, |i| i.mass)
+    }
+
     /// System centre of mass in the base frame (m).
     pub fn center_of_mass(&self, theta: &Vector7) -> Vector3<f64> {
         let kin = self.kinematics(theta);

@@ -31,6 +31,19 @@ pub struct Kinematics {
     pub acc: [Vector3<f64>; NJ + 1],
 }
 
+/// The system centre of mass relative to the base, base frame ([`Robot::com_terms`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ComTerms {
+    /// `c(θ)` [m].
+    pub position: Vector3<f64>,
+    /// `J_c = ∂c/∂θ` [m/rad].
+    pub jacobian: Matrix3x7,
+    /// `J_c θ̇` [m/s].
+    pub velocity: Vector3<f64>,
+    /// `J̇_c θ̇` [m/s²].
+    pub jdot_qdot: Vector3<f64>,
+}
+
 /// Position, Jacobian and drift of a collision-sphere centre (base frame).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SphereState {
@@ -127,6 +140,39 @@ impl Robot {
         let r = pose.rot * local;
         let w = kin.omega[link];
         Some(kin.acc[link] + kin.alpha[link].cross(&r) + w.cross(&w.cross(&r)))
+    }
+
+    /// The servicer's system centre of mass relative to the base (base frame, the base
+    /// held fixed) at the kinematic state `kin` of [`Robot::kinematics_vel`]: its position
+    /// `c` [m], Jacobian `J_c = ∂c/∂θ` [m/rad], velocity `J_c θ̇` [m/s] and `J̇_c θ̇` [m/s²]
+    /// — the mass-weighted sum of every body's CoM point (the base's fixed).
+    pub fn com_terms(&self, kin: &Kinematics) -> ComTerms {
+        let mut t = ComTerms {
+            position: Vector3::zeros(),
+            jacobian: Matrix3x7::zeros(),
+            velocity: Vector3::zeros(),
+            jdot_qdot: Vector3::zeros(),
+        };
+        for (k, inertia) in self.inertias.iter().enumerate() {
+            if inertia.mass <= 0.0 {
+                continue;
+            }
+            let local = inertia.h / inertia.mass;
+            let w = inertia.mass / self.total_mass;
+            let (Some(p), Some(j), Some(a)) = (
+                self.point_position(kin, k, &local),
+                self.point_jacobian(kin, k, &local),
+                self.point_jdot_qdot(kin, k, &local),
+            ) else {
+                continue;
+            };
+            let r = kin.pose[k].rot * local;
+            t.position += p * w;
+            t.jacobian += j * w;
+            t.velocity += (kin.vel[k] + kin.omega[k].cross(&r)) * w;
+            t.jdot_qdot += a * w;
+        }
+        t
     }
 
     /// Pose of the end-effector frame in the base frame.

@@ -18,7 +18,7 @@ pub mod spatial;
 
 pub use dynamics::{BaseAngularDynamics, Momentum, ReducedArmDynamics};
 pub use error::ModelError;
-pub use kinematics::{Kinematics, SphereState};
+pub use kinematics::{ComTerms, Kinematics, SphereState};
 pub use model::{CollisionSphere, Frame, JointLimits, Robot};
 
 /// Number of arm joints (revolute, serial chain).

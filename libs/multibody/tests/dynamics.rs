@@ -245,3 +245,31 @@ fn free_flyer_conserves_momentum_and_energy_under_zero_input() {
         assert!((r.center_of_mass(&s.th) - mo.com).amax() < 1e-14);
     }
 }
+
+/// `body_com_distance_bounds` bounds the system CoM's distance from a base-fixed point at
+/// every joint state (the weighted sum of the bodies' bounds), and is not loose beyond
+/// the chain's length.
+#[test]
+fn the_com_distance_bounds_hold_at_every_joint_state() {
+    for (name, r) in robots() {
+        let q = Vector3::new(0.1, -0.2, 0.05);
+        let b = r.body_com_distance_bounds(&q);
+        let weighted: f64 = (0..=NJ).map(|k| r.body_mass(k) * b[k]).sum::<f64>() / r.total_mass();
+        let mut rng = Rng::new(17);
+        let mut largest: f64 = 0.0;
+        for _ in 0..2000 {
+            let th = rng.theta(&r);
+            let d = (q - r.center_of_mass(&th)).norm();
+            assert!(d <= weighted + 1e-12, "{name}: {d} > {weighted}");
+            largest = largest.max(d);
+        }
+        assert!(
+            b.iter().all(|v| v.is_finite() && *v >= 0.0),
+            "{name}: {b:?}"
+        );
+        assert!(
+            weighted < 3.0 * largest + 0.5,
+            "{name}: {weighted} vs {largest}"
+        );
+    }
+}

@@ -162,3 +162,32 @@ fn reach_configuration_puts_ee_1p1_m_in_front_of_the_mount() {
     assert!((1.0..=1.2).contains(&d.x) && d.yz().norm() < 1e-9);
     assert!(base_clearance(&r, &th) > 0.05);
 }
+
+/// The system CoM's terms agree with `center_of_mass` and `center_of_mass_velocity` and
+/// with finite differences: `J_c` along each joint, `J̇_c θ̇` along the motion.
+#[test]
+fn com_terms_match_the_com_and_finite_differences() {
+    for (name, r) in robots() {
+        let mut rng = Rng::new(23);
+        for _ in 0..20 {
+            let th = rng.theta(&r);
+            let qd = rng.vec7(0.5);
+            let t = r.com_terms(&r.kinematics_vel(&th, &qd));
+            assert!(
+                (t.position - r.center_of_mass(&th)).norm() < 1e-14,
+                "{name}"
+            );
+            let v = r.center_of_mass_velocity(&th, &qd);
+            assert!((t.velocity - v).norm() < 1e-13, "{name}");
+            assert!((t.jacobian * qd - v).norm() < 1e-13, "{name}");
+            let h = 1e-6;
+            let vel_at = |s: f64| r.center_of_mass_velocity(&(th + qd * s), &qd);
+            let fd = (vel_at(h) - vel_at(-h)) / (2.0 * h);
+            assert!(
+                (t.jdot_qdot - fd).norm() < 1e-7,
+                "{name}: {} vs {fd}",
+                t.jdot_qdot
+            );
+        }
+    }
+}
