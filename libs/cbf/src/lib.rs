@@ -27,6 +27,7 @@
 //! one outside its input bounds.
 
 pub mod arm_model_error;
+pub mod arm_target;
 pub mod attitude;
 pub mod barrier;
 pub mod chain;
@@ -36,6 +37,7 @@ pub mod engine;
 pub mod envelope;
 pub mod filter;
 pub mod knowledge;
+pub mod link_target;
 pub mod los_contract;
 pub mod monitor;
 pub mod qp;
@@ -67,8 +69,10 @@ pub type AttitudeOutput = FilterOutput<3, { attitude::N }>;
 /// Output of the robotic filter: `τ_M` (42 constraints).
 pub type RoboticOutput = FilterOutput<7, { robotic::N }>;
 
-/// Stable constraint names of the three filters, in report order, and their units.
+/// Stable constraint names of the three filters, in report order, the barriers only the
+/// monitor evaluates ([`ARM_TARGET`](names::ARM_TARGET)), and their units.
 pub mod names {
+    pub use crate::arm_target::NAMES as ARM_TARGET;
     pub use crate::attitude::NAMES as ATTITUDE;
     pub use crate::robotic::NAMES as ROBOTIC;
     pub use crate::translational::NAMES as TRANSLATIONAL;
@@ -76,7 +80,8 @@ pub mod names {
     /// The unit of a barrier `h` by its name, as the filters and the safety monitor
     /// compute it: the corridor `d·r − ‖r‖ cos ψ` [m], the zone `‖r‖² − R²` [m²], the line
     /// of sight `d_B·ρ̂ − cos β` [-], the rate limits [rad/s], the joint-angle limits
-    /// `(θ − θ_min)(θ_max − θ)` [rad²], the link–base spheres `‖d‖² − (ρ_i + ρ_B)²` [m²].
+    /// `(θ − θ_min)(θ_max − θ)` [rad²], the link–base spheres `‖d‖² − (ρ_i + ρ_B)²` [m²]
+    /// and the arm's and base's clearance from the target `‖d‖² − (ρ_i + ρ_k)²` [m²].
     /// `None` for a name it does not know.
     pub fn unit(name: &str) -> Option<&'static str> {
         Some(match name {
@@ -86,6 +91,7 @@ pub mod names {
             n if n.starts_with("omega_") || n.starts_with("theta_dot_") => "rad/s",
             n if n.starts_with("theta_") => "rad²",
             n if n.starts_with("link_base_") => "m²",
+            n if n.starts_with("link_target_") || n == "base_target" => "m²",
             _ => return None,
         })
     }

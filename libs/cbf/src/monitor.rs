@@ -15,21 +15,27 @@
 //! * body-rate limits, eq. "CBF-omega": `ω_max,i − ω_i`, `ω_i − ω_min,i` [rad/s];
 //! * joint angles, eq. "CBF-joint-angle": `(θ_i − θ_min,i)(θ_max,i − θ_i)` [rad²];
 //! * joint rates, eq. "CBF-joint-velocity": `θ̇_max,i ∓ θ̇_i` [rad/s];
-//! * link–base spheres, eq. "CBF-link-base": `‖p_i(θ) − c_base‖² − (ρ_i + R_base)²` [m²].
+//! * link–base spheres, eq. "CBF-link-base": `‖p_i(θ) − c_base‖² − (ρ_i + R_base)²` [m²];
+//! * arm and base against the target's keep-out spheres (not the paper's,
+//!   [`crate::arm_target`]): `min_k ‖p_i − c_k‖² − (ρ_i + ρ_k)²` [m²].
 //!
 //! `r` is the servicer's **system centre of mass** relative to the target's, in the
 //! inertially fixed reference frame F_R (where the corridor axis `d_R` is constant): the
 //! point whose motion the Clohessy–Wiltshire model describes exactly (docs/SAFETY.md).
 
-use crate::{attitude, robotic, translational};
+use crate::arm_target::TargetBody;
+use crate::{arm_target, attitude, robotic, translational};
 use nalgebra::Vector3;
 use sc_core::BarrierState;
 use sc_models::quat;
 use sc_multibody::{Robot, Vector7};
 use std::sync::Arc;
 
-/// Number of barriers: 2 translational + 7 attitude + 42 robotic.
-pub const N_ALL: usize = translational::N + attitude::N + robotic::N;
+/// Number of barriers: 2 translational + 7 attitude + 63 robotic, then the base against
+/// the target, which only the monitor evaluates.
+pub const N_ALL: usize = N_FILTERED + arm_target::N;
+/// The barriers the filters enforce (the first ones, in causal order).
+pub const N_FILTERED: usize = translational::N + attitude::N + robotic::N;
 
 /// Every barrier value, in [`crate::names`] order (translational, attitude, robotic).
 pub type Barriers = [f64; N_ALL];
@@ -47,6 +53,7 @@ pub struct Monitor {
     theta_min: Vector7,
     theta_max: Vector7,
     theta_dot_max: Vector7,
+    target: TargetBody,
     robot: Arc<Robot>,
 }
 
@@ -67,6 +74,7 @@ impl Monitor {
             theta_min: Vector7::from(r.theta_min_rad),
             theta_max: Vector7::from(r.theta_max_rad),
             theta_dot_max: Vector7::from(r.theta_dot_max_rad_s),
+            target: TargetBody::from_scenario(s),
             robot,
         }
     }
@@ -98,18 +106,34 @@ impl Monitor {
             h[o + 2 * nj + i] = x.theta_dot[i] + self.theta_dot_max[i];
         }
         if x.theta.iter().all(|v| v.is_finite()) {
-            let kin = self.robot.kinematics(&x.theta);
-            if let Some(base) = self.robot.base_sphere() {
-                for (k, (idx, _)) in self.robot.arm_spheres().take(robotic::NS).enumerate() {
-                    if let Some(sp) = self.robot.sphere_state(&kin, idx) {
-                        let d = sp.center - base.center;
-                        let rr = sp.radius + base.radius;
-                        h[o + 3 * nj + k] = d.dot(&d) - rr * rr;
-                    }
-                }
-            }
+            self.spheres(x, &mut h);
         }
         h
+    }
+
+    /// The sphere barriers: link–base (CBF-link-base) and arm–target
+    /// ([`crate::arm_target`]); left NaN where the model has no such sphere.
+    fn spheres(&self, x: &BarrierState, h: &mut Barriers) {
+        let o = translational::N + attitude::N + 3 * robotic::NJ;
+        let ot = translational::N + attitude::N + robotic::LINK_TARGET;
+        let Some(base) = self.robot.base_sphere() else {
+            return;
+        };
+        let kin = self.robot.kinematics(&x.theta);
+        let r_rb = quat::to_matrix(&x.q_rb);
+        let r_rt = quat::to_matrix(&x.q_rt);
+        let in_r = |p: &Vector3<f64>| x.base_r + r_rb * p;
+        for (k, (idx, _)) in self.robot.arm_spheres().take(robotic::NS).enumerate() {
+            if let Some(sp) = self.robot.sphere_state(&kin, idx) {
+                let d = sp.center - base.center;
+                let rr = sp.radius + base.radius;
+                h[o + k] = d.dot(&d) - rr * rr;
+                h[ot + k] = self.target.clearance(&in_r(&sp.center), sp.radius, &r_rt);
+            }
+        }
+        h[N_FILTERED] = self
+            .target
+            .clearance(&in_r(&base.center), base.radius, &r_rt);
     }
 }
 

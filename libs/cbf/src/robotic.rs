@@ -28,18 +28,20 @@
 //! angular acceleration of what the arm does beyond holding its joint rates within the
 //! budget the attitude filter assumes, `|(Q (τ_M − τ_hold))_i| ≤ β_i` (six hard rows).
 
+use crate::arm_target::TargetBody;
 use crate::barrier::{RelDegOne, RelDegTwo, Row};
 use crate::common::{self, BOX_MARGIN, FilterOutput, FilterReport, clamp_box};
 use crate::engine::{Engine, Kind, LastProblem, Outcome, SolverTally};
 use crate::filter::{Coupling, SafetyFilter};
+use crate::link_target::{self, Sampled, Surroundings, TargetMotion};
 use crate::sampled::{
     Decay, RateBounds, RateDecay, SampleBounds, braking_barrier, hdot_required_of, phi_required_of,
 };
 use crate::step::{self, Actuated, FilterStep, Invalid, Solved};
 use crate::{Formulation, qp::SolverParams};
-use nalgebra::{SMatrix, SVector, Vector3, Vector6};
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3, Vector6};
 use sc_core::{Observation, Subsystem};
-use sc_multibody::{CollisionSphere, Robot, Vector13};
+use sc_multibody::{CollisionSphere, ComTerms, Robot, Vector13};
 use std::sync::Arc;
 
 /// Joint-space vector and matrix.
@@ -48,13 +50,15 @@ pub type Matrix7 = SMatrix<f64, 7, 7>;
 /// Point Jacobian (3×7).
 pub type Matrix3x7 = SMatrix<f64, 3, 7>;
 
-/// Number of joints, link collision spheres, constraints.
+/// Number of joints, link collision spheres, constraints (the joints' angles and rates,
+/// every sphere against the base, every sphere against the target).
 pub const NJ: usize = 7;
 pub const NS: usize = 21;
-pub const N: usize = 3 * NJ + NS;
+pub const N: usize = 3 * NJ + 2 * NS;
 
 /// Constraint names in report order: `theta_1..7`, `theta_dot_max_1..7`,
-/// `theta_dot_min_1..7`, `link_base_<link>_<k>` (link 1..7, sphere k 1..3 along the link).
+/// `theta_dot_min_1..7`, `link_base_<link>_<k>` (link 1..7, sphere k 1..3 along the link),
+/// `link_target_<link>_<k>` (the same spheres against the target, [`crate::link_target`]).
 pub const NAMES: [&str; N] = [
     "theta_1",
     "theta_2",
@@ -98,7 +102,31 @@ pub const NAMES: [&str; N] = [
     "link_base_7_1",
     "link_base_7_2",
     "link_base_7_3",
+    "link_target_1_1",
+    "link_target_1_2",
+    "link_target_1_3",
+    "link_target_2_1",
+    "link_target_2_2",
+    "link_target_2_3",
+    "link_target_3_1",
+    "link_target_3_2",
+    "link_target_3_3",
+    "link_target_4_1",
+    "link_target_4_2",
+    "link_target_4_3",
+    "link_target_5_1",
+    "link_target_5_2",
+    "link_target_5_3",
+    "link_target_6_1",
+    "link_target_6_2",
+    "link_target_6_3",
+    "link_target_7_1",
+    "link_target_7_2",
+    "link_target_7_3",
 ];
+
+/// Index of the first link–target row.
+pub const LINK_TARGET: usize = 3 * NJ + NS;
 
 /// Accepted ranges of the model terms (any finite joint angle and rate is accepted: the
 /// filter never switches itself off): drift and coupling accelerations `≤ MAX_ACCEL`, `A`
@@ -149,6 +177,16 @@ pub struct RoboticInput {
     pub omega_b: Vector3<f64>,
     pub force_b: Vector3<f64>,
     pub torque_b: Vector3<f64>,
+    /// The system CoM relative to the base, F_B (the link–target rows).
+    pub com: ComTerms,
+    /// `ω̇_B` at `τ_M = 0` under the upstream safe force and torque [rad/s², F_B].
+    pub omega_dot_b0: Vector3<f64>,
+    /// The servicer's mass [kg].
+    pub total_mass: f64,
+    /// Where the servicer and the target are, from the observation; `None` for an input
+    /// built from the model alone (no target known: the link–target rows read
+    /// [`link_target::FAR_M`]² and hold for any command — tests and the envelope's samples).
+    pub around: Option<Surroundings>,
 }
 
 /// Parameters of the robotic filter.
@@ -187,6 +225,12 @@ pub struct RoboticParams {
     /// ([`TorqueError`]); zero for the `exact` profile, where the rows are the nominal
     /// ones bit for bit.
     pub joint_torque_error: TorqueError,
+    /// The target's keep-out spheres, its declared inertia [kg m²] and the inverse (the
+    /// verification propagates its tumble; the scenario's validation makes the inertia
+    /// positive definite).
+    pub target: TargetBody,
+    pub target_inertia: Matrix3<f64>,
+    pub target_inertia_inv: Matrix3<f64>,
 }
 
 /// The declared bound on the joint motors' torque error, from the scenario's
@@ -247,6 +291,7 @@ impl TorqueError {
 impl RoboticParams {
     pub fn from_scenario(s: &sc_scenario::Scenario) -> Self {
         let r = &s.safety.robotic;
+        let inertia = Matrix3::from_row_slice(&s.target.inertia_kg_m2.concat());
         Self {
             theta_min: Vector7::from(r.theta_min_rad),
             theta_max: Vector7::from(r.theta_max_rad),
@@ -268,6 +313,10 @@ impl RoboticParams {
             sphere_jerk_bound: Vector7::from(r.link_sphere_jerk_bound_m_s3),
             arm_reaction_budget: Vector3::from(s.safety.attitude.arm_reaction_budget_rad_s2),
             joint_torque_error: TorqueError::from_scenario(s),
+            target: TargetBody::from_scenario(s),
+            target_inertia: inertia,
+            // validated positive definite; a singular one would predict no tumble
+            target_inertia_inv: inertia.try_inverse().unwrap_or_else(Matrix3::zeros),
         }
     }
 }
@@ -353,6 +402,7 @@ pub struct RoboticTerms {
     pub theta_dot_max: [RelDegOne<NJ>; NJ],
     pub theta_dot_min: [RelDegOne<NJ>; NJ],
     pub link_base: [RelDegTwo<NJ>; NS],
+    pub link_target: [RelDegTwo<NJ>; NS],
 }
 
 impl RoboticTerms {
@@ -365,8 +415,19 @@ impl RoboticTerms {
             self.theta_dot_max[j - NJ].hdot_u
         } else if j < 3 * NJ {
             self.theta_dot_min[j - 2 * NJ].hdot_u
-        } else {
+        } else if j < LINK_TARGET {
             self.link_base[j - 3 * NJ].hddot_u
+        } else {
+            self.link_target[j - LINK_TARGET].hddot_u
+        }
+    }
+
+    /// The relative-degree-two terms of sphere row `j` (link–base or link–target).
+    fn sphere(&self, j: usize) -> &RelDegTwo<NJ> {
+        if j < LINK_TARGET {
+            &self.link_base[j - 3 * NJ]
+        } else {
+            &self.link_target[j - LINK_TARGET]
         }
     }
 
@@ -380,6 +441,7 @@ impl RoboticTerms {
         }
         for k in 0..NS {
             h[3 * NJ + k] = self.link_base[k].h;
+            h[LINK_TARGET + k] = self.link_target[k].h;
         }
         h
     }
@@ -557,6 +619,12 @@ struct ArmSnapshot {
     velocities: [Vector3<f64>; NS],
     /// The spheres' radii [m]; `None` where the sphere's state could not be evaluated.
     radii: [Option<f64>; NS],
+    /// The centres and velocities in F_R, relative to the target's CoM.
+    world: [Vector3<f64>; NS],
+    world_v: [Vector3<f64>; NS],
+    /// Each sphere's link–target barrier and rate (the nearest keep-out sphere).
+    target_h: [f64; NS],
+    target_hdot: [f64; NS],
 }
 
 /// The robotic CBF-QP safety filter (paper eq. "robotic_qp").
@@ -637,6 +705,14 @@ impl RoboticFilter {
                     && finite_in(&s.jdot_qdot, MAX_ACCEL)
                     && (0.0..=MAX_REACH_M).contains(&s.radius)
             })
+            && finite_in(&x.com.position, MAX_REACH_M)
+            && finite_in(&x.com.jacobian, MAX_REACH_M)
+            && finite_in(&x.com.jdot_qdot, MAX_ACCEL)
+            && finite_in(&x.omega_dot_b0, MAX_ACCEL)
+            && x.total_mass.is_finite()
+            && x.total_mass > 0.0
+            && x.around
+                .is_none_or(|a| a.valid(MAX_BASE_RATE_RAD_S, MAX_ACCEL))
     }
 
     /// Barrier terms for a valid input (`None` otherwise).
@@ -666,7 +742,7 @@ impl RoboticFilter {
     }
 
     /// The barrier terms of a checked input (paper eqs. "CBF-joint-angle",
-    /// "CBF-joint-velocity", "CBF-link-base").
+    /// "CBF-joint-velocity", "CBF-link-base"; the link–target rows beyond the paper).
     fn terms_of(&self, x: &RoboticInput) -> RoboticTerms {
         let p = &self.params;
         let rates: [_; NJ] = std::array::from_fn(|i| joint_velocity(i, x, p.theta_dot_max[i]));
@@ -675,6 +751,9 @@ impl RoboticFilter {
             theta_dot_max: std::array::from_fn(|i| rates[i][0]),
             theta_dot_min: std::array::from_fn(|i| rates[i][1]),
             link_base: std::array::from_fn(|k| link_base(&x.spheres[k], x)),
+            link_target: std::array::from_fn(|k| {
+                link_target::link_target(&x.spheres[k], x, &p.target)
+            }),
         }
     }
 
@@ -701,9 +780,10 @@ impl RoboticFilter {
     /// [`Disturbance`]), the rates within `v̄_i = |θ̇_i| + ā_i T`; then
     /// * joint angle (`ḧ = kθ̈ − 2θ̇²`): `M₃ = |k|_max J_i + 6 v̄_i ā_i`;
     /// * joint rate: `J = J_i`;
-    /// * link sphere (`ḧ = 2‖ṗ‖² + 2dᵀp̈`): `M₃ = 6 V A + 2 D J_k` with the centre's
-    ///   acceleration `A = ‖p̈‖ + ‖J‖_F ‖δ‖ + J_k T`, speed `V = ‖ṗ‖ + A T`, distance
-    ///   `D = ‖d‖ + V T`;
+    /// * link sphere against the base (`ḧ = 2‖ṗ‖² + 2dᵀp̈`): `M₃ = 6 V A + 2 D J_k` with
+    ///   the centre's acceleration `A = ‖p̈‖ + ‖J‖_F ‖δ‖ + J_k T`, speed `V = ‖ṗ‖ + A T`,
+    ///   distance `D = ‖d‖ + V T`;
+    /// * link sphere against the target: `M₃ = 0` (left to the verification);
     ///
     /// and every row's `M₂` (or `D`) is its share of the torque error at the sample.
     fn certified_bounds(
@@ -711,7 +791,7 @@ impl RoboticFilter {
         x: &RoboticInput,
         qdd: &Vector7,
         dist: &Disturbance,
-    ) -> ([SampleBounds; NJ], [RateBounds; NJ], [SampleBounds; NS]) {
+    ) -> ([SampleBounds; NJ], [RateBounds; NJ], [SampleBounds; 2 * NS]) {
         let p = &self.params;
         let t = p.period;
         let acc = Vector7::from_fn(|i, _| qdd[i].abs() + dist.joint[i] + p.joint_jerk_bound[i] * t);
@@ -730,16 +810,27 @@ impl RoboticFilter {
             j: p.joint_jerk_bound[i],
         });
         let joint_norm = dist.joint.norm();
-        let lb = std::array::from_fn(|k| {
-            let s = &x.spheres[k];
-            let jk = p.sphere_jerk_bound[k / 3];
+        let lb = std::array::from_fn(|j| {
+            if j >= NS {
+                // the link–target rows: no in-sample bound — the base's and the target's
+                // motion are not in the arm's jerk bounds, and the verification every
+                // command passes integrates all of it (a bound here only made the cheap
+                // candidate needlessly conservative at the target's range)
+                return SampleBounds {
+                    period: t,
+                    m2: dist.rows[3 * NJ + j],
+                    m3: 0.0,
+                };
+            }
+            let s = &x.spheres[j];
+            let jk = p.sphere_jerk_bound[j / 3];
             let a =
                 (s.jacobian * qdd + s.jdot_qdot).norm() + s.jacobian.norm() * joint_norm + jk * t;
             let v = (s.jacobian * x.theta_dot).norm() + a * t;
             let d = (s.center - x.base_center).norm() + v * t;
             SampleBounds {
                 period: t,
-                m2: dist.rows[3 * NJ + k],
+                m2: dist.rows[3 * NJ + j],
                 m3: 6.0 * v * a + 2.0 * d * jk,
             }
         });
@@ -778,7 +869,7 @@ impl RoboticFilter {
                 } else if j < 3 * NJ {
                     t.theta_dot_min[j - 2 * NJ].row(p.gamma_theta_dot, p.eps_theta_dot)
                 } else {
-                    t.link_base[j - 3 * NJ].row(p.gamma, p.eps_lb, p.u_max_lb)
+                    t.sphere(j).row(p.gamma, p.eps_lb, p.u_max_lb)
                 }
             }),
             Formulation::SampledData => {
@@ -829,7 +920,7 @@ impl RoboticFilter {
                 (
                     std::array::from_fn(|i| z(dist.rows[i])),
                     std::array::from_fn(zr),
-                    std::array::from_fn(|k| z(dist.rows[3 * NJ + k])),
+                    std::array::from_fn(|j| z(dist.rows[3 * NJ + j])),
                 )
             }
         };
@@ -849,7 +940,7 @@ impl RoboticFilter {
             } else if j < 3 * NJ {
                 rel1(&t.theta_dot_min[j - 2 * NJ], &br[j - 2 * NJ])
             } else {
-                rel2(&t.link_base[j - 3 * NJ], &blb[j - 3 * NJ], p.u_max_lb)
+                rel2(t.sphere(j), &blb[j - 3 * NJ], p.u_max_lb)
             }
         })
     }
@@ -1243,7 +1334,10 @@ impl RoboticFilter {
             }
             u
         });
-        let mut states = [(x.theta, x.theta_dot, x.omega_b); NJ + 1];
+        let around = x.around.unwrap_or_else(Surroundings::far);
+        let mut states = [Sampled::start(x, &around); NJ + 1];
+        let mut target = x.around.map(|a| TargetMotion::start(&a));
+        let accel = x.force_b.norm() / x.total_mass;
         let h = p.physics_step;
         let steps = ((p.period / h).round() as usize).max(1);
         let Some(base) = robot.base_sphere() else {
@@ -1253,23 +1347,31 @@ impl RoboticFilter {
         };
         for step in 1..=steps {
             for (st, u) in states.iter_mut().zip(&inputs).take(perturbed + 1) {
-                let Some(next) = rk4_internal(robot, &st.0, &st.1, &st.2, u, h) else {
+                let Some(next) = link_target::rk4_sampled(robot, st, u, x.total_mass, h) else {
                     verdict.ok = false;
                     verdict.worst = f64::NEG_INFINITY;
                     return verdict;
                 };
                 *st = next;
             }
-            let snap = |k: usize| self.snapshot(robot, &states[k].0, &states[k].1);
+            if let Some(t) = target.as_mut() {
+                *t = t.step(&p.target_inertia, &p.target_inertia_inv, h);
+            }
+            let s = step as f64 * h;
+            let snap = |k: usize| self.snapshot(robot, &states[k], target.as_ref());
             let nominal = snap(0);
             let (hv, hd) = self.barriers_along(base, &nominal);
-            let (dh, dhd) = if perturbed == 0 {
-                ([0.0; N], [0.0; N])
-            } else {
-                let others: [ArmSnapshot; NJ] = std::array::from_fn(|k| snap(k + 1));
-                self.error_effect(base, &nominal, &others)
-            };
-            let s = step as f64 * h;
+            let others: [ArmSnapshot; NJ] =
+                std::array::from_fn(|k| if k < perturbed { snap(k + 1) } else { nominal });
+            // what the prediction leaves out: the differential gravity on the CoM
+            let gravity = link_target::gravity_margin(&around, accel, s);
+            let (dh, dhd) = self.error_effect(
+                base,
+                &nominal,
+                &others[..perturbed],
+                target.as_ref(),
+                gravity,
+            );
             for j in 0..N {
                 let hj = hv[j] - dh[j];
                 verdict.worst = verdict.worst.min(hj / weights[j]);
@@ -1301,12 +1403,16 @@ impl RoboticFilter {
     /// * joint angle (`h = (θ − θ_min)(θ_max − θ)`, `ḣ = k θ̇`): `Δh = |k| Δθ + Δθ²`,
     ///   `Δḣ = |k| Δθ̇ + 2|θ̇| Δθ + 2 Δθ Δθ̇`;
     /// * link sphere (`h = ‖d‖² − (ρ + R)²`, `ḣ = 2 dᵀv`): `Δh = 2‖d‖ Δc + Δc²`,
-    ///   `Δḣ = 2 (Δc ‖v‖ + ‖d‖ Δv + Δc Δv)`.
+    ///   `Δḣ = 2 (Δc ‖v‖ + ‖d‖ Δv + Δc Δv)`, for the link–target rows with the centres
+    ///   and velocities in F_R (the base's attitude and the system CoM's offset moved by
+    ///   the error too) and `d`, `v` against the nearest keep-out sphere.
     fn error_effect(
         &self,
         base: &CollisionSphere,
         nominal: &ArmSnapshot,
         perturbed: &[ArmSnapshot],
+        tm: Option<&TargetMotion>,
+        gravity: (f64, f64),
     ) -> ([f64; N], [f64; N]) {
         let (mut dh, mut dhd) = ([0.0; N], [0.0; N]);
         let r = VERIFY_SECOND_ORDER;
@@ -1322,21 +1428,44 @@ impl RoboticFilter {
             dh[NJ + i] = dv;
             dh[2 * NJ + i] = dv;
         }
+        let grow = |d: f64, v: f64, dc: f64, dvel: f64| {
+            (
+                2.0 * d * dc + dc * dc,
+                2.0 * (dc * v + d * dvel + dc * dvel),
+            )
+        };
         for s in 0..NS {
             let dc = sum(&|o| (o.centers[s] - n.centers[s]).norm());
             let dvel = sum(&|o| (o.velocities[s] - n.velocities[s]).norm());
             let d = (n.centers[s] - base.center).norm();
             let v = n.velocities[s].norm();
-            dh[3 * NJ + s] = 2.0 * d * dc + dc * dc;
-            dhd[3 * NJ + s] = 2.0 * (dc * v + d * dvel + dc * dvel);
+            (dh[3 * NJ + s], dhd[3 * NJ + s]) = grow(d, v, dc, dvel);
+            let (Some(radius), Some(tm)) = (n.radii[s], tm) else {
+                continue;
+            };
+            let dc = sum(&|o| (o.world[s] - n.world[s]).norm()) + gravity.0;
+            let dvel = sum(&|o| (o.world_v[s] - n.world_v[s]).norm()) + gravity.1;
+            // every keep-out sphere lowered by its own distance's share; the lowest decides
+            let (low, low_dot) = link_target::lowered(
+                &self.params.target,
+                &n.world[s],
+                &n.world_v[s],
+                radius,
+                tm,
+                dc,
+                dvel,
+            );
+            dh[LINK_TARGET + s] = n.target_h[s] - low;
+            dhd[LINK_TARGET + s] = n.target_hdot[s] - low_dot;
         }
         (dh, dhd)
     }
 
-    /// The joint state `(θ, θ̇)` of the verification with every arm sphere's centre and
-    /// velocity in the base frame (a sphere whose state cannot be evaluated has no radius:
-    /// its barrier reads 0, as before).
-    fn snapshot(&self, robot: &Robot, th: &Vector7, thd: &Vector7) -> ArmSnapshot {
+    /// The state `st` of the verification with every arm sphere's centre and velocity in
+    /// the base frame and in F_R, and its barrier against the target `tm` (a sphere whose
+    /// state cannot be evaluated has no radius: its barriers read 0, as before).
+    fn snapshot(&self, robot: &Robot, st: &Sampled, tm: Option<&TargetMotion>) -> ArmSnapshot {
+        let (th, thd) = (&st.theta, &st.theta_dot);
         let kin = robot.kinematics_vel(th, thd);
         let mut snap = ArmSnapshot {
             theta: *th,
@@ -1344,6 +1473,10 @@ impl RoboticFilter {
             centers: [Vector3::zeros(); NS],
             velocities: [Vector3::zeros(); NS],
             radii: [None; NS],
+            world: [Vector3::zeros(); NS],
+            world_v: [Vector3::zeros(); NS],
+            target_h: [0.0; NS],
+            target_hdot: [0.0; NS],
         };
         for (k, (idx, _)) in robot.arm_spheres().take(NS).enumerate() {
             if let Some(sp) = robot.sphere_state(&kin, idx) {
@@ -1352,6 +1485,23 @@ impl RoboticFilter {
                 snap.radii[k] = Some(sp.radius);
             }
         }
+        let Some(tm) = tm else {
+            // no target known: the rows' constant value
+            snap.target_h = [link_target::FAR_M * link_target::FAR_M; NS];
+            return snap;
+        };
+        let com = robot.com_terms(&kin);
+        let a = link_target::along(
+            &self.params.target,
+            &snap.centers,
+            &snap.velocities,
+            &snap.radii,
+            &com.position,
+            &com.velocity,
+            st,
+            tm,
+        );
+        (snap.target_h, snap.target_hdot, snap.world, snap.world_v) = (a.h, a.hdot, a.pos, a.vel);
         snap
     }
 
@@ -1375,6 +1525,8 @@ impl RoboticFilter {
                 let rr = radius + base.radius;
                 hv[3 * NJ + k] = d.dot(&d) - rr * rr;
                 hd[3 * NJ + k] = 2.0 * d.dot(&a.velocities[k]);
+                hv[LINK_TARGET + k] = a.target_h[k];
+                hd[LINK_TARGET + k] = a.target_hdot[k];
             }
         }
         (hv, hd)
@@ -1397,7 +1549,7 @@ impl RoboticFilter {
             let (h0, hd0) = if j < NJ {
                 (t0.theta[j].h, t0.theta[j].hdot)
             } else {
-                (t0.link_base[j - 3 * NJ].h, t0.link_base[j - 3 * NJ].hdot)
+                (t0.sphere(j).h, t0.sphere(j).hdot)
             };
             let mu = if j < NJ { p.u_max_theta } else { p.u_max_lb };
             let kappa = (-p.gamma * p.period).exp() * braking_barrier(h0, hd0, mu);
@@ -1521,9 +1673,8 @@ pub fn robotic_input_from_model(
     );
     let red = robot.reduced_arm_dynamics(theta, theta_dot, omega_b, &wrench)?;
     let a = red.m_eff.cholesky()?.inverse();
-    let reaction = robot
-        .base_angular_dynamics(theta, theta_dot, omega_b, f_b_sf)?
-        .q;
+    let base_dyn = robot.base_angular_dynamics(theta, theta_dot, omega_b, f_b_sf)?;
+    let reaction = base_dyn.q;
     let base = robot.base_sphere()?;
     let kin = robot.kinematics_vel(theta, theta_dot);
     let mut spheres = [SphereTerms::default(); NS];
@@ -1558,6 +1709,10 @@ pub fn robotic_input_from_model(
         omega_b: *omega_b,
         force_b: *f_b_sf,
         torque_b: *tau_b_sf,
+        com: robot.com_terms(&kin),
+        omega_dot_b0: base_dyn.r + base_dyn.p * tau_b_sf,
+        total_mass: robot.total_mass(),
+        around: None,
     })
 }
 
@@ -1639,14 +1794,18 @@ impl SafetyFilter<NJ, N> for RoboticFilter {
     /// The robotic input with the upstream safe base force and torque (ξ_rob); `None`
     /// when the model cannot be evaluated (non-finite state or wrench, singular dynamics).
     fn input(&self, model: &Robot, o: &Observation, xi: &Coupling) -> Option<RoboticInput> {
-        robotic_input_from_model(
+        let x = robotic_input_from_model(
             model,
             &o.theta,
             &o.theta_dot,
             &o.omega_b,
             &xi.force_b,
             &xi.torque_b,
-        )
+        )?;
+        Some(RoboticInput {
+            around: Some(Surroundings::from_observation(o)),
+            ..x
+        })
     }
 
     fn filter_with(&mut self, x: &RoboticInput, nominal: Option<&Vector7>) -> FilterOutput<NJ, N> {
@@ -1828,7 +1987,7 @@ mod tests {
                         period: p.period,
                         m2: 0.0,
                         m3: 0.0,
-                    }; NS],
+                    }; 2 * NS],
                 ),
             };
             let decay = Decay::linear(p.gamma).at(p.period);
@@ -1841,11 +2000,7 @@ mod tests {
                 } else if j < 3 * NJ {
                     RelDeg1::from(t.theta_dot_min[j - 2 * NJ]).row_at(&br[j - 2 * NJ], &rate)
                 } else {
-                    RelDeg2::from(t.link_base[j - 3 * NJ]).row_at(
-                        &blb[j - 3 * NJ],
-                        p.u_max_lb,
-                        &decay,
-                    )
+                    RelDeg2::from(*t.sphere(j)).row_at(&blb[j - 3 * NJ], p.u_max_lb, &decay)
                 }
             })
         };
@@ -1926,7 +2081,7 @@ mod tests {
             } else if j < 3 * NJ {
                 rel1(&t.theta_dot_min[j - 2 * NJ])
             } else {
-                rel2(&t.link_base[j - 3 * NJ], p.u_max_lb)
+                rel2(t.sphere(j), p.u_max_lb)
             }
         });
         let got = f.barrier_rows(&x, &t, Level::Local(tau.abs()), &[0.0; N]);

@@ -589,7 +589,7 @@ fn robotic_wild(w: RoboticWild) -> Wild<RoboticInput> {
     Wild { x, realistic }
 }
 
-impl Conformance<7, 42> for RoboticFilter {
+impl Conformance<7, { sc_cbf::robotic::N }> for RoboticFilter {
     fn fresh() -> Self {
         RoboticFilter::from_scenario(&scenario(), robot())
     }
@@ -691,6 +691,12 @@ impl Conformance<7, 42> for RoboticFilter {
             && finite(&x.base_center)
             && x.base_radius.is_finite()
             && x.spheres.iter().all(|s| finite(&s.center))
+            && finite(&x.com.position)
+            && finite(&x.com.jacobian)
+            && finite(&x.omega_dot_b0)
+            && x.total_mass.is_finite()
+            && x.around
+                .is_none_or(|a| finite(&a.com_r) && finite(&a.com_v_r))
     }
     fn coupling_finite(x: &RoboticInput) -> bool {
         finite(&x.xi)
@@ -1416,9 +1422,9 @@ conformance!(
     sc_cbf::names::TRANSLATIONAL
 );
 conformance!(attitude, AttitudeFilter, 3, 7, sc_cbf::names::ATTITUDE);
-conformance!(robotic, RoboticFilter, 7, 42, sc_cbf::names::ROBOTIC);
+conformance!(robotic, RoboticFilter, 7, 63, sc_cbf::names::ROBOTIC);
 
-/// The names of all filters together: 51 barriers, every name once.
+/// The names of all filters together: 72 barriers, every name once.
 #[test]
 fn report_names_are_unique_across_the_filters() {
     let mut all: Vec<&str> = sc_cbf::names::TRANSLATIONAL
@@ -1427,10 +1433,10 @@ fn report_names_are_unique_across_the_filters() {
         .chain(sc_cbf::names::ROBOTIC.iter())
         .copied()
         .collect();
-    assert_eq!(all.len(), 51);
+    assert_eq!(all.len(), 72);
     all.sort();
     all.dedup();
-    assert_eq!(all.len(), 51, "names are unique");
+    assert_eq!(all.len(), 72, "names are unique");
 }
 
 // ================================================================== the relaxed problem

@@ -809,10 +809,11 @@ fn robotic_sign_convention_and_sphere_order() {
 
 /// The safety monitor (barriers from the true state, written independently of the filters)
 /// and the filters' own barrier values agree at random consistent states, in
-/// `sc_cbf::names` order.
+/// `sc_cbf::names` order (the paper's 51; the link–target rows against finite differences
+/// of the monitor's own values in `link_target_rows_match_finite_differences`).
 #[test]
 fn monitor_barriers_equal_the_filters_barriers() {
-    use sc_cbf::monitor::{Monitor, N_ALL};
+    use sc_cbf::monitor::{Monitor, N_FILTERED as N_ALL};
     use sc_core::BarrierState;
     let s = scenario();
     let robot = robot();
@@ -831,6 +832,8 @@ fn monitor_barriers_equal_the_filters_barriers() {
             grasp_r: grasp_at(&s, st.t).0,
             theta: st.theta,
             theta_dot: st.theta_dot,
+            base_r: st.com_r,
+            q_rt: [1.0, 0.0, 0.0, 0.0],
         });
         let mut ours = Vec::with_capacity(N_ALL);
         let tr = ft
@@ -845,6 +848,8 @@ fn monitor_barriers_equal_the_filters_barriers() {
             .unwrap();
         ours.extend(rb.h());
         assert_eq!(ours.len(), N_ALL);
+        // the link–target rows of an input from the model alone know no target
+        ours.truncate(sc_cbf::robotic::LINK_TARGET + 9);
         for (i, (a, b)) in h.iter().zip(&ours).enumerate() {
             assert!(
                 (a - b).abs() <= 1e-12 * (1.0 + b.abs()),

@@ -235,7 +235,8 @@ fn solver_failure_falls_back_to_the_braking_law() {
 fn fault_flags_are_stable_and_the_layer_is_built_from_the_model() {
     assert_eq!(sc_cbf::names::TRANSLATIONAL.len(), 2);
     assert_eq!(sc_cbf::names::ATTITUDE.len(), 7);
-    assert_eq!(sc_cbf::names::ROBOTIC.len(), 42);
+    assert_eq!(sc_cbf::names::ROBOTIC.len(), 63);
+    assert_eq!(sc_cbf::names::ARM_TARGET, ["base_target"]);
     assert_eq!(faults::NAMES.len(), 11);
     assert_eq!(faults::NOMINAL_MISSING, 1 << 7);
     assert_eq!(faults::QP_SECOND_OPINION, 1 << 8);

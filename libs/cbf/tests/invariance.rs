@@ -563,7 +563,8 @@ fn robotic_run_with(filtered: bool, motors: Option<&MotorErrors>) -> RoboticRun 
     let base = robot.base_sphere().unwrap().clone();
     let arm: Vec<usize> = robot.arm_spheres().map(|(i, _)| i).collect();
     let barriers = |th: &Vector7, thd: &Vector7| {
-        let mut h = [0.0; sc_cbf::robotic::N];
+        // the link–target rows have no target here (inputs from the model alone)
+        let mut h = [f64::INFINITY; sc_cbf::robotic::N];
         for i in 0..7 {
             h[i] = (th[i] - p.theta_min[i]) * (p.theta_max[i] - th[i]);
             h[7 + i] = p.theta_dot_max[i] - thd[i];

@@ -87,6 +87,10 @@ pub struct BarrierState {
     /// Joint angles [rad] and rates [rad/s].
     pub theta: Vector7,
     pub theta_dot: Vector7,
+    /// Servicer base origin relative to the target CoM, in F_R [m] (where the arm is).
+    pub base_r: Vector3<f64>,
+    /// `q_RT`: target attitude, rotates F_T vectors into F_R (where its body is).
+    pub q_rt: Quat,
 }
 
 impl Observation {
@@ -100,6 +104,8 @@ impl Observation {
             grasp_r: self.grasp_r,
             theta: self.theta,
             theta_dot: self.theta_dot,
+            base_r: self.r_r,
+            q_rt: self.q_rt,
         }
     }
 

@@ -20,11 +20,13 @@ pub fn constraint_names(s: Subsystem) -> &'static [&'static str] {
 }
 
 /// Every barrier of the safety layer in telemetry order (the filters' constraints in
-/// causal order; `SimState.barriers`).
+/// causal order, then the arm–target barriers only the monitor evaluates;
+/// `SimState.barriers`).
 pub fn all_barrier_names() -> Vec<&'static str> {
     Subsystem::ALL
         .into_iter()
         .flat_map(|s| constraint_names(s).iter().copied())
+        .chain(sc_cbf::names::ARM_TARGET.iter().copied())
         .collect()
 }
 

@@ -223,7 +223,8 @@ pub fn messages() -> String {
 }
 
 /// Every barrier: its index in telemetry (`SimState.barriers`), its filter and index
-/// in that filter's report (`h`, `phi`, `active_mask`), its name and unit.
+/// in that filter's report (`h`, `phi`, `active_mask`) — none for the barriers only the
+/// monitor evaluates —, its name and unit.
 pub fn barriers() -> String {
     let mut t = String::from(
         "| telemetry index | filter | report index | name | unit of h |\n|---|---|---|---|---|\n",
@@ -235,6 +236,11 @@ pub fn barriers() -> String {
             let _ = writeln!(t, "| {k} | {s} | {i} | `{n}` | {} |", cell(unit));
             k += 1;
         }
+    }
+    for n in sc_cbf::names::ARM_TARGET {
+        let unit = barrier_unit(n).unwrap_or("?");
+        let _ = writeln!(t, "| {k} | (monitor only) | — | `{n}` | {} |", cell(unit));
+        k += 1;
     }
     t
 }

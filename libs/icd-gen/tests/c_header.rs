@@ -128,7 +128,7 @@ fn c_compiler_lays_out_every_message_as_rust_does() {
     }
     assert_eq!(printed.lines().count(), want.lines().count());
     // every message, every field and every constant was compared
-    assert!(want.contains("field ScSimState.barriers_between 1160 408"));
+    assert!(want.contains("field ScSimState.barriers_between 1336 584"));
     assert!(want.contains("str SC_SERVICE_PARTNER_STATE safe_capture/partner/state"));
     assert!(want.contains("int SC_DUE_ROBOTIC 4"));
 }
@@ -140,7 +140,7 @@ fn header_compiles_as_cpp17() {
     std::fs::write(
         src,
         "#include \"safe_capture_icd.h\"\n#include <cstring>\n\
-         static_assert(sizeof(ScSimState) == 1616, \"size\");\n\
+         static_assert(sizeof(ScSimState) == 1968, \"size\");\n\
          int main() { ScNominalTranslational m{}; m.tick = 1; m.f_h[2] = 1.0;\n\
          if (m.f_h[2] != 1.0 || m.tick != 1) return 2;\n\
          return std::strcmp(ScNominalTranslational::IOX2_TYPE_NAME, SC_TYPE_NAME_NOMINAL_TRANSLATIONAL); }\n",

@@ -27,8 +27,9 @@ extern "C" {
 #define SC_N_JOINTS 7u /* Number of manipulator joints. */
 #define SC_N_CONSTRAINTS_TRANSLATIONAL 2u /* Number of translational safety constraints: AC (approach corridor), CAZ (collision-avoidance zone). */
 #define SC_N_CONSTRAINTS_ATTITUDE 7u /* Number of attitude safety constraints: ATT (pointing), ω1..3 upper, ω1..3 lower. */
-#define SC_N_CONSTRAINTS_ROBOTIC 42u /* Number of robotic safety constraints: θ limits 7, θ̇ upper 7, θ̇ lower 7, link-base 21. */
-#define SC_N_BARRIERS 51u /* Number of barriers of the whole safety layer (translational, attitude, robotic). */
+#define SC_N_CONSTRAINTS_ROBOTIC 63u /* Number of robotic safety constraints: θ limits 7, θ̇ upper 7, θ̇ lower 7, link-base 21, link-target 21. */
+#define SC_N_BARRIERS_MONITORED 1u /* Number of barriers only the safety monitor evaluates: the base's collision zone against the target's body (implied by the collision-avoidance zone). */
+#define SC_N_BARRIERS 73u /* Number of barriers of the whole safety layer (translational, attitude, robotic, then the monitored ones). */
 
 /* Service names (relative: a run's iceoryx2 global.prefix is "sc_<SC_RUN_ID>_"). Each pub/sub service has an event service of the same name. */
 #define SC_SERVICE_TICK "safe_capture/scheduler/tick" /* Tick, QoS flight */
@@ -55,13 +56,13 @@ extern "C" {
 
 /* iceoryx2 type names: give them when opening a service (iceoryx2 matches types by name, size and alignment) */
 #define SC_TYPE_NAME_TICK "safe_capture::v2::Tick"
-#define SC_TYPE_NAME_SIM_STATE "safe_capture::v4::SimState"
+#define SC_TYPE_NAME_SIM_STATE "safe_capture::v5::SimState"
 #define SC_TYPE_NAME_NOMINAL_TRANSLATIONAL "safe_capture::v2::NominalTranslational"
 #define SC_TYPE_NAME_NOMINAL_ATTITUDE "safe_capture::v2::NominalAttitude"
 #define SC_TYPE_NAME_NOMINAL_ROBOTIC "safe_capture::v2::NominalRobotic"
 #define SC_TYPE_NAME_SAFE_TRANSLATIONAL "safe_capture::v3::SafeTranslational"
 #define SC_TYPE_NAME_SAFE_ATTITUDE "safe_capture::v3::SafeAttitude"
-#define SC_TYPE_NAME_SAFE_ROBOTIC "safe_capture::v3::SafeRobotic"
+#define SC_TYPE_NAME_SAFE_ROBOTIC "safe_capture::v4::SafeRobotic"
 #define SC_TYPE_NAME_STEP_RESULT "safe_capture::v1::StepResult"
 #define SC_TYPE_NAME_NAVIGATION_ERROR "safe_capture::v1::NavigationError"
 #define SC_TYPE_NAME_NAV_STATE "safe_capture::v1::NavState"
@@ -152,7 +153,7 @@ SC_ICD_STATIC_ASSERT(offsetof(ScTick, send_ns) == 24, "ScTick.send_ns: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScTick, command) == 32, "ScTick.command: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScTick, _pad0) == 36, "ScTick._pad0: offset");
 
-/* SimState -- safe_capture::v4::SimState, 1616 B. Simulator → nominal controllers, safety filters, recorder: the observation at the start of the step. Every field of `sc_core::Observation`, copied as f64, so that the stages compute exactly what they compute in one process. */
+/* SimState -- safe_capture::v5::SimState, 1968 B. Simulator → nominal controllers, safety filters, recorder: the observation at the start of the step. Every field of `sc_core::Observation`, copied as f64, so that the stages compute exactly what they compute in one process. */
 typedef struct ScSimState {
     uint64_t tick; /* Tick index this state answers (= simulator step count at the base rate) [-] */
     double t; /* Simulation time [s] */
@@ -188,16 +189,16 @@ typedef struct ScSimState {
     double com_v_h[3]; /* Derivative of com_h in the rotating Hill frame, frame F_H [m/s] */
     double com_r[3]; /* Servicer system centre of mass relative to the target CoM, frame F_R [m] */
     double com_v_r[3]; /* Inertial velocity of the servicer system centre of mass, frame F_R [m/s] */
-    double barriers[51]; /* Every barrier h at this state, from the simulator's own state (the safety monitor), in telemetry order; NaN (null in the MCAP) = not evaluated. With a declared `[uncertainty]` the state is the estimate and these the barriers on knowledge (the declared model on it) [unit per constraint] */
-    double barriers_between[51]; /* The smallest value of every barrier over the physics steps since the previous state message (this state included); with a declared `[uncertainty]` equal to `barriers` (knowledge exists at the ticks only) [unit per constraint] */
+    double barriers[73]; /* Every barrier h at this state, from the simulator's own state (the safety monitor), in telemetry order; NaN (null in the MCAP) = not evaluated. With a declared `[uncertainty]` the state is the estimate and these the barriers on knowledge (the declared model on it) [unit per constraint] */
+    double barriers_between[73]; /* The smallest value of every barrier over the physics steps since the previous state message (this state included); with a declared `[uncertainty]` equal to `barriers` (knowledge exists at the ticks only) [unit per constraint] */
     double held_f_b[3]; /* The base force the simulator holds from the previous step: what acts in this tick while the translational group is not due (a downstream filter certifies against it then; docs/PARTITION.md, "Only what was certified acts"), frame F_B [N] */
     double held_tau_b[3]; /* The base torque the simulator holds from the previous step, as `held_f_b`, frame F_B [N·m] */
 #if defined(__cplusplus) && __cplusplus >= 201703L
     /* the name iceoryx2's C++ API matches the payload type by */
-    static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v4::SimState";
+    static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v5::SimState";
 #endif
 } ScSimState;
-SC_ICD_STATIC_ASSERT(sizeof(ScSimState) == 1616, "ScSimState: size");
+SC_ICD_STATIC_ASSERT(sizeof(ScSimState) == 1968, "ScSimState: size");
 SC_ICD_STATIC_ASSERT(SC_ICD_ALIGNOF(ScSimState) == 8, "ScSimState: alignment");
 SC_ICD_STATIC_ASSERT(offsetof(ScSimState, tick) == 0, "ScSimState.tick: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSimState, t) == 8, "ScSimState.t: offset");
@@ -234,9 +235,9 @@ SC_ICD_STATIC_ASSERT(offsetof(ScSimState, com_v_h) == 680, "ScSimState.com_v_h: 
 SC_ICD_STATIC_ASSERT(offsetof(ScSimState, com_r) == 704, "ScSimState.com_r: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSimState, com_v_r) == 728, "ScSimState.com_v_r: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSimState, barriers) == 752, "ScSimState.barriers: offset");
-SC_ICD_STATIC_ASSERT(offsetof(ScSimState, barriers_between) == 1160, "ScSimState.barriers_between: offset");
-SC_ICD_STATIC_ASSERT(offsetof(ScSimState, held_f_b) == 1568, "ScSimState.held_f_b: offset");
-SC_ICD_STATIC_ASSERT(offsetof(ScSimState, held_tau_b) == 1592, "ScSimState.held_tau_b: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScSimState, barriers_between) == 1336, "ScSimState.barriers_between: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScSimState, held_f_b) == 1920, "ScSimState.held_f_b: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScSimState, held_tau_b) == 1944, "ScSimState.held_tau_b: offset");
 
 /* NominalTranslational -- safe_capture::v2::NominalTranslational, 64 B. Nominal translational controller → translational safety filter, recorder. */
 typedef struct ScNominalTranslational {
@@ -406,7 +407,7 @@ SC_ICD_STATIC_ASSERT(offsetof(ScSafeAttitude, actuated) == 216, "ScSafeAttitude.
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeAttitude, xi_f_b) == 240, "ScSafeAttitude.xi_f_b: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeAttitude, xi_tau_b) == 264, "ScSafeAttitude.xi_tau_b: offset");
 
-/* SafeRobotic -- safe_capture::v3::SafeRobotic, 912 B. Robotic safety filter → simulator, recorder. Constraint order: θ limits 0..7, θ̇ upper 7..14, θ̇ lower 14..21, link-base 21..42. */
+/* SafeRobotic -- safe_capture::v4::SafeRobotic, 1248 B. Robotic safety filter → simulator, recorder. Constraint order: θ limits 0..7, θ̇ upper 7..14, θ̇ lower 14..21, link-base 21..42, link-target 42..63. */
 typedef struct ScSafeRobotic {
     uint64_t tick; /* Tick index this command answers [-] */
     double t; /* Simulation time of the state used [s] */
@@ -421,18 +422,18 @@ typedef struct ScSafeRobotic {
     uint32_t phase; /* Mission phase of the nominal command filtered (0-based) [-] */
     uint32_t solve_cpu_ns; /* CPU time of the filter call on its thread, saturating at u32::MAX [ns] */
     double slack; /* Slack of the relaxed QP (0 otherwise), normalised rows; for a translational step degraded under a declared uncertainty, the share of the declared margins given up (docs/SAFETY.md) [-] */
-    double h[42]; /* Barrier values h_i the filter evaluated; NaN (null in the MCAP) = not evaluated [unit per constraint] */
-    double phi[42]; /* CBF conditions Φ_i at the safe command [unit per constraint / s] */
+    double h[63]; /* Barrier values h_i the filter evaluated; NaN (null in the MCAP) = not evaluated [unit per constraint] */
+    double phi[63]; /* CBF conditions Φ_i at the safe command [unit per constraint / s] */
     double u[7]; /* Safe joint torques τ_M, frame M [N·m] */
     double actuated[7]; /* Actuated joint torques τ_M (equals `u`), frame M [N·m] */
     double xi_f_b[3]; /* Coupling ξ this command was certified against: the base force f_B acting upstream (the translational command or its backup; 0 for the translational filter, which has no upstream). The simulator applies the command only with exactly this force acting (docs/PARTITION.md), frame F_B [N] */
     double xi_tau_b[3]; /* Coupling ξ this command was certified against: the base torque τ_B acting upstream (the attitude command or its backup; 0 for the translational and attitude filters), frame F_B [N·m] */
 #if defined(__cplusplus) && __cplusplus >= 201703L
     /* the name iceoryx2's C++ API matches the payload type by */
-    static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v3::SafeRobotic";
+    static constexpr const char* IOX2_TYPE_NAME = "safe_capture::v4::SafeRobotic";
 #endif
 } ScSafeRobotic;
-SC_ICD_STATIC_ASSERT(sizeof(ScSafeRobotic) == 912, "ScSafeRobotic: size");
+SC_ICD_STATIC_ASSERT(sizeof(ScSafeRobotic) == 1248, "ScSafeRobotic: size");
 SC_ICD_STATIC_ASSERT(SC_ICD_ALIGNOF(ScSafeRobotic) == 8, "ScSafeRobotic: alignment");
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, tick) == 0, "ScSafeRobotic.tick: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, t) == 8, "ScSafeRobotic.t: offset");
@@ -448,11 +449,11 @@ SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, phase) == 64, "ScSafeRobotic.phase:
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, solve_cpu_ns) == 68, "ScSafeRobotic.solve_cpu_ns: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, slack) == 72, "ScSafeRobotic.slack: offset");
 SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, h) == 80, "ScSafeRobotic.h: offset");
-SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, phi) == 416, "ScSafeRobotic.phi: offset");
-SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, u) == 752, "ScSafeRobotic.u: offset");
-SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, actuated) == 808, "ScSafeRobotic.actuated: offset");
-SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, xi_f_b) == 864, "ScSafeRobotic.xi_f_b: offset");
-SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, xi_tau_b) == 888, "ScSafeRobotic.xi_tau_b: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, phi) == 584, "ScSafeRobotic.phi: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, u) == 1088, "ScSafeRobotic.u: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, actuated) == 1144, "ScSafeRobotic.actuated: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, xi_f_b) == 1200, "ScSafeRobotic.xi_f_b: offset");
+SC_ICD_STATIC_ASSERT(offsetof(ScSafeRobotic, xi_tau_b) == 1224, "ScSafeRobotic.xi_tau_b: offset");
 
 /* StepResult -- safe_capture::v1::StepResult, 152 B. Simulator → scheduler, recorder: the command applied over the step and how the step ended. Sent once all due safe commands of the tick are in (or their deadline passed and the simulator used the filter's fallback). */
 typedef struct ScStepResult {

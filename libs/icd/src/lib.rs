@@ -55,15 +55,19 @@ icd_constants! {
         /// Number of attitude safety constraints: ATT (pointing), ω1..3 upper, ω1..3 lower.
         N_CONSTRAINTS_ATTITUDE = 7,
         /// Number of robotic safety constraints: θ limits 7, θ̇ upper 7, θ̇ lower 7,
-        /// link-base 21.
-        N_CONSTRAINTS_ROBOTIC = 42,
-        /// Number of barriers of the whole safety layer (translational, attitude, robotic).
-        N_BARRIERS = N_CONSTRAINTS_TRANSLATIONAL + N_CONSTRAINTS_ATTITUDE + N_CONSTRAINTS_ROBOTIC,
+        /// link-base 21, link-target 21.
+        N_CONSTRAINTS_ROBOTIC = 63,
+        /// Number of barriers only the safety monitor evaluates: the base's collision zone
+        /// against the target's body (implied by the collision-avoidance zone).
+        N_BARRIERS_MONITORED = 1,
+        /// Number of barriers of the whole safety layer (translational, attitude, robotic,
+        /// then the monitored ones).
+        N_BARRIERS = N_CONSTRAINTS_TRANSLATIONAL + N_CONSTRAINTS_ATTITUDE + N_CONSTRAINTS_ROBOTIC + N_BARRIERS_MONITORED,
     }
 }
 pub use lengths::{
-    N_BARRIERS, N_CONSTRAINTS_ATTITUDE, N_CONSTRAINTS_ROBOTIC, N_CONSTRAINTS_TRANSLATIONAL,
-    N_JOINTS,
+    N_BARRIERS, N_BARRIERS_MONITORED, N_CONSTRAINTS_ATTITUDE, N_CONSTRAINTS_ROBOTIC,
+    N_CONSTRAINTS_TRANSLATIONAL, N_JOINTS,
 };
 
 icd_constants! {
@@ -247,7 +251,7 @@ icd_message! {
     /// Simulator → nominal controllers, safety filters, recorder: the observation at
     /// the start of the step. Every field of `sc_core::Observation`, copied as f64, so
     /// that the stages compute exactly what they compute in one process.
-    #[type_name("safe_capture::v4::SimState")]
+    #[type_name("safe_capture::v5::SimState")]
     pub struct SimState {
         /// Tick index this state answers (= simulator step count at the base rate)
         pub tick: u64 = ["-"],
@@ -473,8 +477,8 @@ safe_msg! {
 }
 safe_msg! {
     /// Robotic safety filter → simulator, recorder.
-    /// Constraint order: θ limits 0..7, θ̇ upper 7..14, θ̇ lower 14..21, link-base 21..42.
-    SafeRobotic = "safe_capture::v3::SafeRobotic", Robotic, N_CONSTRAINTS_ROBOTIC,
+    /// Constraint order: θ limits 0..7, θ̇ upper 7..14, θ̇ lower 14..21, link-base 21..42, link-target 42..63.
+    SafeRobotic = "safe_capture::v4::SafeRobotic", Robotic, N_CONSTRAINTS_ROBOTIC,
     /// Safe joint torques τ_M
     u: [f64; N_JOINTS] = ["N·m", Joints, Joints],
     /// Actuated joint torques τ_M (equals `u`)
@@ -645,13 +649,13 @@ pub fn type_name_of<T: ZeroCopySend>() -> &'static str {
 // Size guards: a change of one is a change of the ICD (regenerate the artefacts with
 // `SC_WRITE_ICD=1 cargo test -p sc-icd-gen`, and version the type name).
 const _: () = assert!(core::mem::size_of::<Tick>() == 40);
-const _: () = assert!(core::mem::size_of::<SimState>() == 1616);
+const _: () = assert!(core::mem::size_of::<SimState>() == 1968);
 const _: () = assert!(core::mem::size_of::<NominalTranslational>() == 64);
 const _: () = assert!(core::mem::size_of::<NominalAttitude>() == 64);
 const _: () = assert!(core::mem::size_of::<NominalRobotic>() == 96);
 const _: () = assert!(core::mem::size_of::<SafeTranslational>() == 208);
 const _: () = assert!(core::mem::size_of::<SafeAttitude>() == 288);
-const _: () = assert!(core::mem::size_of::<SafeRobotic>() == 912);
+const _: () = assert!(core::mem::size_of::<SafeRobotic>() == 1248);
 const _: () = assert!(core::mem::size_of::<StepResult>() == 152);
 const _: () = assert!(core::mem::size_of::<NavigationError>() == 96);
 const _: () = assert!(core::mem::size_of::<NavState>() == 376);
@@ -670,7 +674,7 @@ mod tests {
         assert_eq!(type_name_of::<Tick>(), "safe_capture::v2::Tick");
         assert_eq!(
             type_name_of::<SafeRobotic>(),
-            "safe_capture::v3::SafeRobotic"
+            "safe_capture::v4::SafeRobotic"
         );
     }
 
@@ -799,7 +803,8 @@ mod tests {
         assert_eq!(due::GROUP.items[2].name, "ROBOTIC");
         assert_eq!(due::GROUP.items[2].value, 4);
         assert_eq!(due::ALL, due::TRANSLATIONAL | due::ATTITUDE | due::ROBOTIC);
-        assert_eq!(lengths::GROUP.items[4].value, 51);
+        assert_eq!(lengths::GROUP.items[5].name, "N_BARRIERS");
+        assert_eq!(lengths::GROUP.items[5].value, 73);
         assert_eq!(
             fault::GROUP.qualified(&fault::GROUP.items[8]),
             "FAULT_REJECTED_COMMAND"

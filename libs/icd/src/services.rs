@@ -113,7 +113,7 @@ mod tests {
         assert_eq!(by("SIM_STATE").name, SIM_STATE);
         assert_eq!(
             by("PARTNER_STATE").message.unwrap().type_name,
-            "safe_capture::v4::SimState"
+            "safe_capture::v5::SimState"
         );
         assert_eq!(by("HANDSHAKE").sub_services, ["ready", "go"]);
         assert!(by("PREPARE").message.is_none());

@@ -36,11 +36,13 @@ pub use replay::ReplayNominals;
 pub use setup::{Setup, SetupError};
 pub use summary::{SafeModeSummary, Summary, UncertaintySummary, summarize};
 
-/// Names of all 51 constraints in telemetry order (translational, attitude, robotic).
+/// Names of all 73 barriers in telemetry order: the filters' constraints (translational,
+/// attitude, robotic), then the arm–target barriers only the monitor evaluates.
 pub fn constraint_names() -> Vec<&'static str> {
     let mut v: Vec<&'static str> = Vec::new();
     v.extend(sc_cbf::names::TRANSLATIONAL.iter());
     v.extend(sc_cbf::names::ATTITUDE.iter());
     v.extend(sc_cbf::names::ROBOTIC.iter());
+    v.extend(sc_cbf::names::ARM_TARGET.iter());
     v
 }

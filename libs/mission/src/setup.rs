@@ -76,6 +76,7 @@ impl Setup {
                 });
             }
         }
+        check_target_geometry(&scenario, &robot)?;
         Ok(Self {
             scenario,
             robot: Arc::new(robot),
@@ -205,9 +206,62 @@ impl Setup {
     }
 }
 
+/// The target's keep-out spheres against the servicer (docs/SAFETY.md, "The arm and the
+/// target"): the grasping fixture stands off every sphere by at least what the gripper's
+/// own spheres stick out beyond it ([`sc_cbf::arm_target::gripper_overhang`]) — or
+/// capture itself would break an arm–target barrier — and the collision-avoidance zone keeps the base off the target
+/// ([`sc_cbf::arm_target::base_clearance_from_caz`]), for every plant the declared
+/// mass-property errors allow.
+fn check_target_geometry(s: &Scenario, robot: &Robot) -> Result<(), SetupError> {
+    use sc_cbf::arm_target::{
+        TargetBody, base_clearance_from_caz, base_com_offset_bound, gripper_overhang,
+    };
+    let overhang = gripper_overhang(robot);
+    let g = nalgebra::Vector3::from(s.target.grasp_point_m);
+    for (k, sp) in s.target.collision_spheres.iter().enumerate() {
+        let standoff = (g - nalgebra::Vector3::from(sp.center_m)).norm() - sp.radius_m;
+        if standoff < overhang {
+            return Err(SetupError::Inconsistent {
+                key: format!("target.collision_spheres[{k}]"),
+                value: format!("centre {:?}, radius {} m", sp.center_m, sp.radius_m),
+                rule: format!(
+                    "the grasping fixture stands {standoff:.3} m off it, the gripper's spheres stick out {overhang:.3} m beyond the grasping point: capture would break an arm–target barrier; move the fixture out or shrink the sphere"
+                ),
+            });
+        }
+    }
+    let model = s.uncertainty_bounds().model;
+    let (Some(delta), Some(base)) = (base_com_offset_bound(robot, &model), robot.base_sphere())
+    else {
+        return Err(SetupError::Other(
+            "the servicer model has no base collision sphere or no mass: the base cannot be kept off the target".into(),
+        ));
+    };
+    let target = TargetBody::from_scenario(s).bounding_radius();
+    let r_caz = s.safety.translational.caz_radius_m;
+    let clear = base_clearance_from_caz(r_caz, delta, base.radius, target);
+    if clear < 0.0 {
+        return Err(SetupError::Inconsistent {
+            key: "safety.translational.caz_radius_m".into(),
+            value: r_caz.to_string(),
+            rule: format!(
+                "too small to keep the base off the target: the base's zone ({:.3} m), the target's keep-out spheres ({target:.3} m from its CoM) and the system CoM's offset from the base's centre (up to {delta:.3} m) need at least {:.3} m",
+                base.radius,
+                r_caz - clear
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// The scenario key of the initial state a barrier depends on, and its value.
 fn start_key(barrier: &str, s: &sc_scenario::Servicer) -> (&'static str, String) {
-    if barrier.starts_with("theta_dot") {
+    if barrier.starts_with("link_target") || barrier == "base_target" {
+        (
+            "servicer.initial_position_m/initial_theta_rad",
+            format!("{:?}/{:?}", s.initial_position_m, s.initial_theta_rad),
+        )
+    } else if barrier.starts_with("theta_dot") {
         (
             "servicer.initial_theta_dot_rad_s",
             format!("{:?}", s.initial_theta_dot_rad_s),
@@ -250,5 +304,42 @@ mod tests {
             msg.starts_with("`safety.translational.u_max_ac_m_s2` = 0.01: ") && msg.contains("c_t"),
             "{msg}"
         );
+    }
+
+    /// The target's geometry against the servicer: a fixture the gripper's own spheres
+    /// cannot reach without touching a keep-out sphere, and a collision-avoidance zone too
+    /// small to keep the base off the target, are refused on one line naming the key; the
+    /// default keeps both with room (its numbers below are the model's).
+    #[test]
+    fn a_target_geometry_the_servicer_cannot_respect_is_refused() {
+        use sc_cbf::arm_target::{base_com_offset_bound, gripper_overhang};
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/scenario.toml");
+        let setup = Setup::load(&path).expect("the default loads");
+        // link 7's last sphere (radius 0.06) 0.02 m short of the end effector
+        assert!((gripper_overhang(&setup.robot) - 0.04).abs() < 1e-12);
+        let model = setup.scenario.uncertainty_bounds().model;
+        let delta = base_com_offset_bound(&setup.robot, &model).unwrap();
+        assert!(delta > 0.05 && delta < 0.3, "{delta}");
+        let refused = |s: sc_scenario::Scenario, key: &str| {
+            let msg = Setup::from_scenario(s).expect_err("refused").to_string();
+            assert!(!msg.contains('\n'), "{msg}");
+            assert!(msg.starts_with(&format!("`{key}`")), "{msg}");
+            msg
+        };
+        // the fixture (0.652 m from the CoM) 0.03 m off a 0.622 m sphere: refused
+        let mut s = setup.scenario.clone();
+        s.target.collision_spheres[0].radius_m = 0.622;
+        let msg = refused(s.clone(), "target.collision_spheres[0]");
+        assert!(msg.contains("stick out 0.040 m"), "{msg}");
+        // 0.05 m off: accepted
+        s.target.collision_spheres[0].radius_m = 0.602;
+        Setup::from_scenario(s).expect("0.05 m off the sphere is accepted");
+        // a zone that leaves the base's sphere (0.6 m) and the target's (0.45 m) no room
+        let mut s = setup.scenario.clone();
+        s.safety.translational.caz_radius_m = 1.05 + delta - 1e-3;
+        let msg = refused(s.clone(), "safety.translational.caz_radius_m");
+        assert!(msg.contains("keep the base off the target"), "{msg}");
+        s.safety.translational.caz_radius_m = 1.05 + delta + 1e-3;
+        Setup::from_scenario(s).expect("room for the base is accepted");
     }
 }

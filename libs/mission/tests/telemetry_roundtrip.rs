@@ -85,7 +85,7 @@ fn assert_recorded_fields_equal(a: &StepRecord, b: &StepRecord, filtered: bool) 
     ] {
         bits::<7>(x.as_slice(), y.as_slice(), what, s);
     }
-    bits::<51>(&a.h(), &b.h(), "h", s);
+    bits::<{ sc_cbf::monitor::N_ALL }>(&a.h(), &b.h(), "h", s);
     assert_eq!(a.solve_time_us(), b.solve_time_us(), "step {s}");
     for (x, y) in [
         (

@@ -79,6 +79,11 @@ const FAMILIES: [&[Family]; 3] = [
             "min h_LB [m²]",
             |n| n.starts_with("link_base"),
         ),
+        (
+            "Robotic: arm and base off the target (min of 22)",
+            "min h_LT [m²]",
+            |n| n.starts_with("link_target") || n == "base_target",
+        ),
     ],
 ];
 

@@ -7,6 +7,8 @@ use crate::strategy::{STALE_LAG, Strategy, Target, barrier_names};
 use nalgebra::{SVector, Vector3};
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::{Rng, SeedableRng};
+use sc_cbf::arm_target::TargetBody;
+use sc_cbf::link_target::{self, Surroundings};
 use sc_cbf::monitor::{Barriers, Monitor};
 use sc_cbf::robotic;
 use sc_core::{PerSubsystem, Subsystem};
@@ -55,6 +57,8 @@ struct Geometry {
     /// Distance-like scale of every barrier (for the greedy choice).
     scale: Barriers,
     robot: Arc<Robot>,
+    /// The target's keep-out spheres (the link–target barriers).
+    target: TargetBody,
 }
 
 impl Adversary {
@@ -81,6 +85,7 @@ impl Adversary {
                 joint_torque_max: s.limits.joint_torque_max_nm,
                 scale,
                 robot: robot.clone(),
+                target: TargetBody::from_scenario(s),
             },
             monitor: Monitor::from_scenario(s, robot),
             rng: ChaCha8Rng::seed_from_u64(seed),
@@ -131,7 +136,7 @@ impl Adversary {
             }
         };
         // robotic: a joint to its nearer limit, a joint rate up or down, a link sphere
-        // into the base
+        // into the base or into the target
         let nj = robotic::NJ;
         let tm = OVERDRIVE * g.joint_torque_max;
         let k = which[Subsystem::Robotic];
@@ -147,8 +152,12 @@ impl Adversary {
             let mut t = Vector7::zeros();
             t[k - 2 * nj] = -tm;
             t
-        } else {
+        } else if k < robotic::LINK_TARGET {
             self.sphere_into_base(o, k - 3 * nj)
+                .map(|d| d.map(|x| -tm * x.signum()))
+                .unwrap_or_else(Vector7::zeros)
+        } else {
+            self.sphere_into_target(o, k - robotic::LINK_TARGET)
                 .map(|d| d.map(|x| -tm * x.signum()))
                 .unwrap_or_else(Vector7::zeros)
         };
@@ -171,6 +180,27 @@ impl Adversary {
         let sp = robot.sphere_state(&kin, idx)?;
         let d = sp.center - base.center;
         Some(a.transpose() * (sp.jacobian.transpose() * d) * 2.0)
+    }
+
+    /// `∂ḧ_LT/∂τ_M` of link sphere `k` against the nearest keep-out sphere of the target:
+    /// the robotic filter's own row (`sc_cbf::link_target`), from the observation — the
+    /// attacker knows the filter's model and pushes straight down its gradient.
+    fn sphere_into_target(&self, o: &Observation, k: usize) -> Option<Vector7> {
+        let z = Vector3::zeros();
+        let x = sc_cbf::robotic_input_from_model(
+            &self.geometry.robot,
+            &o.theta,
+            &o.theta_dot,
+            &o.omega_b,
+            &z,
+            &z,
+        )?;
+        let x = sc_cbf::RoboticInput {
+            around: Some(Surroundings::from_observation(o)),
+            ..x
+        };
+        let row = link_target::link_target(x.spheres.get(k)?, &x, &self.geometry.target);
+        Some(row.hddot_u)
     }
 
     /// The index, per subsystem, of the barrier closest to its boundary (distance-normalised).

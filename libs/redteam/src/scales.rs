@@ -1,8 +1,9 @@
 //! A characteristic scale of every barrier, so that margins of different units can be
 //! compared: roughly the barrier's value at the middle of its safe range (the corridor on
-//! its axis, a joint at mid-range, a rate at zero, a sphere touching the base's centre).
+//! its axis, a joint at mid-range, a rate at zero, a sphere touching the base's or the
+//! target's centre).
 
-use sc_cbf::monitor::{Barriers, N_ALL};
+use sc_cbf::monitor::{Barriers, N_ALL, N_FILTERED};
 use sc_cbf::{attitude, robotic, translational};
 use sc_multibody::Robot;
 use sc_scenario::Scenario;
@@ -37,6 +38,17 @@ pub fn barrier_scales(s: &Scenario, robot: &Robot) -> Barriers {
             let rr = sp.radius + base.radius;
             scale[o + 3 * nj + k] = rr * rr;
         }
+    }
+    // arm and base against the target: a sphere touching the target's bounding sphere's
+    // centre
+    let target = sc_cbf::arm_target::TargetBody::from_scenario(s).bounding_radius();
+    for (k, (_, sp)) in robot.arm_spheres().take(robotic::NS).enumerate() {
+        let rr = sp.radius + target;
+        scale[o + robotic::LINK_TARGET + k] = rr * rr;
+    }
+    if let Some(base) = robot.base_sphere() {
+        let rr = base.radius + target;
+        scale[N_FILTERED] = rr * rr;
     }
     for v in scale.iter_mut() {
         if !(v.is_finite() && *v > 0.0) {

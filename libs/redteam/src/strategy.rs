@@ -282,7 +282,7 @@ mod tests {
         assert!(Case::parse("robotic/toward:approach_corridor").is_err());
         assert!(Case::parse("robotic/random:x").is_err());
         assert!(Case::parse("nowhere/greedy").is_err());
-        assert_eq!(Case::all(5).len(), 2 + 7 + 42 + 4 * 11);
+        assert_eq!(Case::all(5).len(), 2 + 7 + 63 + 4 * 11);
     }
 
     #[test]

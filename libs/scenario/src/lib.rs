@@ -114,6 +114,20 @@ pub struct Target {
     /// `servicer.gripper_axis_body`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub grasp_fixture_axis: Option<V3>,
+    /// The target's keep-out geometry: spheres fixed in F_T that cover its body (not the
+    /// grasping fixture, which stands off it). The safety monitor keeps every arm sphere
+    /// and the base's collision zone off them (docs/SAFETY.md, "The arm and the target").
+    pub collision_spheres: Vec<TargetSphere>,
+}
+
+/// One keep-out sphere of the target, fixed in F_T.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TargetSphere {
+    /// Centre in F_T, relative to the target's CoM [m].
+    pub center_m: V3,
+    /// Radius [m].
+    pub radius_m: f64,
 }
 
 /// Timing and phases of the mission.

@@ -102,6 +102,12 @@ impl ScenarioError {
 /// below it the atmosphere brings an orbit down within a revolution).
 pub const MIN_ORBIT_ALTITUDE_M: f64 = 100_000.0;
 
+/// How many keep-out spheres the target may have: the robotic filter's proof covers one
+/// (docs/SAFETY.md, "The arm and the target").
+pub const MAX_KEEP_OUT_SPHERES: usize = 1;
+/// How far from the target's CoM a keep-out sphere may reach [m].
+pub const MAX_TARGET_EXTENT_M: f64 = 100.0;
+
 pub(crate) fn invalid(key: &str, value: impl Debug, rule: impl Into<String>) -> ScenarioError {
     ScenarioError::Invalid {
         key: key.to_string(),
@@ -343,7 +349,57 @@ impl Scenario {
         inertia("target.inertia_kg_m2", &t.inertia_kg_m2)?;
         unit("target.initial_attitude", &t.initial_attitude)?;
         finite_all("target.initial_omega_rad_s", &t.initial_omega_rad_s)?;
-        finite_all("target.grasp_point_m", &t.grasp_point_m)
+        finite_all("target.grasp_point_m", &t.grasp_point_m)?;
+        self.validate_keep_out_spheres()
+    }
+
+    /// One keep-out sphere ([`MAX_KEEP_OUT_SPHERES`]), finite, with a positive radius,
+    /// within [`MAX_TARGET_EXTENT_M`] of the CoM, and the grasping fixture outside it (the
+    /// gripper must be able to reach it).
+    fn validate_keep_out_spheres(&self) -> Result<(), ScenarioError> {
+        let t = &self.target;
+        if t.collision_spheres.is_empty() {
+            return Err(invalid(
+                "target.collision_spheres",
+                "[]",
+                "declare one keep-out sphere covering the target's body",
+            ));
+        }
+        if t.collision_spheres.len() > MAX_KEEP_OUT_SPHERES {
+            return Err(invalid(
+                "target.collision_spheres",
+                format!("{} spheres", t.collision_spheres.len()),
+                "one keep-out sphere for now: the robotic filter's next-sample condition is proven for the nearest sphere only (docs/SAFETY.md, \"The arm and the target\")",
+            ));
+        }
+        for (k, sp) in t.collision_spheres.iter().enumerate() {
+            let key = format!("target.collision_spheres[{k}]");
+            finite_all(&format!("{key}.center_m"), &sp.center_m)?;
+            positive(&format!("{key}.radius_m"), sp.radius_m)?;
+            let far = sp.center_m.iter().any(|c| c.abs() > MAX_TARGET_EXTENT_M);
+            if far || sp.radius_m > MAX_TARGET_EXTENT_M {
+                return Err(invalid(
+                    &key,
+                    format!("centre {:?}, radius {} m", sp.center_m, sp.radius_m),
+                    format!("must lie within {MAX_TARGET_EXTENT_M} m of the target's CoM"),
+                ));
+            }
+            let d: f64 = (0..3)
+                .map(|i| (t.grasp_point_m[i] - sp.center_m[i]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            if d <= sp.radius_m {
+                return Err(invalid(
+                    &format!("target.collision_spheres[{k}]"),
+                    format!("centre {:?}, radius {} m", sp.center_m, sp.radius_m),
+                    format!(
+                        "contains the grasping fixture (target.grasp_point_m {:?}, {d:.3} m from its centre): the fixture must stand off the body",
+                        t.grasp_point_m
+                    ),
+                ));
+            }
+        }
+        Ok(())
     }
 
     fn validate_mission(&self) -> Result<(), ScenarioError> {

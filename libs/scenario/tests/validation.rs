@@ -281,3 +281,51 @@ fn a_tangential_coefficient_at_or_below_zero_is_refused() {
     // the default budget with a servicer four times as heavy
     refused(&s, 4.0 * mass);
 }
+
+/// The target's keep-out spheres: at least one, finite, with a positive radius, and none
+/// containing the grasping fixture — each refused on one line naming the key.
+#[test]
+fn target_keep_out_spheres_are_validated() {
+    let s = Scenario::load(&config_dir().join("scenario.toml")).unwrap();
+    assert_eq!(s.target.collision_spheres.len(), 1);
+    let refused = |s: &Scenario| {
+        let msg = reject(&s.to_toml_string());
+        assert!(msg.contains("target.collision_spheres"), "{msg}");
+        msg
+    };
+    let mut none = s.clone();
+    none.target.collision_spheres.clear();
+    assert!(refused(&none).contains("one keep-out sphere"));
+    let mut huge = s.clone();
+    huge.target.collision_spheres[0].radius_m = 1e3;
+    assert!(refused(&huge).contains("within 100 m"));
+    let mut flat = s.clone();
+    flat.target.collision_spheres[0].radius_m = 0.0;
+    assert!(refused(&flat).contains("radius_m"));
+    let mut nan = s.clone();
+    nan.target.collision_spheres[0].center_m[1] = f64::NAN;
+    assert!(refused(&nan).contains("center_m"));
+    // a sphere around the fixture
+    let mut over = s.clone();
+    over.target.collision_spheres[0] = sc_scenario::TargetSphere {
+        center_m: [-0.5, 0.3, 0.0],
+        radius_m: 0.1,
+    };
+    let msg = refused(&over);
+    assert!(
+        msg.contains("collision_spheres[0]") && msg.contains("fixture"),
+        "{msg}"
+    );
+    // just outside is accepted
+    over.target.collision_spheres[0].radius_m = 0.07;
+    Scenario::from_toml_str(&over.to_toml_string(), &config_dir()).unwrap();
+    // a second sphere: not yet (the proof covers one)
+    let mut two = s.clone();
+    two.target
+        .collision_spheres
+        .push(sc_scenario::TargetSphere {
+            center_m: [0.0, 2.0, 0.0],
+            radius_m: 0.3,
+        });
+    assert!(refused(&two).contains("proven for the nearest sphere only"));
+}

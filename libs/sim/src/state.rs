@@ -363,6 +363,8 @@ impl Simulator {
             grasp_r: quat::to_matrix(&q_rt) * self.p.grasp_point_t,
             theta: s.theta,
             theta_dot: s.theta_dot,
+            base_r: r_ri * s.dr,
+            q_rt,
         }
     }
 

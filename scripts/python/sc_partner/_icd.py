@@ -13,8 +13,9 @@ import ctypes
 N_JOINTS = 7  # Number of manipulator joints.
 N_CONSTRAINTS_TRANSLATIONAL = 2  # Number of translational safety constraints: AC (approach corridor), CAZ (collision-avoidance zone).
 N_CONSTRAINTS_ATTITUDE = 7  # Number of attitude safety constraints: ATT (pointing), ω1..3 upper, ω1..3 lower.
-N_CONSTRAINTS_ROBOTIC = 42  # Number of robotic safety constraints: θ limits 7, θ̇ upper 7, θ̇ lower 7, link-base 21.
-N_BARRIERS = 51  # Number of barriers of the whole safety layer (translational, attitude, robotic).
+N_CONSTRAINTS_ROBOTIC = 63  # Number of robotic safety constraints: θ limits 7, θ̇ upper 7, θ̇ lower 7, link-base 21, link-target 21.
+N_BARRIERS_MONITORED = 1  # Number of barriers only the safety monitor evaluates: the base's collision zone against the target's body (implied by the collision-avoidance zone).
+N_BARRIERS = 73  # Number of barriers of the whole safety layer (translational, attitude, robotic, then the monitored ones).
 
 # Service names (relative: a run's iceoryx2 global.prefix is "sc_<SC_RUN_ID>_").
 # Each pub/sub service has an event service of the same name.
@@ -195,15 +196,15 @@ class SimState(ctypes.Structure):
         ("com_v_h", ctypes.c_double * 3),  # Derivative of com_h in the rotating Hill frame, frame F_H [m/s]
         ("com_r", ctypes.c_double * 3),  # Servicer system centre of mass relative to the target CoM, frame F_R [m]
         ("com_v_r", ctypes.c_double * 3),  # Inertial velocity of the servicer system centre of mass, frame F_R [m/s]
-        ("barriers", ctypes.c_double * 51),  # Every barrier h at this state, from the simulator's own state (the safety monitor), in telemetry order; NaN (null in the MCAP) = not evaluated. With a declared `[uncertainty]` the state is the estimate and these the barriers on knowledge (the declared model on it) [unit per constraint]
-        ("barriers_between", ctypes.c_double * 51),  # The smallest value of every barrier over the physics steps since the previous state message (this state included); with a declared `[uncertainty]` equal to `barriers` (knowledge exists at the ticks only) [unit per constraint]
+        ("barriers", ctypes.c_double * 73),  # Every barrier h at this state, from the simulator's own state (the safety monitor), in telemetry order; NaN (null in the MCAP) = not evaluated. With a declared `[uncertainty]` the state is the estimate and these the barriers on knowledge (the declared model on it) [unit per constraint]
+        ("barriers_between", ctypes.c_double * 73),  # The smallest value of every barrier over the physics steps since the previous state message (this state included); with a declared `[uncertainty]` equal to `barriers` (knowledge exists at the ticks only) [unit per constraint]
         ("held_f_b", ctypes.c_double * 3),  # The base force the simulator holds from the previous step: what acts in this tick while the translational group is not due (a downstream filter certifies against it then; docs/PARTITION.md, "Only what was certified acts"), frame F_B [N]
         ("held_tau_b", ctypes.c_double * 3),  # The base torque the simulator holds from the previous step, as `held_f_b`, frame F_B [N·m]
     ]
 
     @staticmethod
     def type_name():
-        return "safe_capture::v4::SimState"
+        return "safe_capture::v5::SimState"
 
 
 class NominalTranslational(ctypes.Structure):
@@ -321,7 +322,7 @@ class SafeAttitude(ctypes.Structure):
 
 
 class SafeRobotic(ctypes.Structure):
-    """Robotic safety filter → simulator, recorder. Constraint order: θ limits 0..7, θ̇ upper 7..14, θ̇ lower 14..21, link-base 21..42."""
+    """Robotic safety filter → simulator, recorder. Constraint order: θ limits 0..7, θ̇ upper 7..14, θ̇ lower 14..21, link-base 21..42, link-target 42..63."""
 
     _fields_ = [
         ("tick", ctypes.c_uint64),  # Tick index this command answers [-]
@@ -337,8 +338,8 @@ class SafeRobotic(ctypes.Structure):
         ("phase", ctypes.c_uint32),  # Mission phase of the nominal command filtered (0-based) [-]
         ("solve_cpu_ns", ctypes.c_uint32),  # CPU time of the filter call on its thread, saturating at u32::MAX [ns]
         ("slack", ctypes.c_double),  # Slack of the relaxed QP (0 otherwise), normalised rows; for a translational step degraded under a declared uncertainty, the share of the declared margins given up (docs/SAFETY.md) [-]
-        ("h", ctypes.c_double * 42),  # Barrier values h_i the filter evaluated; NaN (null in the MCAP) = not evaluated [unit per constraint]
-        ("phi", ctypes.c_double * 42),  # CBF conditions Φ_i at the safe command [unit per constraint / s]
+        ("h", ctypes.c_double * 63),  # Barrier values h_i the filter evaluated; NaN (null in the MCAP) = not evaluated [unit per constraint]
+        ("phi", ctypes.c_double * 63),  # CBF conditions Φ_i at the safe command [unit per constraint / s]
         ("u", ctypes.c_double * 7),  # Safe joint torques τ_M, frame M [N·m]
         ("actuated", ctypes.c_double * 7),  # Actuated joint torques τ_M (equals `u`), frame M [N·m]
         ("xi_f_b", ctypes.c_double * 3),  # Coupling ξ this command was certified against: the base force f_B acting upstream (the translational command or its backup; 0 for the translational filter, which has no upstream). The simulator applies the command only with exactly this force acting (docs/PARTITION.md), frame F_B [N]
@@ -347,7 +348,7 @@ class SafeRobotic(ctypes.Structure):
 
     @staticmethod
     def type_name():
-        return "safe_capture::v3::SafeRobotic"
+        return "safe_capture::v4::SafeRobotic"
 
 
 class StepResult(ctypes.Structure):
@@ -462,6 +463,7 @@ __all__ = [
     "N_CONSTRAINTS_TRANSLATIONAL",
     "N_CONSTRAINTS_ATTITUDE",
     "N_CONSTRAINTS_ROBOTIC",
+    "N_BARRIERS_MONITORED",
     "N_BARRIERS",
     "SERVICE_TICK",
     "SERVICE_CONTROL",

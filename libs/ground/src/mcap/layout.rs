@@ -63,8 +63,9 @@ struct BarrierPlot {
 }
 
 /// The barrier panels: the translational and attitude filters' barriers each in one,
-/// the robotic filter's by kind (joint angles, joint rates, link–base spheres).
-fn barrier_plots() -> [BarrierPlot; 5] {
+/// the robotic filter's by kind (joint angles, joint rates, link–base spheres, link–target
+/// spheres).
+fn barrier_plots() -> [BarrierPlot; 6] {
     let nj = sc_icd::N_JOINTS;
     let plot = |id, title, service, subsystem, range| BarrierPlot {
         id,
@@ -108,7 +109,14 @@ fn barrier_plots() -> [BarrierPlot; 5] {
             "Barriers h: link-base spheres",
             svc::SAFE_ROBOTIC,
             Subsystem::Robotic,
-            3 * nj..all(Subsystem::Robotic).end,
+            3 * nj..sc_cbf::robotic::LINK_TARGET,
+        ),
+        plot(
+            "barriers_link_target",
+            "Barriers h: link-target spheres",
+            svc::SAFE_ROBOTIC,
+            Subsystem::Robotic,
+            sc_cbf::robotic::LINK_TARGET..all(Subsystem::Robotic).end,
         ),
     ]
 }
@@ -299,6 +307,7 @@ mod tests {
             .flat_map(|p| p["paths"].as_array().cloned().unwrap_or_default())
             .filter(|p| p["value"].as_str().unwrap().contains(".h["))
             .count();
-        assert_eq!(h_paths, sc_icd::N_BARRIERS);
+        // every filter's barrier (the monitor-only `base_target` is in no filter report)
+        assert_eq!(h_paths, sc_icd::N_BARRIERS - sc_icd::N_BARRIERS_MONITORED);
     }
 }
