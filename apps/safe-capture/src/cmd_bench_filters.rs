@@ -264,6 +264,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         .collect::<anyhow::Result<Vec<_>>>()?;
     for s in &mut setups {
         a.uncertainty.apply(&mut s.scenario)?;
+        s.check_target_geometry()?;
     }
     let load_start = HostSample::now();
     let mut samples = run_missions(&a, &setups, case)?;

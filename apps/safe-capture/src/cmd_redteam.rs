@@ -341,6 +341,8 @@ fn load(a: &Args) -> anyhow::Result<Setup> {
     a.uncertainty.refuse_truth("redteam")?;
     let declared_in_file = setup.scenario.uncertainty.clone();
     a.uncertainty.apply(&mut setup.scenario)?;
+    // the base's clearance from the target, for the mass errors now declared
+    setup.check_target_geometry()?;
     if a.partition && setup.scenario.uncertainty != declared_in_file {
         // the partition's processes read the scenario file: a profile given on the
         // command line would be reported but not run

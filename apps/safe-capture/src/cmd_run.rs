@@ -267,6 +267,8 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         .check_before_run(&a.scenario)
         .map_err(|e| anyhow::anyhow!("{}: {e}", a.scenario.display()))?;
     a.uncertainty.apply(&mut setup.scenario)?;
+    // the base's clearance from the target, for the mass errors now declared
+    setup.check_target_geometry()?;
     if a.basilisk && setup.scenario.uncertainty.is_some() {
         // Basilisk propagates the scenario file's model, not the drawn plant
         anyhow::bail!(

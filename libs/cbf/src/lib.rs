@@ -66,7 +66,7 @@ pub use translational::{TranslationalFilter, TranslationalInput, TranslationalPa
 pub type TranslationalOutput = FilterOutput<3, { translational::N }>;
 /// Output of the attitude filter: `τ_B` (7 constraints).
 pub type AttitudeOutput = FilterOutput<3, { attitude::N }>;
-/// Output of the robotic filter: `τ_M` (42 constraints).
+/// Output of the robotic filter: `τ_M` (63 constraints).
 pub type RoboticOutput = FilterOutput<7, { robotic::N }>;
 
 /// Stable constraint names of the three filters, in report order, the barriers only the

@@ -459,6 +459,82 @@ mod tests {
         .h
     }
 
+    /// The filter's link–target barriers (from the system CoM) equal the safety monitor's
+    /// (from the base origin, written independently), and `base_target` is the base's
+    /// zone against the keep-out sphere, at random states with the target tumbling.
+    #[test]
+    fn the_monitor_and_the_rows_agree_on_the_arm_target_barriers() {
+        use crate::monitor::{Monitor, N_FILTERED};
+        use sc_core::BarrierState;
+        let (s, robot) = setup();
+        let robot = std::sync::Arc::new(robot);
+        let body = TargetBody::from_scenario(&s);
+        let monitor = Monitor::from_scenario(&s, robot.clone());
+        let mut seed = 0x9e37_79b9u64;
+        let mut r = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        for _ in 0..50 {
+            let theta =
+                Vector7::from(s.servicer.initial_theta_rad) + Vector7::from_fn(|_, _| 0.5 * r());
+            let q = |a: f64, b: f64, c: f64| {
+                let u = UnitQuaternion::from_euler_angles(a, b, c);
+                [u.w, u.i, u.j, u.k]
+            };
+            let (q_rb, q_rt) = (q(r(), r(), r()), q(r(), r(), r()));
+            let com_r = Vector3::new(-1.8 + 0.3 * r(), 0.4 * r(), 0.4 * r());
+            let c_b = robot.center_of_mass(&theta);
+            let base_r = com_r - quat::to_matrix(&q_rb) * c_b;
+            let around = Surroundings {
+                q_rb,
+                com_r,
+                com_v_r: Vector3::zeros(),
+                q_rt,
+                omega_t: Vector3::zeros(),
+                omega_dot_t: Vector3::zeros(),
+                mean_motion: 0.0,
+            };
+            let z = Vector3::zeros();
+            let x =
+                robotic_input_from_model(&robot, &theta, &Vector7::zeros(), &z, &z, &z).unwrap();
+            let x = RoboticInput {
+                around: Some(around),
+                ..x
+            };
+            let h = monitor.evaluate(&BarrierState {
+                t: 0.0,
+                com_r,
+                q_rb,
+                omega_b: z,
+                grasp_r: z,
+                theta,
+                theta_dot: Vector7::zeros(),
+                base_r,
+                q_rt,
+            });
+            let first = N_FILTERED - NS;
+            for k in 0..NS {
+                let row = link_target(&x.spheres[k], &x, &body);
+                let m = h[first + k];
+                assert!(
+                    (row.h - m).abs() < 1e-12 * (1.0 + m.abs()),
+                    "sphere {k}: {} vs {m}",
+                    row.h
+                );
+            }
+            let base = robot.base_sphere().unwrap();
+            let c = base_r + quat::to_matrix(&q_rb) * base.center;
+            let rr = base.radius + s.target.collision_spheres[0].radius_m;
+            let centre =
+                quat::to_matrix(&q_rt) * Vector3::from(s.target.collision_spheres[0].center_m);
+            let want = (c - centre).norm_squared() - rr * rr;
+            assert!((h[N_FILTERED] - want).abs() < 1e-12 * (1.0 + want.abs()));
+        }
+    }
+
     /// The rows' `h`, `ḣ` and `ḧ = drift + ∂ḧ/∂τ·τ` equal central differences of the
     /// barrier along the motion the verification integrates (the joints, the base's rate
     /// and attitude, the system CoM under the upstream force, the target's torque-free

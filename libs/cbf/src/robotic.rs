@@ -851,7 +851,7 @@ impl RoboticFilter {
         }
     }
 
-    /// The 42 barrier rows at `level`, each tightened by `margin[j]` [row units].
+    /// The 63 barrier rows at `level`, each tightened by `margin[j]` [row units].
     fn barrier_rows(
         &self,
         x: &RoboticInput,
@@ -886,7 +886,7 @@ impl RoboticFilter {
         rows
     }
 
-    /// The offsets `c` of the 42 barrier rows at `level` (untightened). Only the offsets
+    /// The offsets `c` of the 63 barrier rows at `level` (untightened). Only the offsets
     /// depend on the level — the normals are the terms' `∂ḧ/∂τ` and `∂ḣ/∂τ` — so the
     /// a-posteriori certificate checks a command against the rows of another level
     /// without building them: `c_j + a_j·τ` with the normals of any level.
@@ -1040,7 +1040,7 @@ impl RoboticFilter {
         self.filter_with(x, None)
     }
 
-    /// One filter step: safe `τ_M` closest to `tau_nom` subject to the 42 barrier rows, the
+    /// One filter step: safe `τ_M` closest to `tau_nom` subject to the 63 barrier rows, the
     /// contract rows and `‖τ_M‖∞ ≤ T_M`.
     pub fn filter(&mut self, x: &RoboticInput, tau_nom: &Vector7) -> FilterOutput<NJ, N> {
         self.filter_with(x, Some(tau_nom))
@@ -1571,7 +1571,8 @@ impl RoboticFilter {
 
     /// How many commands the envelope bounds certified did not verify on the servicer
     /// model's sample (each then went to the verification path): how often the arm left
-    /// the configured jerk bounds — or the model could not be integrated over the sample.
+    /// the configured jerk bounds, a link–target row's next-sample condition failed (those
+    /// rows have no in-sample bound), or the model could not be integrated over the sample.
     pub fn bounds_refuted(&self) -> u64 {
         self.bounds_refuted
     }
@@ -1716,7 +1717,7 @@ pub fn robotic_input_from_model(
     })
 }
 
-/// The robotic filter's own parts of the shared step ([`crate::step`]): its 42 rows, the
+/// The robotic filter's own parts of the shared step ([`crate::step`]): its 63 rows, the
 /// a-posteriori certificate, the verification with the servicer model and its braking law.
 impl FilterStep<NJ, N> for RoboticFilter {
     type Input = RoboticInput;

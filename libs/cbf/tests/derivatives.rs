@@ -809,8 +809,9 @@ fn robotic_sign_convention_and_sphere_order() {
 
 /// The safety monitor (barriers from the true state, written independently of the filters)
 /// and the filters' own barrier values agree at random consistent states, in
-/// `sc_cbf::names` order (the paper's 51; the link–target rows against finite differences
-/// of the monitor's own values in `link_target_rows_match_finite_differences`).
+/// `sc_cbf::names` order (the paper's 51; the link–target rows in `sc_cbf::link_target`'s
+/// tests: against the monitor, and against finite differences along the verification's
+/// motion).
 #[test]
 fn monitor_barriers_equal_the_filters_barriers() {
     use sc_cbf::monitor::{Monitor, N_FILTERED as N_ALL};

@@ -200,6 +200,13 @@ impl Setup {
         }
     }
 
+    /// The target's geometry against the servicer ([`check_target_geometry`]) — run when
+    /// the model is loaded and again by every command after `--uncertainty` declared
+    /// other mass-property errors than the scenario file's.
+    pub fn check_target_geometry(&self) -> Result<(), SetupError> {
+        check_target_geometry(&self.scenario, &self.robot)
+    }
+
     /// Total servicer mass [kg] (base + arm), the `m` of the CW model.
     pub fn mass(&self) -> f64 {
         self.robot.total_mass()
@@ -234,7 +241,7 @@ fn check_target_geometry(s: &Scenario, robot: &Robot) -> Result<(), SetupError> 
     let (Some(delta), Some(base)) = (base_com_offset_bound(robot, &model), robot.base_sphere())
     else {
         return Err(SetupError::Other(
-            "the servicer model has no base collision sphere or no mass: the base cannot be kept off the target".into(),
+            "the base cannot be shown off the target: the servicer model has no base collision sphere, or the declared mass errors leave it no mass".into(),
         ));
     };
     let target = TargetBody::from_scenario(s).bounding_radius();
@@ -341,5 +348,29 @@ mod tests {
         assert!(msg.contains("keep the base off the target"), "{msg}");
         s.safety.translational.caz_radius_m = 1.05 + delta + 1e-3;
         Setup::from_scenario(s).expect("room for the base is accepted");
+        // mass errors declared afterwards (`--uncertainty`) widen the CoM's offset: the
+        // check after declaring them refuses what the exact model left room for
+        let mut s = setup.scenario.clone();
+        s.safety.translational.caz_radius_m = 1.05 + delta + 1e-3;
+        let mut exact = Setup::from_scenario(s).expect("room without mass errors");
+        let spec = sc_scenario::UncertaintySpec {
+            profile: sc_scenario::uncertainty::REALISTIC_NAME.into(),
+            seed: 3,
+            model: None,
+            actuators: None,
+            navigation: None,
+            truth: None,
+        };
+        exact.scenario.set_uncertainty(spec).unwrap();
+        let real = base_com_offset_bound(&exact.robot, &exact.scenario.uncertainty_bounds().model);
+        assert!(real.unwrap() > delta + 1e-3, "{real:?} vs {delta}");
+        let msg = exact
+            .check_target_geometry()
+            .expect_err("refused")
+            .to_string();
+        assert!(
+            msg.starts_with("`safety.translational.caz_radius_m`"),
+            "{msg}"
+        );
     }
 }

@@ -181,6 +181,10 @@ fn load_base(opts: &CampaignOptions) -> Result<Setup, McError> {
         s.set_uncertainty(spec.clone())
             .and_then(|()| s.validate())
             .map_err(|e| McError::Setup(format!("--uncertainty: {e}")))?;
+        // the base's clearance from the target, for the mass errors now declared
+        setup
+            .check_target_geometry()
+            .map_err(|e| McError::Setup(format!("--uncertainty: {e}")))?;
     }
     opts.config.check_against(&setup.scenario)?;
     Ok(setup)

@@ -411,12 +411,12 @@ fn run_figures_have_readable_ticks_and_labelled_reference_lines() {
         assert_readable_labels(f, &svg);
     }
     let bar = std::fs::read_to_string(d.join("barriers.svg")).unwrap();
-    assert_eq!(assert_y_ticks("barriers.svg", &bar), 7);
+    assert_eq!(assert_y_ticks("barriers.svg", &bar), 8);
     let zero = texts(&bar)
         .iter()
         .filter(|t| t.text.starts_with("h = 0"))
         .count();
-    assert_eq!(zero, 7, "every barrier panel labels its h = 0 line");
+    assert_eq!(zero, 8, "every barrier panel labels its h = 0 line");
     let rr = std::fs::read_to_string(d.join("range_rate.svg")).unwrap();
     assert!(rr.contains("R_CAZ") && rr.contains("Go-for-Capture"));
     let jt = std::fs::read_to_string(d.join("joint_torques.svg")).unwrap();
