@@ -276,9 +276,14 @@ fn partition_executor(
     // campaign's, checked by the campaign)
     sc_ground::preflight::check_programs(&cfg, &None)
         .map_err(|e| anyhow::anyhow!("--partition-config {}: {e}", config.display()))?;
-    let period = sc_scenario::Scenario::load(scenario)
-        .map(|s| s.mission.control_period_s)
-        .ok();
+    let base = sc_scenario::Scenario::load(scenario).ok();
+    // the base scenario's tumble inside the envelope at the attitude group's hold, as
+    // `launch` checks (each draw's tumble is checked at the control period by the campaign)
+    if let Some(s) = &base {
+        sc_ground::preflight::held_envelope(&cfg, s)
+            .map_err(|e| anyhow::anyhow!("--partition-config {}: {e}", config.display()))?;
+    }
+    let period = base.map(|s| s.mission.control_period_s);
     let note = match period {
         Some(p) if schedule.period_s.iter().all(|(_, x)| *x == p) => None,
         Some(p) => Some(format!(

@@ -162,13 +162,20 @@ fn run_ticks(a: &Args, setup: &Setup) -> u64 {
 
 /// `--partition`: the hostile partners, after checking the deadline scale, every role's
 /// program and that the partner script understands every case.
-fn partition_partners(a: &Args, cases: &[CaseLabel]) -> anyhow::Result<HostilePartners> {
+fn partition_partners(
+    a: &Args,
+    scenario: &sc_scenario::Scenario,
+    cases: &[CaseLabel],
+) -> anyhow::Result<HostilePartners> {
     if !(a.deadline_scale.is_finite() && a.deadline_scale >= 1.0) {
         anyhow::bail!("--deadline-scale {}: must be >= 1", a.deadline_scale);
     }
+    let cfg = sc_ground::PartitionConfig::load(&a.partition_config)?;
+    // the tumble inside the envelope at the attitude group's hold, as `launch` checks
+    sc_ground::preflight::held_envelope(&cfg, scenario)
+        .map_err(|e| anyhow::anyhow!("--partition-config {}: {e}", a.partition_config.display()))?;
     let p = hostile_partners(&a.python, &a.partner)?;
     // every role's program, as the launcher will find it, before any case runs
-    let cfg = sc_ground::PartitionConfig::load(&a.partition_config)?;
     sc_ground::preflight::check_programs(&cfg, &None)
         .map_err(|e| anyhow::anyhow!("--partition-config {}: {e}", a.partition_config.display()))?;
     for c in cases {
@@ -364,7 +371,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     }
     let partners = a
         .partition
-        .then(|| partition_partners(&a, &cases))
+        .then(|| partition_partners(&a, &setup.scenario, &cases))
         .transpose()?;
     // real-time runs side by side would measure each other
     if let Some(j) = a.jobs.or(a.real_time.then_some(1)) {

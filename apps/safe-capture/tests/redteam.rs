@@ -308,3 +308,44 @@ fn a_missing_partition_program_stops_the_campaign_before_any_case() {
     );
     assert!(!out.exists(), "{t}");
 }
+
+/// A partition whose attitude group holds its commands longer than the scenario's tumble
+/// allows is refused before any case runs, as `launch` refuses it: one line naming the
+/// hold and the tumble's limit (no partner process is needed to see it).
+#[test]
+fn a_partition_holding_the_attitude_too_long_is_refused_before_any_case() {
+    let d = tmp("redteam-held-envelope");
+    let cfg = partition_toml_absolute_scenario().replace(
+        "[[rate_groups]]\nname = \"control\"\nperiod_s = 0.1\nmembers = [\"translational\", \"attitude\", \"robotic\"]",
+        "[[rate_groups]]\nname = \"control\"\nperiod_s = 0.3\nmembers = [\"translational\", \"attitude\", \"robotic\"]",
+    );
+    assert!(
+        cfg.contains("period_s = 0.3"),
+        "the config's rate group changed"
+    );
+    let p = d.join("partition.toml");
+    std::fs::write(&p, cfg).unwrap();
+    let out = d.join("out");
+    let (o, _) = cli_partition(
+        &[
+            "redteam",
+            "--partition",
+            "--partition-config",
+            p.to_str().unwrap(),
+            "--cases",
+            "robotic/frozen",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{t}");
+    assert_eq!(t.lines().count(), 1, "{t}");
+    assert!(
+        t.contains("held for the attitude rate group's period 0.3 s")
+            && t.contains("the tumble may be at most"),
+        "{t}"
+    );
+    assert!(!out.exists(), "{t}");
+}

@@ -84,8 +84,9 @@ pub fn check_scenario(cfg: &PartitionConfig) -> Result<PathBuf, ConfigError> {
 /// rows' margins — and the run-time watch on the tumble (`SafetyLayer::with_holds`) — take
 /// its rate group's period, so the declared tumble must be inside the envelope of the
 /// scenario held that long too (else the watch would put the run in safe mode at once).
-/// A config whose schedule is invalid is refused where the schedule is built.
-fn held_envelope(cfg: &PartitionConfig, s: &sc_scenario::Scenario) -> Result<(), ConfigError> {
+/// A config whose schedule is invalid is refused where the schedule is built. `launch`
+/// runs it on the config's scenario, the campaigns' `--partition` modes on theirs.
+pub fn held_envelope(cfg: &PartitionConfig, s: &sc_scenario::Scenario) -> Result<(), ConfigError> {
     let Ok(schedule) = cfg.schedule() else {
         return Ok(());
     };
