@@ -88,25 +88,15 @@ fn a_spin_up_beyond_the_envelope_puts_every_filter_in_safe_mode_at_once() {
     );
 }
 
-/// A spin within the envelope (0.1 rad/s) changes nothing the layer does: no safe mode,
-/// every barrier held, captured. One robotic step at the grasp (121.3 s) is not certified
-/// since the arm–target rows (docs/SAFETY.md, "The arm and the target": the verification
-/// path does not converge in its rounds there) — pinned here, so that it is seen when it
-/// changes.
+/// A spin within the envelope (0.1 rad/s) changes nothing the layer does: no safe mode.
+/// (With the arm–target rows and 4 verification rounds one robotic step at the grasp was
+/// not certified here; with 8 every step is — docs/SAFETY.md, "The arm and the target".)
 #[test]
 fn a_spin_change_inside_the_envelope_is_no_safe_mode() {
     let (s, records) = spun_up(40.0, 0.1);
     assert_eq!(s.safe_mode, None);
     assert!(records.iter().all(|r| in_safe_mode(r) == [false; 3]));
-    assert!(s.safe() && s.captured, "{}", s.verdict());
-    let relaxed: Vec<f64> = records
-        .iter()
-        .filter(|r| r.robotic.report.faults != 0)
-        .map(|r| r.t)
-        .collect();
-    assert_eq!(s.fault_count, 1, "{}", s.verdict());
-    assert_eq!(relaxed.len(), 1, "{relaxed:?}");
-    assert!((relaxed[0] - 121.3).abs() < 1e-9, "{relaxed:?}");
+    assert!(s.passed(), "{}", s.verdict());
 }
 
 /// Under the `realistic` profile (the target's rate known to 1e-3 rad/s) a spin-up beyond
