@@ -423,6 +423,7 @@ pub(crate) fn lowered(
 mod tests {
     use super::*;
     use crate::robotic::robotic_input_from_model;
+    use crate::test_draws::lcg;
     use nalgebra::UnitQuaternion;
     use std::path::Path;
 
@@ -471,12 +472,7 @@ mod tests {
         let body = TargetBody::from_scenario(&s);
         let monitor = Monitor::from_scenario(&s, robot.clone());
         let mut seed = 0x9e37_79b9u64;
-        let mut r = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut r = || 2.0 * lcg(&mut seed) - 1.0;
         for _ in 0..50 {
             let theta =
                 Vector7::from(s.servicer.initial_theta_rad) + Vector7::from_fn(|_, _| 0.5 * r());
@@ -547,12 +543,7 @@ mod tests {
         let inertia = Matrix3::from_row_slice(&s.target.inertia_kg_m2.concat());
         let inertia_inv = inertia.try_inverse().unwrap();
         let mut seed = 0x1234_5678u64;
-        let mut r = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut r = || 2.0 * lcg(&mut seed) - 1.0;
         for case in 0..20 {
             let theta =
                 Vector7::from(s.servicer.initial_theta_rad) + Vector7::from_fn(|_, _| 0.3 * r());

@@ -1323,19 +1323,8 @@ impl RoboticFilter {
             worst: f64::INFINITY,
         };
         let te = &p.joint_torque_error;
-        let e = te.at(tau);
         let perturbed = if te.is_zero() { 0 } else { NJ };
-        // input 0 the command, input k the command with joint k − 1's error
-        let inputs: [Vector13; NJ + 1] = std::array::from_fn(|k| {
-            let mut u = Vector13::zeros();
-            u.fixed_rows_mut::<3>(0).copy_from(&x.force_b);
-            u.fixed_rows_mut::<3>(3).copy_from(&x.torque_b);
-            u.fixed_rows_mut::<NJ>(6).copy_from(tau);
-            if k > 0 {
-                u[6 + k - 1] += e[k - 1];
-            }
-            u
-        });
+        let inputs = held_inputs(x, tau, &te.at(tau));
         let around = x.around.unwrap_or_else(Surroundings::far);
         let mut states = [Sampled::start(x, &around); NJ + 1];
         let mut target = x.around.map(|a| TargetMotion::start(&a));
@@ -1492,14 +1481,14 @@ impl RoboticFilter {
             snap.target_h = [link_target::FAR_M * link_target::FAR_M; NS];
             return snap;
         };
-        let com = robot.com_terms(&kin);
+        let (com, com_v) = robot.com_motion(&kin);
         let a = link_target::along(
             &self.params.target,
             &snap.centers,
             &snap.velocities,
             &snap.radii,
-            &com.position,
-            &com.velocity,
+            &com,
+            &com_v,
             st,
             tm,
         );
@@ -1602,6 +1591,21 @@ impl RoboticFilter {
     pub fn dump_qp(&self) -> crate::QpDump {
         self.last.dump()
     }
+}
+
+/// The held inputs `[f_B; τ_B; τ_M]` of the verification: input 0 the command `tau`, input
+/// `k` the command with joint `k − 1`'s declared error `e_{k−1}` added.
+fn held_inputs(x: &RoboticInput, tau: &Vector7, e: &Vector7) -> [Vector13; NJ + 1] {
+    std::array::from_fn(|k| {
+        let mut u = Vector13::zeros();
+        u.fixed_rows_mut::<3>(0).copy_from(&x.force_b);
+        u.fixed_rows_mut::<3>(3).copy_from(&x.torque_b);
+        u.fixed_rows_mut::<NJ>(6).copy_from(tau);
+        if k > 0 {
+            u[6 + k - 1] += e[k - 1];
+        }
+        u
+    })
 }
 
 /// `τ_hold = c_eff = −M_eff (b + ξ)`: the torque that holds the joint rates (`θ̈ = 0`).

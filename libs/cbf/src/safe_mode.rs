@@ -154,14 +154,10 @@ mod tests {
     /// The default scenario under the `realistic` profile (ē = 1e-3 rad/s).
     fn realistic() -> Scenario {
         let mut s = default_scenario();
-        s.set_uncertainty(sc_scenario::UncertaintySpec {
-            profile: sc_scenario::uncertainty::REALISTIC_NAME.into(),
-            seed: 0,
-            model: None,
-            actuators: None,
-            navigation: None,
-            truth: None,
-        })
+        s.set_uncertainty(sc_scenario::UncertaintySpec::profile(
+            sc_scenario::uncertainty::REALISTIC_NAME,
+            0,
+        ))
         .unwrap();
         s
     }

@@ -326,7 +326,8 @@ mod tests {
         assert!((gripper_overhang(&setup.robot) - 0.04).abs() < 1e-12);
         let model = setup.scenario.uncertainty_bounds().model;
         let delta = base_com_offset_bound(&setup.robot, &model).unwrap();
-        assert!(delta > 0.05 && delta < 0.3, "{delta}");
+        // the numbers docs/SAFETY.md quotes ("The base: derived")
+        assert!((delta - 0.1004).abs() < 1e-4, "{delta}");
         let refused = |s: sc_scenario::Scenario, key: &str| {
             let msg = Setup::from_scenario(s).expect_err("refused").to_string();
             assert!(!msg.contains('\n'), "{msg}");
@@ -353,17 +354,11 @@ mod tests {
         let mut s = setup.scenario.clone();
         s.safety.translational.caz_radius_m = 1.05 + delta + 1e-3;
         let mut exact = Setup::from_scenario(s).expect("room without mass errors");
-        let spec = sc_scenario::UncertaintySpec {
-            profile: sc_scenario::uncertainty::REALISTIC_NAME.into(),
-            seed: 3,
-            model: None,
-            actuators: None,
-            navigation: None,
-            truth: None,
-        };
+        let spec =
+            sc_scenario::UncertaintySpec::profile(sc_scenario::uncertainty::REALISTIC_NAME, 3);
         exact.scenario.set_uncertainty(spec).unwrap();
         let real = base_com_offset_bound(&exact.robot, &exact.scenario.uncertainty_bounds().model);
-        assert!(real.unwrap() > delta + 1e-3, "{real:?} vs {delta}");
+        assert!((real.unwrap() - 0.1579).abs() < 1e-4, "{real:?} vs {delta}");
         let msg = exact
             .check_target_geometry()
             .expect_err("refused")

@@ -21,14 +21,8 @@ fn changed(t_s: f64, omega: [f64; 3], realistic: bool) -> (sc_mission::Summary, 
         }),
     });
     if realistic {
-        let spec = sc_scenario::UncertaintySpec {
-            profile: sc_scenario::uncertainty::REALISTIC_NAME.into(),
-            seed: 3,
-            model: None,
-            actuators: None,
-            navigation: None,
-            truth: None,
-        };
+        let spec =
+            sc_scenario::UncertaintySpec::profile(sc_scenario::uncertainty::REALISTIC_NAME, 3);
         setup.scenario.set_uncertainty(spec).unwrap();
     }
     let scenario = setup.scenario.clone();

@@ -175,6 +175,24 @@ impl Robot {
         t
     }
 
+    /// The system centre of mass's position [m] and velocity `J_c θ̇` [m/s] relative to the
+    /// base (base frame) — [`Robot::com_terms`] without its Jacobians (the same sums, the
+    /// same bits), for a caller that needs the motion only.
+    pub fn com_motion(&self, kin: &Kinematics) -> (Vector3<f64>, Vector3<f64>) {
+        let (mut c, mut v) = (Vector3::zeros(), Vector3::zeros());
+        for (k, inertia) in self.inertias.iter().enumerate() {
+            if inertia.mass <= 0.0 || k >= kin.pose.len() {
+                continue;
+            }
+            let local = inertia.h / inertia.mass;
+            let w = inertia.mass / self.total_mass;
+            let r = kin.pose[k].rot * local;
+            c += kin.pose[k].act_point(&local) * w;
+            v += (kin.vel[k] + kin.omega[k].cross(&r)) * w;
+        }
+        (c, v)
+    }
+
     /// Pose of the end-effector frame in the base frame.
     pub fn ee_pose(&self, kin: &Kinematics) -> Transform {
         let f = self.ee_frame();

@@ -172,7 +172,9 @@ fn com_terms_match_the_com_and_finite_differences() {
         for _ in 0..20 {
             let th = rng.theta(&r);
             let qd = rng.vec7(0.5);
-            let t = r.com_terms(&r.kinematics_vel(&th, &qd));
+            let kin = r.kinematics_vel(&th, &qd);
+            let t = r.com_terms(&kin);
+            assert_eq!(r.com_motion(&kin), (t.position, t.velocity), "{name}");
             assert!(
                 (t.position - r.center_of_mass(&th)).norm() < 1e-14,
                 "{name}"

@@ -247,6 +247,19 @@ fn parse_profile(text: &str, path: &Path) -> Result<Uncertainty, ScenarioError> 
 }
 
 impl UncertaintySpec {
+    /// A named profile alone (`exact`, `realistic` or a file), with `seed`: no section
+    /// overridden, no separate truth.
+    pub fn profile(name: &str, seed: u64) -> Self {
+        Self {
+            profile: name.into(),
+            seed,
+            model: None,
+            actuators: None,
+            navigation: None,
+            truth: None,
+        }
+    }
+
     /// The bounds: the profile's, with the sections written in the scenario instead
     /// (the profile is not read when the scenario writes all three).
     pub fn resolve(&self, base_dir: &Path) -> Result<Uncertainty, ScenarioError> {

@@ -228,14 +228,10 @@ fn the_start_keeps_the_watchs_margin() {
     let mut s = default();
     s.target.initial_omega_rad_s = [-0.123, 0.0, 0.0];
     assert!(s.validate().is_ok());
-    s.set_uncertainty(sc_scenario::UncertaintySpec {
-        profile: sc_scenario::uncertainty::REALISTIC_NAME.into(),
-        seed: 0,
-        model: None,
-        actuators: None,
-        navigation: None,
-        truth: None,
-    })
+    s.set_uncertainty(sc_scenario::UncertaintySpec::profile(
+        sc_scenario::uncertainty::REALISTIC_NAME,
+        0,
+    ))
     .unwrap();
     let e = s.validate().unwrap_err().to_string();
     assert!(e.contains("which the run-time watch adds"), "{e}");
