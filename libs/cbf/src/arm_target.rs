@@ -32,10 +32,15 @@ pub const N: usize = 1;
 /// Names in report order.
 pub const NAMES: [&str; N] = ["base_target"];
 
+/// Sharpness `κ` of the smooth minimum over keep-out spheres [1/m²]: it lowers the row's
+/// barrier below the nearest sphere's by at most `ln(K)/κ` (K spheres).
+pub const KEEP_OUT_SHARPNESS_PER_M2: f64 = 200.0;
+
 /// The target's keep-out spheres (F_T).
 #[derive(Debug, Clone, PartialEq)]
 pub struct TargetBody {
     spheres: Vec<TargetSphere>,
+    sharpness: f64,
 }
 
 impl TargetBody {
@@ -44,7 +49,20 @@ impl TargetBody {
     pub fn from_scenario(s: &sc_scenario::Scenario) -> Self {
         Self {
             spheres: s.target.collision_spheres.clone(),
+            sharpness: KEEP_OUT_SHARPNESS_PER_M2,
         }
+    }
+
+    /// Keep-out spheres with the smooth minimum's sharpness `κ` [1/m²] (tests; a
+    /// scenario's body comes from [`Self::from_scenario`]).
+    pub fn new(spheres: Vec<TargetSphere>, sharpness: f64) -> Self {
+        Self { spheres, sharpness }
+    }
+
+    /// `κ` [1/m²] of the robotic rows' smooth minimum over the spheres
+    /// ([`crate::link_target`]).
+    pub fn sharpness(&self) -> f64 {
+        self.sharpness
     }
 
     /// The keep-out spheres (F_T).
@@ -146,6 +164,7 @@ mod tests {
                     radius_m: 0.2,
                 },
             ],
+            sharpness: KEEP_OUT_SHARPNESS_PER_M2,
         }
     }
 

@@ -20,10 +20,13 @@
 //! upstream safe force (internal forces do not move it). The target's tumble and the base's
 //! motion under the upstream commands are the known coupling.
 //!
-//! The scenario declares one keep-out sphere today (its validation refuses more): the
-//! verification checks the barrier at every physics step against the minimum over all of
-//! them, but the next-sample condition only for the sphere the row was built for, which is
-//! a proof for one sphere only.
+//! Several keep-out spheres: the row is the smooth minimum of the per-sphere barriers
+//! ([`soft_min`]), `s = −ln(Σ_k e^{−κ h_k})/κ ≤ min_k h_k` with
+//! `ṡ = Σ w_k ḣ_k`, `s̈ = Σ w_k ḧ_k − κ Σ w_k (ḣ_k − ṡ)²`, `w_k = e^{−κ h_k} / Σ_j e^{−κ h_j}`
+//! (`κ` [1/m²], [`TargetBody::sharpness`]): one barrier per arm sphere whose gradient
+//! pushes away from every keep-out sphere it is near, and `s ≥ 0` keeps every `h_k ≥ 0`.
+//! The verification checks (C1) and (C2) on `s` itself. With one sphere `s` is that
+//! sphere's barrier, bit for bit.
 
 use crate::arm_target::TargetBody;
 use crate::barrier::RelDegTwo;
@@ -32,6 +35,7 @@ use nalgebra::{Matrix3, Vector3, Vector4};
 use sc_core::Observation;
 use sc_models::quat::{self, Quat};
 use sc_multibody::{Robot, Vector13};
+use sc_scenario::MAX_KEEP_OUT_SPHERES;
 
 /// Where the servicer and the target are at the sample's start (knowledge, like every
 /// other input of the filter).
@@ -121,7 +125,45 @@ fn keep_out(
     ]
 }
 
-/// The row of arm sphere `s` against the nearest keep-out sphere of `body` (module doc).
+/// The weights `w_k = e^{−κ(h_k − h_min)} / Σ_j e^{−κ(h_j − h_min)}` (written into `w`)
+/// and the smooth minimum `s = h_min − ln(Σ_j e^{−κ(h_j − h_min)})/κ` of `h` (module doc),
+/// `None` when a value is not finite or there is none. One value is returned as it is.
+fn soft_min(h: &[f64], kappa: f64, w: &mut [f64]) -> Option<f64> {
+    if h.is_empty() || h.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
+    if h.len() == 1 {
+        w[0] = 1.0;
+        return Some(h[0]);
+    }
+    let min = h.iter().copied().fold(f64::INFINITY, f64::min);
+    let mut sum = 0.0;
+    for (wk, hk) in w.iter_mut().zip(h) {
+        *wk = (-kappa * (hk - min)).exp();
+        sum += *wk;
+    }
+    for wk in w.iter_mut().take(h.len()) {
+        *wk /= sum;
+    }
+    Some(min - sum.ln() / kappa)
+}
+
+/// `ṡ = Σ w_k ḣ_k` and the curvature term `κ Σ w_k (ḣ_k − ṡ)²` of `s̈` (module doc).
+fn soft_min_rate(w: &[f64], hdot: &[f64], kappa: f64) -> (f64, f64) {
+    if hdot.len() == 1 {
+        return (hdot[0], 0.0);
+    }
+    let sdot: f64 = w.iter().zip(hdot).map(|(a, b)| a * b).sum();
+    let spread: f64 = w
+        .iter()
+        .zip(hdot)
+        .map(|(a, b)| a * (b - sdot).powi(2))
+        .sum();
+    (sdot, kappa * spread)
+}
+
+/// The row of arm sphere `s` against the keep-out spheres of `body`: their smooth minimum
+/// (module doc; with one sphere, its own row).
 pub fn link_target(s: &SphereTerms, x: &RoboticInput, body: &TargetBody) -> RelDegTwo<NJ> {
     let far = RelDegTwo {
         h: FAR_M * FAR_M,
@@ -145,8 +187,9 @@ pub fn link_target(s: &SphereTerms, x: &RoboticInput, body: &TargetBody) -> RelD
     let inner = x.omega_dot_b0.cross(&q) + w.cross(&w.cross(&q)) + w.cross(&v) * 2.0 + rel0;
     let pdd0 = r_rb * (x.force_b / x.total_mass + inner);
     let g: Matrix3x7 = r_rb * (jr * x.a - skew(&q) * x.reaction);
-    let mut best: Option<RelDegTwo<NJ>> = None;
-    for sp in body.spheres() {
+    let mut rows = [far; MAX_KEEP_OUT_SPHERES];
+    let n = body.spheres().len().min(MAX_KEEP_OUT_SPHERES);
+    for (row, sp) in rows.iter_mut().zip(body.spheres()) {
         let [c, cdot, cdd] = keep_out(
             &Vector3::from(sp.center_m),
             &r_rt,
@@ -156,18 +199,51 @@ pub fn link_target(s: &SphereTerms, x: &RoboticInput, body: &TargetBody) -> RelD
         let d = p - c;
         let dd = pdot - cdot;
         let rr = s.radius + sp.radius_m;
-        let row = RelDegTwo {
+        *row = RelDegTwo {
             h: d.dot(&d) - rr * rr,
             hdot: 2.0 * d.dot(&dd),
             hddot_drift: 2.0 * dd.dot(&dd) + 2.0 * d.dot(&(pdd0 - cdd)),
             hddot_u: g.transpose() * d * 2.0,
         };
-        if best.as_ref().is_none_or(|b| row.h < b.h) {
-            best = Some(row);
+    }
+    combine(&rows[..n], body.sharpness())
+}
+
+/// The smooth minimum of the per-sphere rows (module doc): one row as it is, none the
+/// target far away, a value that is not finite a non-finite row (which the filter refuses).
+fn combine(rows: &[RelDegTwo<NJ>], kappa: f64) -> RelDegTwo<NJ> {
+    match rows {
+        [] => RelDegTwo {
+            h: FAR_M * FAR_M,
+            hdot: 0.0,
+            hddot_drift: 0.0,
+            hddot_u: Vector7::zeros(),
+        },
+        [one] => *one,
+        _ => {
+            let h: Vec<f64> = rows.iter().map(|r| r.h).collect();
+            let hdot: Vec<f64> = rows.iter().map(|r| r.hdot).collect();
+            let mut w = [0.0; MAX_KEEP_OUT_SPHERES];
+            let Some(sv) = soft_min(&h, kappa, &mut w) else {
+                return RelDegTwo {
+                    h: f64::NAN,
+                    ..rows[0]
+                };
+            };
+            let (sdot, curvature) = soft_min_rate(&w[..rows.len()], &hdot, kappa);
+            let mut out = RelDegTwo {
+                h: sv,
+                hdot: sdot,
+                hddot_drift: -curvature,
+                hddot_u: Vector7::zeros(),
+            };
+            for (wk, r) in w.iter().zip(rows) {
+                out.hddot_drift += wk * r.hddot_drift;
+                out.hddot_u += r.hddot_u * *wk;
+            }
+            out
         }
     }
-    // no keep-out sphere (a scenario always has one): the target far away
-    best.unwrap_or(far)
 }
 
 /// The servicer's state the verification integrates: the joints, the base's rate and
@@ -321,11 +397,11 @@ pub(crate) fn gravity_margin(a: &Surroundings, accel: f64, s: f64) -> (f64, f64)
     (0.5 * g * s * s, g * s)
 }
 
-/// Every arm sphere against the nearest keep-out sphere at one step of the verification
+/// Every arm sphere against the keep-out spheres at one step of the verification
 /// ([`along`]).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Along {
-    /// `h` [m²] and `ḣ` [m²/s].
+    /// The smooth minimum `s` [m²] and `ṡ` [m²/s] (module doc).
     pub h: [f64; NS],
     pub hdot: [f64; NS],
     /// The spheres' centres [m] and velocities [m/s] in F_R.
@@ -333,8 +409,8 @@ pub(crate) struct Along {
     pub vel: [Vector3<f64>; NS],
 }
 
-/// Every arm sphere's barrier against the nearest keep-out sphere at one step of the
-/// verification: the spheres' centres and velocities in F_B (`centers`, `velocities`,
+/// Every arm sphere's barrier against the keep-out spheres (their smooth minimum) at one
+/// step of the verification: the spheres' centres and velocities in F_B (`centers`, `velocities`,
 /// `None` radius where a sphere could not be evaluated: its values stay 0), the system
 /// CoM's position and velocity in F_B (`com`, `com_v`), the servicer's state `st` and the
 /// target's `tm`.
@@ -364,31 +440,53 @@ pub(crate) fn along(
         out.pos[k] = st.com_r + r_rb * q;
         out.vel[k] = st.com_v_r + r_rb * (st.omega_b.cross(&q) + v);
         let Some(radius) = radii[k] else { continue };
-        out.h[k] = f64::INFINITY;
-        for sp in body.spheres() {
-            let [c, cdot, _] = keep_out(
-                &Vector3::from(sp.center_m),
-                &r_rt,
-                &tm.omega_t,
-                &Vector3::zeros(),
-            );
-            let d = out.pos[k] - c;
-            let dd = out.vel[k] - cdot;
-            let rr = radius + sp.radius_m;
-            let hk = d.dot(&d) - rr * rr;
-            if hk < out.h[k] {
-                out.h[k] = hk;
-                out.hdot[k] = 2.0 * d.dot(&dd);
-            }
-        }
+        (out.h[k], out.hdot[k]) = clearance(body, &out.pos[k], &out.vel[k], radius, &r_rt, tm);
     }
     out
 }
 
-/// The lowest barrier (and its rate) of an arm sphere at `pos`, `vel` (F_R) with radius
-/// `radius` against every keep-out sphere when its centre may be off by `dc` and its
-/// velocity by `dv`: per keep-out sphere `h − 2‖d‖dc − dc²` and `ḣ − 2(dc‖ḋ‖ + ‖d‖dv +
-/// dc dv)` (as for the link–base rows), the lowest `h` deciding.
+/// The barrier `s` [m²] and `ṡ` [m²/s] (module doc) of an arm sphere at `pos`, `vel` (F_R)
+/// with radius `radius` against the keep-out spheres of `body`, the target at attitude
+/// `r_rt` turning as `tm`; a value that is not finite is a violation (`−∞`), never a
+/// clearance.
+fn clearance(
+    body: &TargetBody,
+    pos: &Vector3<f64>,
+    vel: &Vector3<f64>,
+    radius: f64,
+    r_rt: &Matrix3<f64>,
+    tm: &TargetMotion,
+) -> (f64, f64) {
+    let (mut h, mut hdot) = ([0.0; MAX_KEEP_OUT_SPHERES], [0.0; MAX_KEEP_OUT_SPHERES]);
+    let n = body.spheres().len().min(MAX_KEEP_OUT_SPHERES);
+    for (j, sp) in body.spheres().iter().take(n).enumerate() {
+        let [c, cdot, _] = keep_out(
+            &Vector3::from(sp.center_m),
+            r_rt,
+            &tm.omega_t,
+            &Vector3::zeros(),
+        );
+        let d = pos - c;
+        let dd = vel - cdot;
+        let rr = radius + sp.radius_m;
+        h[j] = d.dot(&d) - rr * rr;
+        hdot[j] = 2.0 * d.dot(&dd);
+    }
+    let mut w = [0.0; MAX_KEEP_OUT_SPHERES];
+    match soft_min(&h[..n], body.sharpness(), &mut w) {
+        Some(sv) => (sv, soft_min_rate(&w[..n], &hdot[..n], body.sharpness()).0),
+        None => (f64::NEG_INFINITY, 0.0),
+    }
+}
+
+/// A lower bound on the barrier `s` and its rate `ṡ` (module doc) of an arm sphere at
+/// `pos`, `vel` (F_R) with radius `radius` when its centre may be off by `dc` and its
+/// velocity by `dv`. Per keep-out sphere `h_k` lies within `±(2‖d‖dc + dc²)` and `ḣ_k`
+/// is at least `a_k = ḣ_k − 2(dc‖ḋ‖ + ‖d‖dv + dc dv)` (as for the link–base rows); `s`
+/// grows with every `h_k`, so `s(h − Δ)` bounds it, and `ṡ = Σ w_k ḣ_k ≥ a_max + Σ w̄_k
+/// (a_k − a_max)` with `w̄_k` the largest weight `h_k`'s interval and the others' allow
+/// (`e^{−κ h_k,low} / (e^{−κ h_k,low} + Σ_{j≠k} e^{−κ h_j,high})`). With one sphere: its
+/// `h − Δ` and `a`.
 pub(crate) fn lowered(
     body: &TargetBody,
     pos: &Vector3<f64>,
@@ -399,8 +497,13 @@ pub(crate) fn lowered(
     dv: f64,
 ) -> (f64, f64) {
     let r_rt = tm.rotation();
-    let mut low = (f64::INFINITY, 0.0);
-    for sp in body.spheres() {
+    let n = body.spheres().len().min(MAX_KEEP_OUT_SPHERES);
+    let (mut low, mut high, mut a) = (
+        [0.0; MAX_KEEP_OUT_SPHERES],
+        [0.0; MAX_KEEP_OUT_SPHERES],
+        [0.0; MAX_KEEP_OUT_SPHERES],
+    );
+    for (j, sp) in body.spheres().iter().take(n).enumerate() {
         let [c, cdot, _] = keep_out(
             &Vector3::from(sp.center_m),
             &r_rt,
@@ -411,12 +514,30 @@ pub(crate) fn lowered(
         let dd = vel - cdot;
         let rr = radius + sp.radius_m;
         let (dn, vn) = (d.norm(), dd.norm());
-        let h = d.dot(&d) - rr * rr - (2.0 * dn * dc + dc * dc);
-        if h < low.0 {
-            low = (h, 2.0 * d.dot(&dd) - 2.0 * (dc * vn + dn * dv + dc * dv));
-        }
+        let h = d.dot(&d) - rr * rr;
+        low[j] = h - (2.0 * dn * dc + dc * dc);
+        high[j] = h + (2.0 * dn * dc + dc * dc);
+        a[j] = 2.0 * d.dot(&dd) - 2.0 * (dc * vn + dn * dv + dc * dv);
     }
-    low
+    let kappa = body.sharpness();
+    let mut w = [0.0; MAX_KEEP_OUT_SPHERES];
+    let Some(s_low) = soft_min(&low[..n], kappa, &mut w) else {
+        return (f64::NEG_INFINITY, 0.0);
+    };
+    if n == 1 {
+        return (s_low, a[0]);
+    }
+    let (low, high, a) = (&low[..n], &high[..n], &a[..n]);
+    let a_max = a.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let m = low.iter().copied().fold(f64::INFINITY, f64::min);
+    let e = |h: f64| (-kappa * (h - m)).exp();
+    let others: f64 = high.iter().map(|&h| e(h)).sum();
+    let mut sdot = a_max;
+    for j in 0..n {
+        let w_max = e(low[j]) / (e(low[j]) + others - e(high[j]));
+        sdot += w_max.min(1.0) * (a[j] - a_max);
+    }
+    (s_low, sdot)
 }
 
 #[cfg(test)]
@@ -458,6 +579,75 @@ mod tests {
             tm,
         )
         .h
+    }
+
+    /// The smooth minimum lies at most `ln(K)/κ` below the smallest value, its weights sum
+    /// to one, one value comes back as it is, and a value that is not finite is refused.
+    #[test]
+    fn the_smooth_minimum_is_within_ln_k_over_kappa_below_the_minimum() {
+        let mut w = [0.0; MAX_KEEP_OUT_SPHERES];
+        assert_eq!(soft_min(&[0.123], 200.0, &mut w), Some(0.123));
+        assert_eq!(w[0], 1.0);
+        let mut seed = 7u64;
+        for _ in 0..500 {
+            let n = 2 + (lcg(&mut seed) * (MAX_KEEP_OUT_SPHERES - 1) as f64) as usize;
+            let h: Vec<f64> = (0..n).map(|_| 0.05 * lcg(&mut seed) - 0.01).collect();
+            let kappa = 1.0 + 1000.0 * lcg(&mut seed);
+            let sv = soft_min(&h, kappa, &mut w).unwrap();
+            let min = h.iter().copied().fold(f64::INFINITY, f64::min);
+            assert!(sv <= min, "{sv} > {min}");
+            assert!(
+                sv >= min - (n as f64).ln() / kappa - 1e-15,
+                "{sv} {min} {n} {kappa}"
+            );
+            assert!((w[..n].iter().sum::<f64>() - 1.0).abs() < 1e-12);
+        }
+        assert_eq!(soft_min(&[0.1, f64::NAN], 200.0, &mut w), None);
+        assert_eq!(soft_min(&[0.1, f64::INFINITY], 200.0, &mut w), None);
+        assert_eq!(soft_min(&[], 200.0, &mut w), None);
+    }
+
+    /// [`lowered`] bounds `s` and `ṡ` from below for every arm sphere centre within `dc`
+    /// and velocity within `dv` of the nominal ones (corners of the balls included), with
+    /// several keep-out spheres at sharp and soft `κ`.
+    #[test]
+    fn lowered_bounds_the_smooth_barrier_for_every_centre_within_the_error() {
+        use crate::test_draws::ball;
+        let sphere = |c: [f64; 3], r: f64| sc_scenario::TargetSphere {
+            center_m: c,
+            radius_m: r,
+        };
+        let spheres = vec![
+            sphere([0.0, 0.0, 0.0], 0.45),
+            sphere([-0.5, -0.25, 0.0], 0.15),
+            sphere([-0.45, 0.0, 0.35], 0.12),
+        ];
+        let mut seed = 11u64;
+        for kappa in [2.0, 200.0, 5000.0] {
+            let body = TargetBody::new(spheres.clone(), kappa);
+            for _ in 0..300 {
+                let pos = Vector3::new(-0.8, 0.0, 0.0) + ball(&mut seed, 0.4);
+                let vel = ball(&mut seed, 0.3);
+                let radius = 0.03 + 0.05 * lcg(&mut seed);
+                let tm = TargetMotion {
+                    q_rt: Vector4::new(1.0, 0.0, 0.0, 0.0),
+                    omega_t: ball(&mut seed, 0.1),
+                };
+                let (dc, dv) = (0.02 * lcg(&mut seed), 0.02 * lcg(&mut seed));
+                let (s_low, sdot_low) = lowered(&body, &pos, &vel, radius, &tm, dc, dv);
+                for _ in 0..20 {
+                    let (mut ep, mut ev) = (ball(&mut seed, dc), ball(&mut seed, dv));
+                    if lcg(&mut seed) < 0.5 {
+                        ep *= dc / ep.norm().max(1e-300);
+                        ev *= dv / ev.norm().max(1e-300);
+                    }
+                    let r_rt = tm.rotation();
+                    let (sv, sdot) = clearance(&body, &(pos + ep), &(vel + ev), radius, &r_rt, &tm);
+                    assert!(sv >= s_low - 1e-12, "κ {kappa}: s {sv} < {s_low}");
+                    assert!(sdot >= sdot_low - 1e-12, "κ {kappa}: ṡ {sdot} < {sdot_low}");
+                }
+            }
+        }
     }
 
     /// The filter's link–target barriers (from the system CoM) equal the safety monitor's
@@ -539,7 +729,22 @@ mod tests {
     #[test]
     fn link_target_rows_match_finite_differences() {
         let (s, robot) = setup();
-        let body = TargetBody::from_scenario(&s);
+        // the scenario's one sphere, and the bus with an appendage under a soft κ, so
+        // that both spheres carry weight and the smooth minimum's curvature term counts
+        let bus = s.target.collision_spheres[0];
+        let appendage = sc_scenario::TargetSphere {
+            center_m: [-1.0, 0.3, 0.0],
+            radius_m: 0.3,
+        };
+        for body in [
+            TargetBody::from_scenario(&s),
+            TargetBody::new(vec![bus, appendage], 2.0),
+        ] {
+            rows_match_finite_differences(&s, &robot, &body);
+        }
+    }
+
+    fn rows_match_finite_differences(s: &sc_scenario::Scenario, robot: &Robot, body: &TargetBody) {
         let inertia = Matrix3::from_row_slice(&s.target.inertia_kg_m2.concat());
         let inertia_inv = inertia.try_inverse().unwrap();
         let mut seed = 0x1234_5678u64;
@@ -571,7 +776,7 @@ mod tests {
                 ),
                 mean_motion: 0.0,
             };
-            let x = robotic_input_from_model(&robot, &theta, &theta_dot, &w, &f, &tb).unwrap();
+            let x = robotic_input_from_model(robot, &theta, &theta_dot, &w, &f, &tb).unwrap();
             let x = RoboticInput {
                 around: Some(around),
                 ..x
@@ -584,13 +789,13 @@ mod tests {
             let start = Sampled::start(&x, &around);
             let tm0 = TargetMotion::start(&around);
             let at = |step: f64| {
-                let st = rk4_sampled(&robot, &start, &u, x.total_mass, step).unwrap();
+                let st = rk4_sampled(robot, &start, &u, x.total_mass, step).unwrap();
                 let tm = tm0.step(&inertia, &inertia_inv, step);
-                h_at(&robot, &body, &st, &tm)
+                h_at(robot, body, &st, &tm)
             };
-            let (hm, h0, hp) = (at(-dt), h_at(&robot, &body, &start, &tm0), at(dt));
+            let (hm, h0, hp) = (at(-dt), h_at(robot, body, &start, &tm0), at(dt));
             for k in 0..NS {
-                let row = link_target(&x.spheres[k], &x, &body);
+                let row = link_target(&x.spheres[k], &x, body);
                 let hdot = (hp[k] - hm[k]) / (2.0 * dt);
                 let hddot = (hp[k] - 2.0 * h0[k] + hm[k]) / (dt * dt);
                 let want = row.hddot_drift + row.hddot_u.dot(&tau);

@@ -14,7 +14,7 @@ mod validate;
 
 pub use envelope::{LineOfSightEnvelope, TumbleRule};
 pub use uncertainty::{Uncertainty, UncertaintySpec};
-pub use validate::ScenarioError;
+pub use validate::{MAX_DECLARED_KEEP_OUT_SPHERES, MAX_KEEP_OUT_SPHERES, ScenarioError};
 
 /// Three-vector as written in the file.
 pub type V3 = [f64; 3];
