@@ -8,13 +8,18 @@
 #   scripts/setup.sh --with-basilisk   also Basilisk (bsk, ~600 MB): `safe-capture run
 #                                      --basilisk` and scripts/basilisk_reference.py
 #                                      (scripts/test.sh installs it: its test needs it)
+#   scripts/setup.sh --with-slurm      also Slurm and munge from Debian's packages
+#                                      (slurm-wlm, munge; as root): the test against a
+#                                      running single-node Slurm (scripts/slurm/local_cluster.sh)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 WITH_BASILISK=0
+WITH_SLURM=0
 for arg in "$@"; do
   case "$arg" in
     --with-basilisk) WITH_BASILISK=1 ;;
-    -h|--help) sed -n '2,10p' "$0"; exit 0 ;;
+    --with-slurm) WITH_SLURM=1 ;;
+    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
     *) echo "setup: unknown option $arg (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -31,6 +36,16 @@ if ! has_font; then
       || { apt-get update -qq >/dev/null 2>&1 && apt-get install -y -qq fonts-dejavu-core >/dev/null; }
   else
     echo "setup: no system font for PNG/PDF figures (SVG needs none); install one, e.g. sudo apt-get install fonts-dejavu-core" >&2
+  fi
+fi
+if [ "$WITH_SLURM" = 1 ] && ! { command -v slurmctld && command -v slurmd && command -v munged; } >/dev/null; then
+  if command -v apt-get >/dev/null && [ "$(id -u)" = 0 ]; then
+    echo "setup: installing Slurm and munge (Debian's slurm-wlm, munge)"
+    apt-get update -qq >/dev/null
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq slurm-wlm munge >/dev/null
+  else
+    echo "setup: --with-slurm needs Debian's slurm-wlm and munge: sudo apt-get install slurm-wlm munge" >&2
+    exit 1
   fi
 fi
 VENV=scripts/.venv

@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
-# The project's test command (README, CI): set-up (with Basilisk), fresh Pinocchio reference
+# The project's test command (README, CI): set-up (with Basilisk and Slurm), fresh Pinocchio reference
 # data, then every Rust test of the workspace.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # Basilisk too: the closed-loop cross-check (apps/safe-capture/tests/basilisk.rs) must run
-scripts/setup.sh --with-basilisk
-export SC_REQUIRE_BASILISK=1
+# Slurm and munge from Debian's packages: the test against a running single-node Slurm
+# (apps/safe-capture/tests/slurm.rs) starts and stops its own cluster
+scripts/setup.sh --with-basilisk --with-slurm
+export SC_REQUIRE_BASILISK=1 SC_REQUIRE_SLURM=1
 mkdir -p tests/reference
 scripts/.venv/bin/python scripts/pinocchio_reference.py
 # the partition's Python partner controller and the interop tests find the venv here

@@ -543,6 +543,101 @@ fn run_dirs(dir: &Path) -> (Vec<usize>, Vec<String>) {
     (runs, other)
 }
 
+/// Starts the campaign `common` of scenario `sc` into `out` and returns once its first
+/// run is saved (a new campaign is written into `out.incomplete`, which replaces `out`
+/// at the end).
+fn spawn_until_first_run(common: &[&str], sc: &str, out: &Path) -> std::process::Child {
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_safe-capture"))
+        .current_dir(root())
+        .args(common)
+        .args(["--scenario", sc, "--out", out.to_str().unwrap()])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    let mut staging = out.as_os_str().to_owned();
+    staging.push(".incomplete");
+    while !Path::new(&staging).join("runs/0").is_dir() {
+        if let Some(status) = child.try_wait().unwrap() {
+            panic!("the campaign ended before a run finished: {status}");
+        }
+        if started.elapsed() > FIRST_RUN_TIMEOUT {
+            let _ = child.kill();
+            panic!("no run finished within {FIRST_RUN_TIMEOUT:?}");
+        }
+        std::thread::sleep(POLL);
+    }
+    child
+}
+
+/// A campaign killed outright (SIGKILL: a cluster's task pre-empted or timed out without
+/// a grace period) never reached `--out`; `--resume --out` with the same folder takes its
+/// saved runs over from the staging folder and completes it, `runs.csv` identical to an
+/// uninterrupted campaign's (issue #28).
+#[test]
+fn a_killed_campaign_resumes_from_its_staging_folder() {
+    let _cpu = exclusive();
+    let d = tmp("killed");
+    let sc = short_scenario(&d, INTERRUPTED_MISSION_S);
+    let sc = sc.to_str().unwrap();
+    let out = d.join("c");
+    let runs = INTERRUPTED_RUNS.to_string();
+    let common = [
+        "montecarlo",
+        "--runs",
+        &runs,
+        "--seed",
+        "5",
+        "--jobs",
+        "1",
+        "-q",
+    ];
+    let mut child = spawn_until_first_run(&common, sc, &out);
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(!out.exists());
+    let saved = run_dirs(&d.join("c.incomplete")).0;
+    assert!(
+        !saved.is_empty() && saved.len() < INTERRUPTED_RUNS,
+        "{saved:?}"
+    );
+    let o = cli(
+        &[
+            "montecarlo",
+            "--resume",
+            "--out",
+            out.to_str().unwrap(),
+            "-q",
+        ],
+        &[],
+    );
+    // short missions do not capture: 1, the campaign complete
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(
+        text(&o).contains("resuming the campaign that was stopped before it reached"),
+        "{}",
+        text(&o)
+    );
+    assert!(!d.join("c.incomplete").exists());
+    let whole = d.join("whole");
+    let o = cli(
+        &[
+            &common[..],
+            &["--scenario", sc, "--out", whole.to_str().unwrap()],
+        ]
+        .concat(),
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert_eq!(run_dirs(&out), run_dirs(&whole));
+    assert_eq!(
+        std::fs::read(out.join("runs.csv")).unwrap(),
+        std::fs::read(whole.join("runs.csv")).unwrap()
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
 /// Ctrl-C in-process: SIGINT after the first run finished stops the campaign — exit 3,
 /// summary.json, report.md and the terminal say "interrupted after K of N", only the
 /// finished runs are there and aggregated (no run half-written); `--resume` completes
@@ -566,26 +661,7 @@ fn ctrl_c_stops_an_in_process_campaign_and_resume_completes_it() {
         "1",
         "-q",
     ];
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_safe-capture"))
-        .current_dir(root())
-        .args(common)
-        .args(["--scenario", sc, "--out", out.to_str().unwrap()])
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let started = std::time::Instant::now();
-    // a new campaign is written into c.incomplete, which replaces c at the end
-    while !d.join("c.incomplete/runs/0").is_dir() {
-        if let Some(status) = child.try_wait().unwrap() {
-            panic!("the campaign ended before a run finished: {status}");
-        }
-        if started.elapsed() > FIRST_RUN_TIMEOUT {
-            let _ = child.kill();
-            panic!("no run finished within {FIRST_RUN_TIMEOUT:?}");
-        }
-        std::thread::sleep(POLL);
-    }
+    let child = spawn_until_first_run(&common, sc, &out);
     let kill = std::process::Command::new("kill")
         .args(["-INT", &child.id().to_string()])
         .status()

@@ -100,29 +100,93 @@ fn copy_shard_runs(
 }
 
 /// Copies every shard's runs into `out` and checks that they cover the campaign's
-/// `runs`; the shards' sessions (wall time summed, host loads in shard order).
-fn copy_runs(dirs: &[PathBuf], out: &Path, runs: usize) -> Result<Sessions, McError> {
+/// `runs` ([`missing_runs`]); the shards' sessions (wall time summed, host loads in shard
+/// order).
+fn copy_runs(dirs: &[PathBuf], out: &Path, info: &CampaignInfo) -> Result<Sessions, McError> {
     let mut seen: BTreeMap<usize, PathBuf> = BTreeMap::new();
     let mut sessions = Sessions::default();
     for d in dirs {
-        copy_shard_runs(d, out, runs, &mut seen)?;
+        copy_shard_runs(d, out, info.runs, &mut seen)?;
         let (wall, load) = earlier_sessions(d);
         sessions.wall_time_s += wall;
         sessions.host_load.extend(load);
     }
-    let missing: Vec<String> = (0..runs)
-        .filter(|k| !seen.contains_key(k))
-        .map(|k| k.to_string())
-        .collect();
+    let missing: Vec<usize> = (0..info.runs).filter(|k| !seen.contains_key(k)).collect();
     if !missing.is_empty() {
-        let shown: Vec<String> = missing.iter().take(10).cloned().collect();
-        return Err(McError::Invalid(format!(
-            "merge: {} of {runs} runs missing (e.g. {}); merge every shard",
-            missing.len(),
-            shown.join(", ")
-        )));
+        return Err(McError::Invalid(missing_runs(dirs, info, &missing)));
     }
     Ok(sessions)
+}
+
+/// Up to ten numbers of a list, then how many more.
+fn some_of(ks: &[usize]) -> String {
+    let shown: Vec<String> = ks.iter().take(10).map(usize::to_string).collect();
+    match ks.len() {
+        n if n > 10 => format!("{} and {} more", shown.join(", "), n - 10),
+        _ => shown.join(", "),
+    }
+}
+
+/// What `merge` says when runs are missing: per shard of the campaign's sharding, the
+/// runs it lacks and the command that completes it — `--resume` on a shard that was given
+/// (a task that failed, timed out or was pre-empted), the shard's own command for one
+/// that was not.
+fn missing_runs(dirs: &[PathBuf], info: &CampaignInfo, missing: &[usize]) -> String {
+    let n = info.shard.map_or(1, |[_, n]| n);
+    let mut lines = vec![format!(
+        "merge: {} of {} runs missing:",
+        missing.len(),
+        info.runs
+    )];
+    for i in 0..n {
+        let ks: Vec<usize> = missing.iter().copied().filter(|k| k % n == i).collect();
+        if ks.is_empty() {
+            continue;
+        }
+        let given = dirs.iter().find(|d| {
+            json::<CampaignInfo>(&d.join("campaign.json")).is_ok_and(|c| c.shard == Some([i, n]))
+        });
+        lines.push(match given {
+            Some(d) => format!(
+                "  shard {i}/{n} ({}) lacks runs {}: complete it with `safe-capture montecarlo --resume --out {}`, then merge again",
+                d.display(),
+                some_of(&ks),
+                d.display()
+            ),
+            None => format!(
+                "  shard {i}/{n} was not given (runs {}): run it with `{}`, then merge it too",
+                some_of(&ks),
+                shard_command(dirs, info, i, n)
+            ),
+        });
+    }
+    lines.join("\n")
+}
+
+/// The command that runs shard `i/n` of the campaign the shards `dirs` belong to, from
+/// the first shard's copies of the base scenario and the dispersions, into a sibling
+/// folder `shard-<i>`.
+fn shard_command(dirs: &[PathBuf], info: &CampaignInfo, i: usize, n: usize) -> String {
+    let first = &dirs[0];
+    let out = first
+        .parent()
+        .map_or(PathBuf::from(format!("shard-{i}")), |p| {
+            p.join(format!("shard-{i}"))
+        });
+    let mut cmd = format!(
+        "safe-capture montecarlo --runs {} --seed {} --shard {i}/{n} --scenario {} --config {}",
+        info.runs,
+        info.seed,
+        first.join("base_scenario.toml").display(),
+        first.join("montecarlo.toml").display()
+    );
+    if info.execution == sc_mission::Execution::Partition {
+        cmd += " --mode partition";
+    }
+    if let Some(u) = &info.uncertainty {
+        cmd += &format!(" --uncertainty {u}");
+    }
+    cmd + &format!(" --out {}", out.display())
 }
 
 /// Merges shard directories into `out`: checks that they belong to the same campaign and
@@ -130,13 +194,14 @@ fn copy_runs(dirs: &[PathBuf], out: &Path, runs: usize) -> Result<Sessions, McEr
 /// result is the sum of the shards'.
 pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<CampaignSummary, McError> {
     let (info0, base0, urdf0) = check_shards(dirs, out)?;
+    let info0_sharding = info0.clone();
     prepare_out(out)?;
     let info = CampaignInfo {
         shard: None,
         ..info0
     };
     write_base_files(out, &info, &urdf0, &base0)?;
-    let sessions = copy_runs(dirs, out, info.runs)?;
+    let sessions = copy_runs(dirs, out, &info0_sharding)?;
     aggregate(out, &sessions)
 }
 

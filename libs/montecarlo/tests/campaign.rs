@@ -83,6 +83,19 @@ fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
     out
 }
 
+/// A copy of the folder tree `from` at `to`.
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let e = e.unwrap();
+        if e.path().is_dir() {
+            copy_tree(&e.path(), &to.join(e.file_name()));
+        } else {
+            std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+        }
+    }
+}
+
 fn deterministic(dir: &Path) -> BTreeMap<String, Vec<u8>> {
     let mut f = files(dir);
     f.retain(|k, _| !WALL_CLOCK_FILES.contains(&k.as_str()) && !k.ends_with("timing.json"));
@@ -295,10 +308,30 @@ fn merged_shards_equal_the_whole_campaign_and_reruns_reproduce() {
     assert!(rerun(&whole, 99).is_err());
 
     // merging an incomplete set or mixing campaigns is refused
+    // (shards is [shard1, shard0] here): the shard not given is named with its command
     let e = merge(&shards[..1], &base.join("partial"))
         .unwrap_err()
         .to_string();
-    assert!(e.contains("missing"), "{e}");
+    assert!(e.contains("3 of 5 runs missing"), "{e}");
+    assert!(
+        e.contains("shard 0/2 was not given (runs 0, 2, 4)")
+            && e.contains("--runs 5 --seed 7 --shard 0/2")
+            && e.contains("base_scenario.toml --config"),
+        "{e}"
+    );
+    // a shard that lost a run (a task killed mid-shard) is named with `--resume`
+    let cut = base.join("cut");
+    copy_tree(&shards[1], &cut);
+    std::fs::remove_dir_all(cut.join("runs/2")).unwrap();
+    let e = merge(&[shards[0].clone(), cut.clone()], &base.join("lost"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("1 of 5 runs missing")
+            && e.contains("shard 0/2")
+            && e.contains("lacks runs 2: complete it with `safe-capture montecarlo --resume --out"),
+        "{e}"
+    );
     let mut other = options(sc.clone(), base.join("other"), 5);
     other.seed = 8;
     other.shard = Some((0, 2));
