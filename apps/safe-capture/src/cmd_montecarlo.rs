@@ -206,45 +206,6 @@ struct Params {
     mode: Mode,
 }
 
-/// `--resume` of a campaign that never reached `out`: quit at once by a second signal,
-/// or killed (a cluster's task pre-empted or timed out without a grace period) — its
-/// runs are still in the staging folder `out.incomplete`. An empty or absent `out`
-/// takes it over (the campaign then completes there); anything else in `out` is left
-/// alone and the command says how to resume the staging folder itself.
-fn adopt_staging(out: &std::path::Path) -> anyhow::Result<()> {
-    let mut staging = out.to_path_buf().into_os_string();
-    staging.push(sc_mission::out_dir::INCOMPLETE_SUFFIX);
-    let staging = PathBuf::from(staging);
-    if out.join("campaign.json").is_file() || !staging.join("campaign.json").is_file() {
-        return Ok(());
-    }
-    let empty = std::fs::read_dir(out).map_or(true, |mut d| d.next().is_none());
-    if !empty {
-        anyhow::bail!(
-            "--resume: {} holds no campaign, but {} holds one that was quit before it was complete: resume it with --resume --out {}",
-            out.display(),
-            staging.display(),
-            staging.display()
-        );
-    }
-    if out.exists() {
-        std::fs::remove_dir(out).with_context(|| format!("--resume: {}", out.display()))?;
-    }
-    std::fs::rename(&staging, out).with_context(|| {
-        format!(
-            "--resume: moving {} to {}",
-            staging.display(),
-            out.display()
-        )
-    })?;
-    errln!(
-        "montecarlo: resuming the campaign that was stopped before it reached {} (from {})",
-        out.display(),
-        staging.display()
-    );
-    Ok(())
-}
-
 fn params(a: &RunArgs) -> anyhow::Result<Params> {
     let shard = a
         .shard
@@ -271,7 +232,7 @@ fn params(a: &RunArgs) -> anyhow::Result<Params> {
             mode: a.mode.unwrap_or(Mode::InProcess),
         });
     }
-    adopt_staging(&a.out)?;
+    crate::out_folder::adopt_staging(&a.out, "montecarlo")?;
     let info = sc_montecarlo::campaign_info(&a.out).context("--resume")?;
     Ok(Params {
         runs: a.runs.unwrap_or(info.runs),

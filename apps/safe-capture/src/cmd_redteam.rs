@@ -45,8 +45,64 @@ use std::sync::Mutex;
 ///
 /// Exit codes: 0 every case safe and no bystander disturbed, 1 a case unsafe or a
 /// bystander disturbed, 2 bad arguments or configuration.
+///
+/// Shards: `--shard i/N` runs every N-th case from i; `redteam merge` merges the shards'
+/// folders into the campaign (the same outputs as unsharded but for the wall-clock
+/// columns); `--resume --out DIR` completes a campaign or shard that was stopped, keeping
+/// every case that finished (each case's result is recorded in OUT/cases/<case>/ as it
+/// finishes). On a Slurm cluster: scripts/slurm/submit.sh redteam (docs/MONTECARLO.md).
 #[derive(clap::Args)]
+#[command(args_conflicts_with_subcommands = true)]
 pub struct Args {
+    #[command(subcommand)]
+    action: Option<Action>,
+    #[command(flatten)]
+    run: RunArgs,
+}
+
+#[derive(clap::Subcommand)]
+enum Action {
+    /// Merge shard folders (`redteam --shard i/N`) into one campaign: the same cases.csv,
+    /// min_h.csv, summary.json, report.md and figure as the campaign unsharded, but for
+    /// the wall-clock columns (the wall time is the shards' sum).
+    ///
+    /// Exit codes: 0 every case safe and no bystander disturbed, 1 a case unsafe or a
+    /// bystander disturbed, 2 bad arguments, cases missing or shards that do not fit
+    /// together (the message names the missing cases and the command for each shard).
+    Merge(MergeArgs),
+}
+
+#[derive(clap::Args)]
+struct MergeArgs {
+    /// Shard folders.
+    #[arg(required = true)]
+    dirs: Vec<PathBuf>,
+    #[arg(long, value_name = "DIR", help = crate::out_help!())]
+    out: PathBuf,
+    #[arg(long, help = crate::out_folder::FORCE_HELP)]
+    force: bool,
+    #[command(flatten)]
+    figures: crate::figure_format::FigureFormatArg,
+}
+
+/// `safe-capture redteam` with its options (the parser of a shard's recorded options).
+#[derive(clap::Parser)]
+#[command(name = "redteam")]
+struct Recorded {
+    #[command(flatten)]
+    run: RunArgs,
+}
+
+#[derive(clap::Args)]
+struct RunArgs {
+    /// Run only shard i of N (0-based): the cases at positions k with k mod N = i of the
+    /// campaign's list (`--list` shows the shard's).
+    #[arg(long, value_name = "i/N")]
+    shard: Option<String>,
+    /// Complete the campaign (or shard) in --out that was stopped: its finished cases are
+    /// kept, the others run; every other option is the campaign's own (campaign.json).
+    #[arg(long, conflicts_with = "force")]
+    resume: bool,
     /// Scenario file.
     #[arg(long, value_name = "FILE", default_value_os_t = crate::default_scenario())]
     scenario: PathBuf,
@@ -115,7 +171,7 @@ pub struct Args {
 }
 
 /// The cases the arguments select (`ticks`: a partition run's length).
-fn selected(a: &Args, ticks: u64) -> anyhow::Result<Vec<CaseLabel>> {
+fn selected(a: &RunArgs, ticks: u64) -> anyhow::Result<Vec<CaseLabel>> {
     if !a.cases.is_empty() {
         return a
             .cases
@@ -151,7 +207,7 @@ fn selected(a: &Args, ticks: u64) -> anyhow::Result<Vec<CaseLabel>> {
 }
 
 /// The ticks of a partition run: `--max-ticks`, at most the mission's.
-fn run_ticks(a: &Args, setup: &Setup) -> u64 {
+fn run_ticks(a: &RunArgs, setup: &Setup) -> u64 {
     let mission_ticks = setup.scenario.control_steps() as u64;
     if a.max_ticks > 0 {
         a.max_ticks.min(mission_ticks)
@@ -163,7 +219,7 @@ fn run_ticks(a: &Args, setup: &Setup) -> u64 {
 /// `--partition`: the hostile partners, after checking the deadline scale, every role's
 /// program and that the partner script understands every case.
 fn partition_partners(
-    a: &Args,
+    a: &RunArgs,
     scenario: &sc_scenario::Scenario,
     cases: &[CaseLabel],
 ) -> anyhow::Result<HostilePartners> {
@@ -186,7 +242,7 @@ fn partition_partners(
 
 /// The partition's executor of `--partition`: lock-step (scaled deadlines) or real
 /// time, every run's recordings kept in its case folder.
-fn partition_executor(a: &Args) -> Partition {
+fn partition_executor(a: &RunArgs) -> Partition {
     Partition::new(&a.partition_config)
         .clock(if a.real_time {
             ClockMode::RealTime
@@ -202,7 +258,7 @@ fn partition_executor(a: &Args) -> Partition {
 /// Runs the campaign's cases, showing the progress on stderr (a bar on a terminal, a
 /// line every 10 cases — every case through the partition — in a log).
 fn run_cases(
-    a: &Args,
+    a: &RunArgs,
     campaign: &Campaign,
     cases: &[CaseLabel],
 ) -> Vec<Result<CaseResult, CaseError>> {
@@ -242,7 +298,7 @@ fn run_cases(
 }
 
 /// The report's paragraph on how the cases ran.
-fn how(a: &Args) -> &'static str {
+fn how(a: &RunArgs) -> &'static str {
     if a.real_time {
         "Each case runs the mission through the process partition in real time (10 Hz on the wall clock, one case at a time), the hostile partner process `scripts/python/hostile_nominal.py` in place of the nominal controller process of its target (`all`: all three); the barriers come from the simulator's state as the recorder logged it (`cases/<case>/telemetry.csv`)."
     } else if a.partition {
@@ -263,7 +319,7 @@ fn under(scenario: &sc_scenario::Scenario) -> String {
 }
 
 /// The report's paragraph on how the cases ran, with the declared uncertainty if any.
-fn how_with_uncertainty(a: &Args, scenario: &sc_scenario::Scenario) -> String {
+fn how_with_uncertainty(a: &RunArgs, scenario: &sc_scenario::Scenario) -> String {
     match &scenario.uncertainty {
         None => how(a).to_string(),
         Some(u) => format!(
@@ -310,7 +366,7 @@ fn safe_mode_part(s: &report::CampaignSummary) -> String {
 }
 
 /// The final line.
-fn verdict_line(a: &Args, s: &report::CampaignSummary, wall: f64, under: &str) {
+fn verdict_line(a: &RunArgs, s: &report::CampaignSummary, wall: f64, under: &str) {
     outln!(
         "redteam{}{under}: {} of {} cases safe{}{}{}; non-finite applied {}, out-of-bound applied {}; bystanders disturbed in {} cases{}; solve time geomean (worst case) {:.1} us, max {:.0} us; wall {:.1} s -> {}",
         match (a.partition, a.real_time) {
@@ -340,7 +396,7 @@ fn verdict_line(a: &Args, s: &report::CampaignSummary, wall: f64, under: &str) {
 
 /// The scenario with its model, checked before any case runs, under the campaign's
 /// declared uncertainty (a partition campaign only under the file's own).
-fn load(a: &Args) -> anyhow::Result<Setup> {
+fn load(a: &RunArgs) -> anyhow::Result<Setup> {
     let mut setup = Setup::load(&a.scenario)?;
     setup
         .check_before_run(&a.scenario)
@@ -361,13 +417,147 @@ fn load(a: &Args) -> anyhow::Result<Setup> {
 }
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    match a.action {
+        Some(Action::Merge(m)) => merge(m),
+        None => run_campaign(a.run),
+    }
+}
+
+/// `redteam merge`.
+fn merge(m: MergeArgs) -> anyhow::Result<ExitCode> {
+    m.figures.check()?;
+    let inputs: Vec<&std::path::Path> = m.dirs.iter().map(PathBuf::as_path).collect();
+    let merged = sc_redteam::shard::merge(&m.dirs, &m.out)?;
+    let staged = crate::out_folder::stage_reading(&m.out, "redteam merge", m.force, &inputs)?;
+    let out = staged.path().to_path_buf();
+    let info = &merged.info;
+    let scales: sc_cbf::monitor::Barriers =
+        info.scales.as_slice().try_into().map_err(|_| {
+            anyhow::anyhow!("{}: barrier scales of another build", m.dirs[0].display())
+        })?;
+    let s = report::write(
+        &out,
+        &scales,
+        &info.how,
+        &merged.cases,
+        &merged.results,
+        merged.wall_s,
+    )?;
+    sc_redteam::shard::write_info(&out, info)?;
+    m.figures.export_dir(&out.join("figures"))?;
+    staged.commit()?;
+    let partition = if info.partition { " (partition)" } else { "" };
+    outln!(
+        "redteam merge{partition}: {} of {} cases safe{}; bystanders disturbed in {} cases; from {} shards -> {}",
+        s.safe,
+        s.cases,
+        listed(&s.unsafe_cases, " (unsafe: ", ", ", ")"),
+        s.bystanders_disturbed.len(),
+        m.dirs.len(),
+        m.out.display()
+    );
+    Ok(verdict_code(&s))
+}
+
+/// The exit code of a campaign's summary.
+fn verdict_code(s: &report::CampaignSummary) -> ExitCode {
+    if s.safe == s.cases && s.errors.is_empty() && s.bystanders_disturbed.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    }
+}
+
+/// With `--resume`: the stopped campaign's own options (from its campaign.json, run in
+/// the folder it ran in), `--out` the campaign's absolute path; otherwise `a`.
+fn resumed(a: RunArgs) -> anyhow::Result<RunArgs> {
+    if !a.resume {
+        return Ok(a);
+    }
+    crate::out_folder::adopt_staging(&a.out, "redteam")?;
+    let out = std::path::absolute(&a.out)?;
+    let info = sc_redteam::shard::read_info(&out).map_err(|e| {
+        anyhow::anyhow!(
+            "--resume: {} holds no red-team campaign: {e}",
+            a.out.display()
+        )
+    })?;
+    std::env::set_current_dir(&info.cwd)
+        .with_context(|| format!("--resume: the campaign's folder {}", info.cwd.display()))?;
+    let mut argv = vec!["redteam".to_string()];
+    argv.extend(info.options.iter().cloned());
+    if let Some([i, n]) = info.shard {
+        argv.push(format!("--shard={i}/{n}"));
+    }
+    argv.push(format!("--out={}", out.display()));
+    argv.push("--resume".into());
+    let mut r = <Recorded as clap::Parser>::try_parse_from(argv)
+        .map_err(|e| anyhow::anyhow!("--resume: the campaign's recorded options: {e}"))?
+        .run;
+    (r.quiet, r.jobs) = (a.quiet, a.jobs);
+    Ok(r)
+}
+
+/// The campaign's description (campaign.json) for the cases `all` of this build.
+fn campaign_info(
+    a: &RunArgs,
+    setup: &Setup,
+    all: &[CaseLabel],
+    shard: Option<(usize, usize)>,
+) -> anyhow::Result<sc_redteam::shard::CampaignInfo> {
+    let args: Vec<String> = std::env::args()
+        .skip_while(|x| x != "redteam")
+        .skip(1)
+        .collect();
+    Ok(sc_redteam::shard::CampaignInfo {
+        build: sc_mission::build::current(),
+        shard: shard.map(|(i, n)| [i, n]),
+        cases: all.iter().map(CaseLabel::name).collect(),
+        options: sc_redteam::shard::campaign_options(&args),
+        cwd: std::env::current_dir()?,
+        partition: a.partition,
+        how: how_with_uncertainty(a, &setup.scenario),
+        scenario: setup.scenario.to_toml_string(),
+        scales: sc_redteam::scales::barrier_scales(&setup.scenario, &setup.robot).to_vec(),
+    })
+}
+
+fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
+    let a = resumed(a)?;
     let setup = load(&a)?;
-    let cases = selected(&a, run_ticks(&a, &setup))?;
+    let all = selected(&a, run_ticks(&a, &setup))?;
+    let shard = a
+        .shard
+        .as_deref()
+        .map(sc_montecarlo::parse_shard)
+        .transpose()?;
+    let cases: Vec<CaseLabel> = match shard {
+        Some((i, n)) => sc_redteam::shard::shard_positions(all.len(), i, n)
+            .into_iter()
+            .map(|k| all[k].clone())
+            .collect(),
+        None => all.clone(),
+    };
     if a.list {
         for c in &cases {
             outln!("{}", c.name());
         }
         return Ok(ExitCode::SUCCESS);
+    }
+    let info = campaign_info(&a, &setup, &all, shard)?;
+    if a.resume {
+        let saved = sc_redteam::shard::read_info(&a.out)?;
+        let same = sc_redteam::shard::CampaignInfo {
+            options: info.options.clone(),
+            cwd: info.cwd.clone(),
+            ..saved.clone()
+        } == info;
+        if !same {
+            anyhow::bail!(
+                "--resume: {} holds a campaign of another build, scenario or case list; resume it with that build, or choose another --out",
+                a.out.display()
+            );
+        }
     }
     let partners = a
         .partition
@@ -381,8 +571,19 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             .context("--jobs")?;
     }
     a.figures.check()?;
-    let staged = crate::out_folder::stage(&a.out, "redteam", a.force)?;
-    let out = staged.path().to_path_buf();
+    // a new campaign is written apart and replaces --out when done; --resume completes
+    // the campaign in place
+    let staged = if a.resume {
+        None
+    } else {
+        Some(crate::out_folder::stage(&a.out, "redteam", a.force)?)
+    };
+    let out = staged
+        .as_ref()
+        .map_or(a.out.clone(), |s| s.path().to_path_buf());
+    if !a.resume {
+        sc_redteam::shard::write_info(&out, &info)?;
+    }
     let started = std::time::Instant::now();
     let partition = partition_executor(&a);
     let scenario_file = std::path::absolute(&a.scenario).unwrap_or_else(|_| a.scenario.clone());
@@ -398,18 +599,14 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         out: Some(&out),
         telemetry: a.telemetry,
     };
-    let results = run_cases(&a, &campaign, &cases);
+    let results = run_remaining(&a, &campaign, &cases, &out);
     let wall = started.elapsed().as_secs_f64();
-    let s = report::write(
-        &out,
-        &setup,
-        &how_with_uncertainty(&a, &setup.scenario),
-        &cases,
-        &results,
-        wall,
-    )?;
+    let scales = sc_redteam::scales::barrier_scales(&setup.scenario, &setup.robot);
+    let s = report::write(&out, &scales, &info.how, &cases, &results, wall)?;
     a.figures.export_dir(&out.join("figures"))?;
-    staged.commit()?;
+    if let Some(staged) = staged {
+        staged.commit()?;
+    }
     for (c, r) in cases.iter().zip(&results) {
         if let Err(e) = r {
             errln!("redteam: {}: {e}", c.name());
@@ -420,11 +617,41 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         outln!("redteam:{open}");
     }
     verdict_line(&a, &s, wall, &under(&setup.scenario));
-    Ok(
-        if s.safe == s.cases && s.errors.is_empty() && s.bystanders_disturbed.is_empty() {
-            ExitCode::SUCCESS
-        } else {
-            ExitCode::from(1)
-        },
-    )
+    Ok(verdict_code(&s))
+}
+
+/// Runs the cases that have no recorded outcome in `out` yet (all of them unless
+/// resuming); every case's outcome, in the order of `cases`.
+fn run_remaining(
+    a: &RunArgs,
+    campaign: &Campaign,
+    cases: &[CaseLabel],
+    out: &std::path::Path,
+) -> Vec<Result<CaseResult, CaseError>> {
+    let done: Vec<Option<Result<CaseResult, CaseError>>> = cases
+        .iter()
+        .map(|c| {
+            a.resume
+                .then(|| sc_redteam::shard::recorded(out, c))
+                .flatten()
+        })
+        .collect();
+    let todo: Vec<CaseLabel> = cases
+        .iter()
+        .zip(&done)
+        .filter(|(_, d)| d.is_none())
+        .map(|(c, _)| c.clone())
+        .collect();
+    if a.resume {
+        errln!(
+            "redteam: resuming: {} of {} cases finished before, {} to run",
+            cases.len() - todo.len(),
+            cases.len(),
+            todo.len()
+        );
+    }
+    let mut fresh = run_cases(a, campaign, &todo).into_iter();
+    done.into_iter()
+        .map(|d| d.unwrap_or_else(|| fresh.next().expect("one result per case to run")))
+        .collect()
 }

@@ -1,6 +1,7 @@
 //! The command line's side of the output-folder policy ([`sc_mission::out_dir`]): the
 //! help of `--out` and `--force`, the same for every command that writes a folder.
 
+use anyhow::Context;
 use sc_mission::out_dir::Staged;
 use std::path::Path;
 
@@ -82,4 +83,43 @@ pub fn stage_reading(
     let staged = Staged::begin_with_inputs(out, command, force, inputs)?;
     say_what_force_replaces(out, command, force);
     Ok(staged)
+}
+
+/// `--resume` of a campaign that never reached `out`: quit at once by a second signal,
+/// or killed (a cluster's task pre-empted or timed out without a grace period) — its
+/// runs are still in the staging folder `out.incomplete`. An empty or absent `out`
+/// takes it over (the campaign then completes there); anything else in `out` is left
+/// alone and the command says how to resume the staging folder itself.
+pub fn adopt_staging(out: &Path, command: &str) -> anyhow::Result<()> {
+    let mut staging = out.to_path_buf().into_os_string();
+    staging.push(sc_mission::out_dir::INCOMPLETE_SUFFIX);
+    let staging = std::path::PathBuf::from(staging);
+    if out.join("campaign.json").is_file() || !staging.join("campaign.json").is_file() {
+        return Ok(());
+    }
+    let empty = std::fs::read_dir(out).map_or(true, |mut d| d.next().is_none());
+    if !empty {
+        anyhow::bail!(
+            "--resume: {} holds no campaign, but {} holds one that was quit before it was complete: resume it with --resume --out {}",
+            out.display(),
+            staging.display(),
+            staging.display()
+        );
+    }
+    if out.exists() {
+        std::fs::remove_dir(out).with_context(|| format!("--resume: {}", out.display()))?;
+    }
+    std::fs::rename(&staging, out).with_context(|| {
+        format!(
+            "--resume: moving {} to {}",
+            staging.display(),
+            out.display()
+        )
+    })?;
+    errln!(
+        "{command}: resuming the campaign that was stopped before it reached {} (from {})",
+        out.display(),
+        staging.display()
+    );
+    Ok(())
 }

@@ -349,3 +349,131 @@ fn a_partition_holding_the_attitude_too_long_is_refused_before_any_case() {
     );
     assert!(!out.exists(), "{t}");
 }
+
+/// `cases.csv` without its wall-clock columns (the solve times).
+fn cases_without_wall_clock(dir: &std::path::Path) -> Vec<String> {
+    let text = std::fs::read_to_string(dir.join("cases.csv")).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let keep: Vec<usize> = (0..header.len())
+        .filter(|&i| !header[i].starts_with("solve_"))
+        .collect();
+    text.lines()
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            keep.iter().map(|&i| f[i]).collect::<Vec<_>>().join(",")
+        })
+        .collect()
+}
+
+/// Shards (issue #28): `--shard i/N` runs every N-th case, `redteam merge` gives the
+/// unsharded campaign's `min_h.csv` and `cases.csv` (but for the solve times) and names
+/// a shard that is missing with its command; a shard killed outright (SIGKILL) is
+/// completed by `--resume` with the cases it had finished kept, the same as a shard that
+/// ran through.
+#[test]
+fn shards_merge_to_the_whole_red_team_and_a_killed_shard_resumes() {
+    let _cpu = exclusive();
+    let d = tmp("redteam-shards");
+    let p = |n: &str| d.join(n).to_str().unwrap().to_string();
+    let run = |extra: &[&str], out: &str| {
+        let mut args = vec!["redteam", "--target", "attitude", "--seeds", "1", "-q"];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["--out", out]);
+        let o = cli(&args, &[]);
+        assert!(o.status.success(), "{}", text(&o));
+    };
+    run(&[], &p("whole"));
+    run(&["--shard", "0/2"], &p("s0"));
+    run(&["--shard", "1/2", "-j", "1"], &p("s1"));
+    let info = json(&d.join("s1/campaign.json"));
+    assert_eq!(info["shard"], serde_json::json!([1, 2]), "{info}");
+    assert_eq!(info["cases"].as_array().unwrap().len(), 14, "{info}");
+    let o = cli(
+        &[
+            "redteam",
+            "merge",
+            &p("s1"),
+            &p("s0"),
+            "--out",
+            &p("merged"),
+        ],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(
+        std::fs::read(d.join("whole/min_h.csv")).unwrap(),
+        std::fs::read(d.join("merged/min_h.csv")).unwrap()
+    );
+    assert_eq!(
+        cases_without_wall_clock(&d.join("whole")),
+        cases_without_wall_clock(&d.join("merged"))
+    );
+    let o = cli(&["redteam", "merge", &p("s0"), "--out", &p("half")], &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(
+        text(&o).contains("7 of 14 cases missing")
+            && text(&o).contains("shard 1/2 was not given")
+            && text(&o).contains("--target attitude --seeds 1 --shard 1/2"),
+        "{}",
+        text(&o)
+    );
+
+    // killed after its first recorded case, resumed: the shard as if it had run through
+    let killed = d.join("k");
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_safe-capture"))
+        .current_dir(root())
+        .args([
+            "redteam", "--target", "robotic", "--seeds", "1", "--shard", "0/4",
+        ])
+        .args(["-j", "1", "-q", "--out", killed.to_str().unwrap()])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    let recorded = || {
+        std::fs::read_dir(d.join("k.incomplete/cases")).map_or(0, |r| {
+            r.flatten()
+                .filter(|e| e.path().join("result.json").is_file())
+                .count()
+        })
+    };
+    while recorded() == 0 {
+        assert!(child.try_wait().unwrap().is_none(), "the shard ended first");
+        assert!(started.elapsed().as_secs() < 120, "no case recorded");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let o = cli(
+        &[
+            "redteam",
+            "--resume",
+            "--out",
+            killed.to_str().unwrap(),
+            "-q",
+        ],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("cases finished before"), "{}", text(&o));
+    let o = cli(
+        &[
+            "redteam", "--target", "robotic", "--seeds", "1", "--shard", "0/4", "-q",
+        ]
+        .iter()
+        .copied()
+        .chain(["--out", &p("kwhole")])
+        .collect::<Vec<_>>(),
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(
+        std::fs::read(killed.join("min_h.csv")).unwrap(),
+        std::fs::read(d.join("kwhole/min_h.csv")).unwrap()
+    );
+    assert_eq!(
+        cases_without_wall_clock(&killed),
+        cases_without_wall_clock(&d.join("kwhole"))
+    );
+}

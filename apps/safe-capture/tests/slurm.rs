@@ -225,7 +225,36 @@ fn campaigns_run_as_job_arrays_on_a_running_slurm() {
         deterministic(&out.join("merged")) == one,
         "the requeued campaign differs from one machine's"
     );
+    red_team_as_a_job_array(&cluster, &d);
     drop(cluster);
+}
+
+/// The red team as an array of 2 tasks, merged after it: the same `min_h.csv` as the
+/// campaign unsharded.
+fn red_team_as_a_job_array(cluster: &Cluster, d: &Path) {
+    let out = d.join("rt");
+    let options = ["--target", "attitude", "--seeds", "1"];
+    let (array, merge) = cluster.submit("redteam", 2, &out, &options);
+    cluster.wait(&[&array, &merge]);
+    assert!(
+        out.join("merged/min_h.csv").is_file(),
+        "{}",
+        log(&out, "merge")
+    );
+    let whole = d.join("rt-whole");
+    let o = cli(
+        &[
+            &["redteam", "-q", "--out", whole.to_str().unwrap()],
+            &options[..],
+        ]
+        .concat(),
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(
+        std::fs::read(out.join("merged/min_h.csv")).unwrap(),
+        std::fs::read(whole.join("min_h.csv")).unwrap()
+    );
 }
 
 /// Waits until a run of the shard is saved in `runs` (a folder named by its number).

@@ -134,7 +134,7 @@ fn some_of(ks: &[usize]) -> String {
 fn missing_runs(dirs: &[PathBuf], info: &CampaignInfo, missing: &[usize]) -> String {
     let n = info.shard.map_or(1, |[_, n]| n);
     let mut lines = vec![format!(
-        "merge: {} of {} runs missing:",
+        "merge: {} of {} runs missing",
         missing.len(),
         info.runs
     )];
@@ -148,19 +148,19 @@ fn missing_runs(dirs: &[PathBuf], info: &CampaignInfo, missing: &[usize]) -> Str
         });
         lines.push(match given {
             Some(d) => format!(
-                "  shard {i}/{n} ({}) lacks runs {}: complete it with `safe-capture montecarlo --resume --out {}`, then merge again",
+                "shard {i}/{n} ({}) lacks runs {}: complete it with `safe-capture montecarlo --resume --out {}`, then merge again",
                 d.display(),
                 some_of(&ks),
                 d.display()
             ),
             None => format!(
-                "  shard {i}/{n} was not given (runs {}): run it with `{}`, then merge it too",
+                "shard {i}/{n} was not given (runs {}): run it with `{}`, then merge it too",
                 some_of(&ks),
                 shard_command(dirs, info, i, n)
             ),
         });
     }
-    lines.join("\n")
+    lines.join("; ")
 }
 
 /// The command that runs shard `i/n` of the campaign the shards `dirs` belong to, from

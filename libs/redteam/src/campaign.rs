@@ -35,6 +35,47 @@ mod per_subsystem {
     }
 }
 
+/// Barrier values in files: a number, or `"NaN"`, `"inf"`, `"-inf"` for one that is not
+/// finite (JSON has no such numbers), so that a recorded case reads back bit for bit.
+mod float_map {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+    use std::collections::BTreeMap;
+
+    #[derive(Serialize, Deserialize)]
+    #[serde(untagged)]
+    enum Value {
+        Number(f64),
+        Text(String),
+    }
+
+    pub fn serialize<S: Serializer>(v: &BTreeMap<String, f64>, s: S) -> Result<S::Ok, S::Error> {
+        v.iter()
+            .map(|(k, x)| {
+                let x = if x.is_finite() {
+                    Value::Number(*x)
+                } else {
+                    Value::Text(x.to_string())
+                };
+                (k, x)
+            })
+            .collect::<BTreeMap<_, _>>()
+            .serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<BTreeMap<String, f64>, D::Error> {
+        BTreeMap::<String, Value>::deserialize(d)?
+            .into_iter()
+            .map(|(k, v)| match v {
+                Value::Number(x) => Ok((k, x)),
+                Value::Text(t) => t
+                    .parse::<f64>()
+                    .map(|x| (k, x))
+                    .map_err(|_| serde::de::Error::custom(format!("`{t}` is not a number"))),
+            })
+            .collect()
+    }
+}
+
 /// What one case measured.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CaseResult {
@@ -48,6 +89,7 @@ pub struct CaseResult {
     pub final_time_s: f64,
     pub steps: usize,
     /// Smallest value of every barrier over every physics step (true state).
+    #[serde(with = "float_map")]
     pub min_h: BTreeMap<String, f64>,
     /// Barriers that went below zero (or could not be evaluated) at any physics step.
     pub violated: Vec<String>,
@@ -155,6 +197,9 @@ pub enum CaseError {
     /// Its telemetry could not be written.
     #[error("{}: {error}", .dir.display())]
     Telemetry { dir: PathBuf, error: std::io::Error },
+    /// The error a shard recorded for it ([`crate::shard`]).
+    #[error("{0}")]
+    Recorded(String),
 }
 
 /// Where the nominal commands of the cases come from.
@@ -251,7 +296,9 @@ impl Campaign<'_> {
     }
 
     /// Runs every case in parallel (rayon), calling `progress(done, total, result)` as
-    /// cases finish (from worker threads). Results come back in the order of `cases`.
+    /// cases finish (from worker threads), and records each outcome in its folder as it
+    /// finishes ([`crate::shard::record`]: what `--resume` and `merge` read; a case whose
+    /// outcome cannot be recorded is an error). Results come back in the order of `cases`.
     pub fn run(
         &self,
         cases: &[CaseLabel],
@@ -262,7 +309,14 @@ impl Campaign<'_> {
             .par_iter()
             .enumerate()
             .map(|(k, case)| {
-                let r = self.run_case(k, case);
+                let mut r = self.run_case(k, case);
+                if let Some(out) = self.out
+                    && let Err(e) = crate::shard::record(out, case, &r)
+                {
+                    r = Err(CaseError::Recorded(format!(
+                        "its result could not be recorded: {e}"
+                    )));
+                }
                 let n = done.fetch_add(1, Ordering::SeqCst) + 1;
                 progress(n, cases.len(), &r);
                 r

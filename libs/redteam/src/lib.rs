@@ -7,6 +7,7 @@ pub mod campaign;
 pub mod partners;
 pub mod report;
 pub mod scales;
+pub mod shard;
 pub mod strategy;
 
 pub use adversary::Adversary;

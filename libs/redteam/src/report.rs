@@ -3,10 +3,8 @@
 //! `figures/redteam_margins.svg`.
 
 use crate::campaign::{CaseError, CaseResult};
-use crate::scales::barrier_scales;
 use crate::strategy::CaseLabel;
 use sc_core::PerSubsystem;
-use sc_mission::Setup;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -205,11 +203,12 @@ struct Tables {
     values: Vec<Vec<f64>>,
 }
 
-/// Writes every output into `dir`; returns the summary. `how` is the report's paragraph
-/// on how the cases were run.
+/// Writes every output into `dir`; returns the summary. `scales` are every barrier's
+/// scale of the normalised margins ([`crate::scales::barrier_scales`]), `how` the report's paragraph on
+/// how the cases were run.
 pub fn write(
     dir: &Path,
-    setup: &Setup,
+    scales: &sc_cbf::monitor::Barriers,
     how: &str,
     cases: &[CaseLabel],
     results: &[Result<CaseResult, CaseError>],
@@ -224,7 +223,6 @@ pub fn write(
         error,
     })?;
     let names = sc_mission::constraint_names();
-    let scales = barrier_scales(&setup.scenario, &setup.robot);
     let mut summary = empty_summary(cases.len(), wall_s);
     let mut t = Tables {
         cases_csv: CASES_COLUMNS.to_string(),
@@ -241,7 +239,7 @@ pub fn write(
             }
         };
         tally(&mut summary, r);
-        let normalised = normalised(r, &scales);
+        let normalised = normalised(r, scales);
         t.cases_csv += &cases_line(r, &normalised);
         t.min_csv += &min_h_line(r);
         t.rows.push(r.case.clone());
@@ -255,7 +253,7 @@ pub fn write(
     )?;
     write(
         "report.md",
-        &markdown(&summary, how, cases, results, &scales),
+        &markdown(&summary, how, cases, results, scales),
     )?;
     let barrier_names: Vec<String> = names.iter().map(|s| s.to_string()).collect();
     sc_plots::redteam_margins(
