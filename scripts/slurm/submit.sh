@@ -46,16 +46,20 @@ done
 [ -n "$out" ] || { echo "submit.sh: --out DIR is required" >&2; exit 2; }
 [ -x "$bin" ] || { echo "submit.sh: $bin is not an executable (build it: cargo build --release, or pass --bin)" >&2; exit 2; }
 for a in "$@"; do
-  case "$a" in --out|--out=*|--shard|--shard=*|--jobs|--jobs=*|-j|--resume)
+  case "$a" in --out|--out=*|--shard|--shard=*|--jobs|--jobs=*|-j*|--resume|-q|--quiet|--force|-[a-z]*q*)
     echo "submit.sh: '$a' is set per task; leave it out of the campaign's options" >&2; exit 2 ;;
   esac
 done
 command -v sbatch >/dev/null || { echo "submit.sh: sbatch not found (is this a Slurm login node?)" >&2; exit 2; }
+if [ -n "$(ls -A "$out/shards" 2>/dev/null)" ]; then
+  echo "submit.sh: $out/shards holds a campaign already: choose another --out (a shard of it is completed with \`safe-capture $kind --resume --out $out/shards/<i>\`)" >&2
+  exit 2
+fi
 mkdir -p "$out/logs" "$out/shards"
 out="$(cd "$out" && pwd)"
 bin="$(cd "$(dirname "$bin")" && pwd)/$(basename "$bin")"
 # the campaign's options, checked before anything is queued (a task would fail on them)
-printf '%s\n' "$@" > "$out/campaign.args"
+if [ $# -gt 0 ]; then printf '%s\n' "$@"; fi > "$out/campaign.args"
 if [ "$kind" = redteam ]; then
   "$bin" redteam "$@" --list >/dev/null || { echo "submit.sh: the red team's options are refused (above)" >&2; exit 2; }
 fi

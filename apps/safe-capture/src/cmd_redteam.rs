@@ -492,7 +492,10 @@ fn resumed(a: RunArgs) -> anyhow::Result<RunArgs> {
     argv.push(format!("--out={}", out.display()));
     argv.push("--resume".into());
     let mut r = <Recorded as clap::Parser>::try_parse_from(argv)
-        .map_err(|e| anyhow::anyhow!("--resume: the campaign's recorded options: {e}"))?
+        .map_err(|e| {
+            let first = e.to_string().lines().next().unwrap_or_default().to_string();
+            anyhow::anyhow!("--resume: the campaign's recorded options: {first}")
+        })?
         .run;
     (r.quiet, r.jobs) = (a.quiet, a.jobs);
     Ok(r)
@@ -503,9 +506,16 @@ fn campaign_info(
     a: &RunArgs,
     setup: &Setup,
     all: &[CaseLabel],
-    shard: Option<(usize, usize)>,
+    shard: Shard,
 ) -> anyhow::Result<sc_redteam::shard::CampaignInfo> {
-    let args: Vec<String> = std::env::args()
+    let args = std::env::args_os()
+        .map(|a| {
+            a.into_string()
+                .map_err(|a| anyhow::anyhow!("the argument {a:?} is not UTF-8"))
+        })
+        .collect::<anyhow::Result<Vec<String>>>()?;
+    let args: Vec<String> = args
+        .into_iter()
         .skip_while(|x| x != "redteam")
         .skip(1)
         .collect();
@@ -526,18 +536,7 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
     let a = resumed(a)?;
     let setup = load(&a)?;
     let all = selected(&a, run_ticks(&a, &setup))?;
-    let shard = a
-        .shard
-        .as_deref()
-        .map(sc_montecarlo::parse_shard)
-        .transpose()?;
-    let cases: Vec<CaseLabel> = match shard {
-        Some((i, n)) => sc_redteam::shard::shard_positions(all.len(), i, n)
-            .into_iter()
-            .map(|k| all[k].clone())
-            .collect(),
-        None => all.clone(),
-    };
+    let (shard, cases) = shard_cases(&a, &all)?;
     if a.list {
         for c in &cases {
             outln!("{}", c.name());
@@ -546,18 +545,7 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
     }
     let info = campaign_info(&a, &setup, &all, shard)?;
     if a.resume {
-        let saved = sc_redteam::shard::read_info(&a.out)?;
-        let same = sc_redteam::shard::CampaignInfo {
-            options: info.options.clone(),
-            cwd: info.cwd.clone(),
-            ..saved.clone()
-        } == info;
-        if !same {
-            anyhow::bail!(
-                "--resume: {} holds a campaign of another build, scenario or case list; resume it with that build, or choose another --out",
-                a.out.display()
-            );
-        }
+        check_resumable(&a.out, &info)?;
     }
     let partners = a
         .partition
@@ -618,6 +606,47 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
     }
     verdict_line(&a, &s, wall, &under(&setup.scenario));
     Ok(verdict_code(&s))
+}
+
+/// `i` and `N` of `--shard i/N`.
+type Shard = Option<(usize, usize)>;
+
+/// `--shard i/N` parsed, and the cases it runs of the campaign's `all`.
+fn shard_cases(a: &RunArgs, all: &[CaseLabel]) -> anyhow::Result<(Shard, Vec<CaseLabel>)> {
+    let shard = a
+        .shard
+        .as_deref()
+        .map(sc_montecarlo::parse_shard)
+        .transpose()?;
+    let cases = match shard {
+        Some((i, n)) => sc_redteam::shard::shard_positions(all.len(), i, n)
+            .into_iter()
+            .map(|k| all[k].clone())
+            .collect(),
+        None => all.to_vec(),
+    };
+    Ok((shard, cases))
+}
+
+/// `--resume` only completes the campaign `out` holds: the same build, scenario, cases
+/// and shard as `info` (its options as recorded).
+fn check_resumable(
+    out: &std::path::Path,
+    info: &sc_redteam::shard::CampaignInfo,
+) -> anyhow::Result<()> {
+    let saved = sc_redteam::shard::read_info(out)?;
+    let same = sc_redteam::shard::CampaignInfo {
+        options: info.options.clone(),
+        cwd: info.cwd.clone(),
+        ..saved
+    } == *info;
+    if !same {
+        anyhow::bail!(
+            "--resume: {} holds a campaign of another build, scenario or case list; resume it with that build, or choose another --out",
+            out.display()
+        );
+    }
+    Ok(())
 }
 
 /// Runs the cases that have no recorded outcome in `out` yet (all of them unless

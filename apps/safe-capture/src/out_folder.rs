@@ -97,6 +97,12 @@ pub fn adopt_staging(out: &Path, command: &str) -> anyhow::Result<()> {
     if out.join("campaign.json").is_file() || !staging.join("campaign.json").is_file() {
         return Ok(());
     }
+    if let Some(pid) = sc_mission::out_dir::writer_alive(&staging) {
+        anyhow::bail!(
+            "--resume: {} is still being written by process {pid}; stop it first, or wait for it",
+            staging.display()
+        );
+    }
     let empty = std::fs::read_dir(out).map_or(true, |mut d| d.next().is_none());
     if !empty {
         anyhow::bail!(

@@ -602,6 +602,12 @@ fn a_killed_campaign_resumes_from_its_staging_folder() {
         !saved.is_empty() && saved.len() < INTERRUPTED_RUNS,
         "{saved:?}"
     );
+    // a run saved before the kill is kept as it was, not run again
+    let first = format!("runs/{}/result.json", saved[0]);
+    let written = std::fs::metadata(d.join("c.incomplete").join(&first))
+        .unwrap()
+        .modified()
+        .unwrap();
     let o = cli(
         &[
             "montecarlo",
@@ -620,6 +626,11 @@ fn a_killed_campaign_resumes_from_its_staging_folder() {
         text(&o)
     );
     assert!(!d.join("c.incomplete").exists());
+    let kept = std::fs::metadata(out.join(&first))
+        .unwrap()
+        .modified()
+        .unwrap();
+    assert_eq!(kept, written, "run {} was run again", saved[0]);
     let whole = d.join("whole");
     let o = cli(
         &[

@@ -350,6 +350,20 @@ fn a_partition_holding_the_attitude_too_long_is_refused_before_any_case() {
     assert!(!out.exists(), "{t}");
 }
 
+/// How long the first case of a shard may take, and how often it is looked for.
+const CASE_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(120);
+const POLL: std::time::Duration = std::time::Duration::from_millis(20);
+
+/// A child process killed when the test ends, however it ends.
+struct KillOnDrop(std::process::Child);
+
+impl Drop for KillOnDrop {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
 /// `cases.csv` without its wall-clock columns (the solve times).
 fn cases_without_wall_clock(dir: &std::path::Path) -> Vec<String> {
     let text = std::fs::read_to_string(dir.join("cases.csv")).unwrap();
@@ -420,7 +434,7 @@ fn shards_merge_to_the_whole_red_team_and_a_killed_shard_resumes() {
 
     // killed after its first recorded case, resumed: the shard as if it had run through
     let killed = d.join("k");
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_safe-capture"))
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_safe-capture"))
         .current_dir(root())
         .args([
             "redteam", "--target", "robotic", "--seeds", "1", "--shard", "0/4",
@@ -430,21 +444,31 @@ fn shards_merge_to_the_whole_red_team_and_a_killed_shard_resumes() {
         .stderr(std::process::Stdio::null())
         .spawn()
         .unwrap();
+    // killed on every way out of this test
+    let mut child = KillOnDrop(child);
     let started = std::time::Instant::now();
     let recorded = || {
-        std::fs::read_dir(d.join("k.incomplete/cases")).map_or(0, |r| {
+        std::fs::read_dir(d.join("k.incomplete/cases")).map_or(Vec::new(), |r| {
             r.flatten()
-                .filter(|e| e.path().join("result.json").is_file())
-                .count()
+                .map(|e| e.path().join("result.json"))
+                .filter(|p| p.is_file())
+                .collect::<Vec<_>>()
         })
     };
-    while recorded() == 0 {
-        assert!(child.try_wait().unwrap().is_none(), "the shard ended first");
-        assert!(started.elapsed().as_secs() < 120, "no case recorded");
-        std::thread::sleep(std::time::Duration::from_millis(20));
+    while recorded().is_empty() {
+        assert!(
+            child.0.try_wait().unwrap().is_none(),
+            "the shard ended first"
+        );
+        assert!(started.elapsed() < CASE_TIMEOUT, "no case recorded");
+        std::thread::sleep(POLL);
     }
-    child.kill().unwrap();
-    child.wait().unwrap();
+    child.0.kill().unwrap();
+    child.0.wait().unwrap();
+    // a case that finished before the kill is kept as it was, not run again
+    let first = recorded()[0].clone();
+    let kept = killed.join(first.strip_prefix(d.join("k.incomplete")).unwrap());
+    let written = std::fs::metadata(&first).unwrap().modified().unwrap();
     let o = cli(
         &[
             "redteam",
@@ -457,6 +481,11 @@ fn shards_merge_to_the_whole_red_team_and_a_killed_shard_resumes() {
     );
     assert!(o.status.success(), "{}", text(&o));
     assert!(text(&o).contains("cases finished before"), "{}", text(&o));
+    assert!(!text(&o).contains(" 0 of "), "{}", text(&o));
+    assert_eq!(
+        std::fs::metadata(&kept).unwrap().modified().unwrap(),
+        written
+    );
     let o = cli(
         &[
             "redteam", "--target", "robotic", "--seeds", "1", "--shard", "0/4", "-q",

@@ -35,7 +35,10 @@ use nalgebra::{Matrix3, Vector3, Vector4};
 use sc_core::Observation;
 use sc_models::quat::{self, Quat};
 use sc_multibody::{Robot, Vector13};
-use sc_scenario::MAX_KEEP_OUT_SPHERES;
+use sc_scenario::{MAX_DECLARED_KEEP_OUT_SPHERES, MAX_KEEP_OUT_SPHERES};
+
+// every sphere a scenario may declare is one the rows combine
+const _: () = assert!(MAX_DECLARED_KEEP_OUT_SPHERES <= MAX_KEEP_OUT_SPHERES);
 
 /// Where the servicer and the target are at the sample's start (knowledge, like every
 /// other input of the filter).
@@ -129,7 +132,7 @@ fn keep_out(
 /// and the smooth minimum `s = h_min − ln(Σ_j e^{−κ(h_j − h_min)})/κ` of `h` (module doc),
 /// `None` when a value is not finite or there is none. One value is returned as it is.
 fn soft_min(h: &[f64], kappa: f64, w: &mut [f64]) -> Option<f64> {
-    if h.is_empty() || h.iter().any(|v| !v.is_finite()) {
+    if h.is_empty() || h.len() > w.len() || h.iter().any(|v| !v.is_finite()) {
         return None;
     }
     if h.len() == 1 {
@@ -221,16 +224,19 @@ fn combine(rows: &[RelDegTwo<NJ>], kappa: f64) -> RelDegTwo<NJ> {
         },
         [one] => *one,
         _ => {
-            let h: Vec<f64> = rows.iter().map(|r| r.h).collect();
-            let hdot: Vec<f64> = rows.iter().map(|r| r.hdot).collect();
+            let n = rows.len().min(MAX_KEEP_OUT_SPHERES);
+            let (mut h, mut hdot) = ([0.0; MAX_KEEP_OUT_SPHERES], [0.0; MAX_KEEP_OUT_SPHERES]);
+            for (k, r) in rows.iter().take(n).enumerate() {
+                (h[k], hdot[k]) = (r.h, r.hdot);
+            }
             let mut w = [0.0; MAX_KEEP_OUT_SPHERES];
-            let Some(sv) = soft_min(&h, kappa, &mut w) else {
+            let Some(sv) = soft_min(&h[..n], kappa, &mut w) else {
                 return RelDegTwo {
                     h: f64::NAN,
                     ..rows[0]
                 };
             };
-            let (sdot, curvature) = soft_min_rate(&w[..rows.len()], &hdot, kappa);
+            let (sdot, curvature) = soft_min_rate(&w[..n], &hdot[..n], kappa);
             let mut out = RelDegTwo {
                 h: sv,
                 hdot: sdot,
@@ -472,6 +478,10 @@ fn clearance(
         h[j] = d.dot(&d) - rr * rr;
         hdot[j] = 2.0 * d.dot(&dd);
     }
+    if n == 0 {
+        // no keep-out sphere: the target far away, as the rows read it
+        return (FAR_M * FAR_M, 0.0);
+    }
     let mut w = [0.0; MAX_KEEP_OUT_SPHERES];
     match soft_min(&h[..n], body.sharpness(), &mut w) {
         Some(sv) => (sv, soft_min_rate(&w[..n], &hdot[..n], body.sharpness()).0),
@@ -519,6 +529,10 @@ pub(crate) fn lowered(
         high[j] = h + (2.0 * dn * dc + dc * dc);
         a[j] = 2.0 * d.dot(&dd) - 2.0 * (dc * vn + dn * dv + dc * dv);
     }
+    if n == 0 {
+        // no keep-out sphere: the target far away, as the rows read it
+        return (FAR_M * FAR_M, 0.0);
+    }
     let kappa = body.sharpness();
     let mut w = [0.0; MAX_KEEP_OUT_SPHERES];
     let Some(s_low) = soft_min(&low[..n], kappa, &mut w) else {
@@ -531,10 +545,13 @@ pub(crate) fn lowered(
     let a_max = a.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let m = low.iter().copied().fold(f64::INFINITY, f64::min);
     let e = |h: f64| (-kappa * (h - m)).exp();
-    let others: f64 = high.iter().map(|&h| e(h)).sum();
+    if !a_max.is_finite() || a.iter().any(|v| !v.is_finite()) {
+        return (f64::NEG_INFINITY, 0.0);
+    }
     let mut sdot = a_max;
     for j in 0..n {
-        let w_max = e(low[j]) / (e(low[j]) + others - e(high[j]));
+        let others: f64 = (0..n).filter(|&i| i != j).map(|i| e(high[i])).sum();
+        let w_max = e(low[j]) / (e(low[j]) + others);
         sdot += w_max.min(1.0) * (a[j] - a_max);
     }
     (s_low, sdot)

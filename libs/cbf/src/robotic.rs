@@ -1365,6 +1365,12 @@ impl RoboticFilter {
             );
             for j in 0..N {
                 let hj = hv[j] - dh[j];
+                if !(hj.is_finite() && (hd[j] - dhd[j]).is_finite()) {
+                    // a barrier the sample cannot evaluate is a violation, never a margin
+                    verdict.ok = false;
+                    verdict.worst = f64::NEG_INFINITY;
+                    continue;
+                }
                 verdict.worst = verdict.worst.min(hj / weights[j]);
                 if hj < 0.0 {
                     // C1: the barrier inside the sample

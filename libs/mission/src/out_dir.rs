@@ -96,6 +96,14 @@ pub fn marker(dir: &Path) -> Option<Option<Marker>> {
     Some(serde_json::from_str(&text).ok())
 }
 
+/// The process still writing `dir`, if its marker names one that runs (not this one).
+pub fn writer_alive(dir: &Path) -> Option<u32> {
+    marker(dir)
+        .flatten()
+        .map(|m| m.pid)
+        .filter(|&pid| alive(pid))
+}
+
 /// True when `dir` holds the marker of a folder written by safe-capture.
 pub fn is_ours(dir: &Path) -> bool {
     dir.join(MARKER).is_file()

@@ -144,7 +144,8 @@ fn missing_runs(dirs: &[PathBuf], info: &CampaignInfo, missing: &[usize]) -> Str
             continue;
         }
         let given = dirs.iter().find(|d| {
-            json::<CampaignInfo>(&d.join("campaign.json")).is_ok_and(|c| c.shard == Some([i, n]))
+            json::<CampaignInfo>(&d.join("campaign.json"))
+                .is_ok_and(|c| c.shard.map_or(n == 1, |s| s == [i, n]))
         });
         lines.push(match given {
             Some(d) => format!(

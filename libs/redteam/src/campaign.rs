@@ -310,7 +310,9 @@ impl Campaign<'_> {
             .enumerate()
             .map(|(k, case)| {
                 let mut r = self.run_case(k, case);
-                if let Some(out) = self.out
+                // a case stopped by a signal did not finish: --resume runs it again
+                let stopped = matches!(r, Err(CaseError::Run(ExecError::Interrupted)));
+                if let Some(out) = self.out.filter(|_| !stopped)
                     && let Err(e) = crate::shard::record(out, case, &r)
                 {
                     r = Err(CaseError::Recorded(format!(

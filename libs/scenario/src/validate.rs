@@ -374,7 +374,7 @@ impl Scenario {
             return Err(invalid(
                 "target.collision_spheres",
                 format!("{} spheres", t.collision_spheres.len()),
-                "one keep-out sphere for now: with more, the red team breaks the arm's barriers (measured: 4 of 116 cases unsafe with the bus and two appendages; docs/SAFETY.md, \"The arm and the target\")",
+                "one keep-out sphere for now: with more, the red team found the arm's barriers broken (docs/SAFETY.md, \"The arm and the target\")",
             ));
         }
         for (k, sp) in t.collision_spheres.iter().enumerate() {
