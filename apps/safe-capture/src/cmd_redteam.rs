@@ -444,6 +444,10 @@ fn merge(m: MergeArgs) -> anyhow::Result<ExitCode> {
         merged.wall_s,
     )?;
     sc_redteam::shard::write_info(&out, info)?;
+    // the merged campaign records its cases too: it can be merged and resumed like any
+    for (case, r) in merged.cases.iter().zip(&merged.results) {
+        sc_redteam::shard::record(&out, case, r)?;
+    }
     m.figures.export_dir(&out.join("figures"))?;
     staged.commit()?;
     let partition = if info.partition { " (partition)" } else { "" };
@@ -474,6 +478,13 @@ fn resumed(a: RunArgs) -> anyhow::Result<RunArgs> {
     if !a.resume {
         return Ok(a);
     }
+    let given = sc_redteam::shard::campaign_options(&command_args()?);
+    if !given.is_empty() {
+        anyhow::bail!(
+            "--resume completes the campaign with its own options: give only --out, --jobs and --quiet (not {})",
+            given.join(" ")
+        );
+    }
     crate::out_folder::adopt_staging(&a.out, "redteam")?;
     let out = std::path::absolute(&a.out)?;
     let info = sc_redteam::shard::read_info(&out).map_err(|e| {
@@ -501,6 +512,21 @@ fn resumed(a: RunArgs) -> anyhow::Result<RunArgs> {
     Ok(r)
 }
 
+/// This command's arguments after `redteam`.
+fn command_args() -> anyhow::Result<Vec<String>> {
+    let args = std::env::args_os()
+        .map(|a| {
+            a.into_string()
+                .map_err(|a| anyhow::anyhow!("the argument {a:?} is not UTF-8"))
+        })
+        .collect::<anyhow::Result<Vec<String>>>()?;
+    Ok(args
+        .into_iter()
+        .skip_while(|x| x != "redteam")
+        .skip(1)
+        .collect())
+}
+
 /// The campaign's description (campaign.json) for the cases `all` of this build.
 fn campaign_info(
     a: &RunArgs,
@@ -508,17 +534,7 @@ fn campaign_info(
     all: &[CaseLabel],
     shard: Shard,
 ) -> anyhow::Result<sc_redteam::shard::CampaignInfo> {
-    let args = std::env::args_os()
-        .map(|a| {
-            a.into_string()
-                .map_err(|a| anyhow::anyhow!("the argument {a:?} is not UTF-8"))
-        })
-        .collect::<anyhow::Result<Vec<String>>>()?;
-    let args: Vec<String> = args
-        .into_iter()
-        .skip_while(|x| x != "redteam")
-        .skip(1)
-        .collect();
+    let args = command_args()?;
     Ok(sc_redteam::shard::CampaignInfo {
         build: sc_mission::build::current(),
         shard: shard.map(|(i, n)| [i, n]),

@@ -250,8 +250,10 @@ fn a_run_that_fails_leaves_the_earlier_output_unchanged() {
     assert_eq!(names(&d), ["run", "scenario.toml"], "{}", text(&o));
 }
 
-/// A campaign quit at once (second signal) stays in OUT.incomplete: `--resume --out OUT`
-/// names it and the command that resumes it.
+/// A campaign quit at once (second signal) or killed stays in OUT.incomplete: an empty or
+/// absent OUT takes it over (`a_killed_campaign_resumes_from_its_staging_folder`,
+/// tests/montecarlo.rs); an OUT holding something else is left alone and `--resume --out
+/// OUT` names the staging folder and the command that resumes it.
 #[test]
 fn resume_names_a_campaign_left_in_its_staging_folder() {
     let d = tmp("out-resume");
@@ -259,6 +261,8 @@ fn resume_names_a_campaign_left_in_its_staging_folder() {
     std::fs::create_dir_all(&staging).unwrap();
     std::fs::write(staging.join("campaign.json"), "{}").unwrap();
     let out = d.join("c");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
     let o = cli(
         &["montecarlo", "--resume", "--out", out.to_str().unwrap()],
         &[],
@@ -270,5 +274,6 @@ fn resume_names_a_campaign_left_in_its_staging_folder() {
         err.contains(&format!("--resume --out {}", staging.display())),
         "{err}"
     );
-    assert!(!out.exists());
+    assert_eq!(std::fs::read(out.join("notes.txt")).unwrap(), b"mine");
+    assert!(staging.join("campaign.json").is_file());
 }

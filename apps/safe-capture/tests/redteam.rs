@@ -380,12 +380,10 @@ fn cases_without_wall_clock(dir: &std::path::Path) -> Vec<String> {
 }
 
 /// Shards (issue #28): `--shard i/N` runs every N-th case, `redteam merge` gives the
-/// unsharded campaign's `min_h.csv` and `cases.csv` (but for the solve times) and names
-/// a shard that is missing with its command; a shard killed outright (SIGKILL) is
-/// completed by `--resume` with the cases it had finished kept, the same as a shard that
-/// ran through.
+/// unsharded campaign's `min_h.csv` and `cases.csv` (but for the solve times), the merge
+/// merged again the same, and a shard that is missing is named with its command.
 #[test]
-fn shards_merge_to_the_whole_red_team_and_a_killed_shard_resumes() {
+fn shards_merge_to_the_whole_red_team() {
     let _cpu = exclusive();
     let d = tmp("redteam-shards");
     let p = |n: &str| d.join(n).to_str().unwrap().to_string();
@@ -422,6 +420,16 @@ fn shards_merge_to_the_whole_red_team_and_a_killed_shard_resumes() {
         cases_without_wall_clock(&d.join("whole")),
         cases_without_wall_clock(&d.join("merged"))
     );
+    // the merged campaign records its cases: merged again, it is the same
+    let o = cli(
+        &["redteam", "merge", &p("merged"), "--out", &p("again")],
+        &[],
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(
+        std::fs::read(d.join("merged/min_h.csv")).unwrap(),
+        std::fs::read(d.join("again/min_h.csv")).unwrap()
+    );
     let o = cli(&["redteam", "merge", &p("s0"), "--out", &p("half")], &[]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(
@@ -431,7 +439,16 @@ fn shards_merge_to_the_whole_red_team_and_a_killed_shard_resumes() {
         "{}",
         text(&o)
     );
+}
 
+/// A shard killed outright (SIGKILL) after its first recorded case is completed by
+/// `--resume` with that case kept as it was, the same as a shard that ran through;
+/// `--resume` refuses options of its own (issue #28).
+#[test]
+fn a_killed_red_team_shard_resumes_keeping_its_finished_cases() {
+    let _cpu = exclusive();
+    let d = tmp("redteam-killed");
+    let p = |n: &str| d.join(n).to_str().unwrap().to_string();
     // killed after its first recorded case, resumed: the shard as if it had run through
     let killed = d.join("k");
     let child = std::process::Command::new(env!("CARGO_BIN_EXE_safe-capture"))
@@ -469,6 +486,20 @@ fn shards_merge_to_the_whole_red_team_and_a_killed_shard_resumes() {
     let first = recorded()[0].clone();
     let kept = killed.join(first.strip_prefix(d.join("k.incomplete")).unwrap());
     let written = std::fs::metadata(&first).unwrap().modified().unwrap();
+    // --resume takes the campaign's own options, no others
+    let o = cli(
+        &[
+            "redteam",
+            "--resume",
+            "--seeds",
+            "2",
+            "--out",
+            killed.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("give only --out"), "{}", text(&o));
     let o = cli(
         &[
             "redteam",
