@@ -34,7 +34,8 @@ stop() {
     export SLURM_CONF="$dir/slurm.conf"
     timeout "$GRACE_S" scancel --user="$(id -un)" 2>/dev/null || true
     # the jobs' steps end before their node daemon does
-    for _ in $(seq $((GRACE_S * 10))); do
+    local until=$((SECONDS + GRACE_S))
+    while [ "$SECONDS" -lt "$until" ]; do
       [ -z "$(timeout "$GRACE_S" squeue -h 2>/dev/null)" ] && break
       sleep 0.1
     done

@@ -688,6 +688,12 @@ fn run_remaining(
         .map(|(c, _)| c.clone())
         .collect();
     if a.resume {
+        // what a case stopped mid-run left (a partition run's files) goes before it runs
+        for c in &todo {
+            let _ = std::fs::remove_dir_all(out.join("cases").join(c.dir_name()));
+        }
+    }
+    if a.resume {
         errln!(
             "redteam: resuming: {} of {} cases finished before, {} to run",
             cases.len() - todo.len(),

@@ -1367,9 +1367,10 @@ impl RoboticFilter {
                 let hj = hv[j] - dh[j];
                 if !(hj.is_finite() && (hd[j] - dhd[j]).is_finite()) {
                     // a barrier the sample cannot evaluate is a violation, never a margin
+                    // (as a sample whose integration failed: no margin repairs it)
                     verdict.ok = false;
                     verdict.worst = f64::NEG_INFINITY;
-                    continue;
+                    return verdict;
                 }
                 verdict.worst = verdict.worst.min(hj / weights[j]);
                 if hj < 0.0 {

@@ -310,8 +310,10 @@ impl Campaign<'_> {
             .enumerate()
             .map(|(k, case)| {
                 let mut r = self.run_case(k, case);
-                // a case stopped by a signal did not finish: --resume runs it again
-                let stopped = matches!(r, Err(CaseError::Run(ExecError::Interrupted)));
+                // a case stopped by a signal did not finish (also one that failed once the
+                // executor was told to stop): --resume runs it again
+                let stopped = matches!(r, Err(CaseError::Run(ExecError::Interrupted)))
+                    || (r.is_err() && self.executor.stopped());
                 if let Some(out) = self.out.filter(|_| !stopped)
                     && let Err(e) = crate::shard::record(out, case, &r)
                 {

@@ -180,16 +180,15 @@ fn check_shards(dirs: &[PathBuf], out: &Path) -> Result<Vec<CampaignInfo>, Shard
                 out.display()
             )));
         }
-        // the folder a shard ran in does not matter (the scenario's text is compared)
+        // the folder a shard ran in counts: relative paths in its options name files there
         let same = CampaignInfo {
             shard: infos[0].shard,
-            cwd: infos[0].cwd.clone(),
             ..info.clone()
         } == infos[0]
             && n(info) == n(&infos[0]);
         if !same {
             return Err(ShardError::Invalid(format!(
-                "{} belongs to a different campaign than {} (cases, options, scenario, build or number of shards differ)",
+                "{} belongs to a different campaign than {} (cases, options, the folder it ran in, scenario, build or number of shards differ)",
                 d.display(),
                 first.display()
             )));
