@@ -165,17 +165,18 @@ struct RerunArgs {
     figures: crate::figure_format::FigureFormatArg,
 }
 
+/// The arguments of `montecarlo merge` and `redteam merge`.
 #[derive(clap::Args)]
-struct MergeArgs {
+pub(crate) struct MergeArgs {
     /// Shard directories.
     #[arg(required = true)]
-    dirs: Vec<PathBuf>,
+    pub dirs: Vec<PathBuf>,
     #[arg(long, value_name = "DIR", help = crate::out_help!())]
-    out: PathBuf,
+    pub out: PathBuf,
     #[arg(long, help = crate::out_folder::FORCE_HELP)]
-    force: bool,
+    pub force: bool,
     #[command(flatten)]
-    figures: crate::figure_format::FigureFormatArg,
+    pub figures: crate::figure_format::FigureFormatArg,
 }
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {

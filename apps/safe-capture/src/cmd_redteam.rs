@@ -69,20 +69,7 @@ enum Action {
     /// Exit codes: 0 every case safe and no bystander disturbed, 1 a case unsafe or a
     /// bystander disturbed, 2 bad arguments, cases missing or shards that do not fit
     /// together (the message names the missing cases and the command for each shard).
-    Merge(MergeArgs),
-}
-
-#[derive(clap::Args)]
-struct MergeArgs {
-    /// Shard folders.
-    #[arg(required = true)]
-    dirs: Vec<PathBuf>,
-    #[arg(long, value_name = "DIR", help = crate::out_help!())]
-    out: PathBuf,
-    #[arg(long, help = crate::out_folder::FORCE_HELP)]
-    force: bool,
-    #[command(flatten)]
-    figures: crate::figure_format::FigureFormatArg,
+    Merge(crate::cmd_montecarlo::MergeArgs),
 }
 
 /// `safe-capture redteam` with its options (the parser of a shard's recorded options).
@@ -424,7 +411,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
 }
 
 /// `redteam merge`.
-fn merge(m: MergeArgs) -> anyhow::Result<ExitCode> {
+fn merge(m: crate::cmd_montecarlo::MergeArgs) -> anyhow::Result<ExitCode> {
     m.figures.check()?;
     let inputs: Vec<&std::path::Path> = m.dirs.iter().map(PathBuf::as_path).collect();
     let merged = sc_redteam::shard::merge(&m.dirs, &m.out)?;
@@ -635,7 +622,7 @@ fn shard_cases(a: &RunArgs, all: &[CaseLabel]) -> anyhow::Result<(Shard, Vec<Cas
         .map(sc_montecarlo::parse_shard)
         .transpose()?;
     let cases = match shard {
-        Some((i, n)) => sc_redteam::shard::shard_positions(all.len(), i, n)
+        Some(_) => sc_montecarlo::shard_runs(all.len(), shard)
             .into_iter()
             .map(|k| all[k].clone())
             .collect(),

@@ -1363,33 +1363,52 @@ impl RoboticFilter {
                 target.as_ref(),
                 gravity,
             );
-            for j in 0..N {
-                let hj = hv[j] - dh[j];
-                if !(hj.is_finite() && (hd[j] - dhd[j]).is_finite()) {
-                    // a barrier the sample cannot evaluate is a violation, never a margin
-                    // (as a sample whose integration failed: no margin repairs it)
-                    verdict.ok = false;
-                    verdict.worst = f64::NEG_INFINITY;
-                    return verdict;
-                }
-                verdict.worst = verdict.worst.min(hj / weights[j]);
-                if hj < 0.0 {
-                    // C1: the barrier inside the sample
-                    let short = if is_rel_deg_two(j) {
-                        2.0 * -hj / (s * s)
-                    } else {
-                        -hj / s
-                    };
-                    verdict.fail(j, short);
-                }
-                if step == steps
-                    && let Some(short) = self.next_sample_shortfall(j, t0, hj, hd[j] - dhd[j], s)
-                {
-                    verdict.fail(j, short);
-                }
+            let h: [f64; N] = std::array::from_fn(|j| hv[j] - dh[j]);
+            let hdot: [f64; N] = std::array::from_fn(|j| hd[j] - dhd[j]);
+            if !self.check_rows(&mut verdict, t0, weights, (&h, &hdot), s, step == steps) {
+                return verdict;
             }
         }
         verdict
+    }
+
+    /// Every row's (C1) at the physics step `s` [s] into the sample and, at its end
+    /// (`last`), its next-sample condition, with the barriers and rates `h`, `hdot`
+    /// lowered by the declared errors; `false` (a violation no margin repairs) when one of
+    /// them is not finite.
+    fn check_rows(
+        &self,
+        verdict: &mut Verdict,
+        t0: &RoboticTerms,
+        weights: &[f64; N],
+        (h, hdot): (&[f64; N], &[f64; N]),
+        s: f64,
+        last: bool,
+    ) -> bool {
+        for j in 0..N {
+            let hj = h[j];
+            if !(hj.is_finite() && hdot[j].is_finite()) {
+                // a barrier the sample cannot evaluate is a violation, never a margin
+                // (as a sample whose integration failed)
+                verdict.ok = false;
+                verdict.worst = f64::NEG_INFINITY;
+                return false;
+            }
+            verdict.worst = verdict.worst.min(hj / weights[j]);
+            if hj < 0.0 {
+                // C1: the barrier inside the sample
+                let short = if is_rel_deg_two(j) {
+                    2.0 * -hj / (s * s)
+                } else {
+                    -hj / s
+                };
+                verdict.fail(j, short);
+            }
+            if last && let Some(short) = self.next_sample_shortfall(j, t0, hj, hdot[j], s) {
+                verdict.fail(j, short);
+            }
+        }
+        true
     }
 
     /// How far the declared torque error may lower every barrier and rate ([`NAMES`]

@@ -67,11 +67,6 @@ fn io_err(path: &Path) -> impl Fn(std::io::Error) -> ShardError + '_ {
     }
 }
 
-/// The positions of shard `i` of `n` in a campaign of `cases` cases: every n-th from i.
-pub fn shard_positions(cases: usize, i: usize, n: usize) -> Vec<usize> {
-    (0..cases).filter(|k| k % n.max(1) == i).collect()
-}
-
 /// The case named `name` (`<target>/<strategy>`).
 pub fn label(name: &str) -> Option<CaseLabel> {
     let (target, strategy) = name.split_once('/')?;
@@ -316,14 +311,6 @@ pub fn campaign_options(args: &[String]) -> Vec<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn shards_take_every_nth_case_and_cover_the_campaign_once() {
-        let mut all: Vec<usize> = (0..3).flat_map(|i| shard_positions(10, i, 3)).collect();
-        assert_eq!(shard_positions(10, 1, 3), vec![1, 4, 7]);
-        all.sort_unstable();
-        assert_eq!(all, (0..10).collect::<Vec<_>>());
-    }
 
     #[test]
     fn the_campaign_options_leave_out_what_is_set_per_shard() {
