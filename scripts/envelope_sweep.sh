@@ -15,10 +15,13 @@
 # With --spin-up-at T the tumble starts as in config/scenario.toml and the world spins the
 # target up to the swept rate at T s ([world.target_spin_change], undeclared to the
 # filters): the sweep of leaving the envelope during a run (docs/SAFETY.md, "Safe mode").
+# With --fixture-at Y the scenario declares the fixture at each swept offset, but the world
+# puts it at [-0.55, Y, 0.0] ([world] grasp_point_m, undeclared to the filters): a target
+# that is not the one catalogued.
 #
 # Usage: scripts/envelope_sweep.sh [--out DIR] [--spins "0.05 0.08 …"]
 #                                  [--offsets "0.1 0.35 0.6"] [--cases LIST] [--partition]
-#                                  [--spin-up-at T]
+#                                  [--spin-up-at T] [--fixture-at Y]
 # Defaults: the acceptance grid, spins 0.05–0.30 rad/s, offsets 0.1–0.6 m (measured on two
 # cores: ≈ 4 min in process, ≈ 7 min and ≈ 1.5 GB of telemetry per accepted cell with
 # --partition; --cases narrows the red team).
@@ -30,6 +33,7 @@ offsets="0.1 0.35 0.6"
 cases=""
 partition=
 spin_up=
+fixture=
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --out) out="${2:?--out needs a directory}"; shift 2 ;;
@@ -38,7 +42,8 @@ while [[ $# -gt 0 ]]; do
     --cases) cases="${2:?--cases needs a list}"; shift 2 ;;
     --partition) partition="--partition"; shift ;;
     --spin-up-at) spin_up="${2:?--spin-up-at needs a time in s}"; shift 2 ;;
-    -h|--help) sed -n '2,24p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --fixture-at) fixture="${2:?--fixture-at needs an offset in m}"; shift 2 ;;
+    -h|--help) sed -n '2,28p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "envelope_sweep.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -63,6 +68,9 @@ for w in $spins; do
     if [[ -n "$spin_up" ]]; then
       printf '\n[world.target_spin_change]\nt_s = %s\nomega_rad_s = [-%s, 0.0, 0.0]\n' \
         "$spin_up" "$w" >> "$dir/scenario.toml"
+    fi
+    if [[ -n "$fixture" ]]; then
+      printf '\n[world]\ngrasp_point_m = [-0.55, %s, 0.0]\n' "$fixture" >> "$dir/scenario.toml"
     fi
     if ! line="$("$sc" check "$dir/scenario.toml" 2>&1)"; then
       echo "$w,$o,refused,0,0,\"${line//\"/\'}\"" >> "$csv"

@@ -156,6 +156,31 @@ fn a_spin_up_puts_the_partition_in_safe_mode_as_in_process() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// The world's fixture 0.25 m farther off the spin axis than declared (undeclared to the
+/// filters): the simulator process takes it as the truth and estimates it, and the three
+/// filter processes go to safe mode on the first tick, as the mission in one process does,
+/// telemetry byte for byte; the summary names both fixtures.
+#[test]
+fn a_fixture_elsewhere_puts_the_partition_in_safe_mode_as_in_process() {
+    let dir = tmp("fixture");
+    let out = dir.join("out");
+    let config = write_config(&dir, Some(10.0), None, 20.0);
+    let scenario = dir.join("scenario.toml");
+    let mut text = std::fs::read_to_string(&scenario).unwrap();
+    text.push_str("\n[world]\ngrasp_point_m = [-0.55, 0.6, 0.0]\n");
+    std::fs::write(&scenario, text).unwrap();
+    let rep = sc_ground::launch(&options(&config, &out, "fixture")).unwrap();
+    assert_eq!(rep.code, 1, "{rep:?}");
+    assert_clean(&rep, &out);
+    let b = assert_as_in_process(&scenario, &out);
+    let m = &b["safe_mode"];
+    assert_eq!(m["entered_t_s"].as_f64(), Some(0.0), "{b}");
+    assert_eq!(m["rule"], "line_of_sight_rate", "{b}");
+    assert_eq!(m["fixture_m"], serde_json::json!([-0.55, 0.6, 0.0]), "{b}");
+    assert_eq!(m["undetected_t_s"], serde_json::Value::Null);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 const MULTI_RATE: &str = "[[rate_groups]]\nname = \"translational\"\nperiod_s = 0.2\nmembers = [\"translational\"]\n\n[[rate_groups]]\nname = \"attitude\"\nperiod_s = 0.1\nmembers = [\"attitude\"]\n\n[[rate_groups]]\nname = \"robotic\"\nperiod_s = 0.02\nmembers = [\"robotic\"]\n\n";
 
 /// Robotic 0.02 s, attitude 0.1 s, translational 0.2 s: runs to capture.

@@ -157,6 +157,34 @@ fn uncertified_note(s: &Scenario, robot: &sc_multibody::Robot) -> String {
 /// What the scenario's `[world]` does to the certified envelope (the filters never read
 /// it; the run then tests the safe mode, docs/SAFETY.md "Safe mode"); empty without one.
 fn world_note(s: &Scenario) -> String {
+    spin_change_note(s) + &fixture_note(s)
+}
+
+/// What the world's fixture (`[world] grasp_point_m`) does to the envelope at the declared
+/// tumble, as the run-time watch takes an estimate at it; empty without one.
+fn fixture_note(s: &Scenario) -> String {
+    let Some(p) = s.world.as_ref().and_then(|w| w.grasp_point_m) else {
+        return String::new();
+    };
+    let watch = sc_cbf::safe_mode::EnvelopeWatch::from_scenario(s);
+    let after = match watch.check_known(&s.target.initial_omega_rad_s, &p) {
+        Some(rule) => format!(
+            "outside the certified envelope ({}): the run tests the safe mode",
+            rule.name()
+        ),
+        None if watch.known_fixture(&p).is_none() => {
+            "within the declared grasp point error of the declared one".into()
+        }
+        None => "inside the certified envelope".into(),
+    };
+    format!(
+        "; NOTE: [world] puts the grasping fixture at {p:?} m in F_T (declared {:?}), undeclared to the filters: {after}",
+        s.target.grasp_point_m
+    )
+}
+
+/// What the world's change of the target's rate does to the envelope; empty without one.
+fn spin_change_note(s: &Scenario) -> String {
     let Some(c) = s.world.as_ref().and_then(|w| w.target_spin_change) else {
         return String::new();
     };

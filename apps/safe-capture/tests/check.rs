@@ -143,6 +143,35 @@ fn a_world_event_is_named_and_checked() {
     );
 }
 
+/// The world's fixture elsewhere than declared is named with what the run-time watch will
+/// make of it: outside the envelope at 0.6 m off the spin axis, inside at 0.4 m; a
+/// non-finite one is refused on one line.
+#[test]
+fn a_world_fixture_is_named_and_checked() {
+    let d = tmp("check-world-fixture");
+    for (y, after) in [
+        (
+            "0.6",
+            "outside the certified envelope (line_of_sight_rate): the run tests the safe mode",
+        ),
+        ("0.4", "inside the certified envelope"),
+    ] {
+        let world = format!("[world]\ngrasp_point_m = [-0.55, {y}, 0.0]\n\n[mission]");
+        let s = shipped_with(&d, "scenario.toml", "[mission]", &world);
+        let o = check(&[s.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+        let out = String::from_utf8_lossy(&o.stdout);
+        let note = format!(
+            "NOTE: [world] puts the grasping fixture at [-0.55, {y}, 0.0] m in F_T (declared [-0.55, 0.35, 0.0]), undeclared to the filters: {after}"
+        );
+        assert!(out.contains(&note), "{}", text(&o));
+    }
+    let world = "[world]\ngrasp_point_m = [-0.55, nan, 0.0]\n\n[mission]";
+    let s = shipped_with(&d, "scenario.toml", "[mission]", world);
+    let o = check(&[s.to_str().unwrap()]);
+    assert_invalid(&o, &s, &["`world.grasp_point_m`"]);
+}
+
 #[test]
 fn a_scenario_with_a_bad_value_names_the_key_and_the_rule() {
     let d = tmp("check-bad-value");

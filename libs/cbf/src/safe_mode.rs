@@ -18,14 +18,26 @@
 //! * the robotic nominal becomes the arm's brake ([`crate::RoboticFilter::brake`]);
 //! * the attitude nominal is kept (its filter's rows adapt to the estimated tumble).
 //!
+//! The watch checks the grasping fixture the same way: the rules take the fixture's
+//! position (its lever about the spin axis, its distance from the centre), and a target
+//! whose fixture is not where the mission declared it turns the line of sight at another
+//! rate. An estimate `p̂_G` within `ē_G` of the declared fixture may be that fixture and is
+//! judged as declared; one farther out is not, and the rules then take every fixture
+//! within `ē_G` of it as well as the declared one.
+//!
 //! Every command still goes through its filter. The decision is a function of the
 //! observation alone, so every filter process of the partition takes it on the same step
 //! as the mission in one process does, without a message between them.
 
 use nalgebra::Vector3;
 use sc_core::Observation;
+use sc_models::quat;
 use sc_scenario::envelope::KNOWLEDGE_ROUNDING_RAD_S;
-use sc_scenario::{LineOfSightEnvelope, Scenario, TumbleRule};
+use sc_scenario::{FixtureBall, LineOfSightEnvelope, Scenario, TumbleRule};
+
+/// The rounding on a fixture position recovered from knowledge, `R̂_RTᵀ (R̂_RT p̂_G)`, and
+/// on the navigation gate's admission of an estimate at its bound [m].
+pub const FIXTURE_ROUNDING_M: f64 = 1e-9;
 
 /// What the safe mode does (`[safety.safe_mode]`).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -43,6 +55,8 @@ pub struct EnvelopeWatch {
     scenario: Scenario,
     /// The declared bound on the error of `ω̂_T` [rad/s].
     rate_error: f64,
+    /// The declared bound `ē_G` on the error of the grasping point's estimate [m].
+    fixture_error: f64,
     params: SafeModeParams,
 }
 
@@ -54,6 +68,7 @@ impl EnvelopeWatch {
         scenario.world = None;
         Self {
             rate_error: s.target_rate_error(),
+            fixture_error: s.grasp_point_error(),
             params: SafeModeParams {
                 retreat_speed: s.safety.safe_mode.retreat_speed_m_s,
                 hold_range: s.safety.safe_mode.hold_range_m,
@@ -67,13 +82,58 @@ impl EnvelopeWatch {
         self.params
     }
 
-    /// The rule of the envelope the tumble known at `o` breaks (`None`: inside): the
-    /// fastest tumble within `ē` of the estimate. A non-finite or overflowing estimate is
-    /// [`TumbleRule::Unknown`] (nothing is known about the tumble).
+    /// The declared grasping fixture, `target.grasp_point_m` [m, F_T].
+    pub fn declared_fixture_m(&self) -> [f64; 3] {
+        self.scenario.target.grasp_point_m
+    }
+
+    /// The rule of the envelope the target known at `o` breaks (`None`: inside): the
+    /// fastest tumble within `ē` of the estimate, with the declared fixture and, when the
+    /// fixture known is not the declared one, with every fixture within `ē_G` of it. A
+    /// non-finite or overflowing estimate is [`TumbleRule::Unknown`] (nothing is known
+    /// about the tumble or the fixture).
     pub fn check(&self, o: &Observation) -> Option<TumbleRule> {
-        let w = o.omega_t;
-        self.envelope(&[w.x, w.y, w.z], self.rate_error)
+        let w = [o.omega_t.x, o.omega_t.y, o.omega_t.z];
+        self.check_known(&w, &fixture_in_target_frame(o))
+    }
+
+    /// [`Self::check`] for the estimates `omega_t` [rad/s, F_T] and `fixture_t` [m, F_T].
+    pub fn check_known(&self, omega_t: &[f64; 3], fixture_t: &[f64; 3]) -> Option<TumbleRule> {
+        let declared = self.scenario.declared_fixture();
+        self.envelope(omega_t, self.rate_error, &declared)
             .broken_tumble_rule()
+            .or_else(|| {
+                let known = self.known_fixture(fixture_t)?;
+                self.envelope(omega_t, self.rate_error, &known)
+                    .broken_tumble_rule()
+            })
+    }
+
+    /// The fixtures the estimate `p̂_G` [m, F_T] may stand for, when they are not the
+    /// declared one (`None`: within `ē_G` of it, the declared fixture may be the truth):
+    /// the ball of radius `ē_G` about it. A non-finite estimate is a ball the rules call
+    /// [`TumbleRule::Unknown`].
+    pub fn known_fixture(&self, estimate: &[f64; 3]) -> Option<FixtureBall> {
+        let radius = self.fixture_error + FIXTURE_ROUNDING_M;
+        let off = distance(estimate, &self.scenario.target.grasp_point_m);
+        beyond(off, radius).then_some(FixtureBall {
+            point_m: *estimate,
+            radius_m: radius,
+        })
+    }
+
+    /// The true fixture `p_G` [m, F_T] on the watch's premise (`None`: as declared): within
+    /// `2ē_G` of the declared one it is the declared one — an estimate of it may lie within
+    /// `ē_G` of the declared fixture, and the watch then judges it as declared — anywhere
+    /// else itself. The premise is the fixture's counterpart of the tumble's axis
+    /// tolerance (docs/SAFETY.md, "Safe mode").
+    pub fn true_fixture(&self, truth: &[f64; 3]) -> Option<FixtureBall> {
+        let premise = 2.0 * (self.fixture_error + FIXTURE_ROUNDING_M);
+        let off = distance(truth, &self.scenario.target.grasp_point_m);
+        beyond(off, premise).then_some(FixtureBall {
+            point_m: *truth,
+            radius_m: 0.0,
+        })
     }
 
     /// The rule the true tumble `omega_t` [rad/s, F_T] breaks, judged on the watch's own
@@ -84,36 +144,52 @@ impl EnvelopeWatch {
     /// `‖ω̂‖ + ē ≥ ‖ω‖`, never less restrictive than a principal one: its worst case is
     /// never below this one, so a true tumble outside is seen by the watch too (the
     /// summary's check for a silent exit).
-    pub fn check_truth(&self, omega_t: &[f64; 3]) -> Option<TumbleRule> {
-        self.truth_envelope(omega_t).broken_tumble_rule()
+    /// The fixture `fixture_t` [m, F_T] likewise ([`Self::true_fixture`]): the watch takes
+    /// every fixture within `ē_G` of its estimate, which holds the truth.
+    pub fn check_truth(&self, omega_t: &[f64; 3], fixture_t: &[f64; 3]) -> Option<TumbleRule> {
+        self.truth_envelope(omega_t, fixture_t).broken_tumble_rule()
     }
 
-    /// The envelope of the true tumble `omega_t` on the watch's premise (numbers for
-    /// reports).
-    pub fn truth_envelope(&self, omega_t: &[f64; 3]) -> LineOfSightEnvelope {
+    /// The envelope of the true tumble `omega_t` with the true fixture `fixture_t` on the
+    /// watch's premise (numbers for reports).
+    pub fn truth_envelope(&self, omega_t: &[f64; 3], fixture_t: &[f64; 3]) -> LineOfSightEnvelope {
+        let fixture = self
+            .true_fixture(fixture_t)
+            .unwrap_or_else(|| self.scenario.declared_fixture());
         // 3ē and the gate's rounding twice: an estimate admitted at ē plus rounding of a
         // truth beyond this is beyond the watch's 2ē plus rounding
         if self.rate_error == 0.0 {
             // nothing unknown: the tumble is judged as the start judges it
-            return self.scenario.line_of_sight_envelope_for(omega_t);
+            return self.scenario.line_of_sight_envelope_at(omega_t, &fixture);
         }
         let tolerance =
             self.scenario.watch_axis_tolerance_rad_s() + self.rate_error + KNOWLEDGE_ROUNDING_RAD_S;
-        self.scenario.knowledge_envelope(omega_t, tolerance, 0.0)
+        self.scenario
+            .knowledge_envelope_at(omega_t, tolerance, 0.0, &fixture)
     }
 
     /// The envelope of the fastest tumble within `error` of the estimate `omega_t`: about
     /// the declared axis within `2ē` of it (a truth within `ē` of the axis seen through an
-    /// estimate up to `ē` off is not mistaken for a tumble off the axes).
-    fn envelope(&self, omega_t: &[f64; 3], error: f64) -> LineOfSightEnvelope {
+    /// estimate up to `ē` off is not mistaken for a tumble off the axes), with the fixture
+    /// anywhere in `fixture`.
+    fn envelope(
+        &self,
+        omega_t: &[f64; 3],
+        error: f64,
+        fixture: &FixtureBall,
+    ) -> LineOfSightEnvelope {
         if self.rate_error == 0.0 {
             // nothing unknown: the estimate is the truth, judged as the start judges it
-            return self.scenario.line_of_sight_envelope_for(omega_t);
+            return self.scenario.line_of_sight_envelope_at(omega_t, fixture);
         }
         // the gate admits an error up to ē plus its rounding
         let tolerance = self.scenario.watch_axis_tolerance_rad_s();
-        self.scenario
-            .knowledge_envelope(omega_t, tolerance, error + KNOWLEDGE_ROUNDING_RAD_S)
+        self.scenario.knowledge_envelope_at(
+            omega_t,
+            tolerance,
+            error + KNOWLEDGE_ROUNDING_RAD_S,
+            fixture,
+        )
     }
 
     /// The safe mode's reference velocity of the CoM in F_H [m/s] at `r_h` [m, F_H] with
@@ -133,6 +209,23 @@ impl EnvelopeWatch {
         };
         radial - omega_h.cross(r_h)
     }
+}
+
+/// The grasping point known at `o` in F_T, `R̂_RTᵀ ρ̂_G` [m] (non-finite when `o` is).
+pub fn fixture_in_target_frame(o: &Observation) -> [f64; 3] {
+    let p = quat::to_matrix(&o.q_rt).transpose() * o.grasp_r;
+    [p.x, p.y, p.z]
+}
+
+/// `x > limit`, or not comparable (a NaN): fails safe.
+fn beyond(x: f64, limit: f64) -> bool {
+    x.partial_cmp(&limit)
+        .is_none_or(|o| o == std::cmp::Ordering::Greater)
+}
+
+/// `‖a − b‖` (NaN when either is).
+fn distance(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f64>().sqrt()
 }
 
 #[cfg(test)]
@@ -172,7 +265,8 @@ mod tests {
         let e = s.target_rate_error();
         assert_eq!(e, 1e-3);
         let w = EnvelopeWatch::from_scenario(&s);
-        let rule = |omega: [f64; 3]| w.envelope(&omega, e).broken_tumble_rule();
+        let declared = s.declared_fixture();
+        let rule = |omega: [f64; 3]| w.envelope(&omega, e, &declared).broken_tumble_rule();
         // estimates of the fastest draw (0.12) within 2ē of the axis (a truth up to ē off
         // it, seen through an estimate up to ē off; plus the gate's rounding)
         let r = 2.0 * e + KNOWLEDGE_ROUNDING_RAD_S;
@@ -194,9 +288,15 @@ mod tests {
             assert_eq!(rule([bad, bad, 0.0]), Some(TumbleRule::Unknown), "{bad}");
         }
         // the truth on the watch's premise: near the axis a constant spin, nothing added
-        assert_eq!(w.check_truth(&[-0.12, 5e-4, 0.0]), None);
-        assert_eq!(w.check_truth(&[0.0; 3]), None);
-        assert_eq!(w.check_truth(&[-0.125, 0.0, 0.0]), Some(TumbleRule::Sync));
+        assert_eq!(
+            w.check_truth(&[-0.12, 5e-4, 0.0], &s.target.grasp_point_m),
+            None
+        );
+        assert_eq!(w.check_truth(&[0.0; 3], &s.target.grasp_point_m), None);
+        assert_eq!(
+            w.check_truth(&[-0.125, 0.0, 0.0], &s.target.grasp_point_m),
+            Some(TumbleRule::Sync)
+        );
     }
 
     /// Never silent: wherever the true tumble is outside on the watch's premise
@@ -206,6 +306,7 @@ mod tests {
     fn the_watch_fires_whenever_the_truth_is_outside() {
         let s = realistic();
         let w = EnvelopeWatch::from_scenario(&s);
+        let declared = s.declared_fixture();
         let e = s.target_rate_error();
         let h = std::f64::consts::FRAC_1_SQRT_2;
         let dirs = [
@@ -232,18 +333,139 @@ mod tests {
         dirs.extend([[0.0, 0.0, -0.5], [-0.5, 0.0, 0.0]]);
         let (mut outside, mut fired) = (0, 0);
         for truth in truths {
-            if w.check_truth(&truth).is_none() {
+            if w.check_truth(&truth, &s.target.grasp_point_m).is_none() {
                 continue;
             }
             outside += 1;
             for d in &dirs {
                 let est: [f64; 3] = std::array::from_fn(|i| truth[i] + e * d[i]);
-                let fires = w.envelope(&est, e).broken_tumble_rule().is_some();
+                let fires = w
+                    .envelope(&est, e, &declared)
+                    .broken_tumble_rule()
+                    .is_some();
                 assert!(fires, "truth {truth:?} outside, estimate {est:?} not");
                 fired += 1;
             }
         }
         assert!(outside > 20 && fired == outside * dirs.len(), "{outside}");
+    }
+
+    /// Unit directions for the fixture tests: the axes, diagonals and no offset at all.
+    fn fixture_directions() -> Vec<[f64; 3]> {
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let r = 1.0 / 3f64.sqrt();
+        vec![
+            [0.0; 3],
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+            [h, h, 0.0],
+            [-h, 0.0, h],
+            [0.0, -h, -h],
+            [r, -r, r],
+        ]
+    }
+
+    fn moved(p: &[f64; 3], d: &[f64; 3], by: f64) -> [f64; 3] {
+        std::array::from_fn(|i| p[i] + by * d[i])
+    }
+
+    /// Never silent for the fixture either: wherever the true fixture, with the true tumble,
+    /// is outside on the watch's premise, every estimate of both within their declared
+    /// errors makes the watch fire — fixtures from just beyond the premise (`2ē_G`) to
+    /// 0.3 m off the declared one, in every direction, at tumbles up to the campaign's
+    /// fastest; and with the fixture as declared nothing changes.
+    #[test]
+    fn the_watch_fires_whenever_the_true_fixture_is_outside() {
+        let s = realistic();
+        let w = EnvelopeWatch::from_scenario(&s);
+        let (e, eg) = (s.target_rate_error(), s.grasp_point_error());
+        assert_eq!(eg, 0.005);
+        let declared = s.target.grasp_point_m;
+        let dirs = fixture_directions();
+        let (mut outside, mut fired) = (0, 0);
+        for spin in [0.0, 0.04, 0.06, 0.08, 0.1, 0.12] {
+            let omega = [-spin, 0.0, 0.0];
+            for by in [
+                0.0, 1.0, 2.0, 2.1, 3.0, 4.0, 5.0, 7.0, 10.0, 15.0, 20.0, 40.0, 60.0,
+            ] {
+                for d in &dirs[1..] {
+                    let truth = moved(&declared, d, by * eg);
+                    if w.check_truth(&omega, &truth).is_none() {
+                        continue;
+                    }
+                    outside += 1;
+                    for dw in &dirs {
+                        for dg in &dirs {
+                            let omega_est = moved(&omega, dw, e);
+                            let fixture_est = moved(&truth, dg, eg);
+                            let fires = w.check_known(&omega_est, &fixture_est).is_some();
+                            assert!(
+                                fires,
+                                "truth {omega:?} {truth:?} outside, {fixture_est:?} not"
+                            );
+                            fired += 1;
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            outside > 50 && fired == outside * dirs.len().pow(2),
+            "{outside}"
+        );
+    }
+
+    /// No false alarm: the campaign's fastest tumble (0.12 rad/s) with the fixture known
+    /// anywhere within `ē_G` of the declared one is inside; the same tumble with the
+    /// fixture 2 cm farther off the spin axis is not ((E1): the line of sight).
+    #[test]
+    fn a_fixture_as_declared_is_no_alarm_and_one_farther_out_is() {
+        let s = realistic();
+        let w = EnvelopeWatch::from_scenario(&s);
+        let eg = s.grasp_point_error();
+        let declared = s.target.grasp_point_m;
+        let omega = [-0.12, 0.0, 0.0];
+        for d in fixture_directions() {
+            assert_eq!(
+                w.check_known(&omega, &moved(&declared, &d, eg)),
+                None,
+                "{d:?}"
+            );
+            assert_eq!(w.known_fixture(&moved(&declared, &d, eg)), None);
+        }
+        let out = moved(&declared, &[0.0, 1.0, 0.0], 0.02);
+        assert_eq!(w.check_known(&omega, &out), Some(TumbleRule::LineOfSight));
+        assert_eq!(w.check_truth(&omega, &out), Some(TumbleRule::LineOfSight));
+        // at the default tumble the same fixture is inside
+        assert_eq!(w.check_known(&[-0.08, 0.0, 0.0], &out), None);
+        for bad in [f64::NAN, f64::INFINITY] {
+            let est = [bad, 0.35, 0.0];
+            assert_eq!(
+                w.check_known(&[-0.08, 0.0, 0.0], &est),
+                Some(TumbleRule::Unknown)
+            );
+        }
+    }
+
+    /// Without declared errors the fixture known is the truth: any offset beyond the
+    /// rounding is judged at its own position, by the watch and the truth check alike.
+    #[test]
+    fn without_declared_errors_the_fixture_is_judged_where_it_is() {
+        let s = default_scenario();
+        let w = EnvelopeWatch::from_scenario(&s);
+        let declared = s.target.grasp_point_m;
+        let omega = [-0.08, 0.0, 0.0];
+        assert_eq!(w.true_fixture(&declared), None);
+        for (by, outside) in [(1e-6, false), (0.05, false), (0.25, true)] {
+            let p = moved(&declared, &[0.0, 1.0, 0.0], by);
+            assert!(w.true_fixture(&p).is_some());
+            assert_eq!(w.check_known(&omega, &p).is_some(), outside, "{by}");
+            assert_eq!(w.check_truth(&omega, &p).is_some(), outside, "{by}");
+        }
     }
 
     /// The retreat: `v_s` radially in F_R inside the hold range, at rest in F_R beyond it,

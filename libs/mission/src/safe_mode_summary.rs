@@ -1,12 +1,12 @@
 //! What a run's summary says about the certified envelope during the run: when the safety
 //! layer went to safe mode (the filters' [`faults::SAFE_MODE`] flags, decided on
-//! knowledge), what the true tumble broke then, whether the line of sight was still
+//! knowledge), what the true tumble (with the true grasping fixture) broke then, whether the line of sight was still
 //! certifiable at that range — and when the true tumble left the envelope while the layer
 //! did not say so (docs/SAFETY.md, "Safe mode").
 
 use crate::record::StepRecord;
 use sc_cbf::faults;
-use sc_cbf::safe_mode::EnvelopeWatch;
+use sc_cbf::safe_mode::{EnvelopeWatch, fixture_in_target_frame};
 use serde::{Deserialize, Serialize};
 
 /// The safe mode of a run, from its records and the true state.
@@ -29,6 +29,12 @@ pub struct SafeModeSummary {
     /// which the boresight can follow the true tumble's grasping point [m].
     pub line_of_sight_m: f64,
     pub range_needed_m: f64,
+    /// The true grasping fixture [m, F_T] when the run began, if it is not the declared one
+    /// on the watch's premise (`[world] grasp_point_m`), and the declared one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fixture_m: Option<[f64; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub declared_fixture_m: Option<[f64; 3]>,
 }
 
 impl SafeModeSummary {
@@ -49,7 +55,11 @@ impl SafeModeSummary {
             .iter()
             .any(|f| f & faults::SAFE_MODE != 0)
         };
-        let outside = |r: &StepRecord| watch.check_truth(&true_rate(r)).is_some();
+        let outside = |r: &StepRecord| {
+            watch
+                .check_truth(&true_rate(r), &fixture_in_target_frame(&r.obs))
+                .is_some()
+        };
         let entered = records.iter().find(|r| in_safe_mode(r));
         let truth_left = records.iter().find(|r| outside(r));
         if entered.is_none() && truth_left.is_none() {
@@ -57,7 +67,9 @@ impl SafeModeSummary {
         }
         let undetected = records.iter().find(|r| outside(r) && !in_safe_mode(r));
         let at = entered.or(truth_left)?;
-        let env = watch.truth_envelope(&true_rate(at));
+        let fixture = fixture_in_target_frame(&at.obs);
+        let env = watch.truth_envelope(&true_rate(at), &fixture);
+        let moved = watch.true_fixture(&fixture).map(|f| f.point_m);
         let rule = env.broken_tumble_rule();
         Some(Self {
             entered_t_s: entered.map(|r| r.t),
@@ -70,6 +82,8 @@ impl SafeModeSummary {
             }),
             line_of_sight_m: (at.obs.grasp_r - at.obs.com_r).norm(),
             range_needed_m: env.range_needed_m(),
+            fixture_m: moved,
+            declared_fixture_m: moved.map(|_| watch.declared_fixture_m()),
         })
     }
 
@@ -86,7 +100,8 @@ impl SafeModeSummary {
     pub fn line(&self) -> String {
         let mut s = match self.entered_t_s {
             Some(t) => format!(
-                "safe mode from t = {t:.1} s (the tumble known left the certified envelope: {}; {})",
+                "safe mode from t = {t:.1} s ({} left the certified envelope: {}; {})",
+                self.what_left(),
                 self.rule,
                 self.range_line()
             ),
@@ -97,11 +112,28 @@ impl SafeModeSummary {
                 s.push_str("; ");
             }
             s.push_str(&format!(
-                "the true tumble left the certified envelope UNDETECTED at t = {t:.1} s ({})",
+                "the true {} left the certified envelope UNDETECTED at t = {t:.1} s ({})",
+                if self.fixture_m.is_some() {
+                    "target"
+                } else {
+                    "tumble"
+                },
                 self.rule
             ));
         }
         s
+    }
+
+    /// What the layer knew to be outside: the tumble, or the target with its fixture
+    /// elsewhere than declared.
+    fn what_left(&self) -> String {
+        match (self.fixture_m, self.declared_fixture_m) {
+            (Some(p), Some(d)) => format!(
+                "the target known, its grasping fixture at [{:.3}, {:.3}, {:.3}] m in F_T instead of the declared [{:.3}, {:.3}, {:.3}],",
+                p[0], p[1], p[2], d[0], d[1], d[2]
+            ),
+            _ => "the tumble known".into(),
+        }
     }
 
     fn range_line(&self) -> String {

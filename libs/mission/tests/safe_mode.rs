@@ -1,5 +1,6 @@
 //! Leaving the certified envelope during a run (docs/SAFETY.md, "Safe mode"): the world
-//! spins the target up beyond the envelope without the mission declaring it; the layer
+//! spins the target up beyond the envelope, or presents a grasping fixture elsewhere than
+//! declared, without the mission declaring it; the layer
 //! detects it on the step the estimate first shows it, every filter goes to safe mode
 //! (retreat, arm brake), the summary says when, what broke and whether the line of sight
 //! was still certifiable at that range — and the barriers on the true state hold.
@@ -19,6 +20,7 @@ fn changed(t_s: f64, omega: [f64; 3], realistic: bool) -> (sc_mission::Summary, 
             t_s,
             omega_rad_s: omega,
         }),
+        ..World::default()
     });
     if realistic {
         let spec =
@@ -113,6 +115,63 @@ fn under_realistic_navigation_the_watch_is_neither_late_nor_jumpy() {
     assert!(records.iter().all(|r| in_safe_mode(r) == [false; 3]));
 }
 
+/// The default mission with the world's grasping fixture at `fixture` [m, F_T] instead of
+/// the declared one (under the `realistic` profile if `realistic`).
+fn fixture_at(fixture: [f64; 3], realistic: bool) -> (sc_mission::Summary, Vec<StepRecord>) {
+    let mut setup = common::default_setup();
+    setup.scenario.world = Some(World {
+        grasp_point_m: Some(fixture),
+        ..World::default()
+    });
+    if realistic {
+        let spec =
+            sc_scenario::UncertaintySpec::profile(sc_scenario::uncertainty::REALISTIC_NAME, 3);
+        setup.scenario.set_uncertainty(spec).unwrap();
+    }
+    let scenario = setup.scenario.clone();
+    let (_, records, end, phases) = common::run_mission(setup);
+    let mut summary = summarize(&records, &end, &phases, true);
+    summary.safe_mode = SafeModeSummary::of(&records, &scenario);
+    (summary, records)
+}
+
+/// A target whose fixture is 0.25 m farther off the spin axis than declared (0.6 m: at the
+/// declared 0.08 rad/s it turns the line of sight faster than the boresight may follow,
+/// (E1)) is detected on the first step — the estimate shows where the fixture is — in
+/// every filter, exact and under `realistic` navigation; the summary names both positions;
+/// never silently; the line of sight holds.
+#[test]
+fn a_fixture_farther_out_than_declared_puts_the_layer_in_safe_mode_at_once() {
+    for realistic in [false, true] {
+        let (s, records) = fixture_at([-0.55, 0.6, 0.0], realistic);
+        let m = s.safe_mode.as_ref().expect("a safe mode in the summary");
+        assert_eq!(m.entered_t_s, Some(records[0].t), "{m:?}");
+        assert_eq!(m.undetected_t_s, None, "{m:?}");
+        assert_eq!(m.rule, "line_of_sight_rate");
+        assert_eq!(m.fixture_m, Some([-0.55, 0.6, 0.0]));
+        assert_eq!(m.declared_fixture_m, Some([-0.55, 0.35, 0.0]));
+        assert!(m.line_of_sight_certifiable(), "{m:?}");
+        assert!(records.iter().all(|r| in_safe_mode(r) == [true; 3]));
+        assert!(
+            s.verdict()
+                .contains("its grasping fixture at [-0.550, 0.600, 0.000] m")
+        );
+        let los = "line_of_sight".to_string();
+        assert!(!s.violated_constraints.contains(&los), "{}", s.verdict());
+        assert!(!s.passed());
+    }
+}
+
+/// A fixture 5 cm off its declared place but inside the envelope changes nothing the layer
+/// decides: no safe mode, and the mission captures (the filters take the fixture known).
+#[test]
+fn a_fixture_moved_inside_the_envelope_is_no_safe_mode() {
+    let (s, records) = fixture_at([-0.55, 0.40, 0.0], false);
+    assert_eq!(s.safe_mode, None);
+    assert!(records.iter().all(|r| in_safe_mode(r) == [false; 3]));
+    assert!(s.passed(), "{}", s.verdict());
+}
+
 /// A plant outside the simulator (Basilisk) cannot apply the world's change: refused when
 /// it is set, before the run, not when the change falls due.
 #[test]
@@ -137,6 +196,7 @@ fn an_external_plant_is_refused_with_a_world_event() {
             t_s: 10.0,
             omega_rad_s: [-0.2, 0.0, 0.0],
         }),
+        ..World::default()
     });
     let mut m = sc_mission::Mission::new(setup, sc_mission::RunOptions::default()).unwrap();
     let e = m.set_plant(Box::new(Never)).unwrap_err();

@@ -68,6 +68,8 @@ fn a_run_that_entered_the_safe_mode_does_not_pass() {
         reason: String::new(),
         line_of_sight_m: 2.0,
         range_needed_m: 1.5,
+        fixture_m: None,
+        declared_fixture_m: None,
     };
     assert!(m.line_of_sight_certifiable());
     s.safe_mode = Some(m.clone());
@@ -81,13 +83,25 @@ fn a_run_that_entered_the_safe_mode_does_not_pass() {
         m.rule = rule.into();
         assert!(!m.line_of_sight_certifiable(), "{rule}");
     }
+    // a fixture elsewhere than declared is named with both positions
+    m.fixture_m = Some([-0.55, 0.6, 0.0]);
+    m.declared_fixture_m = Some([-0.55, 0.35, 0.0]);
+    s.safe_mode = Some(m.clone());
+    assert!(
+        s.verdict().contains(
+            "the target known, its grasping fixture at [-0.550, 0.600, 0.000] m in F_T instead of the declared [-0.550, 0.350, 0.000]"
+        ),
+        "{}",
+        s.verdict()
+    );
     // the true tumble outside with no filter in safe mode: not safe
     m.entered_t_s = None;
     m.undetected_t_s = Some(1.0);
     s.safe_mode = Some(m);
     assert!(!s.safe());
     assert!(
-        s.verdict().contains("UNDETECTED at t = 1.0 s"),
+        s.verdict()
+            .contains("the true target left the certified envelope UNDETECTED at t = 1.0 s"),
         "{}",
         s.verdict()
     );

@@ -44,6 +44,17 @@ pub fn across_boresight(d: &V3) -> [V3; 2] {
     [e1, cross(d, &e1)]
 }
 
+/// Where the grasping fixture is, in F_T, as far as the envelope is concerned: a point and
+/// the radius of a ball about it that holds the fixture [m] (the declared fixture: its
+/// point, radius 0). Every quantity of the envelope the fixture enters — its distance from
+/// the spin axis and from the centre, its reach along the corridor axis — is 1-Lipschitz
+/// in the fixture's position, so the ball's worst case is the point's plus the radius.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FixtureBall {
+    pub point_m: V3,
+    pub radius_m: f64,
+}
+
 /// The line-of-sight envelope of a scenario (all bounds over the whole run).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LineOfSightEnvelope {
@@ -145,25 +156,48 @@ impl Scenario {
     /// The line-of-sight envelope for the tumble `ω_T(0)` (in F_T) in this scenario's
     /// geometry (a Monte Carlo checks its fastest draw).
     pub fn line_of_sight_envelope_for(&self, omega_t: &V3) -> LineOfSightEnvelope {
-        self.envelope_about(omega_t, self.principal_axis(omega_t))
+        self.line_of_sight_envelope_at(omega_t, &self.declared_fixture())
+    }
+
+    /// [`Self::line_of_sight_envelope_for`] with the fixture anywhere in `fixture`.
+    pub fn line_of_sight_envelope_at(
+        &self,
+        omega_t: &V3,
+        fixture: &FixtureBall,
+    ) -> LineOfSightEnvelope {
+        self.envelope_about(omega_t, self.principal_axis(omega_t), fixture)
+    }
+
+    /// The declared fixture, `target.grasp_point_m`, as a ball of radius 0.
+    pub fn declared_fixture(&self) -> FixtureBall {
+        FixtureBall {
+            point_m: self.target.grasp_point_m,
+            radius_m: 0.0,
+        }
     }
 
     /// The envelope of a tumble `omega_t` that is a constant spin about `principal`, or
-    /// (`None`) one off the principal axes (amplification `κ`, lever `‖p_G‖`).
-    fn envelope_about(&self, omega_t: &V3, principal: Option<V3>) -> LineOfSightEnvelope {
+    /// (`None`) one off the principal axes (amplification `κ`, lever `‖p_G‖`), with the
+    /// fixture anywhere in `fixture` (the lever grows by its radius).
+    fn envelope_about(
+        &self,
+        omega_t: &V3,
+        principal: Option<V3>,
+        fixture: &FixtureBall,
+    ) -> LineOfSightEnvelope {
         let t = &self.target;
-        let p = &t.grasp_point_m;
+        let (p, e) = (&fixture.point_m, fixture.radius_m);
         let spin = norm(omega_t);
         let d = normalize(&self.safety.translational.corridor_axis);
         let (amplification, lever_m, axial, across) = match principal {
             Some(a) => {
                 let a_r = rotate(&t.initial_attitude, &a);
                 let across = norm(&cross(&a_r, &d));
-                (1.0, norm(&cross(&a, p)), Some((a, dot(&a, p))), across)
+                (1.0, norm(&cross(&a, p)) + e, Some((a, dot(&a, p))), across)
             }
-            None => (self.target_inertia_ratio(), norm(p), None, 1.0),
+            None => (self.target_inertia_ratio(), norm(p) + e, None, 1.0),
         };
-        let los_min_m = self.shortest_line_of_sight(lever_m, axial);
+        let los_min_m = self.shortest_line_of_sight(fixture, axial);
         LineOfSightEnvelope {
             boresight_follow_rad_s: self.boresight_follow_rad_s(),
             translational_rad_s: 2f64.sqrt() * self.safety.translational.los_speed_budget(),
@@ -173,20 +207,19 @@ impl Scenario {
             spin_rad_s: spin,
             sync_limit_rad_s: self.sync_limit_rad_s(),
             spin_across_axis: across,
-            contract_sigma_min: self.contract_sigma_min(los_min_m),
+            contract_sigma_min: self.contract_sigma_min(los_min_m, norm(p) + e),
         }
     }
 
     /// `√(1 − s²)`, `s = min(1, sin ψ + ‖p_G‖(1 + sin ψ)/L_min)`: the line of sight's
     /// component across the corridor axis is at most `‖P⊥r‖ + ‖p_G‖ ≤ (L + ‖p_G‖) sin ψ +
-    /// ‖p_G‖` for a CoM in the corridor, over `L ≥ L_min`.
-    fn contract_sigma_min(&self, los_min_m: f64) -> f64 {
+    /// ‖p_G‖` for a CoM in the corridor, over `L ≥ L_min` (`p` the bound on `‖p_G‖` [m]).
+    fn contract_sigma_min(&self, los_min_m: f64, p: f64) -> f64 {
         let psi = self
             .safety
             .translational
             .corridor_half_angle_deg
             .to_radians();
-        let p = norm(&self.target.grasp_point_m);
         let s = if los_min_m > 0.0 {
             (psi.sin() + p * (1.0 + psi.sin()) / los_min_m).min(1.0)
         } else {
@@ -229,17 +262,19 @@ impl Scenario {
     /// The shortest line of sight from a servicer CoM outside the zone (`‖r‖ ≥ R_CAZ`) and
     /// inside the corridor (`d·r ≥ ‖r‖ cos ψ`) to the grasping point: `R_CAZ − ‖p_G‖`, and
     /// `R_CAZ cos ψ − max_t d·p_G(t)` (for a principal spin `max_t d·p_G = (â·p)(â_R·d) +
-    /// ‖â × p‖ √(1 − (â_R·d)²)`, `â_R` the spin axis in F_R; else `‖p_G‖`).
-    fn shortest_line_of_sight(&self, lever_m: f64, axial: Option<(V3, f64)>) -> f64 {
+    /// ‖â × p‖ √(1 − (â_R·d)²)`, `â_R` the spin axis in F_R; else `‖p_G‖`), with the fixture anywhere in
+    /// `fixture`: both grow by its radius.
+    fn shortest_line_of_sight(&self, fixture: &FixtureBall, axial: Option<(V3, f64)>) -> f64 {
         let tr = &self.safety.translational;
         let r_caz = tr.caz_radius_m;
-        let p_norm = norm(&self.target.grasp_point_m);
+        let (p, e) = (&fixture.point_m, fixture.radius_m);
+        let p_norm = norm(p) + e;
         let d = normalize(&tr.corridor_axis);
         let reach_along_d = match axial {
             Some((a, along)) => {
                 let a_r = rotate(&self.target.initial_attitude, &a);
                 let c = dot(&a_r, &d).clamp(-1.0, 1.0);
-                along * c + lever_m * (1.0 - c * c).max(0.0).sqrt()
+                along * c + norm(&cross(&a, p)) * (1.0 - c * c).max(0.0).sqrt() + e
             }
             None => p_norm,
         };
@@ -397,6 +432,11 @@ impl Scenario {
             .bound()
     }
 
+    /// The declared bound `ē_G` on the error of the grasping point's estimate [m].
+    pub fn grasp_point_error(&self) -> f64 {
+        self.uncertainty_bounds().navigation.grasp_point_m.bound()
+    }
+
     /// What the run-time watch adds to a true tumble at most: `2ē` [rad/s] (the estimate
     /// is up to `ē` off, and the watch adds `ē` to it; docs/SAFETY.md, "Safe mode").
     pub fn watch_margin_rad_s(&self) -> f64 {
@@ -449,12 +489,24 @@ impl Scenario {
         axis_tolerance: f64,
         error: f64,
     ) -> LineOfSightEnvelope {
+        self.knowledge_envelope_at(omega, axis_tolerance, error, &self.declared_fixture())
+    }
+
+    /// [`Self::knowledge_envelope`] with the fixture anywhere in `fixture`.
+    pub fn knowledge_envelope_at(
+        &self,
+        omega: &V3,
+        axis_tolerance: f64,
+        error: f64,
+        fixture: &FixtureBall,
+    ) -> LineOfSightEnvelope {
         let spin = norm(omega);
         if let Some(a) = self.declared_spin_axis() {
             let along = dot(omega, &a);
             if norm(&sub(omega, &scale(&a, along))) <= axis_tolerance {
                 let sign = if along < 0.0 { -1.0 } else { 1.0 };
-                return self.envelope_about(&scale(&a, sign * (along.abs() + error)), Some(a));
+                let tumble = scale(&a, sign * (along.abs() + error));
+                return self.envelope_about(&tumble, Some(a), fixture);
             }
         }
         let tumble = if spin == 0.0 {
@@ -463,7 +515,7 @@ impl Scenario {
         } else {
             scale(omega, (spin + error) / spin)
         };
-        self.envelope_about(&tumble, None)
+        self.envelope_about(&tumble, None, fixture)
     }
 }
 

@@ -12,7 +12,7 @@ pub mod envelope;
 pub mod uncertainty;
 mod validate;
 
-pub use envelope::{LineOfSightEnvelope, TumbleRule};
+pub use envelope::{FixtureBall, LineOfSightEnvelope, TumbleRule};
 pub use uncertainty::{Uncertainty, UncertaintySpec};
 pub use validate::{MAX_DECLARED_KEEP_OUT_SPHERES, MAX_KEEP_OUT_SPHERES, ScenarioError};
 
@@ -248,12 +248,17 @@ pub struct SafeMode {
 }
 
 /// Events of the world the mission does not declare (`[world]`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct World {
     /// The target's body rate jumps (a collision, an outgassing burst) at `t_s`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub target_spin_change: Option<SpinChange>,
+    /// Where the grasping fixture really is, in F_T [m] (a target that is not the one
+    /// catalogued): the simulator's truth and the navigation's estimate take it, the
+    /// mission's declaration stays `target.grasp_point_m`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grasp_point_m: Option<V3>,
 }
 
 /// The target's body rate set to `omega_rad_s` at `t_s`.

@@ -229,6 +229,9 @@ impl Scenario {
         let sm = &self.safety.safe_mode;
         positive("safety.safe_mode.retreat_speed_m_s", sm.retreat_speed_m_s)?;
         positive("safety.safe_mode.hold_range_m", sm.hold_range_m)?;
+        if let Some(g) = self.world.as_ref().and_then(|w| w.grasp_point_m) {
+            finite_all("world.grasp_point_m", &g)?;
+        }
         let Some(c) = self.world.as_ref().and_then(|w| w.target_spin_change) else {
             return Ok(());
         };

@@ -176,7 +176,12 @@ impl Simulator {
             target_inertia: ti,
             target_inertia_inv: ti_inv,
             q_ir,
-            grasp_point_t: v3(tg.grasp_point_m),
+            // the world's fixture where it differs from the declared one
+            grasp_point_t: v3(scenario
+                .world
+                .as_ref()
+                .and_then(|w| w.grasp_point_m)
+                .unwrap_or(tg.grasp_point_m)),
             physics_step: scenario.mission.physics_step_s,
             substeps: scenario.physics_substeps(),
             spin_change: scenario
