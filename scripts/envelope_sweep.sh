@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The certified envelope's sweep (docs/SAFETY.md, "The certified envelope"): for every
 # tumbling rate and grasping-point offset from the spin axis, a scenario that differs from
-# config/scenario.toml in those two values only; `safe-capture check` decides whether it is
+# config/scenario.toml in those two values only (and in [world] with the options below); `safe-capture check` decides whether it is
 # inside the envelope, and every scenario it accepts runs the whole red team
 # (`safe-capture redteam --scenario`, in process; with --partition also through the
 # partition). One line per scenario in OUT/sweep.csv:

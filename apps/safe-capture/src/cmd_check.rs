@@ -160,14 +160,15 @@ fn world_note(s: &Scenario) -> String {
     spin_change_note(s) + &fixture_note(s)
 }
 
-/// What the world's fixture (`[world] grasp_point_m`) does to the envelope at the declared
-/// tumble, as the run-time watch takes an estimate at it; empty without one.
+/// What the world's fixture (`[world] grasp_point_m`) does to the envelope, as the
+/// run-time watch judges an exact estimate of it: at the declared tumble and, when the
+/// world changes it too, at the changed one; empty without one.
 fn fixture_note(s: &Scenario) -> String {
     let Some(p) = s.world.as_ref().and_then(|w| w.grasp_point_m) else {
         return String::new();
     };
     let watch = sc_cbf::safe_mode::EnvelopeWatch::from_scenario(s);
-    let after = match watch.check_known(&s.target.initial_omega_rad_s, &p) {
+    let judge = |omega: &[f64; 3]| match watch.check_known(omega, &p) {
         Some(rule) => format!(
             "outside the certified envelope ({}): the run tests the safe mode",
             rule.name()
@@ -177,6 +178,14 @@ fn fixture_note(s: &Scenario) -> String {
         }
         None => "inside the certified envelope".into(),
     };
+    let mut after = judge(&s.target.initial_omega_rad_s);
+    if let Some(c) = s.world.as_ref().and_then(|w| w.target_spin_change) {
+        after.push_str(&format!(
+            "; with the rate changed at t = {} s: {}",
+            c.t_s,
+            judge(&c.omega_rad_s)
+        ));
+    }
     format!(
         "; NOTE: [world] puts the grasping fixture at {p:?} m in F_T (declared {:?}), undeclared to the filters: {after}",
         s.target.grasp_point_m

@@ -35,8 +35,10 @@ use sc_models::quat;
 use sc_scenario::envelope::KNOWLEDGE_ROUNDING_RAD_S;
 use sc_scenario::{FixtureBall, LineOfSightEnvelope, Scenario, TumbleRule};
 
-/// The rounding on a fixture position recovered from knowledge, `R̂_RTᵀ (R̂_RT p̂_G)`, and
-/// on the navigation gate's admission of an estimate at its bound [m].
+/// The rounding on a fixture position recovered from knowledge, `M(q̂_RT)⁻¹ (M(q̂_RT) p̂_G)`
+/// (the exact inverse of the matrix the observation was built with, so a quaternion the
+/// gate admits a little off unit length changes nothing), and on the navigation gate's
+/// admission of an estimate at its bound [m].
 pub const FIXTURE_ROUNDING_M: f64 = 1e-9;
 
 /// What the safe mode does (`[safety.safe_mode]`).
@@ -94,7 +96,7 @@ impl EnvelopeWatch {
     /// about the tumble or the fixture).
     pub fn check(&self, o: &Observation) -> Option<TumbleRule> {
         let w = [o.omega_t.x, o.omega_t.y, o.omega_t.z];
-        self.check_known(&w, &fixture_in_target_frame(o))
+        self.check_known(&w, &fixture_in_target_frame(&o.q_rt, &o.grasp_r))
     }
 
     /// [`Self::check`] for the estimates `omega_t` [rad/s, F_T] and `fixture_t` [m, F_T].
@@ -144,8 +146,9 @@ impl EnvelopeWatch {
     /// `‖ω̂‖ + ē ≥ ‖ω‖`, never less restrictive than a principal one: its worst case is
     /// never below this one, so a true tumble outside is seen by the watch too (the
     /// summary's check for a silent exit).
-    /// The fixture `fixture_t` [m, F_T] likewise ([`Self::true_fixture`]): the watch takes
-    /// every fixture within `ē_G` of its estimate, which holds the truth.
+    /// The fixture `fixture_t` [m, F_T] likewise ([`Self::true_fixture`]): beyond the
+    /// premise the estimate lies more than `ē_G` from the declared fixture, and the watch
+    /// then takes every fixture within `ē_G` of it, which holds the truth.
     pub fn check_truth(&self, omega_t: &[f64; 3], fixture_t: &[f64; 3]) -> Option<TumbleRule> {
         self.truth_envelope(omega_t, fixture_t).broken_tumble_rule()
     }
@@ -211,10 +214,17 @@ impl EnvelopeWatch {
     }
 }
 
-/// The grasping point known at `o` in F_T, `R̂_RTᵀ ρ̂_G` [m] (non-finite when `o` is).
-pub fn fixture_in_target_frame(o: &Observation) -> [f64; 3] {
-    let p = quat::to_matrix(&o.q_rt).transpose() * o.grasp_r;
-    [p.x, p.y, p.z]
+/// The grasping point in F_T [m] from `ρ_G = M(q_RT) p_G` in F_R (an observation's
+/// `grasp_r`, built with the matrix of its `q_RT` as it is, unit or not): `M⁻¹ ρ_G`;
+/// non-finite when either is or `M` has no inverse.
+pub fn fixture_in_target_frame(q_rt: &quat::Quat, grasp_r: &Vector3<f64>) -> [f64; 3] {
+    match quat::to_matrix(q_rt).try_inverse() {
+        Some(m) => {
+            let p = m * grasp_r;
+            [p.x, p.y, p.z]
+        }
+        None => [f64::NAN; 3],
+    }
 }
 
 /// `x > limit`, or not comparable (a NaN): fails safe.
@@ -350,6 +360,36 @@ mod tests {
         assert!(outside > 20 && fired == outside * dirs.len(), "{outside}");
     }
 
+    /// The fixture comes back in F_T from an observation's `q_RT` and `ρ_G = M(q_RT) p_G`:
+    /// a quarter turn about z (so a transposed rotation would be caught), a general turn,
+    /// and a quaternion 1e-9 off unit length as the navigation gate admits it.
+    #[test]
+    fn the_fixture_is_recovered_in_the_target_frame() {
+        let p = Vector3::new(-0.55, 0.35, 0.1);
+        let turns = [
+            quat::from_axis_angle(&Vector3::z(), std::f64::consts::FRAC_PI_2),
+            quat::from_axis_angle(&Vector3::new(1.0, -2.0, 0.5).normalize(), 3.0),
+        ];
+        for q in turns {
+            let rho = quat::to_matrix(&q) * p;
+            let back = fixture_in_target_frame(&q, &rho);
+            assert!((Vector3::from(back) - p).norm() < 1e-15, "{back:?}");
+            let long = q.map(|c| c * (1.0 + 1e-9));
+            let rho = quat::to_matrix(&long) * p;
+            let back = fixture_in_target_frame(&long, &rho);
+            assert!((Vector3::from(back) - p).norm() < 1e-15, "{back:?}");
+        }
+        // a quarter turn about z takes x_T to y_R: p_G = x̂_T is seen along y_R
+        let q = turns[0];
+        let back = fixture_in_target_frame(&q, &Vector3::y());
+        assert!(
+            (Vector3::from(back) - Vector3::x()).norm() < 1e-15,
+            "{back:?}"
+        );
+        let nan = fixture_in_target_frame(&q, &Vector3::new(f64::NAN, 0.0, 0.0));
+        assert!(nan.iter().any(|x| x.is_nan()));
+    }
+
     /// Unit directions for the fixture tests: the axes, diagonals and no offset at all.
     fn fixture_directions() -> Vec<[f64; 3]> {
         let h = std::f64::consts::FRAC_1_SQRT_2;
@@ -387,8 +427,12 @@ mod tests {
         let declared = s.target.grasp_point_m;
         let dirs = fixture_directions();
         let (mut outside, mut fired) = (0, 0);
-        for spin in [0.0, 0.04, 0.06, 0.08, 0.1, 0.12] {
-            let omega = [-spin, 0.0, 0.0];
+        // about the declared axis, and off the principal axes (amplification κ, lever ‖p_G‖)
+        let tumbles = [0.0, 0.04, 0.06, 0.08, 0.1, 0.12]
+            .map(|spin| [-spin, 0.0, 0.0])
+            .into_iter()
+            .chain([[-0.03, 0.01, 0.01], [-0.02, 0.0, 0.02], [0.0, 0.02, 0.0]]);
+        for omega in tumbles {
             for by in [
                 0.0, 1.0, 2.0, 2.1, 3.0, 4.0, 5.0, 7.0, 10.0, 15.0, 20.0, 40.0, 60.0,
             ] {

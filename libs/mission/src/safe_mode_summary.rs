@@ -1,6 +1,7 @@
 //! What a run's summary says about the certified envelope during the run: when the safety
 //! layer went to safe mode (the filters' [`faults::SAFE_MODE`] flags, decided on
-//! knowledge), what the true tumble (with the true grasping fixture) broke then, whether the line of sight was still
+//! knowledge), what the true tumble (with the true grasping fixture) broke then, whether
+//! the line of sight was still
 //! certifiable at that range — and when the true tumble left the envelope while the layer
 //! did not say so (docs/SAFETY.md, "Safe mode").
 
@@ -16,7 +17,8 @@ pub struct SafeModeSummary {
     pub entered_t_s: Option<f64>,
     /// Steps on which any filter was in safe mode.
     pub steps: usize,
-    /// The first step on which the true tumble broke a rule of the envelope [s].
+    /// The first step on which the true tumble (with the true fixture) broke a rule of the
+    /// envelope [s].
     pub truth_left_t_s: Option<f64>,
     /// The first step on which the true tumble was outside the envelope and no filter in
     /// safe mode [s]: a silent exit (`None`: none).
@@ -29,8 +31,9 @@ pub struct SafeModeSummary {
     /// which the boresight can follow the true tumble's grasping point [m].
     pub line_of_sight_m: f64,
     pub range_needed_m: f64,
-    /// The true grasping fixture [m, F_T] when the run began, if it is not the declared one
-    /// on the watch's premise (`[world] grasp_point_m`), and the declared one.
+    /// The true grasping fixture [m, F_T] at the step the safe mode began (or the truth
+    /// left), if it is not the declared one on the watch's premise (`[world]
+    /// grasp_point_m`), and the declared one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fixture_m: Option<[f64; 3]>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -55,11 +58,7 @@ impl SafeModeSummary {
             .iter()
             .any(|f| f & faults::SAFE_MODE != 0)
         };
-        let outside = |r: &StepRecord| {
-            watch
-                .check_truth(&true_rate(r), &fixture_in_target_frame(&r.obs))
-                .is_some()
-        };
+        let outside = |r: &StepRecord| watch.check_truth(&true_rate(r), &true_fixture(r)).is_some();
         let entered = records.iter().find(|r| in_safe_mode(r));
         let truth_left = records.iter().find(|r| outside(r));
         if entered.is_none() && truth_left.is_none() {
@@ -67,7 +66,7 @@ impl SafeModeSummary {
         }
         let undetected = records.iter().find(|r| outside(r) && !in_safe_mode(r));
         let at = entered.or(truth_left)?;
-        let fixture = fixture_in_target_frame(&at.obs);
+        let fixture = true_fixture(at);
         let env = watch.truth_envelope(&true_rate(at), &fixture);
         let moved = watch.true_fixture(&fixture).map(|f| f.point_m);
         let rule = env.broken_tumble_rule();
@@ -78,7 +77,7 @@ impl SafeModeSummary {
             undetected_t_s: undetected.map(|r| r.t),
             rule: rule.map_or(ESTIMATE_ONLY, |r| r.name()).into(),
             reason: rule.map(|r| env.explain(r)).unwrap_or_else(|| {
-                "the true tumble was inside the envelope; the estimate's worst case (ē added) was not".into()
+                "the true tumble and fixture were inside the envelope; the estimate's worst case (ē and ē_G added) was not".into()
             }),
             line_of_sight_m: (at.obs.grasp_r - at.obs.com_r).norm(),
             range_needed_m: env.range_needed_m(),
@@ -124,12 +123,12 @@ impl SafeModeSummary {
         s
     }
 
-    /// What the layer knew to be outside: the tumble, or the target with its fixture
+    /// What left the envelope: the tumble known, or the target with its true fixture
     /// elsewhere than declared.
     fn what_left(&self) -> String {
         match (self.fixture_m, self.declared_fixture_m) {
             (Some(p), Some(d)) => format!(
-                "the target known, its grasping fixture at [{:.3}, {:.3}, {:.3}] m in F_T instead of the declared [{:.3}, {:.3}, {:.3}],",
+                "the target, its grasping fixture at [{:.3}, {:.3}, {:.3}] m in F_T instead of the declared [{:.3}, {:.3}, {:.3}],",
                 p[0], p[1], p[2], d[0], d[1], d[2]
             ),
             _ => "the tumble known".into(),
@@ -156,6 +155,11 @@ impl SafeModeSummary {
 
 /// `rule` when the watch's worst case left the envelope while the true tumble did not.
 const ESTIMATE_ONLY: &str = "estimate_only";
+
+/// The true grasping fixture [m, F_T] of a record.
+fn true_fixture(r: &StepRecord) -> [f64; 3] {
+    fixture_in_target_frame(&r.obs.q_rt, &r.obs.grasp_r)
+}
 
 /// The true ω_T [rad/s, F_T] of a record.
 fn true_rate(r: &StepRecord) -> [f64; 3] {

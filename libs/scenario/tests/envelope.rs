@@ -247,3 +247,57 @@ fn the_start_keeps_the_watchs_margin() {
     s.target.initial_omega_rad_s = [0.0; 3];
     assert!(s.validate().is_ok());
 }
+
+/// A fixture anywhere in a ball (`FixtureBall`): every quantity of the envelope the fixture
+/// enters is at least as bad for the ball as for any point in it — the lever at least as
+/// long, the shortest line of sight and the contract's least `σ` no larger — about a
+/// principal axis and off the principal axes; and a ball of radius 0 is the point itself.
+#[test]
+fn a_fixture_ball_is_never_better_than_a_fixture_in_it() {
+    let s = default();
+    let centre = s.target.grasp_point_m;
+    let ball = |radius_m| sc_scenario::FixtureBall {
+        point_m: centre,
+        radius_m,
+    };
+    let r = 1.0 / 3f64.sqrt();
+    let dirs = [
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+        [r, r, r],
+        [-r, r, -r],
+        [r, -r, -r],
+    ];
+    for omega in [[-0.08, 0.0, 0.0], [-0.05, 0.02, 0.01]] {
+        let point = s.line_of_sight_envelope_at(&omega, &ball(0.0));
+        assert_eq!(point, s.line_of_sight_envelope_for(&omega), "{omega:?}");
+        for radius in [0.005, 0.05, 0.2] {
+            let env = s.line_of_sight_envelope_at(&omega, &ball(radius));
+            assert!(
+                env.lever_m >= point.lever_m + radius - 1e-12,
+                "{omega:?} {radius}"
+            );
+            for d in dirs {
+                for k in [0.5, 1.0] {
+                    let p: [f64; 3] = std::array::from_fn(|i| centre[i] + k * radius * d[i]);
+                    let inner = sc_scenario::FixtureBall {
+                        point_m: p,
+                        radius_m: 0.0,
+                    };
+                    let at = s.line_of_sight_envelope_at(&omega, &inner);
+                    let what = format!("{omega:?} radius {radius} point {p:?}");
+                    assert!(env.lever_m >= at.lever_m - 1e-12, "{what}");
+                    assert!(env.los_min_m <= at.los_min_m + 1e-12, "{what}");
+                    assert!(
+                        env.contract_sigma_min <= at.contract_sigma_min + 1e-12,
+                        "{what}"
+                    );
+                }
+            }
+        }
+    }
+}

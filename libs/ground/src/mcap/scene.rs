@@ -107,7 +107,8 @@ pub struct SceneGeometry {
     /// Line of sight: apex at the servicer's centre of mass, axis the boresight d_B
     /// (F_B), half angle β_ATT (`safety.attitude`).
     pub line_of_sight: Cone,
-    /// Grasping point in F_T [m] (`target.grasp_point_m`).
+    /// Grasping point in F_T [m] (`target.grasp_point_m`, or where `[world] grasp_point_m`
+    /// puts the true one).
     pub grasp_t: [f64; 3],
     /// Capture tolerance: the radius of the grasping point's sphere [m].
     pub capture_tolerance_m: f64,
@@ -138,7 +139,12 @@ impl SceneGeometry {
                 half_angle_rad: s.safety.attitude.los_half_angle_deg.to_radians(),
                 length_m: range,
             },
-            grasp_t: s.target.grasp_point_m,
+            // the true fixture: the world's where it differs from the declared one
+            grasp_t: s
+                .world
+                .as_ref()
+                .and_then(|w| w.grasp_point_m)
+                .unwrap_or(s.target.grasp_point_m),
             capture_tolerance_m: s.mission.capture_tolerance_m,
         }
     }
