@@ -166,6 +166,17 @@ fn a_world_fixture_is_named_and_checked() {
         );
         assert!(out.contains(&note), "{}", text(&o));
     }
+    // with the rate changed too, the fixture is judged at the changed rate as well
+    let world = "[world]\ngrasp_point_m = [-0.55, 0.4, 0.0]\n\n[world.target_spin_change]\nt_s = 100.0\nomega_rad_s = [-0.12, 0.0, 0.0]\n\n[mission]";
+    let s = shipped_with(&d, "scenario.toml", "[mission]", world);
+    let o = check(&[s.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("inside the certified envelope; with the rate changed at t = 100 s: outside the certified envelope (line_of_sight_rate)"),
+        "{}",
+        text(&o)
+    );
     let world = "[world]\ngrasp_point_m = [-0.55, nan, 0.0]\n\n[mission]";
     let s = shipped_with(&d, "scenario.toml", "[mission]", world);
     let o = check(&[s.to_str().unwrap()]);

@@ -214,11 +214,17 @@ impl EnvelopeWatch {
     }
 }
 
+/// How far from unit length a quaternion may be for [`fixture_in_target_frame`] to trust
+/// it [-] (the navigation gate admits 1e-9; anything beyond is a corrupted observation).
+pub const ROTATION_UNIT_TOLERANCE: f64 = 1e-6;
+
 /// The grasping point in F_T [m] from `ρ_G = M(q_RT) p_G` in F_R (an observation's
 /// `grasp_r`, built with the matrix of its `q_RT` as it is, unit or not): `M⁻¹ ρ_G`;
-/// non-finite when either is or `M` has no inverse.
+/// non-finite when either is, or `q_RT` is not within [`ROTATION_UNIT_TOLERANCE`] of unit
+/// length (nothing is known of the fixture then).
 pub fn fixture_in_target_frame(q_rt: &quat::Quat, grasp_r: &Vector3<f64>) -> [f64; 3] {
-    match quat::to_matrix(q_rt).try_inverse() {
+    let unit = (quat::norm(q_rt) - 1.0).abs() <= ROTATION_UNIT_TOLERANCE;
+    match quat::to_matrix(q_rt).try_inverse().filter(|_| unit) {
         Some(m) => {
             let p = m * grasp_r;
             [p.x, p.y, p.z]
@@ -361,8 +367,10 @@ mod tests {
     }
 
     /// The fixture comes back in F_T from an observation's `q_RT` and `ρ_G = M(q_RT) p_G`:
-    /// a quarter turn about z (so a transposed rotation would be caught), a general turn,
-    /// and a quaternion 1e-9 off unit length as the navigation gate admits it.
+    /// a quarter turn about z (applying `M` instead of its inverse, or the other
+    /// convention, is caught), a general turn, and a quaternion 1e-9 off unit length as
+    /// the navigation gate admits it (where `Mᵀ` would be nanometres off); a singular or
+    /// non-finite one gives a non-finite fixture.
     #[test]
     fn the_fixture_is_recovered_in_the_target_frame() {
         let p = Vector3::new(-0.55, 0.35, 0.1);
@@ -388,6 +396,11 @@ mod tests {
         );
         let nan = fixture_in_target_frame(&q, &Vector3::new(f64::NAN, 0.0, 0.0));
         assert!(nan.iter().any(|x| x.is_nan()));
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        for bad in [[0.0, h, 0.0, 0.0], [f64::NAN; 4]] {
+            let p = fixture_in_target_frame(&bad, &Vector3::y());
+            assert!(p.iter().any(|x| !x.is_finite()), "{bad:?} {p:?}");
+        }
     }
 
     /// Unit directions for the fixture tests: the axes, diagonals and no offset at all.
@@ -427,7 +440,7 @@ mod tests {
         let declared = s.target.grasp_point_m;
         let dirs = fixture_directions();
         let (mut outside, mut fired) = (0, 0);
-        // about the declared axis, and off the principal axes (amplification κ, lever ‖p_G‖)
+        // about the declared axis, and off it (judged off the principal axes: κ, ‖p_G‖)
         let tumbles = [0.0, 0.04, 0.06, 0.08, 0.1, 0.12]
             .map(|spin| [-spin, 0.0, 0.0])
             .into_iter()

@@ -1,8 +1,7 @@
 //! What a run's summary says about the certified envelope during the run: when the safety
 //! layer went to safe mode (the filters' [`faults::SAFE_MODE`] flags, decided on
 //! knowledge), what the true tumble (with the true grasping fixture) broke then, whether
-//! the line of sight was still
-//! certifiable at that range — and when the true tumble left the envelope while the layer
+//! the line of sight was still certifiable at that range — and when the true tumble left the envelope while the layer
 //! did not say so (docs/SAFETY.md, "Safe mode").
 
 use crate::record::StepRecord;
@@ -123,12 +122,12 @@ impl SafeModeSummary {
         s
     }
 
-    /// What left the envelope: the tumble known, or the target with its true fixture
-    /// elsewhere than declared.
+    /// What the layer knew to leave the envelope: the tumble, or the target whose true
+    /// fixture is elsewhere than declared.
     fn what_left(&self) -> String {
         match (self.fixture_m, self.declared_fixture_m) {
             (Some(p), Some(d)) => format!(
-                "the target, its grasping fixture at [{:.3}, {:.3}, {:.3}] m in F_T instead of the declared [{:.3}, {:.3}, {:.3}],",
+                "the target known — its true grasping fixture at [{:.3}, {:.3}, {:.3}] m in F_T instead of the declared [{:.3}, {:.3}, {:.3}] —",
                 p[0], p[1], p[2], d[0], d[1], d[2]
             ),
             _ => "the tumble known".into(),

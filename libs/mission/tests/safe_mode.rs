@@ -154,7 +154,7 @@ fn a_fixture_farther_out_than_declared_puts_the_layer_in_safe_mode_at_once() {
         assert!(records.iter().all(|r| in_safe_mode(r) == [true; 3]));
         assert!(
             s.verdict()
-                .contains("its grasping fixture at [-0.550, 0.600, 0.000] m")
+                .contains("its true grasping fixture at [-0.550, 0.600, 0.000] m")
         );
         let los = "line_of_sight".to_string();
         assert!(!s.violated_constraints.contains(&los), "{}", s.verdict());

@@ -89,7 +89,7 @@ fn a_run_that_entered_the_safe_mode_does_not_pass() {
     s.safe_mode = Some(m.clone());
     assert!(
         s.verdict().contains(
-            "the target, its grasping fixture at [-0.550, 0.600, 0.000] m in F_T instead of the declared [-0.550, 0.350, 0.000]"
+            "the target known — its true grasping fixture at [-0.550, 0.600, 0.000] m in F_T instead of the declared [-0.550, 0.350, 0.000] —"
         ),
         "{}",
         s.verdict()
