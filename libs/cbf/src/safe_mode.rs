@@ -146,6 +146,7 @@ impl EnvelopeWatch {
     /// `‖ω̂‖ + ē ≥ ‖ω‖`, never less restrictive than a principal one: its worst case is
     /// never below this one, so a true tumble outside is seen by the watch too (the
     /// summary's check for a silent exit).
+    ///
     /// The fixture `fixture_t` [m, F_T] likewise ([`Self::true_fixture`]): beyond the
     /// premise the estimate lies more than `ē_G` from the declared fixture, and the watch
     /// then takes every fixture within `ē_G` of it, which holds the truth.

@@ -1,8 +1,9 @@
 //! What a run's summary says about the certified envelope during the run: when the safety
 //! layer went to safe mode (the filters' [`faults::SAFE_MODE`] flags, decided on
 //! knowledge), what the true tumble (with the true grasping fixture) broke then, whether
-//! the line of sight was still certifiable at that range — and when the true tumble left the envelope while the layer
-//! did not say so (docs/SAFETY.md, "Safe mode").
+//! the line of sight was still certifiable at that range — and when the true tumble (or
+//! fixture) left the envelope while the layer did not say so (docs/SAFETY.md, "Safe
+//! mode").
 
 use crate::record::StepRecord;
 use sc_cbf::faults;
