@@ -96,7 +96,7 @@ fn check_file(path: &Path, kind: Option<Kind>, mc_scenario: &Path) -> Result<Str
                 s.mission.control_period_s,
                 env.spin_rad_s,
                 (env.max_spin_rad_s() - s.watch_margin_rad_s()).max(0.0),
-                uncertified_note(s, robot) + &world_note(s)
+                uncertified_note(s, robot) + &world_note(s, robot)
             ))
         }
         Kind::Partition => {
@@ -156,8 +156,32 @@ fn uncertified_note(s: &Scenario, robot: &sc_multibody::Robot) -> String {
 
 /// What the scenario's `[world]` does to the certified envelope (the filters never read
 /// it; the run then tests the safe mode, docs/SAFETY.md "Safe mode"); empty without one.
-fn world_note(s: &Scenario) -> String {
-    spin_change_note(s) + &fixture_note(s)
+fn world_note(s: &Scenario, robot: &sc_multibody::Robot) -> String {
+    spin_change_note(s) + &fixture_note(s) + &fixture_reach_note(s, robot)
+}
+
+/// When the world's fixture stands off a keep-out sphere by less than the gripper's spheres
+/// stick out beyond the grasping point (the rule the start applies to the declared one):
+/// the arm–target barriers then keep the gripper off it, so the run cannot capture; empty
+/// otherwise.
+fn fixture_reach_note(s: &Scenario, robot: &sc_multibody::Robot) -> String {
+    let Some(p) = s.world.as_ref().and_then(|w| w.grasp_point_m) else {
+        return String::new();
+    };
+    let overhang = sc_cbf::arm_target::gripper_overhang(robot);
+    let distance = |c: &[f64; 3]| (0..3).map(|i| (p[i] - c[i]).powi(2)).sum::<f64>().sqrt();
+    let standoff = s
+        .target
+        .collision_spheres
+        .iter()
+        .map(|sp| distance(&sp.center_m) - sp.radius_m)
+        .fold(f64::INFINITY, f64::min);
+    if standoff >= overhang {
+        return String::new();
+    }
+    format!(
+        "; NOTE: the world's fixture stands {standoff:.3} m off the target's keep-out spheres, the gripper's spheres stick out {overhang:.3} m beyond the grasping point: the arm–target barriers keep the gripper off it, so the run cannot capture"
+    )
 }
 
 /// What the world's fixture (`[world] grasp_point_m`) does to the envelope, as the

@@ -177,6 +177,17 @@ fn a_world_fixture_is_named_and_checked() {
         "{}",
         text(&o)
     );
+    // a fixture the gripper cannot close on without touching the body: no capture
+    let world = "[world]\ngrasp_point_m = [-0.47, 0.0, 0.0]\n\n[mission]";
+    let s = shipped_with(&d, "scenario.toml", "[mission]", world);
+    let o = check(&[s.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("NOTE: the world's fixture stands 0.020 m off the target's keep-out spheres, the gripper's spheres stick out 0.040 m beyond the grasping point: the arm–target barriers keep the gripper off it, so the run cannot capture"),
+        "{}",
+        text(&o)
+    );
     let world = "[world]\ngrasp_point_m = [-0.55, nan, 0.0]\n\n[mission]";
     let s = shipped_with(&d, "scenario.toml", "[mission]", world);
     let o = check(&[s.to_str().unwrap()]);
