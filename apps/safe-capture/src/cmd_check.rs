@@ -169,12 +169,11 @@ fn fixture_reach_note(s: &Scenario, robot: &sc_multibody::Robot) -> String {
         return String::new();
     };
     let overhang = sc_cbf::arm_target::gripper_overhang(robot);
-    let distance = |c: &[f64; 3]| (0..3).map(|i| (p[i] - c[i]).powi(2)).sum::<f64>().sqrt();
     let standoff = s
         .target
         .collision_spheres
         .iter()
-        .map(|sp| distance(&sp.center_m) - sp.radius_m)
+        .map(|sp| sp.standoff_m(&p))
         .fold(f64::INFINITY, f64::min);
     if standoff >= overhang {
         return String::new();

@@ -224,9 +224,8 @@ fn check_target_geometry(s: &Scenario, robot: &Robot) -> Result<(), SetupError> 
         TargetBody, base_clearance_from_caz, base_com_offset_bound, gripper_overhang,
     };
     let overhang = gripper_overhang(robot);
-    let g = nalgebra::Vector3::from(s.target.grasp_point_m);
     for (k, sp) in s.target.collision_spheres.iter().enumerate() {
-        let standoff = (g - nalgebra::Vector3::from(sp.center_m)).norm() - sp.radius_m;
+        let standoff = sp.standoff_m(&s.target.grasp_point_m);
         if standoff < overhang {
             return Err(SetupError::Inconsistent {
                 key: format!("target.collision_spheres[{k}]"),

@@ -10,18 +10,11 @@ use sc_cbf::faults;
 use sc_mission::{SafeModeSummary, StepRecord, summarize};
 use sc_scenario::{SpinChange, World};
 
-/// The default mission with the target's rate set to `omega` [rad/s, F_T] at `t_s`
-/// (under the `realistic` profile if `realistic`): the summary (with its safe mode) and
-/// the records.
-fn changed(t_s: f64, omega: [f64; 3], realistic: bool) -> (sc_mission::Summary, Vec<StepRecord>) {
+/// The default mission with `world` (under the `realistic` profile if `realistic`): the
+/// summary (with its safe mode) and the records.
+fn in_world(world: World, realistic: bool) -> (sc_mission::Summary, Vec<StepRecord>) {
     let mut setup = common::default_setup();
-    setup.scenario.world = Some(World {
-        target_spin_change: Some(SpinChange {
-            t_s,
-            omega_rad_s: omega,
-        }),
-        ..World::default()
-    });
+    setup.scenario.world = Some(world);
     if realistic {
         let spec =
             sc_scenario::UncertaintySpec::profile(sc_scenario::uncertainty::REALISTIC_NAME, 3);
@@ -32,6 +25,19 @@ fn changed(t_s: f64, omega: [f64; 3], realistic: bool) -> (sc_mission::Summary, 
     let mut summary = summarize(&records, &end, &phases, true);
     summary.safe_mode = SafeModeSummary::of(&records, &scenario);
     (summary, records)
+}
+
+/// The default mission with the target's rate set to `omega` [rad/s, F_T] at `t_s`.
+fn changed(t_s: f64, omega: [f64; 3], realistic: bool) -> (sc_mission::Summary, Vec<StepRecord>) {
+    let change = SpinChange {
+        t_s,
+        omega_rad_s: omega,
+    };
+    let world = World {
+        target_spin_change: Some(change),
+        ..World::default()
+    };
+    in_world(world, realistic)
 }
 
 /// [`changed`] about the declared spin axis to `rate`, exact navigation.
@@ -116,23 +122,13 @@ fn under_realistic_navigation_the_watch_is_neither_late_nor_jumpy() {
 }
 
 /// The default mission with the world's grasping fixture at `fixture` [m, F_T] instead of
-/// the declared one (under the `realistic` profile if `realistic`).
+/// the declared one.
 fn fixture_at(fixture: [f64; 3], realistic: bool) -> (sc_mission::Summary, Vec<StepRecord>) {
-    let mut setup = common::default_setup();
-    setup.scenario.world = Some(World {
+    let world = World {
         grasp_point_m: Some(fixture),
         ..World::default()
-    });
-    if realistic {
-        let spec =
-            sc_scenario::UncertaintySpec::profile(sc_scenario::uncertainty::REALISTIC_NAME, 3);
-        setup.scenario.set_uncertainty(spec).unwrap();
-    }
-    let scenario = setup.scenario.clone();
-    let (_, records, end, phases) = common::run_mission(setup);
-    let mut summary = summarize(&records, &end, &phases, true);
-    summary.safe_mode = SafeModeSummary::of(&records, &scenario);
-    (summary, records)
+    };
+    in_world(world, realistic)
 }
 
 /// A target whose fixture is 0.25 m farther off the spin axis than declared (0.6 m: at the

@@ -130,6 +130,18 @@ pub struct TargetSphere {
     pub radius_m: f64,
 }
 
+impl TargetSphere {
+    /// How far the point `p` [m, F_T] stands off the sphere's surface [m] (negative
+    /// inside): the grasping fixture's standoff from the body.
+    pub fn standoff_m(&self, p: &V3) -> f64 {
+        let d: f64 = (0..3)
+            .map(|i| (p[i] - self.center_m[i]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        d - self.radius_m
+    }
+}
+
 /// Timing and phases of the mission.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -392,11 +392,9 @@ impl Scenario {
                     format!("must lie within {MAX_TARGET_EXTENT_M} m of the target's CoM"),
                 ));
             }
-            let d: f64 = (0..3)
-                .map(|i| (t.grasp_point_m[i] - sp.center_m[i]).powi(2))
-                .sum::<f64>()
-                .sqrt();
-            if d <= sp.radius_m {
+            let standoff = sp.standoff_m(&t.grasp_point_m);
+            if standoff <= 0.0 {
+                let d = standoff + sp.radius_m;
                 return Err(invalid(
                     &format!("target.collision_spheres[{k}]"),
                     format!("centre {:?}, radius {} m", sp.center_m, sp.radius_m),
