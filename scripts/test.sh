@@ -19,6 +19,8 @@ mkdir -p tests/reference
 scripts/.venv/bin/python scripts/pinocchio_reference.py
 # the partition's Python partner controller and the interop tests find the venv here
 export SC_PYTHON="$PWD/scripts/.venv/bin/python"
+# the disk the build writes to: a full one kills the linker (SIGBUS), say how much there was
+echo "test.sh: $(df -h --output=avail . | tail -1 | tr -d ' ') free on the disk of $PWD before cargo test"
 started=$(date +%s)
 status=0
 cargo test --workspace --no-fail-fast "$@" || status=$?
