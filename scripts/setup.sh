@@ -11,15 +11,19 @@
 #   scripts/setup.sh --with-slurm      also Slurm and munge from Debian's packages
 #                                      (slurm-wlm, munge; as root): the test against a
 #                                      running single-node Slurm (scripts/slurm/local_cluster.sh)
+#   scripts/setup.sh --with-netns      also iproute2 and util-linux (ip, unshare, nsenter; as
+#                                      root): two hosts on this machine (scripts/two_hosts.sh)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 WITH_BASILISK=0
 WITH_SLURM=0
+WITH_NETNS=0
 for arg in "$@"; do
   case "$arg" in
     --with-basilisk) WITH_BASILISK=1 ;;
     --with-slurm) WITH_SLURM=1 ;;
-    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+    --with-netns) WITH_NETNS=1 ;;
+    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
     *) echo "setup: unknown option $arg (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -45,6 +49,16 @@ if [ "$WITH_SLURM" = 1 ] && ! { command -v slurmctld && command -v slurmd && com
     DEBIAN_FRONTEND=noninteractive apt-get install -y -qq slurm-wlm munge >/dev/null
   else
     echo "setup: --with-slurm needs Debian's slurm-wlm and munge: sudo apt-get install slurm-wlm munge" >&2
+    exit 1
+  fi
+fi
+if [ "$WITH_NETNS" = 1 ] && ! { command -v ip && command -v unshare && command -v nsenter; } >/dev/null; then
+  if command -v apt-get >/dev/null && [ "$(id -u)" = 0 ]; then
+    echo "setup: installing iproute2 and util-linux (two hosts on one machine)"
+    apt-get update -qq >/dev/null
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq iproute2 util-linux >/dev/null
+  else
+    echo "setup: --with-netns needs root with Debian's iproute2 and util-linux" >&2
     exit 1
   fi
 fi

@@ -6,10 +6,11 @@ cd "$(dirname "$0")/.."
 # Basilisk too: the closed-loop cross-check (apps/safe-capture/tests/basilisk.rs) must run
 # Slurm and munge from Debian's packages: the test against a running single-node Slurm
 # (apps/safe-capture/tests/slurm.rs) starts and stops its own cluster
-# (as root with apt, as in CI; elsewhere that test says why it is skipped)
+# (as root with apt, as in CI; elsewhere that test says why it is skipped);
+# as root, two network namespaces for the partition across hosts (apps/link/tests/across_hosts.rs)
 if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
-  scripts/setup.sh --with-basilisk --with-slurm
-  export SC_REQUIRE_SLURM=1
+  scripts/setup.sh --with-basilisk --with-slurm --with-netns
+  export SC_REQUIRE_SLURM=1 SC_REQUIRE_NETNS=1
 else
   scripts/setup.sh --with-basilisk
   echo "test.sh: not root with apt: the test against a running Slurm is skipped"

@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 
 /// Command-line usage of `sc-hop-cost`.
 pub const USAGE: &str = "usage: sc-hop-cost [--n N] [--period-us P] [--cpus A,B] [--fifo PRIO] \
-[--cpu-wakeup-latency-us L] [--touch-kib K] [--prewarm-us W]";
+[--cpu-wakeup-latency-us L] [--touch-kib K] [--prewarm-us W] [--remote-echo RUN_ID]";
 
 /// The longest a round trip may take before the measurement fails.
 const ECHO_TIMEOUT: Duration = Duration::from_secs(2);
@@ -43,6 +43,10 @@ pub struct HopCostOptions {
     pub prewarm: Duration,
     /// This process is the echo (set on the child the sender starts).
     pub echo: bool,
+    /// The echo runs elsewhere — another host, across the link (`sc-link`) — in this
+    /// run, started there as `SC_RUN_ID=<id> sc-hop-cost --echo`: the sender joins the
+    /// run and starts no echo of its own.
+    pub remote_echo: Option<String>,
 }
 
 impl Default for HopCostOptions {
@@ -56,6 +60,7 @@ impl Default for HopCostOptions {
             touch_kib: 0,
             prewarm: Duration::ZERO,
             echo: false,
+            remote_echo: None,
         }
     }
 }
@@ -87,6 +92,7 @@ impl HopCostOptions {
                     o.cpus = Some((num(a)? as usize, num(b)? as usize));
                 }
                 "--echo" => o.echo = true,
+                "--remote-echo" => o.remote_echo = Some(val()?.clone()),
                 other => return Err(usage(format!("unknown argument {other} ({USAGE})"))),
             }
         }
@@ -202,7 +208,10 @@ pub fn measure(
         .map(CpuWakeupLatency::request)
         .transpose()
         .map_err(|e| BenchError::Data(format!("PM QoS ({}): {e}", crate::pm_qos::DEVICE)))?;
-    let scope = RunScope::unique("hopcost")?;
+    let scope = match &o.remote_echo {
+        Some(run_id) => RunScope::new(run_id)?,
+        None => RunScope::unique("hopcost")?,
+    };
     let mut rt = Vec::with_capacity(o.n);
     {
         let node = scope.node("sender")?;
@@ -210,12 +219,19 @@ pub fn measure(
         let ping = Publisher::<Tick>::with_name(&node, "hop/ping", &q)?;
         let pong = Subscriber::<Tick>::with_name(&node, "hop/pong", &q)?;
         let coord = Coordinator::new(&node, services::HANDSHAKE, &[1])?;
-        let mut child = std::process::Command::new(exe)
-            .args(args)
-            .arg("--echo")
-            .env(sc_bus::RUN_ID_ENV, scope.run_id())
-            .spawn()
-            .map_err(|e| BenchError::Data(format!("cannot start {}: {e}", exe.display())))?;
+        let mut child = match o.remote_echo {
+            Some(_) => None,
+            None => Some(
+                std::process::Command::new(exe)
+                    .args(args)
+                    .arg("--echo")
+                    .env(sc_bus::RUN_ID_ENV, scope.run_id())
+                    .spawn()
+                    .map_err(|e| {
+                        BenchError::Data(format!("cannot start {}: {e}", exe.display()))
+                    })?,
+            ),
+        };
         coord.wait_all(Duration::from_secs(20))?;
         let waiter = Waiter::new()?;
         let _a = waiter.attach(&pong)?;
@@ -236,11 +252,16 @@ pub fn measure(
             tick: STOP_TICK,
             ..Default::default()
         })?;
-        child
-            .wait()
-            .map_err(|e| BenchError::Data(format!("the echo process: {e}")))?;
+        if let Some(child) = child.as_mut() {
+            child
+                .wait()
+                .map_err(|e| BenchError::Data(format!("the echo process: {e}")))?;
+        }
     }
-    scope.teardown()?;
+    // a run of our own is ours to remove; across hosts the link's node still lives in it
+    if o.remote_echo.is_none() {
+        scope.teardown()?;
+    }
     rt.sort_by(f64::total_cmp);
     let p = |q: f64| rt[((rt.len() - 1) as f64 * q).round() as usize];
     Ok(RoundTrips {
@@ -274,7 +295,16 @@ mod tests {
         assert_eq!(o.prewarm, Duration::from_micros(500));
         assert!(!o.echo);
         assert!(HopCostOptions::parse(&a("--echo")).unwrap().echo);
-        for bad in ["--n 0", "--cpus 1", "--period-us x", "--bogus", "--n"] {
+        let remote = HopCostOptions::parse(&a("--remote-echo run7")).unwrap();
+        assert_eq!(remote.remote_echo.as_deref(), Some("run7"));
+        for bad in [
+            "--n 0",
+            "--cpus 1",
+            "--period-us x",
+            "--bogus",
+            "--n",
+            "--remote-echo",
+        ] {
             assert!(HopCostOptions::parse(&a(bad)).is_err(), "{bad}");
         }
     }
