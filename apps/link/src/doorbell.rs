@@ -20,8 +20,10 @@ use iceoryx2::node::Node;
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::prelude::*;
 use iceoryx2::service::messaging_pattern::MessagingPattern;
+use iceoryx2::service::service_hash::ServiceHash;
+use iceoryx2::service::static_config::messaging_pattern::MessagingPattern as StaticPattern;
 use iceoryx2_link_backend::wire::publish_subscribe::{Header, Payload, Subscriber};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// One pub/sub service's doorbell: a subscriber that sees what the link published,
 /// a notifier on the service's event.
@@ -34,23 +36,27 @@ struct Doorbell {
 #[derive(Default)]
 pub struct Doorbells {
     by_service: BTreeMap<String, Doorbell>,
+    /// Services whose doorbell could not be opened (said once each, retried).
+    refused: BTreeSet<String>,
 }
 
 impl Doorbells {
-    /// Adds a doorbell for every pub/sub service on this host that `admits` and that has
-    /// an event service of the same name, and has none yet.
+    /// Adds a doorbell for every pub/sub service on this host that the link bridges
+    /// (`bridged`, by service hash) and that has an event service of the same name, and
+    /// has none yet.
     pub fn discover(
         &mut self,
         node: &Node<ipc::Service>,
-        admits: &dyn Fn(&ServiceName) -> bool,
+        bridged: &dyn Fn(&ServiceHash) -> bool,
     ) -> Result<()> {
         let mut found = Vec::new();
         ipc::Service::list(node.config(), |s| {
             let config = &s.static_details;
-            if matches!(
+            let pubsub = matches!(
                 config.messaging_pattern(),
-                iceoryx2::service::static_config::messaging_pattern::MessagingPattern::PublishSubscribe(_)
-            ) {
+                StaticPattern::PublishSubscribe(_)
+            );
+            if pubsub && bridged(config.service_hash()) {
                 found.push(*config.name());
             }
             CallbackProgression::Continue
@@ -59,14 +65,19 @@ impl Doorbells {
         .context("listing this host's services")?;
         for name in found {
             let key = name.as_str().to_string();
-            if self.by_service.contains_key(&key) || !admits(&name) || !has_event(node, &name) {
+            if self.by_service.contains_key(&key) || !has_event(node, &name) {
                 continue;
             }
             match Doorbell::open(node, &name) {
                 Ok(d) => {
+                    self.refused.remove(&key);
                     self.by_service.insert(key, d);
                 }
-                Err(e) => eprintln!("sc-link: no doorbell on {name}: {e:#}"),
+                Err(e) => {
+                    if self.refused.insert(key) {
+                        eprintln!("sc-link: no doorbell on {name} (yet): {e:#}");
+                    }
+                }
             }
         }
         Ok(())
@@ -79,8 +90,10 @@ impl Doorbells {
             if d.drain(link)
                 .with_context(|| format!("doorbell of {name}"))?
             {
+                // not to the link's own listener on this event: that would send the ring
+                // back to the other host (as the link's own ports skip themselves)
                 d.notifier
-                    .notify()
+                    .__internal_notify(EventId::new(sc_bus::pubsub::EVENT_SAMPLE), true)
                     .map_err(|e| anyhow!("{e:?}"))
                     .with_context(|| format!("ringing {name}"))?;
                 rung += 1;

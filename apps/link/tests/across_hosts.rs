@@ -18,10 +18,17 @@ fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
-/// target/<profile>/: this test's binary is in target/<profile>/deps.
-fn bin(name: &str) -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    exe.parent().unwrap().parent().unwrap().join(name)
+/// `sc-hop-cost`, of package `safe-capture`: built by `cargo test --workspace`
+/// (scripts/test.sh), not by `cargo test -p sc-link` alone.
+fn hop_cost() -> PathBuf {
+    let link = PathBuf::from(env!("CARGO_BIN_EXE_sc-link"));
+    let hop = link.with_file_name("sc-hop-cost");
+    assert!(
+        hop.exists(),
+        "{} is missing: build it (cargo build -p safe-capture --bin sc-hop-cost, same profile) or run cargo test --workspace",
+        hop.display()
+    );
+    hop
 }
 
 fn have(tool: &str) -> bool {
@@ -100,8 +107,8 @@ fn samples_and_their_wake_ups_cross_between_two_hosts() {
     let name = format!("l{:x}", id % 0xfffffff);
     let run_id = format!("across-{id}");
     let mut hosts = TwoHosts::up(&name);
-    let link = bin("sc-link");
-    let hop = bin("sc-hop-cost");
+    let link = PathBuf::from(env!("CARGO_BIN_EXE_sc-link"));
+    let hop = hop_cost();
 
     let mut b = hosts.on("b", &link);
     b.args(["--run-id", &run_id, "--listen", ENDPOINT_B]);
