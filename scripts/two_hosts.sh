@@ -20,7 +20,7 @@ usage() { sed -n '8,10p' "$0" >&2; exit 2; }
 [ $# -ge 2 ] || usage
 cmd=$1 name=$2
 shift 2
-case "$name" in *[!A-Za-z0-9-]* | "") echo "two_hosts: NAME is [A-Za-z0-9-]+" >&2; exit 2 ;; esac
+case "$name" in -* | *[!A-Za-z0-9-]* | "") echo "two_hosts: NAME is [A-Za-z0-9][A-Za-z0-9-]*" >&2; exit 2 ;; esac
 [ ${#name} -le 8 ] || { echo "two_hosts: NAME is at most 8 characters (interface names)" >&2; exit 2; }
 
 # a private mount point for the namespaces' handles (nsfs bind mounts need one)
@@ -45,17 +45,18 @@ host_up() { # host side address
     'mount -t tmpfs -o size=2g sc-shm /dev/shm && mkdir -p /tmp/iceoryx2 && mount -t tmpfs sc-iceoryx2 /tmp/iceoryx2'
 }
 
+# every step is tried, a failed one is said and makes `down` fail at the end
 host_down() {
   local host=$1
   if [ -e "/run/netns/$host" ]; then
     for pid in $(ip netns pids "$host" 2>/dev/null); do kill -TERM "$pid" 2>/dev/null || true; done
     sleep 0.5
     for pid in $(ip netns pids "$host" 2>/dev/null); do kill -KILL "$pid" 2>/dev/null || true; done
-    ip netns del "$host"
+    ip netns del "$host" || { echo "two_hosts: cannot remove netns $host" >&2; failed=1; }
   fi
   if [ -e "$STATE/$host.mnt" ]; then
     umount "$STATE/$host.mnt" 2>/dev/null || true
-    rm -f "$STATE/$host.mnt"
+    rm -f "$STATE/$host.mnt" || { echo "two_hosts: cannot remove $STATE/$host.mnt" >&2; failed=1; }
   fi
 }
 
@@ -75,9 +76,11 @@ case "$cmd" in
     exec nsenter --mount="$STATE/$name-$side.mnt" --net="/run/netns/$name-$side" --wd="$PWD" -- "$@"
     ;;
   down)
+    failed=0
     host_down "$name-a"
     host_down "$name-b"
     ip link del "$name-a" 2>/dev/null || true
+    [ "$failed" = 0 ] || exit 1
     echo "two_hosts: $name is down"
     ;;
   *) usage ;;

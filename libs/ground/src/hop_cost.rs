@@ -195,8 +195,11 @@ fn round_trip(
     }
 }
 
-/// The sender: starts `exe args --echo` as the echo process, measures `o.n` round
-/// trips (after 10 unmeasured ones), stops the echo and removes the run's files.
+/// The sender: starts `exe args --echo` as the echo process (with `--remote-echo`: joins
+/// that run, whose echo was started on the other host), measures `o.n` round trips
+/// (after 10 unmeasured ones), stops the echo and removes the run's files (not with
+/// `--remote-echo`: the link's node still lives in that run; its host's `down` or the
+/// last process of the run removes them).
 pub fn measure(
     o: &HopCostOptions,
     exe: &std::path::Path,
