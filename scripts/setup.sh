@@ -11,7 +11,7 @@
 #   scripts/setup.sh --with-slurm      also Slurm and munge from Debian's packages
 #                                      (slurm-wlm, munge; as root): the test against a
 #                                      running single-node Slurm (scripts/slurm/local_cluster.sh)
-#   scripts/setup.sh --with-netns      also iproute2 and util-linux (ip, unshare, nsenter; as
+#   scripts/setup.sh --with-netns      also iproute2, util-linux, procps (ip, unshare, nsenter, sysctl; as
 #                                      root): two hosts on this machine (scripts/two_hosts.sh)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -52,13 +52,14 @@ if [ "$WITH_SLURM" = 1 ] && ! { command -v slurmctld && command -v slurmd && com
     exit 1
   fi
 fi
-if [ "$WITH_NETNS" = 1 ] && ! { command -v ip && command -v unshare && command -v nsenter; } >/dev/null; then
+if [ "$WITH_NETNS" = 1 ] && ! { command -v ip && command -v unshare && command -v nsenter \
+    && command -v mountpoint && command -v sysctl; } >/dev/null; then
   if command -v apt-get >/dev/null && [ "$(id -u)" = 0 ]; then
-    echo "setup: installing iproute2 and util-linux (two hosts on one machine)"
+    echo "setup: installing iproute2, util-linux and procps (two hosts on one machine)"
     apt-get update -qq >/dev/null
-    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq iproute2 util-linux >/dev/null
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq iproute2 util-linux procps >/dev/null
   else
-    echo "setup: --with-netns needs root with Debian's iproute2 and util-linux" >&2
+    echo "setup: --with-netns needs root with Debian's iproute2, util-linux and procps" >&2
     exit 1
   fi
 fi

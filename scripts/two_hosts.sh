@@ -3,7 +3,7 @@
 # "Across hosts"): each its own network namespace, joined by a veth pair, and its own
 # mount namespace with a private /dev/shm and /tmp/iceoryx2 — so the two iceoryx2
 # systems share no memory and reach each other only through the network, as two
-# computers would. Needs root (ip, unshare, nsenter from iproute2/util-linux).
+# computers would. Needs root (ip, unshare, nsenter, mountpoint, sysctl: iproute2, util-linux, procps).
 #
 #   scripts/two_hosts.sh up NAME             # hosts NAME-a (127.201.0.1) and NAME-b (127.201.0.2)
 #   scripts/two_hosts.sh exec NAME a CMD...  # runs CMD on host a (or b)

@@ -143,6 +143,16 @@ fn a_world_event_is_named_and_checked() {
     );
 }
 
+/// `check` of the shipped scenario with `world` put before `[mission]`: accepted (exit 0);
+/// its output and stdout.
+fn accepted_with_world(d: &Path, world: &str) -> (Output, String) {
+    let s = shipped_with(d, "scenario.toml", "[mission]", world);
+    let o = check(&[s.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    (o, out)
+}
+
 /// The world's fixture elsewhere than declared is named with what the run-time watch will
 /// make of it: outside the envelope at 0.6 m off the spin axis, inside at 0.4 m; a
 /// non-finite one is refused on one line.
@@ -157,10 +167,7 @@ fn a_world_fixture_is_named_and_checked() {
         ("0.4", "inside the certified envelope"),
     ] {
         let world = format!("[world]\ngrasp_point_m = [-0.55, {y}, 0.0]\n\n[mission]");
-        let s = shipped_with(&d, "scenario.toml", "[mission]", &world);
-        let o = check(&[s.to_str().unwrap()]);
-        assert_eq!(o.status.code(), Some(0), "{}", text(&o));
-        let out = String::from_utf8_lossy(&o.stdout);
+        let (o, out) = accepted_with_world(&d, &world);
         let note = format!(
             "NOTE: [world] puts the grasping fixture at [-0.55, {y}, 0.0] m in F_T (declared [-0.55, 0.35, 0.0]), undeclared to the filters: {after}"
         );
@@ -168,10 +175,7 @@ fn a_world_fixture_is_named_and_checked() {
     }
     // with the rate changed too, the fixture is judged at the changed rate as well
     let world = "[world]\ngrasp_point_m = [-0.55, 0.4, 0.0]\n\n[world.target_spin_change]\nt_s = 100.0\nomega_rad_s = [-0.12, 0.0, 0.0]\n\n[mission]";
-    let s = shipped_with(&d, "scenario.toml", "[mission]", world);
-    let o = check(&[s.to_str().unwrap()]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
-    let out = String::from_utf8_lossy(&o.stdout);
+    let (o, out) = accepted_with_world(&d, world);
     assert!(
         out.contains("inside the certified envelope; with the rate changed at t = 100 s: outside the certified envelope (line_of_sight_rate)"),
         "{}",
@@ -179,10 +183,7 @@ fn a_world_fixture_is_named_and_checked() {
     );
     // a fixture the gripper cannot close on without touching the body: no capture
     let world = "[world]\ngrasp_point_m = [-0.47, 0.0, 0.0]\n\n[mission]";
-    let s = shipped_with(&d, "scenario.toml", "[mission]", world);
-    let o = check(&[s.to_str().unwrap()]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
-    let out = String::from_utf8_lossy(&o.stdout);
+    let (o, out) = accepted_with_world(&d, world);
     assert!(
         out.contains("NOTE: the world's fixture stands 0.020 m off the target's keep-out spheres, the gripper's spheres stick out 0.040 m beyond the grasping point: the arm–target barriers keep the gripper off it, so the run cannot capture"),
         "{}",
