@@ -8,99 +8,14 @@
 //! Needs root with `ip`, `unshare` and `nsenter`; without them the test says so and
 //! passes, unless `SC_REQUIRE_NETNS=1` (scripts/test.sh sets it as root), then it fails.
 
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
+mod common;
+use common::*;
+use std::path::PathBuf;
 use std::time::Instant;
-
-const ENDPOINT_B: &str = "tcp/127.201.0.2:7447";
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-/// `sc-hop-cost`, of package `safe-capture`: built by `cargo test --workspace`
-/// (scripts/test.sh), not by `cargo test -p sc-link` alone.
-fn hop_cost() -> PathBuf {
-    let link = PathBuf::from(env!("CARGO_BIN_EXE_sc-link"));
-    let hop = link.with_file_name("sc-hop-cost");
-    assert!(
-        hop.exists(),
-        "{} is missing: build it (cargo build -p safe-capture --bin sc-hop-cost, same profile) or run cargo test --workspace",
-        hop.display()
-    );
-    hop
-}
-
-fn have(tool: &str) -> bool {
-    Command::new("sh")
-        .args(["-c", &format!("command -v {tool}")])
-        .stdout(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success())
-}
-
-/// The two hosts; `down` on drop, whatever happened.
-struct TwoHosts {
-    name: String,
-    children: Vec<Child>,
-}
-
-impl TwoHosts {
-    fn up(name: &str) -> Self {
-        let hosts = Self {
-            name: name.to_string(),
-            children: Vec::new(),
-        };
-        let out = hosts.script(&["up", name]);
-        assert!(out.status.success(), "two_hosts up: {out:?}");
-        hosts
-    }
-
-    fn script(&self, args: &[&str]) -> Output {
-        Command::new(repo().join("scripts/two_hosts.sh"))
-            .args(args)
-            .output()
-            .unwrap()
-    }
-
-    fn on(&self, side: &str, program: &Path) -> Command {
-        let mut c = Command::new(repo().join("scripts/two_hosts.sh"));
-        c.args(["exec", &self.name, side]).arg(program);
-        c
-    }
-
-    fn spawn(&mut self, mut c: Command) {
-        self.children.push(c.spawn().unwrap());
-    }
-}
-
-impl Drop for TwoHosts {
-    fn drop(&mut self) {
-        for c in &mut self.children {
-            let _ = c.kill();
-            let _ = c.wait();
-        }
-        let out = self.script(&["down", &self.name]);
-        if !out.status.success() {
-            eprintln!("two_hosts down: {out:?}");
-        }
-    }
-}
 
 #[test]
 fn samples_and_their_wake_ups_cross_between_two_hosts() {
-    let tools = ["ip", "unshare", "nsenter"].into_iter().all(have);
-    let root = Command::new("id")
-        .arg("-u")
-        .output()
-        .is_ok_and(|o| o.stdout.trim_ascii() == b"0");
-    if !(tools && root) {
-        let why = format!("root {root}, ip/unshare/nsenter {tools}");
-        assert!(
-            std::env::var("SC_REQUIRE_NETNS").as_deref() != Ok("1"),
-            "SC_REQUIRE_NETNS=1 but two hosts cannot be made here ({why})"
-        );
-        eprintln!("skipped: two network namespaces need root and iproute2 ({why})");
+    if !can_make_hosts() {
         return;
     }
     let id = std::process::id();
@@ -108,7 +23,7 @@ fn samples_and_their_wake_ups_cross_between_two_hosts() {
     let run_id = format!("across-{id}");
     let mut hosts = TwoHosts::up(&name);
     let link = PathBuf::from(env!("CARGO_BIN_EXE_sc-link"));
-    let hop = hop_cost();
+    let hop = sibling("sc-hop-cost");
 
     let mut b = hosts.on("b", &link);
     b.args(["--run-id", &run_id, "--listen", ENDPOINT_B]);

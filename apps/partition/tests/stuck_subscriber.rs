@@ -34,7 +34,10 @@ fn a_subscriber_that_never_reads_changes_nothing() {
     let flight: Vec<_> = sc_icd::services::SERVICES
         .iter()
         .filter(|s| s.qos == Qos::Flight && s.message.is_some())
-        .map(|s| sc_flight::runner::ports::open_input(&node, s.name).unwrap())
+        .map(|s| {
+            let qos = sc_flight::process::Qos::one_host();
+            sc_flight::runner::ports::open_input(&node, s.name, &qos).unwrap()
+        })
         .collect();
     assert!(flight.len() >= 8, "{} flight services", flight.len());
     // left before the run ends (the teardown then removes every port of the run)

@@ -67,6 +67,16 @@ pub struct Args {
         default_value_os_t = crate::home::shipped("scripts/python/hostile_nominal.py")
     )]
     partner: PathBuf,
+    /// A run across hosts (the config's `[hosts]`, docs/PARTITION.md "Across hosts"): start
+    /// the roles of this host and its end of the link (default: the home host, which
+    /// runs the scheduler, simulator and recorder and writes the mission's outputs).
+    #[arg(long, value_name = "NAME")]
+    host: Option<String>,
+    /// The run's id (its iceoryx2 prefix). Across hosts every host's launch takes the
+    /// same one: the home host's launch prints the command for the others (default: a
+    /// fresh one; required with --host for a host other than the home host).
+    #[arg(long, value_name = "ID")]
+    run_id: Option<String>,
 }
 
 fn read_json(path: &std::path::Path) -> Option<serde_json::Value> {
@@ -137,6 +147,8 @@ fn options(a: &Args) -> anyhow::Result<(LaunchOptions, Option<(HostilePartners, 
         out: PathBuf::new(),
         clock: a.real_time.then_some(ClockMode::RealTime),
         max_ticks: a.max_ticks,
+        host: a.host.clone(),
+        run_id: a.run_id.clone(),
         ..Default::default()
     };
     let Some(h) = &a.hostile else {
@@ -185,10 +197,87 @@ fn infrastructure_failure(
     ExitCode::from(rep.code.clamp(0, 255) as u8)
 }
 
+/// Across hosts: the host this launch runs and whether it is the home host; the run id
+/// every host's launch shares (a fresh one at home when none was given), and the
+/// command that starts each other host's side, said before anything starts.
+fn across_hosts(
+    a: &Args,
+    cfg: &sc_ground::PartitionConfig,
+    opts: &mut LaunchOptions,
+) -> anyhow::Result<Option<bool>> {
+    let Some(hosts) = &cfg.hosts else {
+        if let Some(h) = &a.host {
+            anyhow::bail!(
+                "--host {h}: {} has no [hosts] (a run on one host)",
+                a.config.display()
+            );
+        }
+        return Ok(None);
+    };
+    let host = a.host.clone().unwrap_or_else(|| hosts.home.clone());
+    if !hosts.link.contains_key(&host) {
+        anyhow::bail!(
+            "--host {host}: not a host of {}'s hosts.link ({})",
+            a.config.display(),
+            hosts.names().join(", ")
+        );
+    }
+    let home = host == hosts.home;
+    if !home {
+        anyhow::ensure!(
+            a.run_id.is_some(),
+            "--host {host} is not the home host {:?}: give the home launch's --run-id (it prints it)",
+            hosts.home
+        );
+        return Ok(Some(false));
+    }
+    let id = match &a.run_id {
+        Some(id) => id.clone(),
+        None => format!("run-{}-{}", std::process::id(), sc_icd::monotonic_ns()),
+    };
+    opts.run_id = Some(id.clone());
+    let config = std::path::absolute(&a.config).unwrap_or_else(|_| a.config.clone());
+    for other in hosts.names().into_iter().filter(|h| *h != host) {
+        outln!(
+            "launch: host {host} of {}; start host {other} with: safe-capture launch --config {} --host {other} --run-id {id}{}",
+            hosts.link.len(),
+            config.display(),
+            if a.real_time { " --real-time" } else { "" }
+        );
+    }
+    Ok(Some(true))
+}
+
+/// The end of a launch away from the home host: its processes and link, no mission result.
+fn away_end(a: &Args, rep: &LaunchReport, staged: Staged) -> anyhow::Result<ExitCode> {
+    let failed: Vec<&str> = rep
+        .exits
+        .iter()
+        .chain(rep.link.as_ref())
+        .filter(|e| !e.ended_well() && !e.killed_by_launcher)
+        .map(|e| e.role.as_str())
+        .collect();
+    if rep.code != 0 {
+        return Ok(infrastructure_failure(a, rep, staged, None));
+    }
+    staged.commit()?;
+    outln!(
+        "partition (host {}): {} processes ended well, failed: [{}]; shm leftovers: {}; wall {:.2} s -> {} (the mission's outputs are the home host's)",
+        rep.host.as_deref().unwrap_or("?"),
+        rep.exits.len(),
+        failed.join(", "),
+        rep.leftovers.len(),
+        rep.wall_s,
+        a.out.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let (mut opts, partners) = options(&a)?;
     // nothing starts unless the scenario and every program are there
     let cfg = configured(&opts)?;
+    let home = across_hosts(&a, &cfg, &mut opts)?.unwrap_or(true);
     preflight(&cfg, &opts.bin_dir).map_err(|e| anyhow::anyhow!("{}: {e}", a.config.display()))?;
     if let Some((p, case)) = &partners {
         crate::redteam_partition::check_case(p, &a.config, case)?;
@@ -199,6 +288,9 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let out = staged.path().to_path_buf();
     opts.out = out.clone();
     let rep = launch(&opts)?;
+    if !home {
+        return away_end(&a, &rep, staged);
+    }
     let scheduler = read_json(&out.join("scheduler.json"));
     if rep.code >= INFRASTRUCTURE_FAILURE {
         return Ok(infrastructure_failure(&a, &rep, staged, scheduler.as_ref()));

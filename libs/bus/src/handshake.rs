@@ -142,12 +142,44 @@ impl Coordinator {
                 return Err(BusError::HandshakeTimeout { timeout, missing });
             }
         }
+        self.send_go()
+    }
+
+    fn send_go(&self) -> Result<()> {
         self.go.notify().map_err(|e| BusError::Event {
             op: "notify",
             service: self.ready_name.replace("/ready", "/go"),
             reason: reason(e),
         })?;
         Ok(())
+    }
+
+    /// After [`wait_all`](Self::wait_all): answers every announcement that still comes
+    /// with another `go`, until none has come for `quiet` (or `limit` passed). A
+    /// participant announces until it hears a `go`, so an announcement after the `go`
+    /// means one that has not heard it yet. On one host no `go` is lost; across hosts
+    /// (iceoryx2's link) an event sent before the other host's end of its bridge is up
+    /// is, and the participants there would wait for ever. Returns how many `go`s it
+    /// sent again.
+    pub fn settle(&self, quiet: Duration, limit: Duration) -> Result<u32> {
+        let end = Instant::now() + limit;
+        let mut resent = 0;
+        loop {
+            let mut heard = false;
+            let wait = quiet.min(end.saturating_duration_since(Instant::now()));
+            self.listener
+                .timed_wait(|_| heard = true, wait)
+                .map_err(|e| BusError::Event {
+                    op: "wait",
+                    service: self.ready_name.clone(),
+                    reason: reason(e),
+                })?;
+            if !heard || Instant::now() >= end {
+                return Ok(resent);
+            }
+            self.send_go()?;
+            resent += 1;
+        }
     }
 }
 

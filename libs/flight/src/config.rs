@@ -5,6 +5,7 @@ use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use crate::hosts::Hosts;
 use sc_core::{PerSubsystem, Subsystem, SubsystemSet};
 use sc_icd::{ROLES, Role};
 
@@ -56,6 +57,9 @@ pub struct RoleExec {
     /// hand-overs are same-core switches. Empty/absent = any CPU.
     #[serde(default)]
     pub cpus: Vec<usize>,
+    /// The host this role runs on, a name of `[hosts]` (absent: the home host).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub host: Option<String>,
 }
 
 /// Per-stage deadlines in real-time mode [ms], every one from the tick (the simulator's
@@ -128,6 +132,9 @@ pub struct PartitionConfig {
     /// The simulator role's options (absent: our own simulator propagates).
     #[serde(default)]
     pub simulator: SimulatorOptions,
+    /// The run across hosts (absent: every role on this host), `crate::hosts`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hosts: Option<Hosts>,
     /// Directory of the config file (set by [`PartitionConfig::load`]).
     #[serde(skip)]
     pub base_dir: PathBuf,
@@ -371,7 +378,28 @@ impl PartitionConfig {
                 return err(format!("roles.{r}.cpus: CPU {c} is out of range (0..1024)"));
             }
         }
-        Ok(())
+        let role_hosts = self
+            .roles
+            .iter()
+            .map(|(r, e)| (r.as_str(), e.host.as_deref()));
+        match &self.hosts {
+            Some(h) => h.validate(role_hosts),
+            None => crate::hosts::check_no_host(role_hosts),
+        }
+    }
+
+    /// The host `role` runs on (`""` in a run on one host).
+    pub fn host_of(&self, role: &str) -> &str {
+        let Some(h) = &self.hosts else { return "" };
+        self.roles
+            .get(role)
+            .and_then(|e| e.host.as_deref())
+            .unwrap_or(&h.home)
+    }
+
+    /// Whether the run crosses hosts (`[hosts]`).
+    pub fn across_hosts(&self) -> bool {
+        self.hosts.is_some()
     }
 
     /// Every role of the table gets an entry; an empty `exec` is the table's executable.

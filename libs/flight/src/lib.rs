@@ -22,6 +22,7 @@ pub mod component;
 pub mod config;
 pub mod convert;
 pub mod error;
+pub mod hosts;
 pub mod process;
 pub mod roles;
 pub mod runner;

@@ -61,6 +61,58 @@ pub fn partner_qos() -> ServiceSettings {
     }
 }
 
+/// Ports the link (`sc-link`, iceoryx2's tunnel) opens on every service it bridges, on
+/// each host: one publisher (what the other host's processes publish arrives through
+/// it) and two subscribers (the tunnel's own and its doorbell's, apps/link).
+pub const LINK_PUBLISHERS: usize = 1;
+/// See [`LINK_PUBLISHERS`].
+pub const LINK_SUBSCRIBERS: usize = 2;
+
+/// The settings a run's processes open the partition's services with: [`qos`] and
+/// [`partner_qos`], and in a run across hosts the same with room for the link's ports.
+/// The link is then a known second publisher of every service; a subscriber still takes
+/// samples only from the first publisher it heard — the owner on its own host, the link
+/// on the other (docs/PARTITION.md, "Across hosts").
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Qos {
+    /// The flight services'.
+    pub flight: ServiceSettings,
+    /// The services a partner's process publishes on.
+    pub partner: ServiceSettings,
+}
+
+impl Qos {
+    /// On one host: [`qos`] and [`partner_qos`].
+    pub fn one_host() -> Self {
+        Self {
+            flight: qos(),
+            partner: partner_qos(),
+        }
+    }
+
+    /// Across hosts: room for the link's ports on every service.
+    pub fn across_hosts() -> Self {
+        let with_link = |s: ServiceSettings| ServiceSettings {
+            max_publishers: s.max_publishers + LINK_PUBLISHERS,
+            max_subscribers: s.max_subscribers + LINK_SUBSCRIBERS,
+            ..s
+        };
+        Self {
+            flight: with_link(qos()),
+            partner: with_link(partner_qos()),
+        }
+    }
+
+    /// The settings of a run with config `cfg`.
+    pub fn of(cfg: &PartitionConfig) -> Self {
+        if cfg.across_hosts() {
+            Self::across_hosts()
+        } else {
+            Self::one_host()
+        }
+    }
+}
+
 impl Proc {
     /// Parses `--config FILE --out DIR` (or the environment), joins the run of
     /// `SC_RUN_ID` and creates the node `role`.

@@ -537,6 +537,8 @@ mod tests {
         LaunchReport {
             run_id: "t".into(),
             exits,
+            host: None,
+            link: None,
             code,
             interrupted: false,
             leftovers: Vec::new(),

@@ -7,6 +7,7 @@ part of the shared-memory names). Whoever creates a service first fixes its sett
 so every process must ask for the same ones.
 """
 
+import os
 import time
 
 import iceoryx2 as iox2
@@ -24,6 +25,17 @@ PARTITION = dict(LOCK_STEP, buffer=16, max_publishers=1, safe_overflow=False)
 # sc_flight::process::partner_qos(): the services a partner's nominal controller
 # publishes on (safe_capture/nominal/*): newest wins, nobody ever waits
 NOMINAL = dict(PARTITION, safe_overflow=True)
+# sc_flight::process::Qos::across_hosts(): in a run across hosts (the launcher sets
+# SC_ACROSS_HOSTS=1, sc_flight::hosts::ACROSS_HOSTS_ENV) every service also carries the
+# link's ports on each host: one publisher (LINK_PUBLISHERS), two subscribers
+# (LINK_SUBSCRIBERS: the tunnel's and its doorbell's)
+LINK_PUBLISHERS = 1
+LINK_SUBSCRIBERS = 2
+if os.environ.get("SC_ACROSS_HOSTS") == "1":
+    PARTITION, NOMINAL = (
+        dict(q, max_publishers=q["max_publishers"] + LINK_PUBLISHERS, max_subscribers=q["max_subscribers"] + LINK_SUBSCRIBERS)
+        for q in (PARTITION, NOMINAL)
+    )
 # event ids up to this on data services (sc_bus::pubsub::EVENT_ID_MAX)
 EVENT_ID_MAX = 7
 # the handshake's event services (sc_bus::handshake)

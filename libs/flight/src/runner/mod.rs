@@ -49,6 +49,7 @@ impl Ports {
         inputs: &[ServiceName],
         outputs: &[ServiceName],
         warmup: bool,
+        qos: &crate::process::Qos,
     ) -> Result<Self, FlightError> {
         let keep =
             |s: &&ServiceName| **s != services::HANDSHAKE && (warmup || **s != services::PREPARE);
@@ -56,12 +57,12 @@ impl Ports {
             inputs: inputs
                 .iter()
                 .filter(keep)
-                .map(|s| ports::open_input(node, *s))
+                .map(|s| ports::open_input(node, *s, qos))
                 .collect::<Result<_, _>>()?,
             outputs: outputs
                 .iter()
                 .filter(keep)
-                .map(|s| ports::open_output(node, *s))
+                .map(|s| ports::open_output(node, *s, qos))
                 .collect::<Result<_, _>>()?,
         })
     }
@@ -136,7 +137,14 @@ fn run<C: Component>(
     let role = Role::of(kind);
     let p = Proc::start(role.name)?;
     let mut c = make(&p)?;
-    let ports = Ports::open(&p.node, c.inputs(), role.publishes, warmup_enabled(&p.cfg))?;
+    let qos = crate::process::Qos::of(&p.cfg);
+    let ports = Ports::open(
+        &p.node,
+        c.inputs(),
+        role.publishes,
+        warmup_enabled(&p.cfg),
+        &qos,
+    )?;
     let sets = c.wake_sets();
     let waiters: Vec<Waiter> = sets
         .iter()
@@ -277,6 +285,11 @@ fn handshake(p: &Proc, role: &Role, env: &mut Peers) -> Result<(), FlightError> 
     if role.id() != 0 {
         let part = sc_bus::Participant::new(&p.node, services::HANDSHAKE, role.id())?;
         part.announce_and_wait(timeout + HANDSHAKE_GRACE)?;
+        // across hosts the scheduler's mark is in another host's folder: the `go` says
+        // the same to this host's launcher
+        if p.cfg.across_hosts() {
+            write_file(p, crate::ALL_READY, b"")?;
+        }
         return Ok(());
     }
     let peers = &sc_icd::ROLES[1..];
@@ -296,6 +309,14 @@ fn handshake(p: &Proc, role: &Role, env: &mut Peers) -> Result<(), FlightError> 
         }
         e => e.into(),
     })?;
+    if p.cfg.across_hosts() {
+        // a `go` that crossed before the other host's end of its bridge was up is lost
+        let resent = coord.settle(LINK_SETTLE, timeout)?;
+        eprintln!(
+            "{}: the `go` sent {resent} more times across hosts",
+            role.name
+        );
+    }
     eprintln!("{}: all {} processes ready", role.name, ids.len());
     // from now on a process that dies is a degraded mode, not a failed start
     write_file(p, crate::ALL_READY, b"")?;
@@ -308,3 +329,9 @@ fn handshake(p: &Proc, role: &Role, env: &mut Peers) -> Result<(), FlightError> 
 
 /// A participant waits this much longer for the `go` than the coordinator waits for it.
 const HANDSHAKE_GRACE: Duration = Duration::from_secs(5);
+
+/// Across hosts the first tick waits until no participant has announced itself for this
+/// long after the `go` ([`sc_bus::Coordinator::settle`]): every participant heard it, and
+/// the link (which lists the services every 20 ms, `sc-link --discover-ms`) has had 25
+/// rounds to bridge every service created before the announcements.
+const LINK_SETTLE: Duration = Duration::from_millis(500);

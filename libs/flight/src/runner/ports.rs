@@ -4,7 +4,7 @@
 
 use crate::component::Message;
 use crate::error::FlightError;
-use crate::process::{partner_qos, qos};
+use crate::process::Qos;
 use sc_bus::{
     BusNode, Publisher, ServiceSettings, SignalListener, SignalSender, Subscriber, Waitable,
     ZeroCopySend,
@@ -83,29 +83,33 @@ fn sub<T: core::fmt::Debug + ZeroCopySend + Copy + 'static>(
 }
 
 /// Opens the input on `service` (its listener is created when a waiter first needs it).
-pub fn open_input(node: &BusNode, service: ServiceName) -> Result<Box<dyn InPort>, FlightError> {
+pub fn open_input(
+    node: &BusNode,
+    service: ServiceName,
+    qos: &Qos,
+) -> Result<Box<dyn InPort>, FlightError> {
     use services::*;
-    let (q, p) = (qos(), partner_qos());
+    let (q, p) = (&qos.flight, &qos.partner);
     match service {
-        TICK => sub::<Tick>(node, service, &q, Message::Tick),
-        CONTROL => sub::<Tick>(node, service, &q, Message::Control),
-        SIM_STATE => sub::<SimState>(node, service, &q, Message::State),
-        PARTNER_STATE => sub::<SimState>(node, service, &p, Message::PartnerState),
-        TRUTH => sub::<SimState>(node, service, &q, Message::Truth),
-        NAVIGATION_ERROR => sub(node, service, &q, Message::NavigationError),
-        MEASUREMENT => sub(node, service, &p, Message::Measurement),
-        ESTIMATE => sub(node, service, &p, Message::Estimate),
-        NOMINAL_TRANSLATIONAL => sub(node, service, &p, Message::NominalTranslational),
-        NOMINAL_ATTITUDE => sub(node, service, &p, Message::NominalAttitude),
-        NOMINAL_ROBOTIC => sub(node, service, &p, Message::NominalRobotic),
-        SAFE_TRANSLATIONAL => sub(node, service, &q, Message::SafeTranslational),
-        SAFE_ATTITUDE => sub(node, service, &q, Message::SafeAttitude),
-        SAFE_ROBOTIC => sub(node, service, &q, Message::SafeRobotic),
-        STEP_RESULT => sub::<StepResult>(node, service, &q, Message::StepResult),
-        HEALTH => sub::<Health>(node, service, &q, Message::Health),
+        TICK => sub::<Tick>(node, service, q, Message::Tick),
+        CONTROL => sub::<Tick>(node, service, q, Message::Control),
+        SIM_STATE => sub::<SimState>(node, service, q, Message::State),
+        PARTNER_STATE => sub::<SimState>(node, service, p, Message::PartnerState),
+        TRUTH => sub::<SimState>(node, service, q, Message::Truth),
+        NAVIGATION_ERROR => sub(node, service, q, Message::NavigationError),
+        MEASUREMENT => sub(node, service, p, Message::Measurement),
+        ESTIMATE => sub(node, service, p, Message::Estimate),
+        NOMINAL_TRANSLATIONAL => sub(node, service, p, Message::NominalTranslational),
+        NOMINAL_ATTITUDE => sub(node, service, p, Message::NominalAttitude),
+        NOMINAL_ROBOTIC => sub(node, service, p, Message::NominalRobotic),
+        SAFE_TRANSLATIONAL => sub(node, service, q, Message::SafeTranslational),
+        SAFE_ATTITUDE => sub(node, service, q, Message::SafeAttitude),
+        SAFE_ROBOTIC => sub(node, service, q, Message::SafeRobotic),
+        STEP_RESULT => sub::<StepResult>(node, service, q, Message::StepResult),
+        HEALTH => sub::<Health>(node, service, q, Message::Health),
         STAGE_DEADLINE | PREPARE => Ok(Box::new(SignalPort {
             service,
-            listener: SignalListener::new(node, service.as_str(), &q)?,
+            listener: SignalListener::new(node, service.as_str(), q)?,
         })),
         other => Err(FlightError::UnknownService(other.as_str())),
     }
@@ -187,9 +191,13 @@ fn publ<T: core::fmt::Debug + ZeroCopySend + Copy + 'static>(
 }
 
 /// Opens the output on `service`.
-pub fn open_output(node: &BusNode, service: ServiceName) -> Result<Box<dyn OutPort>, FlightError> {
+pub fn open_output(
+    node: &BusNode,
+    service: ServiceName,
+    qos: &Qos,
+) -> Result<Box<dyn OutPort>, FlightError> {
     use services::*;
-    let (q, p) = (qos(), partner_qos());
+    let (q, p) = (&qos.flight, &qos.partner);
     macro_rules! out {
         ($variant:ident, $settings:expr) => {
             publ(node, service, $settings, |m| match m {
@@ -199,25 +207,25 @@ pub fn open_output(node: &BusNode, service: ServiceName) -> Result<Box<dyn OutPo
         };
     }
     match service {
-        TICK => out!(Tick, &q),
-        CONTROL => out!(Control, &q),
-        SIM_STATE => out!(State, &q),
-        PARTNER_STATE => out!(PartnerState, &p),
-        TRUTH => out!(Truth, &q),
-        NAVIGATION_ERROR => out!(NavigationError, &q),
-        MEASUREMENT => out!(Measurement, &p),
-        ESTIMATE => out!(Estimate, &p),
-        NOMINAL_TRANSLATIONAL => out!(NominalTranslational, &p),
-        NOMINAL_ATTITUDE => out!(NominalAttitude, &p),
-        NOMINAL_ROBOTIC => out!(NominalRobotic, &p),
-        SAFE_TRANSLATIONAL => out!(SafeTranslational, &q),
-        SAFE_ATTITUDE => out!(SafeAttitude, &q),
-        SAFE_ROBOTIC => out!(SafeRobotic, &q),
-        STEP_RESULT => out!(StepResult, &q),
-        HEALTH => out!(Health, &q),
+        TICK => out!(Tick, q),
+        CONTROL => out!(Control, q),
+        SIM_STATE => out!(State, q),
+        PARTNER_STATE => out!(PartnerState, p),
+        TRUTH => out!(Truth, q),
+        NAVIGATION_ERROR => out!(NavigationError, q),
+        MEASUREMENT => out!(Measurement, p),
+        ESTIMATE => out!(Estimate, p),
+        NOMINAL_TRANSLATIONAL => out!(NominalTranslational, p),
+        NOMINAL_ATTITUDE => out!(NominalAttitude, p),
+        NOMINAL_ROBOTIC => out!(NominalRobotic, p),
+        SAFE_TRANSLATIONAL => out!(SafeTranslational, q),
+        SAFE_ATTITUDE => out!(SafeAttitude, q),
+        SAFE_ROBOTIC => out!(SafeRobotic, q),
+        STEP_RESULT => out!(StepResult, q),
+        HEALTH => out!(Health, q),
         STAGE_DEADLINE | PREPARE => Ok(Box::new(SignalOut {
             service,
-            sender: SignalSender::new(node, service.as_str(), &q)?,
+            sender: SignalSender::new(node, service.as_str(), q)?,
         })),
         other => Err(FlightError::UnknownService(other.as_str())),
     }

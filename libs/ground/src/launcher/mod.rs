@@ -19,7 +19,7 @@ pub use start::{configured, resolve_exec};
 pub use verdict::{infrastructure_losses, mission_verdict};
 
 use sc_bus::RunScope;
-use sc_flight::config::{ClockMode, ConfigError};
+use sc_flight::config::{ClockMode, ConfigError, PartitionConfig};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -94,6 +94,9 @@ pub struct LaunchOptions {
     pub scenario: Option<PathBuf>,
     /// Print nothing on stderr (how each process ended is in the report and launch.json).
     pub quiet: bool,
+    /// A run across hosts (`[hosts]`): the host whose roles this launch starts (default:
+    /// the home host). Every host's launch needs the same `run_id`.
+    pub host: Option<String>,
 }
 
 /// How one process ended.
@@ -122,6 +125,11 @@ impl ProcessExit {
 pub struct LaunchReport {
     pub run_id: String,
     pub exits: Vec<ProcessExit>,
+    /// A run across hosts: the host this launch ran, and how its end of the link ended.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub host: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub link: Option<ProcessExit>,
     /// 0 all fine and captured safely; 1 the mission did not capture safely; 3 a process
     /// failed; 4 every process ended well but flight-side samples were lost in transport
     /// (an infrastructure failure, named in `error`).
@@ -209,11 +217,23 @@ pub fn launch(opts: &LaunchOptions) -> Result<LaunchReport, LaunchError> {
     }
     let stale_removed = clean_stale_runs(run.run_id());
     let _ = clean::reap_bounded(&run);
-    let (procs, spawn_err) = start::spawn_roles(&cfg, &eff, &out, &run);
+    let host = this_host(&cfg, opts)?;
+    // the link first: it bridges each service as the roles create it
+    let (link, link_err) = match start::spawn_link(&cfg, &host, &opts.bin_dir, &out, &run) {
+        Ok(l) => (l, None),
+        Err(e) => (None, Some(e)),
+    };
+    let (procs, spawn_err) = match link_err {
+        None => start::spawn_roles(&cfg, &host, &eff, &out, &run),
+        e => (Vec::new(), e),
+    };
     let timeout = opts.timeout.unwrap_or(DEFAULT_RUN_TIMEOUT);
-    let watch = supervise::Supervisor::new(procs, spawn_err.is_some(), opts.quiet, &out);
+    let away = cfg.hosts.as_ref().is_some_and(|h| h.home != host);
+    let watch = supervise::Supervisor::new(procs, spawn_err.is_some(), opts.quiet, &out)
+        .with_link(link, away);
     let s = watch.run(started, timeout, &INTERRUPTED);
-    let mut rep = report(&run, &out, s, spawn_err, opts.quiet);
+    let mut rep = report(&run, &out, s, spawn_err, opts.quiet, away);
+    rep.host = cfg.across_hosts().then_some(host);
     rep.stale_removed = stale_removed;
     rep.cpu_wakeup_latency = crate::pm_qos::describe(wakeup_request, &wakeup_held);
     rep.wall_s = started.elapsed().as_secs_f64();
@@ -223,14 +243,32 @@ pub fn launch(opts: &LaunchOptions) -> Result<LaunchReport, LaunchError> {
     Ok(rep)
 }
 
+/// The host this launch runs (`""` on one host): `--host`, else the home host.
+fn this_host(cfg: &PartitionConfig, opts: &LaunchOptions) -> Result<String, LaunchError> {
+    match (&cfg.hosts, &opts.host) {
+        (None, None) => Ok(String::new()),
+        (None, Some(h)) => Err(LaunchError::Output(format!(
+            "--host {h}: the config has no [hosts] (a run on one host)"
+        ))),
+        (Some(hosts), None) => Ok(hosts.home.clone()),
+        (Some(hosts), Some(h)) if hosts.link.contains_key(h) => Ok(h.clone()),
+        (Some(hosts), Some(h)) => Err(LaunchError::Output(format!(
+            "--host {h}: not a host of the config's hosts.link ({})",
+            hosts.names().join(", ")
+        ))),
+    }
+}
+
 /// Every process of the run is gone: removes what the run left behind, names an
-/// interrupted run, and judges it.
+/// interrupted run, and judges it (`away` from the home host there is no mission
+/// result: 0 when every process of this host ended well, else 3).
 fn report(
     run: &RunScope,
     out: &Path,
     s: supervise::Supervised,
     spawn_err: Option<start::SpawnError>,
     quiet: bool,
+    away: bool,
 ) -> LaunchReport {
     if clean::reap_bounded(run).is_none() && !quiet {
         note!(
@@ -247,17 +285,20 @@ fn report(
     }
     let leftovers = run.leftovers();
     let broken = s.failed || s.interrupted || spawn_err.is_some() || !leftovers.is_empty();
-    let (code, error) = verdict::judge(
-        out,
-        broken,
-        spawn_err.map(|e| e.to_string()).or(s.early_err),
-    );
+    let error = spawn_err.map(|e| e.to_string()).or(s.early_err);
+    let (code, error) = if away {
+        (if broken { 3 } else { 0 }, error)
+    } else {
+        verdict::judge(out, broken, error)
+    };
     if let Some(e) = error.as_ref().filter(|_| !quiet) {
         note!("launch: {e}");
     }
     LaunchReport {
         run_id: run.run_id().to_string(),
         exits: s.exits,
+        host: None,
+        link: s.link,
         code,
         interrupted: s.interrupted,
         leftovers,

@@ -86,16 +86,22 @@ pub(super) struct Started {
     pub child: Child,
 }
 
-/// Starts the process of every role in the table's order, each with its log; stops at
-/// the first that cannot start (or whose log cannot be opened) and says why.
+/// Starts the process of every role of `host` (every role on one host, `""`) in the
+/// table's order, each with its log; stops at the first that cannot start (or whose log
+/// cannot be opened) and says why.
 pub(super) fn spawn_roles(
     cfg: &PartitionConfig,
+    host: &str,
     eff: &Path,
     out: &Path,
     run: &RunScope,
 ) -> (Vec<Started>, Option<SpawnError>) {
     let mut procs = Vec::new();
-    for role in ROLES.iter().map(|r| r.name) {
+    for role in ROLES
+        .iter()
+        .map(|r| r.name)
+        .filter(|r| cfg.host_of(r) == host)
+    {
         match spawn_role(cfg, role, eff, out, run) {
             Ok(child) => procs.push(Started { role, child }),
             // the processes already running are torn down, not left behind
@@ -127,6 +133,9 @@ fn spawn_role(
     if !e.no_standard_args {
         cmd.arg("--config").arg(eff).arg("--out").arg(out);
     }
+    if cfg.across_hosts() {
+        cmd.env(sc_flight::hosts::ACROSS_HOSTS_ENV, "1");
+    }
     cmd.env(sc_bus::RUN_ID_ENV, run.run_id())
         .env(sc_flight::process::CONFIG_ENV, eff)
         .env(sc_flight::process::OUT_ENV, out)
@@ -137,6 +146,48 @@ fn spawn_role(
     cmd.spawn().map_err(|source| SpawnError::Exec {
         role: role.to_string(),
         exec: e.exec.clone(),
+        source,
+    })
+}
+
+/// The link's program (apps/link), found like a role's bare executable name.
+pub const LINK_EXEC: &str = "sc-link";
+
+/// Starts this host's end of the link of a run across hosts (`sc-link`, iceoryx2's Zenoh
+/// tunnel scoped to the run): it listens on `host`'s endpoint and connects to every
+/// other host's; its log is `logs/link.log`.
+pub(super) fn spawn_link(
+    cfg: &PartitionConfig,
+    host: &str,
+    bin_dir: &Option<PathBuf>,
+    out: &Path,
+    run: &RunScope,
+) -> Result<Option<Child>, SpawnError> {
+    let Some(hosts) = &cfg.hosts else {
+        return Ok(None);
+    };
+    let role = "link";
+    let path = out.join("logs").join("link.log");
+    let log = std::fs::File::create(&path)
+        .and_then(|l| Ok((l.try_clone()?, l)))
+        .map_err(|source| SpawnError::Log {
+            role: role.to_string(),
+            path: path.display().to_string(),
+            source,
+        })?;
+    let exec = resolve_exec(LINK_EXEC, &abs(&cfg.base_dir), bin_dir);
+    let mut cmd = Command::new(&exec);
+    cmd.arg("--run-id").arg(run.run_id());
+    if let Some(own) = hosts.link.get(host) {
+        cmd.arg("--listen").arg(own);
+    }
+    for other in hosts.others(host) {
+        cmd.arg("--connect").arg(other);
+    }
+    cmd.stdin(Stdio::null()).stdout(log.0).stderr(log.1);
+    cmd.spawn().map(Some).map_err(|source| SpawnError::Exec {
+        role: role.to_string(),
+        exec: exec.display().to_string(),
         source,
     })
 }

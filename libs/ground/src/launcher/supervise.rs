@@ -27,6 +27,10 @@ const POLL: Duration = Duration::from_millis(20);
 const PROGRESS_EVERY_S: f64 = 10.0;
 /// Environment variable with the progress interval [s].
 pub const PROGRESS_ENV: &str = "SC_LAUNCH_PROGRESS_S";
+/// Across hosts: after this host's last role ended, its link keeps moving samples this
+/// long before SIGTERM (the scheduler's stop tick, sent just before it ended, must reach
+/// the other hosts; the link passes every few hundred µs).
+const LINK_DRAIN: Duration = Duration::from_millis(500);
 
 /// The progress interval: [`PROGRESS_ENV`] if it is a positive number, else the default.
 fn progress_every() -> Duration {
@@ -41,6 +45,8 @@ fn progress_every() -> Duration {
 /// What the watch found.
 pub(super) struct Supervised {
     pub exits: Vec<ProcessExit>,
+    /// How this host's end of the link ended (a run across hosts).
+    pub link: Option<ProcessExit>,
     pub interrupted: bool,
     pub failed: bool,
     /// A process that failed by itself before every process was ready.
@@ -56,6 +62,15 @@ struct Watched {
 /// The watch over one run.
 pub(super) struct Supervisor<'a> {
     procs: Vec<Watched>,
+    /// This host's end of the link (a run across hosts): stopped after the roles.
+    link: Option<Watched>,
+    /// This host is not the home host: no scheduler here, the stop tick comes through
+    /// the link and a role that ends well after it starts the teardown.
+    away: bool,
+    /// When the last role of this host ended.
+    roles_done_at: Option<Instant>,
+    /// The link got its SIGTERM.
+    link_termed: bool,
     quiet: bool,
     out: &'a Path,
     teardown_at: Option<Instant>,
@@ -96,6 +111,10 @@ impl<'a> Supervisor<'a> {
                     exit: None,
                 })
                 .collect(),
+            link: None,
+            away: false,
+            roles_done_at: None,
+            link_termed: false,
             quiet,
             out,
             teardown_at: start_failed.then(Instant::now),
@@ -112,11 +131,24 @@ impl<'a> Supervisor<'a> {
         }
     }
 
+    /// A run across hosts: this host's link process, and whether this is not the home host.
+    pub fn with_link(mut self, link: Option<std::process::Child>, away: bool) -> Self {
+        self.link = link.map(|child| Watched {
+            role: "link",
+            child,
+            exit: None,
+        });
+        self.away = away;
+        self
+    }
+
     /// Watches until every process ended.
     pub fn run(mut self, started: Instant, timeout: Duration, signal: &AtomicBool) -> Supervised {
         loop {
             self.reap();
-            if self.procs.iter().all(|p| p.exit.is_some()) {
+            self.watch_link();
+            let roles_done = self.procs.iter().all(|p| p.exit.is_some());
+            if roles_done && self.link.as_ref().is_none_or(|l| l.exit.is_some()) {
                 break;
             }
             self.watch_signal_and_timeout(started, timeout, signal);
@@ -125,6 +157,7 @@ impl<'a> Supervisor<'a> {
             std::thread::sleep(POLL);
         }
         Supervised {
+            link: self.link.and_then(|l| l.exit),
             exits: self.procs.into_iter().filter_map(|p| p.exit).collect(),
             interrupted: self.interrupted,
             failed: self.failed,
@@ -152,6 +185,58 @@ impl<'a> Supervisor<'a> {
             };
             self.on_exit(self.procs[i].role, &ex);
             self.procs[i].exit = Some(ex);
+        }
+    }
+
+    /// The link: a failure when it ends by itself while roles still need it (the run
+    /// cannot go on across hosts: tear down); stopped [`LINK_DRAIN`] after the last role
+    /// ended, killed if it ignores SIGTERM.
+    fn watch_link(&mut self) {
+        let Some(link) = self.link.as_mut() else {
+            return;
+        };
+        if link.exit.is_none()
+            && let Ok(Some(st)) = link.child.try_wait()
+        {
+            use std::os::unix::process::ExitStatusExt;
+            let stopped = self.roles_done_at.is_some();
+            let ex = ProcessExit {
+                role: link.role.to_string(),
+                pid: link.child.id(),
+                code: st.code(),
+                signal: st.signal(),
+                killed_by_launcher: stopped || self.termed,
+            };
+            if !stopped && !self.termed {
+                self.failed = true;
+                if !self.quiet {
+                    note!(
+                        "launch: the link (pid {}) exited: {}; the run cannot go on across hosts",
+                        ex.pid,
+                        how(ex.code, ex.signal, "code")
+                    );
+                }
+                self.teardown_at = Some(Instant::now());
+            } else if !ex.ended_well() && ex.signal != Some(libc::SIGTERM) {
+                self.failed = true;
+            }
+            link.exit = Some(ex);
+            return;
+        }
+        if self.roles_done_at.is_none() && self.procs.iter().all(|p| p.exit.is_some()) {
+            self.roles_done_at = Some(Instant::now());
+        }
+        let Some(done) = self.roles_done_at else {
+            return;
+        };
+        if link.exit.is_none() && done.elapsed() >= LINK_DRAIN && !self.link_termed {
+            self.link_termed = true;
+            signal_pid(link.child.id(), libc::SIGTERM);
+        }
+        if link.exit.is_none() && done.elapsed() >= LINK_DRAIN + TERM_TO_KILL {
+            // a link that ignores SIGTERM is hung
+            self.failed = true;
+            let _ = link.child.kill();
         }
     }
 
@@ -187,8 +272,9 @@ impl<'a> Supervisor<'a> {
                 _ => {}
             }
         }
-        if kind == Some(RoleKind::Scheduler) {
-            // normal end: the others got the stop tick and finish their outputs
+        if kind == Some(RoleKind::Scheduler) || (self.away && ok) {
+            // normal end: the others got the stop tick and finish their outputs (away
+            // from home, where no scheduler runs: the first role that ended well on it)
             self.normal_end = ok && !self.termed;
             self.tear_down_in(AFTER_SCHEDULER);
         }
@@ -222,6 +308,7 @@ impl<'a> Supervisor<'a> {
     /// a latency bench of minutes, otherwise says nothing until it ends.
     fn say_progress(&mut self, started: Instant) {
         if self.quiet
+            || self.away
             || self.teardown_at.is_some()
             || self.progress_at.elapsed() < self.progress_every
             || !self.out.join(ALL_READY).exists()
