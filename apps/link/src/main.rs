@@ -86,7 +86,7 @@ fn run(cli: Cli) -> Result<()> {
             .with_context(|| format!("no --run-id and no ${RUN_ID_ENV}"))?,
     };
     let scope = RunScope::new(&run_id)?;
-    let zenoh = zenoh_config(&cli)?;
+    let zenoh = zenoh_config(&cli, scope.run_id())?;
     let allow = if cli.allow.is_empty() {
         AllowList::all()
     } else {
@@ -109,13 +109,29 @@ fn run(cli: Cli) -> Result<()> {
     outcome.map(|_| ())
 }
 
-/// The Zenoh configuration: the file, or a peer that reaches only the named endpoints.
-fn zenoh_config(cli: &Cli) -> Result<zenoh::Config> {
-    if let Some(path) = &cli.zenoh_config {
-        return zenoh::Config::from_file(path)
+/// The Zenoh configuration: the file, or a peer that reaches only the named endpoints;
+/// either way every key of the link under the run's own namespace `sc/<run id>`, so that
+/// the links of two runs sharing an endpoint never bridge into each other (a file's own
+/// `namespace` is kept).
+fn zenoh_config(cli: &Cli, run_id: &str) -> Result<zenoh::Config> {
+    let mut c = match &cli.zenoh_config {
+        Some(path) => zenoh::Config::from_file(path)
             .map_err(|e| anyhow::anyhow!("{e}"))
-            .with_context(|| format!("zenoh config {}", path.display()));
+            .with_context(|| format!("zenoh config {}", path.display()))?,
+        None => endpoints_only(cli)?,
+    };
+    if c.get_json("namespace").is_ok_and(|v| v == "null") {
+        // a run id is [A-Za-z0-9.-] (sc_bus::RunScope): a valid key chunk
+        let ns = format!("\"sc/{run_id}\"");
+        c.insert_json5("namespace", &ns)
+            .map_err(|e| anyhow::anyhow!("{e}"))
+            .with_context(|| format!("zenoh config namespace = {ns}"))?;
     }
+    Ok(c)
+}
+
+/// A peer that reaches only `--listen`/`--connect`.
+fn endpoints_only(cli: &Cli) -> Result<zenoh::Config> {
     if cli.listen.is_empty() && cli.connect.is_empty() {
         bail!("name the link's endpoints: --listen and/or --connect (or --zenoh-config)");
     }
@@ -268,5 +284,22 @@ impl Complaints {
         if self.count <= Self::SAID_AT_FIRST || self.count.is_multiple_of(Self::THEN_EVERY) {
             eprintln!("sc-link: {what} (failure {})", self.count);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_run_has_its_own_zenoh_namespace() {
+        let cli = Cli::parse_from(["sc-link", "--listen", "tcp/127.0.0.1:7447"]);
+        let c = zenoh_config(&cli, "run-1.a").unwrap();
+        assert_eq!(c.get_json("namespace").unwrap(), "\"sc/run-1.a\"");
+        let c = zenoh_config(&cli, "run-2").unwrap();
+        assert_eq!(c.get_json("namespace").unwrap(), "\"sc/run-2\"");
+        // publications block instead of dropping
+        let qos = c.get_json("qos/publication").unwrap();
+        assert!(qos.contains("\"block\""), "{qos}");
     }
 }

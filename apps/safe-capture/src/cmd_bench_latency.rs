@@ -36,6 +36,11 @@ pub struct Args {
     force: bool,
     #[command(flatten)]
     figures: crate::figure_format::FigureFormatArg,
+    /// The run's id (its iceoryx2 prefix; default: a fresh one). Across hosts (the config's
+    /// `[hosts]`) this runs the home host's side and prints the command that starts each
+    /// other host's; the report marks the hops that cross the link.
+    #[arg(long, value_name = "ID")]
+    run_id: Option<String>,
 }
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
@@ -44,6 +49,16 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     sc_ground::preflight::preflight(&cfg, &None)
         .map_err(|e| anyhow::anyhow!("{}: {e}", a.config.display()))?;
     a.figures.check()?;
+    let run_id = match (&cfg.hosts, &a.run_id) {
+        (Some(hosts), id) => {
+            let id = id.clone().unwrap_or_else(|| {
+                format!("bench-{}-{}", std::process::id(), sc_icd::monotonic_ns())
+            });
+            crate::cmd_launch::say_other_hosts(&a.config, hosts, &hosts.home, &id, true);
+            Some(id)
+        }
+        (None, id) => id.clone(),
+    };
     let staged = crate::out_folder::stage(&a.out, "bench latency", a.force)?;
     let r = match bench(&BenchOptions {
         config: a.config,
@@ -51,7 +66,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         ticks: a.ticks,
         warmup: a.warmup,
         bin_dir: None,
-        run_id: None,
+        run_id,
     }) {
         Ok(r) => r,
         Err(e @ sc_ground::error::BenchError::Interrupted { .. }) => {

@@ -236,16 +236,27 @@ fn across_hosts(
         None => format!("run-{}-{}", std::process::id(), sc_icd::monotonic_ns()),
     };
     opts.run_id = Some(id.clone());
-    let config = std::path::absolute(&a.config).unwrap_or_else(|_| a.config.clone());
+    say_other_hosts(&a.config, hosts, &host, &id, a.real_time);
+    Ok(Some(true))
+}
+
+/// Says, for each host but `host`, the command that starts its side of run `id`.
+pub fn say_other_hosts(
+    config: &std::path::Path,
+    hosts: &sc_flight::hosts::Hosts,
+    host: &str,
+    id: &str,
+    real_time: bool,
+) {
+    let config = std::path::absolute(config).unwrap_or_else(|_| config.to_path_buf());
     for other in hosts.names().into_iter().filter(|h| *h != host) {
         outln!(
             "launch: host {host} of {}; start host {other} with: safe-capture launch --config {} --host {other} --run-id {id}{}",
             hosts.link.len(),
             config.display(),
-            if a.real_time { " --real-time" } else { "" }
+            if real_time { " --real-time" } else { "" }
         );
     }
-    Ok(Some(true))
 }
 
 /// The end of a launch away from the home host: its processes and link, no mission result.

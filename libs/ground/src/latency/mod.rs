@@ -131,6 +131,43 @@ pub const HOPS: [(&str, &str, &str); 9] = [
     ),
 ];
 
+/// The role that stamps each column of latency.csv that a hop of [`HOPS`] starts or
+/// ends at.
+const COLUMN_ROLE: [(&str, &str); 10] = [
+    ("tick_send_ns", "scheduler"),
+    ("sim_recv_ns", "simulator"),
+    ("state_publish_ns", "simulator"),
+    ("nom_t_publish_ns", "nominal_translational"),
+    ("nom_a_publish_ns", "nominal_attitude"),
+    ("nom_r_publish_ns", "nominal_robotic"),
+    ("safe_t_publish_ns", "safety_translational"),
+    ("safe_a_publish_ns", "safety_attitude"),
+    ("safe_r_publish_ns", "safety_robotic"),
+    ("sim_safe_recv_ns", "simulator"),
+];
+
+/// What a hop that crosses hosts is called in the report: its name and this.
+pub const ACROSS_THE_LINK: &str = " (across the link)";
+
+/// The hops of [`HOPS`] whose two ends run on different hosts of `cfg` (none on one host).
+pub fn hops_across_hosts(cfg: &crate::PartitionConfig) -> Vec<&'static str> {
+    let role = |col: &str| COLUMN_ROLE.iter().find(|(c, _)| *c == col).map(|(_, r)| *r);
+    let host = |col: &str| role(col).map(|r| cfg.host_of(r).to_string());
+    HOPS.iter()
+        .filter(|(_, from, to)| host(from) != host(to))
+        .map(|(name, _, _)| *name)
+        .collect()
+}
+
+/// Marks the hops of `r` that cross hosts ([`ACROSS_THE_LINK`]).
+fn mark_hops_across_hosts(r: &mut LatencyReport, cfg: &crate::PartitionConfig) {
+    for name in hops_across_hosts(cfg) {
+        if let Some(h) = r.hops.remove(name) {
+            r.hops.insert(format!("{name}{ACROSS_THE_LINK}"), h);
+        }
+    }
+}
+
 pub(crate) fn hist() -> Histogram<u64> {
     // 1 ns .. 100 s, 3 significant digits
     Histogram::new_with_bounds(1, 100_000_000_000, 3)
@@ -247,6 +284,9 @@ pub fn bench(o: &BenchOptions) -> Result<LatencyReport, BenchError> {
         )));
     }
     let mut r = analyse(&o.out, o.warmup)?;
+    if let Ok(cfg) = crate::PartitionConfig::load(&o.config) {
+        mark_hops_across_hosts(&mut r, &cfg);
+    }
     r.machine.cpu_wakeup_latency = rep.cpu_wakeup_latency.clone();
     r.machine.steal_s = series
         .first()
@@ -323,6 +363,30 @@ mod tests {
     use super::*;
     use crate::steal::{StealSample, write_csv};
     use std::path::Path;
+
+    #[test]
+    fn the_hops_between_the_filters_host_and_home_are_the_links() {
+        let across = repo_config("config/partition_across_hosts.toml");
+        assert_eq!(
+            hops_across_hosts(&across),
+            [
+                "6 state -> translational filter out",
+                "9 robotic safe -> simulator"
+            ]
+        );
+        assert!(hops_across_hosts(&repo_config("config/partition.toml")).is_empty());
+        // every stamp a hop starts or ends at has its role
+        for (_, from, to) in HOPS {
+            for col in [from, to] {
+                assert!(COLUMN_ROLE.iter().any(|(c, _)| *c == col), "{col}");
+            }
+        }
+    }
+
+    fn repo_config(path: &str) -> crate::PartitionConfig {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        crate::PartitionConfig::load(&root.join(path)).unwrap()
+    }
 
     /// Ticks of the synthetic run.
     const TICKS: u64 = 20;
