@@ -77,6 +77,7 @@ fn main() -> std::process::ExitCode {
 }
 
 fn run(cli: Cli) -> Result<()> {
+    sc_bus::init_logging();
     if cli.poll_us == 0 || cli.discover_ms == 0 {
         bail!("--poll-us and --discover-ms must be positive");
     }
@@ -92,7 +93,7 @@ fn run(cli: Cli) -> Result<()> {
     } else {
         AllowList::new(&cli.allow)
     };
-    let mut link = open_link(&scope, zenoh, &allow)?;
+    let (mut link, mut peers) = open_link(&scope, zenoh, &allow)?;
     eprintln!(
         "sc-link: run {} (prefix {}), listening on {:?}, connecting to {:?}",
         scope.run_id(),
@@ -102,11 +103,18 @@ fn run(cli: Cli) -> Result<()> {
     );
     let outcome = spin(
         &mut link,
+        &mut peers,
         Duration::from_micros(cli.poll_us),
         Duration::from_millis(cli.discover_ms),
     );
     eprintln!("sc-link: stopped ({outcome:?})");
-    outcome.map(|_| ())
+    match outcome? {
+        WaitSetRunResult::StopRequest => bail!(
+            "the other host left (no Zenoh peer for {:?})",
+            PeerWatch::GONE_AFTER
+        ),
+        _ => Ok(()),
+    }
 }
 
 /// The Zenoh configuration: the file, or a peer that reaches only the named endpoints;
@@ -177,7 +185,11 @@ fn json_list(v: &[String]) -> String {
 
 /// The link of the run: a node under the run's prefix, the Zenoh tunnel, and the
 /// filter that bridges only services existing on this host (and admitted by `allow`).
-fn open_link(scope: &RunScope, zenoh: zenoh::Config, allow: &AllowList) -> Result<ZenohLink> {
+fn open_link(
+    scope: &RunScope,
+    zenoh: zenoh::Config,
+    allow: &AllowList,
+) -> Result<(ZenohLink, PeerWatch)> {
     let config = link_config(scope);
     let node = NodeBuilder::new()
         .name(&NodeName::new("link")?)
@@ -185,13 +197,57 @@ fn open_link(scope: &RunScope, zenoh: zenoh::Config, allow: &AllowList) -> Resul
         .create::<ipc::Service>()
         .map_err(|e| anyhow::anyhow!("{e:?}"))
         .context("the link's node")?;
-    let carrier = ZenohCarrier::create(zenoh)
-        .map_err(|e| anyhow::anyhow!("{e:?}"))
+    use zenoh::Wait;
+    let session = zenoh::open(zenoh)
+        .wait()
+        .map_err(|e| anyhow::anyhow!("{e}"))
         .context("the zenoh session")?;
+    let peers = PeerWatch::new(session.clone());
+    let carrier = ZenohCarrier::open(session)
+        .map_err(|e| anyhow::anyhow!("{e:?}"))
+        .context("the zenoh carrier")?;
     let allow = allow.clone();
     let link = Link::new(node, Tunnel::new(carrier, &config))
         .with_filter(move |name| bridged(&allow, name, &config));
-    Ok(link)
+    Ok((link, peers))
+}
+
+/// Whether the other host is still there: the Zenoh session's peers, once one was
+/// connected. A link whose peer is gone for [`PeerWatch::GONE_AFTER`] ends (exit 1,
+/// "the other host left"), and its host's launch tears that host's roles down — so a
+/// host whose other side died (or whose stop never came) does not wait for ever.
+struct PeerWatch {
+    session: zenoh::Session,
+    connected: bool,
+    missing_since: Option<Instant>,
+}
+
+impl PeerWatch {
+    const GONE_AFTER: Duration = Duration::from_secs(3);
+
+    fn new(session: zenoh::Session) -> Self {
+        Self {
+            session,
+            connected: false,
+            missing_since: None,
+        }
+    }
+
+    /// `true` once a peer that was connected has been gone for `GONE_AFTER`.
+    fn gone(&mut self) -> bool {
+        use zenoh::Wait;
+        let any = self.session.info().peers_zid().wait().next().is_some();
+        if any {
+            self.connected = true;
+            self.missing_since = None;
+            return false;
+        }
+        if !self.connected {
+            return false;
+        }
+        let since = *self.missing_since.get_or_insert_with(Instant::now);
+        since.elapsed() >= Self::GONE_AFTER
+    }
 }
 
 /// Whether the link bridges `name`: admitted, and created by a process of this host.
@@ -218,7 +274,12 @@ fn exists_here(name: &ServiceName, config: &iceoryx2::config::Config) -> bool {
 
 /// Moves samples every `poll` and on every wake from the other host (then rings the
 /// doorbells, `doorbell.rs`), lists the services every `discover`, until SIGINT/SIGTERM.
-fn spin(link: &mut ZenohLink, poll: Duration, discover: Duration) -> Result<WaitSetRunResult> {
+fn spin(
+    link: &mut ZenohLink,
+    peers: &mut PeerWatch,
+    poll: Duration,
+    discover: Duration,
+) -> Result<WaitSetRunResult> {
     let wake = link
         .listener()
         .map_err(|e| anyhow::anyhow!("{e:?}"))
@@ -248,6 +309,9 @@ fn spin(link: &mut ZenohLink, poll: Duration, discover: Duration) -> Result<Wait
                 let is_bridged = |h: &ServiceHash| bridges.contains(h);
                 if let Err(e) = doorbells.discover(link.node(), &is_bridged) {
                     complaints.say(&format!("{e:#}"));
+                }
+                if peers.gone() {
+                    return CallbackProgression::Stop;
                 }
             }
             // a failed pass leaves the link usable (iceoryx2-link): say so, go on

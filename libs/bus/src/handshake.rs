@@ -154,32 +154,53 @@ impl Coordinator {
         Ok(())
     }
 
-    /// After [`wait_all`](Self::wait_all): answers every announcement that still comes
-    /// with another `go`, until none has come for `quiet` (or `limit` passed). A
-    /// participant announces until it hears a `go`, so an announcement after the `go`
-    /// means one that has not heard it yet. On one host no `go` is lost; across hosts
-    /// (iceoryx2's link) an event sent before the other host's end of its bridge is up
-    /// is, and the participants there would wait for ever. Returns how many `go`s it
-    /// sent again.
+    /// After [`wait_all`](Self::wait_all): sends the `go` again every
+    /// [`ANNOUNCE_PERIOD`] until no participant has announced itself for `quiet` (a
+    /// participant announces until it hears a `go`), or fails at `limit` naming those
+    /// still announcing. On one host no `go` is lost; across hosts (iceoryx2's link) an
+    /// event sent while the other host's end of its bridge is not up — or is being
+    /// re-opened — is, and the participants there would wait for ever. Returns how many
+    /// `go`s it sent again.
     pub fn settle(&self, quiet: Duration, limit: Duration) -> Result<u32> {
-        let end = Instant::now() + limit;
+        let start = Instant::now();
+        let mut last_heard = start;
+        let mut still: Vec<u32> = Vec::new();
         let mut resent = 0;
-        loop {
-            let mut heard = false;
-            let wait = quiet.min(end.saturating_duration_since(Instant::now()));
+        while last_heard.elapsed() < quiet {
+            if start.elapsed() >= limit {
+                still.sort_unstable();
+                still.dedup();
+                return Err(BusError::HandshakeTimeout {
+                    timeout: limit,
+                    missing: still,
+                });
+            }
+            self.send_go()?;
+            resent += 1;
+            let mut heard: Vec<u32> = Vec::new();
             self.listener
-                .timed_wait(|_| heard = true, wait)
+                .timed_wait(
+                    // announcements only: a participant leaving (iceoryx2's
+                    // notifier-dropped event) is none
+                    |a| {
+                        let id = a.id.as_value();
+                        if id >= HANDSHAKE_ID_OFFSET {
+                            heard.push((id - HANDSHAKE_ID_OFFSET) as u32);
+                        }
+                    },
+                    ANNOUNCE_PERIOD,
+                )
                 .map_err(|e| BusError::Event {
                     op: "wait",
                     service: self.ready_name.clone(),
                     reason: reason(e),
                 })?;
-            if !heard || Instant::now() >= end {
-                return Ok(resent);
+            if !heard.is_empty() {
+                last_heard = Instant::now();
+                still = heard;
             }
-            self.send_go()?;
-            resent += 1;
         }
+        Ok(resent)
     }
 }
 

@@ -76,6 +76,14 @@ impl Hosts {
                 ));
             }
         }
+        let mut endpoints: Vec<&str> = self.link.values().map(|e| e.trim()).collect();
+        endpoints.sort_unstable();
+        if let Some(w) = endpoints.windows(2).find(|w| w[0] == w[1]) {
+            return err(format!(
+                "hosts.link: two hosts listen on {:?} (each host's link needs its own endpoint)",
+                w[0]
+            ));
+        }
         if !self.link.contains_key(&self.home) {
             return err(format!(
                 "hosts.home = {:?}: not a host of hosts.link ({})",
@@ -188,6 +196,10 @@ mod tests {
         h.link.insert("flight".into(), "tcp/\"x".into());
         let e = h.validate(std::iter::empty()).unwrap_err().0;
         assert!(e.contains("hosts.link.flight"), "{e}");
+        let mut h = hosts();
+        h.link.insert("flight".into(), "tcp/127.0.0.1:7447".into());
+        let e = h.validate(std::iter::empty()).unwrap_err().0;
+        assert!(e.contains("two hosts listen on"), "{e}");
         let e = check_no_host([("safety_robotic", Some("flight"))].into_iter())
             .unwrap_err()
             .0;

@@ -194,6 +194,14 @@ impl Partition {
         if interrupted() {
             return Err(self.stop());
         }
+        // a campaign runs every process of a run itself: it cannot start another host's
+        if crate::PartitionConfig::load(&self.config).is_ok_and(|c| c.across_hosts()) {
+            return Err(PartitionError::Launcher(format!(
+                "{}: a config across hosts ([hosts]) cannot run in a campaign (each host's side is its own launch, docs/PARTITION.md \"Across hosts\")",
+                self.config.display()
+            ))
+            .into());
+        }
         let rep = launch(&self.options(place, partners, inject))
             .map_err(|e| PartitionError::Launcher(e.to_string().replace('\n', " ")))?;
         if rep.interrupted || interrupted() {
@@ -362,9 +370,25 @@ pub fn failure_reason(rep: &LaunchReport, out: &Path) -> String {
             stopped.join(", ")
         ));
     }
+    if let Some(link) = rep
+        .link
+        .as_ref()
+        .filter(|l| bad(l) && !l.killed_by_launcher)
+    {
+        parts.push(format!(
+            "the link to the other host ended ({}: {})",
+            link.code.map_or_else(
+                || format!("signal {:?}", link.signal),
+                |c| format!("exit {c}")
+            ),
+            super::launcher::last_log_line(&out.join("logs/link.log"), QUOTED_LOG_CHARS)
+                .unwrap_or_default()
+        ));
+    }
     let started: Vec<&str> = rep.exits.iter().map(|e| e.role.as_str()).collect();
+    // across hosts the other hosts' roles are not this launch's
     let missing: Vec<&str> = sc_icd::roles::names()
-        .filter(|r| !started.contains(r))
+        .filter(|r| !started.contains(r) && rep.host.is_none())
         .collect();
     if !missing.is_empty() {
         parts.push(format!("not started: {}", missing.join(", ")));

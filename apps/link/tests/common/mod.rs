@@ -102,6 +102,16 @@ impl TwoHosts {
         child.wait_with_output().unwrap()
     }
 
+    /// Like [`wait`](Self::wait), but kills the process after `limit`.
+    pub fn wait_at_most(&mut self, i: usize, limit: std::time::Duration) -> Output {
+        let start = std::time::Instant::now();
+        while self.children[i].try_wait().unwrap().is_none() && start.elapsed() < limit {
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        }
+        let _ = self.children[i].kill();
+        self.wait(i)
+    }
+
     /// The files of run `run_id` in host `side`'s /dev/shm and /tmp/iceoryx2.
     pub fn run_files(&self, side: &str, run_id: &str) -> String {
         let mut c = self.on(side, Path::new("sh"));

@@ -122,6 +122,10 @@ pub struct FilterRole {
     stop: bool,
     rehearse: bool,
     misses: u64,
+    /// The deadline counts from this process's own receipt of the state, not from the
+    /// simulator's stamp: away from the simulator's host the two monotonic clocks are
+    /// unrelated ([`Self::on_another_host`]).
+    own_clock: bool,
 }
 
 impl FilterRole {
@@ -148,7 +152,16 @@ impl FilterRole {
             stop: false,
             rehearse: false,
             misses: 0,
+            own_clock: false,
         }
+    }
+
+    /// Across hosts, on another host than the simulator's: the stage deadline counts
+    /// from this filter's receipt of the state (the budget then excludes the hop across
+    /// the link), since the simulator's stamp is another computer's monotonic clock.
+    pub fn on_another_host(mut self) -> Self {
+        self.own_clock = true;
+        self
     }
 
     /// From the process's config: the scenario's safety layer with every subsystem's
@@ -159,7 +172,13 @@ impl FilterRole {
         let layer = SafetyLayer::with_holds(s, p.setup.robot.clone(), &p.schedule.period_s);
         let deadline = p.deadline(p.cfg.deadlines.filter_ms(subsystem));
         let ns = deadline.as_nanos().min(u128::from(u64::MAX)) as u64;
-        Ok(Self::new(subsystem, layer, s.clone(), ns))
+        let f = Self::new(subsystem, layer, s.clone(), ns);
+        let simulator = Role::of(RoleKind::Simulator).name;
+        Ok(if p.cfg.host_of(p.role) != p.cfg.host_of(simulator) {
+            f.on_another_host()
+        } else {
+            f
+        })
     }
 
     /// The tick whose nominal command this filter waits for: the pending state's, else
@@ -235,7 +254,8 @@ impl FilterRole {
                 self.last_state = Some(s);
                 // from the tick (the simulator's receipt of it), like the navigation's and
                 // the simulator's deadlines: the wait for the estimate does not shift it
-                let until_ns = deadline_from(s.recv_ns, now_ns, self.deadline_ns);
+                let stamp = if self.own_clock { 0 } else { s.recv_ns };
+                let until_ns = deadline_from(stamp, now_ns, self.deadline_ns);
                 self.pending = Some(Pending { state: s, until_ns });
             }
             let Some(p) = self.pending else { return };
@@ -743,6 +763,28 @@ mod tests {
         let out = handle(&mut r, until + 1, Woke::Event, &[tick_state(1)]);
         assert_eq!(out.send.len(), 1, "tick 1 filtered without waiting");
         assert_eq!(r.misses, 1);
+    }
+
+    #[test]
+    fn on_another_host_the_deadline_counts_from_its_own_receipt() {
+        // the simulator's stamp is another computer's clock: here far ahead of ours
+        let mut r = role(Subsystem::Translational).on_another_host();
+        let mut s = state(0, SubsystemSet::ALL.bits());
+        s.recv_ns = 10 * DEADLINE_NS;
+        let out = handle(&mut r, 2_000, Woke::Event, &[Message::State(s)]);
+        assert!(out.send.is_empty(), "waits for its nominal");
+        assert_eq!(
+            r.next(2_000),
+            Next::Wait {
+                set: NORMAL,
+                until_ns: Some(2_000 + DEADLINE_NS)
+            }
+        );
+        // a stamp far behind ours would have put the deadline in the past
+        let mut r = role(Subsystem::Translational).on_another_host();
+        let late = 100 * DEADLINE_NS;
+        let out = handle(&mut r, late, Woke::Event, &[tick_state(0)]);
+        assert!(out.send.is_empty(), "still waits for its nominal");
     }
 
     #[test]

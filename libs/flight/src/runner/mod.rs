@@ -163,9 +163,37 @@ fn run<C: Component>(
     let why = run_loop(&mut c, &p, &ports, &waiters, &mut attached, &mut env)?;
     let mut out = Outbox::default();
     let code = c.finish(why, &ports.impostors(), &mut out);
+    let last = out.send.clone();
     perform(&mut c, &p, &ports, out)?;
+    if p.cfg.across_hosts() {
+        linger(&ports, &last)?;
+    }
     Ok(code)
 }
+
+/// Across hosts: the last messages (the scheduler's stop) again every
+/// [`LINGER_PERIOD`], [`LINGER_SENDS`] times, before the ports close. The link bridges a
+/// service only while a process of its host holds a port on it, and a bridge can be
+/// re-opened (iceoryx2-link re-resolves a service when a listing pass misses it), losing
+/// what was in flight: a stop lost that way left the other host's roles waiting for ever
+/// (measured: 1 of 4 split runs). A role ends on the first stop; the others are ignored.
+fn linger(ports: &Ports, last: &[Message]) -> Result<(), FlightError> {
+    for _ in 0..LINGER_SENDS {
+        std::thread::sleep(LINGER_PERIOD);
+        for m in last {
+            let mut m = *m;
+            m.stamp_publish(monotonic_ns());
+            // best effort: the first send's result is the one that counts
+            let _ = ports.output(m.service())?.send(&m);
+        }
+    }
+    Ok(())
+}
+
+/// See [`linger`].
+const LINGER_PERIOD: Duration = Duration::from_millis(100);
+/// See [`linger`].
+const LINGER_SENDS: u32 = 10;
 
 /// Sleeps, drains, hands over, acts — until the component is done or a signal ends it.
 fn run_loop<'w, 'p, C: Component>(
@@ -285,9 +313,13 @@ fn handshake(p: &Proc, role: &Role, env: &mut Peers) -> Result<(), FlightError> 
     if role.id() != 0 {
         let part = sc_bus::Participant::new(&p.node, services::HANDSHAKE, role.id())?;
         part.announce_and_wait(timeout + HANDSHAKE_GRACE)?;
-        // across hosts the scheduler's mark is in another host's folder: the `go` says
-        // the same to this host's launcher
-        if p.cfg.across_hosts() {
+        // away from the home host the scheduler's mark is in another host's folder: the
+        // `go` says the same to this host's launcher
+        if p.cfg
+            .hosts
+            .as_ref()
+            .is_some_and(|h| p.cfg.host_of(role.name) != h.home)
+        {
             write_file(p, crate::ALL_READY, b"")?;
         }
         return Ok(());
