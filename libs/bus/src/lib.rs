@@ -36,7 +36,7 @@ pub mod waiter;
 pub use error::{BusError, Result};
 pub use handshake::{Coordinator, Participant};
 pub use liveness::{NodeReport, PeerInfo, PeerMonitor, reap_dead_nodes};
-pub use pubsub::{Events, Publisher, ServiceSettings, Subscriber};
+pub use pubsub::{Events, ExpectedPublisher, Publisher, ServiceSettings, Subscriber};
 pub use run::{BusNode, RUN_ID_ENV, RunScope};
 pub use signal::{SignalListener, SignalSender};
 pub use waiter::{Attachment, WaitOutcome, Waitable, Waiter, Wake};

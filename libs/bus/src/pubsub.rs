@@ -19,6 +19,8 @@
 
 use crate::error::{BusError, Result, reason};
 use crate::run::BusNode;
+use iceoryx2::identifiers::UniqueNodeId;
+use iceoryx2::node::{NodeState, NodeView};
 use iceoryx2::port::BackpressureAction;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
@@ -392,6 +394,37 @@ impl Events {
     }
 }
 
+/// Who may publish on a subscriber's service ([`Subscriber::expect_publisher`]): the
+/// node's name and, when known, its process. The first publisher a subscriber hears is
+/// pinned only if its node is this one; samples of any other are dropped and counted.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ExpectedPublisher {
+    /// The node name of the publisher (the owner role's name, or the link's).
+    pub node_name: String,
+    /// Its process id, if known (the link's: the launcher starts it first).
+    pub pid: Option<i32>,
+}
+
+impl ExpectedPublisher {
+    /// Whether the alive node `id` of the run `config` is this publisher.
+    fn is(&self, config: &iceoryx2::config::Config, id: &UniqueNodeId) -> bool {
+        let mut found = false;
+        let listed = Node::<ipc::Service>::list(config, |state| {
+            if let NodeState::Alive(view) = &state
+                && view.id() == id
+            {
+                found = view.details().as_ref().is_some_and(|d| {
+                    d.name().as_str() == self.node_name
+                        && self.pid.is_none_or(|p| d.process_id().value() == p)
+                });
+                return CallbackProgression::Stop;
+            }
+            CallbackProgression::Continue
+        });
+        listed.is_ok() && found
+    }
+}
+
 /// Subscribing side of one service.
 ///
 /// Its event listener is what a publisher's `notify` wakes: every listener of a
@@ -412,6 +445,8 @@ pub struct Subscriber<T: Debug + ZeroCopySend + Copy + 'static> {
     pinned: std::cell::Cell<Option<iceoryx2::identifiers::UniquePublisherId>>,
     /// Samples from any other publisher, dropped.
     rejected: std::cell::Cell<u64>,
+    /// Only this publisher may be pinned (with the run's config to look its node up).
+    expected: Option<(ExpectedPublisher, iceoryx2::config::Config)>,
 }
 
 impl<T: Debug + ZeroCopySend + Copy + 'static> Subscriber<T> {
@@ -465,7 +500,15 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Subscriber<T> {
             event,
             pinned: std::cell::Cell::new(None),
             rejected: std::cell::Cell::new(0),
+            expected: None,
         })
+    }
+
+    /// Accepts samples only from `publisher`, a node of the run of `node`: the first
+    /// publisher heard is pinned only if it is that one (by default, whichever is heard
+    /// first — on one host the owner, whose port exists before the first tick).
+    pub fn expect_publisher(&mut self, node: &BusNode, publisher: ExpectedPublisher) {
+        self.expected = Some((publisher, node.config().clone()));
     }
 
     /// Service name.
@@ -544,6 +587,13 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Subscriber<T> {
                 Ok(Some(sample)) => {
                     let from = sample.header().publisher_id();
                     match self.pinned.get() {
+                        None if self.expected.as_ref().is_some_and(|(e, config)| {
+                            !e.is(config, &sample.header().node_id())
+                        }) =>
+                        {
+                            self.rejected.set(self.rejected.get() + 1);
+                            continue;
+                        }
                         None => self.pinned.set(Some(from)),
                         Some(p) if p != from => {
                             self.rejected.set(self.rejected.get() + 1);

@@ -292,6 +292,54 @@ fn teardown_refuses_while_a_node_is_alive() {
     assert!(run.leftovers().is_empty(), "{:?}", run.leftovers());
 }
 
+/// Across hosts a subscriber is told whom to accept (the owner's node, or the link's):
+/// an intruder that publishes first is not pinned, and its samples are dropped and
+/// counted; the expected publisher's are taken.
+#[test]
+fn a_subscriber_told_its_publisher_does_not_pin_an_intruder_heard_first() {
+    let run = RunScope::unique("expected").unwrap();
+    {
+        let owner_node = run.node("simulator").unwrap();
+        let intruder_node = run.node("nominal_attitude").unwrap();
+        let reader = run.node("safety_attitude").unwrap();
+        let qos = ServiceSettings::lock_step(); // two publishers allowed
+        let tick = |tick| Tick {
+            tick,
+            ..Default::default()
+        };
+        let mut rx = Subscriber::<Tick>::with_name(&reader, "state", &qos).unwrap();
+        rx.expect_publisher(
+            &reader,
+            sc_bus::ExpectedPublisher {
+                node_name: "simulator".into(),
+                pid: Some(std::process::id() as i32),
+            },
+        );
+        let intruder = Publisher::<Tick>::with_name(&intruder_node, "state", &qos).unwrap();
+        let owner = Publisher::<Tick>::with_name(&owner_node, "state", &qos).unwrap();
+        intruder.send(&tick(666)).unwrap();
+        owner.send(&tick(1)).unwrap();
+        intruder.send(&tick(667)).unwrap();
+        let mut got = Vec::new();
+        rx.receive_all(&mut got).unwrap();
+        assert_eq!(got.iter().map(|t| t.tick).collect::<Vec<_>>(), vec![1]);
+        assert_eq!(rx.rejected(), 2);
+        // the right name in another process is no match either
+        let mut rx = Subscriber::<Tick>::with_name(&reader, "state", &qos).unwrap();
+        rx.expect_publisher(
+            &reader,
+            sc_bus::ExpectedPublisher {
+                node_name: "simulator".into(),
+                pid: Some(1),
+            },
+        );
+        owner.send(&tick(2)).unwrap();
+        assert_eq!(rx.try_receive().unwrap(), None);
+        assert_eq!(rx.rejected(), 1);
+    }
+    run.teardown().unwrap();
+}
+
 /// Who may publish: a subscriber accepts samples only from the first publisher it heard
 /// (a second one's are dropped and counted), and a service created with room for more
 /// publishers than the settings say is refused at open (impersonation, issue #12).

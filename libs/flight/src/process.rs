@@ -79,7 +79,18 @@ pub struct Qos {
     pub flight: ServiceSettings,
     /// The services a partner's process publishes on.
     pub partner: ServiceSettings,
+    /// Across hosts, whom each service's subscribers accept ([`Qos::expected`]); empty
+    /// on one host (there the owner is the first publisher heard).
+    pub publishers: Vec<(sc_icd::ServiceName, sc_bus::ExpectedPublisher)>,
 }
+
+/// Environment variable the launcher sets for every role of a run across hosts: the
+/// process id of this host's `sc-link` (the only process allowed to publish here what
+/// the other host's roles publish).
+pub const LINK_PID_ENV: &str = "SC_LINK_PID";
+
+/// The node name of `sc-link` (apps/link).
+pub const LINK_NODE: &str = "link";
 
 impl Qos {
     /// On one host: [`qos`] and [`partner_qos`].
@@ -87,6 +98,7 @@ impl Qos {
         Self {
             flight: qos(),
             partner: partner_qos(),
+            publishers: Vec::new(),
         }
     }
 
@@ -100,16 +112,54 @@ impl Qos {
         Self {
             flight: with_link(qos()),
             partner: with_link(partner_qos()),
+            publishers: Vec::new(),
         }
     }
 
-    /// The settings of a run with config `cfg`.
-    pub fn of(cfg: &PartitionConfig) -> Self {
-        if cfg.across_hosts() {
-            Self::across_hosts()
-        } else {
-            Self::one_host()
+    /// The settings of `role`'s process in a run with config `cfg`. Across hosts each
+    /// service's subscribers accept only its owner's node when the owner runs on this
+    /// host, else only this host's link (by its process id, [`LINK_PID_ENV`], when the
+    /// launcher gave it): a process of this host that grabbed a publisher port first —
+    /// the link takes one on every service, so there is room — is not taken for the
+    /// owner.
+    pub fn of(cfg: &PartitionConfig, role: &str) -> Self {
+        if !cfg.across_hosts() {
+            return Self::one_host();
         }
+        let here = cfg.host_of(role);
+        let link_pid = std::env::var(LINK_PID_ENV)
+            .ok()
+            .and_then(|p| p.parse::<i32>().ok());
+        let publishers = sc_icd::ROLES
+            .iter()
+            .flat_map(|owner| owner.publishes.iter().map(move |s| (*s, owner.name)))
+            .map(|(service, owner)| {
+                let expected = if cfg.host_of(owner) == here {
+                    sc_bus::ExpectedPublisher {
+                        node_name: owner.to_string(),
+                        pid: None,
+                    }
+                } else {
+                    sc_bus::ExpectedPublisher {
+                        node_name: LINK_NODE.to_string(),
+                        pid: link_pid,
+                    }
+                };
+                (service, expected)
+            })
+            .collect();
+        Self {
+            publishers,
+            ..Self::across_hosts()
+        }
+    }
+
+    /// Whom the subscribers of `service` accept (`None`: the first publisher heard).
+    pub fn expected(&self, service: sc_icd::ServiceName) -> Option<&sc_bus::ExpectedPublisher> {
+        self.publishers
+            .iter()
+            .find(|(s, _)| *s == service)
+            .map(|(_, e)| e)
     }
 }
 

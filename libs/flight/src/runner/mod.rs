@@ -137,7 +137,7 @@ fn run<C: Component>(
     let role = Role::of(kind);
     let p = Proc::start(role.name)?;
     let mut c = make(&p)?;
-    let qos = crate::process::Qos::of(&p.cfg);
+    let qos = crate::process::Qos::of(&p.cfg, role.name);
     let ports = Ports::open(
         &p.node,
         c.inputs(),

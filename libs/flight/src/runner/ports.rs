@@ -74,12 +74,13 @@ fn sub<T: core::fmt::Debug + ZeroCopySend + Copy + 'static>(
     service: ServiceName,
     settings: &ServiceSettings,
     wrap: fn(T) -> Message,
+    expected: Option<&sc_bus::ExpectedPublisher>,
 ) -> Result<Box<dyn InPort>, FlightError> {
-    Ok(Box::new(SubPort {
-        service,
-        sub: Subscriber::<T>::polled(node, service, settings)?,
-        wrap,
-    }))
+    let mut sub = Subscriber::<T>::polled(node, service, settings)?;
+    if let Some(e) = expected {
+        sub.expect_publisher(node, e.clone());
+    }
+    Ok(Box::new(SubPort { service, sub, wrap }))
 }
 
 /// Opens the input on `service` (its listener is created when a waiter first needs it).
@@ -90,23 +91,24 @@ pub fn open_input(
 ) -> Result<Box<dyn InPort>, FlightError> {
     use services::*;
     let (q, p) = (&qos.flight, &qos.partner);
+    let e = qos.expected(service);
     match service {
-        TICK => sub::<Tick>(node, service, q, Message::Tick),
-        CONTROL => sub::<Tick>(node, service, q, Message::Control),
-        SIM_STATE => sub::<SimState>(node, service, q, Message::State),
-        PARTNER_STATE => sub::<SimState>(node, service, p, Message::PartnerState),
-        TRUTH => sub::<SimState>(node, service, q, Message::Truth),
-        NAVIGATION_ERROR => sub(node, service, q, Message::NavigationError),
-        MEASUREMENT => sub(node, service, p, Message::Measurement),
-        ESTIMATE => sub(node, service, p, Message::Estimate),
-        NOMINAL_TRANSLATIONAL => sub(node, service, p, Message::NominalTranslational),
-        NOMINAL_ATTITUDE => sub(node, service, p, Message::NominalAttitude),
-        NOMINAL_ROBOTIC => sub(node, service, p, Message::NominalRobotic),
-        SAFE_TRANSLATIONAL => sub(node, service, q, Message::SafeTranslational),
-        SAFE_ATTITUDE => sub(node, service, q, Message::SafeAttitude),
-        SAFE_ROBOTIC => sub(node, service, q, Message::SafeRobotic),
-        STEP_RESULT => sub::<StepResult>(node, service, q, Message::StepResult),
-        HEALTH => sub::<Health>(node, service, q, Message::Health),
+        TICK => sub::<Tick>(node, service, q, Message::Tick, e),
+        CONTROL => sub::<Tick>(node, service, q, Message::Control, e),
+        SIM_STATE => sub::<SimState>(node, service, q, Message::State, e),
+        PARTNER_STATE => sub::<SimState>(node, service, p, Message::PartnerState, e),
+        TRUTH => sub::<SimState>(node, service, q, Message::Truth, e),
+        NAVIGATION_ERROR => sub(node, service, q, Message::NavigationError, e),
+        MEASUREMENT => sub(node, service, p, Message::Measurement, e),
+        ESTIMATE => sub(node, service, p, Message::Estimate, e),
+        NOMINAL_TRANSLATIONAL => sub(node, service, p, Message::NominalTranslational, e),
+        NOMINAL_ATTITUDE => sub(node, service, p, Message::NominalAttitude, e),
+        NOMINAL_ROBOTIC => sub(node, service, p, Message::NominalRobotic, e),
+        SAFE_TRANSLATIONAL => sub(node, service, q, Message::SafeTranslational, e),
+        SAFE_ATTITUDE => sub(node, service, q, Message::SafeAttitude, e),
+        SAFE_ROBOTIC => sub(node, service, q, Message::SafeRobotic, e),
+        STEP_RESULT => sub::<StepResult>(node, service, q, Message::StepResult, e),
+        HEALTH => sub::<Health>(node, service, q, Message::Health, e),
         STAGE_DEADLINE | PREPARE => Ok(Box::new(SignalPort {
             service,
             listener: SignalListener::new(node, service.as_str(), q)?,

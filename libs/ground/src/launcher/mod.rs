@@ -223,8 +223,9 @@ pub fn launch(opts: &LaunchOptions) -> Result<LaunchReport, LaunchError> {
         Ok(l) => (l, None),
         Err(e) => (None, Some(e)),
     };
+    let link_pid = link.as_ref().map(|l| l.id());
     let (procs, spawn_err) = match link_err {
-        None => start::spawn_roles(&cfg, &host, &eff, &out, &run),
+        None => start::spawn_roles(&cfg, &host, link_pid, &eff, &out, &run),
         e => (Vec::new(), e),
     };
     let timeout = opts.timeout.unwrap_or(DEFAULT_RUN_TIMEOUT);

@@ -92,6 +92,7 @@ pub(super) struct Started {
 pub(super) fn spawn_roles(
     cfg: &PartitionConfig,
     host: &str,
+    link_pid: Option<u32>,
     eff: &Path,
     out: &Path,
     run: &RunScope,
@@ -102,7 +103,7 @@ pub(super) fn spawn_roles(
         .map(|r| r.name)
         .filter(|r| cfg.host_of(r) == host)
     {
-        match spawn_role(cfg, role, eff, out, run) {
+        match spawn_role(cfg, role, link_pid, eff, out, run) {
             Ok(child) => procs.push(Started { role, child }),
             // the processes already running are torn down, not left behind
             Err(why) => return (procs, Some(why)),
@@ -115,6 +116,7 @@ pub(super) fn spawn_roles(
 fn spawn_role(
     cfg: &PartitionConfig,
     role: &str,
+    link_pid: Option<u32>,
     eff: &Path,
     out: &Path,
     run: &RunScope,
@@ -135,6 +137,9 @@ fn spawn_role(
     }
     if cfg.across_hosts() {
         cmd.env(sc_flight::hosts::ACROSS_HOSTS_ENV, "1");
+    }
+    if let Some(pid) = link_pid {
+        cmd.env(sc_flight::process::LINK_PID_ENV, pid.to_string());
     }
     cmd.env(sc_bus::RUN_ID_ENV, run.run_id())
         .env(sc_flight::process::CONFIG_ENV, eff)
