@@ -54,7 +54,8 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             let id = id.clone().unwrap_or_else(|| {
                 format!("bench-{}-{}", std::process::id(), sc_icd::monotonic_ns())
             });
-            crate::cmd_launch::say_other_hosts(&a.config, hosts, &hosts.home, &id, true);
+            let real_time = ["--real-time".to_string()];
+            crate::cmd_launch::say_other_hosts(&a.config, hosts, &hosts.home, &id, &real_time);
             Some(id)
         }
         (None, id) => id.clone(),

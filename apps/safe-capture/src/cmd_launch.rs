@@ -236,8 +236,34 @@ fn across_hosts(
         None => format!("run-{}-{}", std::process::id(), sc_icd::monotonic_ns()),
     };
     opts.run_id = Some(id.clone());
-    say_other_hosts(&a.config, hosts, &host, &id, a.real_time);
+    let mut extra = Vec::new();
+    if a.real_time {
+        extra.push("--real-time".to_string());
+    }
+    if let Some(case) = &a.hostile {
+        // the hostile partners replace the roles of whichever host runs them
+        extra.extend(["--hostile".to_string(), shell_word(case)]);
+        extra.extend([
+            "--python".to_string(),
+            shell_word(&a.python.display().to_string()),
+        ]);
+        extra.extend([
+            "--partner".to_string(),
+            shell_word(&a.partner.display().to_string()),
+        ]);
+    }
+    say_other_hosts(&a.config, hosts, &host, &id, &extra);
     Ok(Some(true))
+}
+
+/// `w` as one word of a POSIX shell command line (quoted when it has to be).
+fn shell_word(w: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "/._-:+=,@%".contains(c);
+    if !w.is_empty() && w.chars().all(plain) {
+        w.to_string()
+    } else {
+        format!("'{}'", w.replace('\'', "'\\''"))
+    }
 }
 
 /// Says, for each host but `host`, the command that starts its side of run `id`.
@@ -246,15 +272,16 @@ pub fn say_other_hosts(
     hosts: &sc_flight::hosts::Hosts,
     host: &str,
     id: &str,
-    real_time: bool,
+    extra: &[String],
 ) {
     let config = std::path::absolute(config).unwrap_or_else(|_| config.to_path_buf());
+    let config = shell_word(&config.display().to_string());
+    let id = shell_word(id);
+    let extra: String = extra.iter().map(|e| format!(" {e}")).collect();
     for other in hosts.names().into_iter().filter(|h| *h != host) {
         outln!(
-            "launch: host {host} of {}; start host {other} with: safe-capture launch --config {} --host {other} --run-id {id}{}",
+            "launch: host {host} of {}; start host {other} with: safe-capture launch --config {config} --host {other} --run-id {id}{extra}",
             hosts.link.len(),
-            config.display(),
-            if real_time { " --real-time" } else { "" }
         );
     }
 }
@@ -352,8 +379,16 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
 
 #[cfg(test)]
 mod tests {
-    use super::outcome;
+    use super::{outcome, shell_word};
     use serde_json::json;
+
+    #[test]
+    fn the_other_hosts_command_quotes_what_the_shell_would_split() {
+        assert_eq!(shell_word("/work/config/p.toml"), "/work/config/p.toml");
+        assert_eq!(shell_word("/my configs/p.toml"), "'/my configs/p.toml'");
+        assert_eq!(shell_word("it's"), "'it'\\''s'");
+        assert_eq!(shell_word(""), "''");
+    }
 
     #[test]
     fn a_run_stopped_by_max_ticks_is_no_timeout() {

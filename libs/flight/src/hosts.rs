@@ -22,6 +22,11 @@ use std::collections::BTreeMap;
 /// opens the services with the link's ports counted in ([`crate::process::Qos`]).
 pub const ACROSS_HOSTS_ENV: &str = "SC_ACROSS_HOSTS";
 
+/// Environment variable the launcher sets (to `1`) for every process away from the home
+/// host: a partner's process in another language marks its start (`all_ready`) there, as
+/// the Rust roles do (the scheduler's mark is in the home host's folder).
+pub const AWAY_FROM_HOME_ENV: &str = "SC_AWAY_FROM_HOME";
+
 /// The roles that always run on the home host: the run's clock (scheduler), its truth
 /// (simulator) and its outputs (recorder).
 pub const HOME_ROLES: [RoleKind; 3] =

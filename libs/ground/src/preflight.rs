@@ -127,6 +127,18 @@ pub fn check_programs(
         )?;
         n += 1;
     }
+    if cfg.across_hosts() {
+        // the link runs beside the roles on every host (docs/PARTITION.md "Across hosts")
+        let link =
+            crate::launcher::resolve_exec(crate::launcher::LINK_EXEC, &cfg.base_dir, bin_dir);
+        if !link.is_file() {
+            return err(format!(
+                "[hosts]: the link's program `{}` is not next to safe-capture nor in SC_PARTITION_BIN_DIR ({}); build it: cargo build --release -p sc-link",
+                crate::launcher::LINK_EXEC,
+                link.display()
+            ));
+        }
+    }
     if let Some((program, args)) = cfg.simulator.plant.split_first() {
         check_plant_program(program, &cfg.base_dir)?;
         check_script(

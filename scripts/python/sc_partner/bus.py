@@ -91,6 +91,19 @@ def data_event(node, name, qos):
     return open_event(node, name, qos["max_publishers"] + qos["max_subscribers"], qos["max_nodes"], EVENT_ID_MAX)
 
 
+def mark_ready_away_from_home():
+    """Across hosts, away from the home host (where the scheduler writes it): the `go`
+    came, so this host's launcher may count a role that ends as a finished one, not as a
+    failed start — the file `all_ready` in the run's folder (sc_flight::ALL_READY), as
+    the Rust roles write it (sc_flight::runner). The launcher sets SC_AWAY_FROM_HOME
+    (sc_flight::hosts::AWAY_FROM_HOME_ENV) for the roles away from the home host, and
+    SC_OUT_DIR."""
+    out = os.environ.get("SC_OUT_DIR")
+    if os.environ.get("SC_AWAY_FROM_HOME") == "1" and out:
+        os.makedirs(out, exist_ok=True)
+        open(os.path.join(out, "all_ready"), "a").close()
+
+
 def handshake(node, role, timeout_s):
     """Announce `role` until the coordinator says go (sc_bus::handshake); False on timeout."""
     id_max = sc_icd.HANDSHAKE_ID_OFFSET + HANDSHAKE_MAX_PARTICIPANTS

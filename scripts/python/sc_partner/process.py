@@ -66,6 +66,7 @@ def serve(label, node_name, role, run_id, inbound, outbound, answer, handshake_t
         if not bus.handshake(node, role, handshake_timeout_s):
             print(f"{label}: handshake timed out", file=sys.stderr)
             return 1
+        bus.mark_ready_away_from_home()
         while True:
             listener.timed_wait(iox2.Duration.from_millis(WAIT_MS))
             _answer_all(label, subscriber, inbound.msg_cls, answer, publisher, notifier, counts, outbound.noun)

@@ -15,7 +15,7 @@ mod supervise;
 mod verdict;
 
 pub use clean::{RUN_OUTPUTS, clean_stale_runs};
-pub use start::{configured, resolve_exec};
+pub use start::{LINK_EXEC, configured, resolve_exec};
 pub use verdict::{infrastructure_losses, mission_verdict};
 
 use sc_bus::RunScope;

@@ -135,8 +135,11 @@ fn spawn_role(
     if !e.no_standard_args {
         cmd.arg("--config").arg(eff).arg("--out").arg(out);
     }
-    if cfg.across_hosts() {
+    if let Some(hosts) = &cfg.hosts {
         cmd.env(sc_flight::hosts::ACROSS_HOSTS_ENV, "1");
+        if cfg.host_of(role) != hosts.home {
+            cmd.env(sc_flight::hosts::AWAY_FROM_HOME_ENV, "1");
+        }
     }
     if let Some(pid) = link_pid {
         cmd.env(sc_flight::process::LINK_PID_ENV, pid.to_string());

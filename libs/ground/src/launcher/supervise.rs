@@ -272,9 +272,10 @@ impl<'a> Supervisor<'a> {
                 _ => {}
             }
         }
-        if kind == Some(RoleKind::Scheduler) || (self.away && ok) {
+        if kind == Some(RoleKind::Scheduler) {
             // normal end: the others got the stop tick and finish their outputs (away
-            // from home, where no scheduler runs: the first role that ended well on it)
+            // from home no scheduler runs: each role ends on the stop tick that came
+            // through the link, and the link ends the run when the home host has left)
             self.normal_end = ok && !self.termed;
             self.tear_down_in(AFTER_SCHEDULER);
         }
