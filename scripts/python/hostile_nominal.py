@@ -317,6 +317,7 @@ def main():
         if not sc_bus.handshake(node, role_id, TIMEOUT_S):
             print("hostile_nominal.py: handshake timed out", file=sys.stderr)
             return 1
+        sc_bus.mark_ready_away_from_home()
         fake = impersonate(node, role) if "impersonate" in beh else None
         if fake is not None:
             ports.insert(0, fake)

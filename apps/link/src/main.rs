@@ -218,7 +218,8 @@ fn open_link(
 /// host whose other side died (or whose stop never came) does not wait for ever.
 struct PeerWatch {
     session: zenoh::Session,
-    connected: bool,
+    /// Every peer seen connected so far (each other host's link).
+    known: Vec<zenoh::session::ZenohId>,
     missing_since: Option<Instant>,
 }
 
@@ -228,21 +229,25 @@ impl PeerWatch {
     fn new(session: zenoh::Session) -> Self {
         Self {
             session,
-            connected: false,
+            known: Vec::new(),
             missing_since: None,
         }
     }
 
-    /// `true` once a peer that was connected has been gone for `GONE_AFTER`.
+    /// `true` once a peer that was connected has been gone for `GONE_AFTER` (with
+    /// three hosts, one that left is noticed while the third is still there). Only
+    /// peers are watched: a `--zenoh-config` in client mode or through a router has
+    /// none, and then the link never ends by itself.
     fn gone(&mut self) -> bool {
         use zenoh::Wait;
-        let any = self.session.info().peers_zid().wait().next().is_some();
-        if any {
-            self.connected = true;
-            self.missing_since = None;
-            return false;
+        let now: Vec<zenoh::session::ZenohId> = self.session.info().peers_zid().wait().collect();
+        for z in &now {
+            if !self.known.contains(z) {
+                self.known.push(*z);
+            }
         }
-        if !self.connected {
+        if self.known.iter().all(|z| now.contains(z)) {
+            self.missing_since = None;
             return false;
         }
         let since = *self.missing_since.get_or_insert_with(Instant::now);

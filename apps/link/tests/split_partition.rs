@@ -216,3 +216,72 @@ fn an_impostor_on_the_home_host_is_not_taken_for_the_filter_across_the_link() {
     );
     assert!(hosts.down(), "the two hosts were not removed");
 }
+
+/// `bench latency` with the config across hosts runs the home side in real time, prints
+/// the flight host's command, and its report marks the two hops that cross the link (the
+/// state to the translational filter, the robotic command back to the simulator).
+#[test]
+fn bench_latency_across_the_link_reports_the_links_hops() {
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|p| p.into_inner());
+    if !can_make_hosts() {
+        return;
+    }
+    let scratch =
+        Scratch(std::env::temp_dir().join(format!("sc-split-bench-{}", std::process::id())));
+    let dir = &scratch.0;
+    let _ = std::fs::remove_dir_all(dir);
+    std::fs::create_dir_all(dir).unwrap();
+    let mut hosts = TwoHosts::up(&format!("b{:x}", std::process::id() % 0xfffffff));
+    let exe = sibling("safe-capture");
+    let run_id = format!("bench-{}", std::process::id());
+    let mut home = hosts.on("a", &exe);
+    home.args([
+        "bench", "latency", "--ticks", "30", "--warmup", "5", "--run-id", &run_id,
+    ])
+    .arg("--config")
+    .arg(repo().join("config/partition_across_hosts.toml"))
+    .arg("--out")
+    .arg(dir.join("bench"))
+    .stdout(Stdio::piped())
+    .stderr(Stdio::piped());
+    let mut home = home.spawn().unwrap();
+    let said = first_line(&mut home);
+    let args = remote_command(&said);
+    assert!(args.iter().any(|a| a == "--real-time"), "{said}");
+    let mut flight = hosts.on("b", &exe);
+    flight
+        .args(&args)
+        .arg("--out")
+        .arg(dir.join("flight"))
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    let flight = hosts.spawn(flight);
+    let home = home.wait_with_output().unwrap();
+    let flight = hosts.wait_at_most(flight, std::time::Duration::from_secs(60));
+    eprintln!("home: {said}\n{}\nflight: {}", text(&home), text(&flight));
+    assert!(home.status.success(), "bench latency: {}", text(&home));
+    assert!(
+        flight.status.success(),
+        "the flight host's launch: {}",
+        text(&flight)
+    );
+    let report = std::fs::read_to_string(dir.join("bench/latency_report.md")).unwrap();
+    for hop in [
+        "6 state -> translational filter out (across the link)",
+        "9 robotic safe -> simulator (across the link)",
+    ] {
+        assert!(report.contains(hop), "{hop} not in {report}");
+    }
+    assert!(
+        !report.contains("7 translational -> attitude filter out (across"),
+        "{report}"
+    );
+    for side in ["a", "b"] {
+        let left = hosts.run_files(side, &run_id);
+        assert!(
+            left.is_empty(),
+            "host {side} keeps files of the run: {left}"
+        );
+    }
+    assert!(hosts.down(), "the two hosts were not removed");
+}

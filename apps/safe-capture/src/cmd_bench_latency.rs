@@ -49,18 +49,19 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     sc_ground::preflight::preflight(&cfg, &None)
         .map_err(|e| anyhow::anyhow!("{}: {e}", a.config.display()))?;
     a.figures.check()?;
-    let run_id = match (&cfg.hosts, &a.run_id) {
-        (Some(hosts), id) => {
-            let id = id.clone().unwrap_or_else(|| {
+    let run_id =
+        match (&cfg.hosts, &a.run_id) {
+            (Some(_), id) => Some(id.clone().unwrap_or_else(|| {
                 format!("bench-{}-{}", std::process::id(), sc_icd::monotonic_ns())
-            });
-            let real_time = ["--real-time".to_string()];
-            crate::cmd_launch::say_other_hosts(&a.config, hosts, &hosts.home, &id, &real_time);
-            Some(id)
-        }
-        (None, id) => id.clone(),
-    };
+            })),
+            (None, id) => id.clone(),
+        };
     let staged = crate::out_folder::stage(&a.out, "bench latency", a.force)?;
+    // said once every check passed: the other hosts' commands
+    if let (Some(hosts), Some(id)) = (&cfg.hosts, &run_id) {
+        let real_time = ["--real-time".to_string()];
+        crate::cmd_launch::say_other_hosts(&a.config, hosts, &hosts.home, None, id, &real_time);
+    }
     let r = match bench(&BenchOptions {
         config: a.config,
         out: staged.path().to_path_buf(),

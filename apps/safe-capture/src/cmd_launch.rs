@@ -236,24 +236,38 @@ fn across_hosts(
         None => format!("run-{}-{}", std::process::id(), sc_icd::monotonic_ns()),
     };
     opts.run_id = Some(id.clone());
-    let mut extra = Vec::new();
-    if a.real_time {
-        extra.push("--real-time".to_string());
-    }
-    if let Some(case) = &a.hostile {
-        // the hostile partners replace the roles of whichever host runs them
-        extra.extend(["--hostile".to_string(), shell_word(case)]);
-        extra.extend([
-            "--python".to_string(),
-            shell_word(&a.python.display().to_string()),
-        ]);
-        extra.extend([
-            "--partner".to_string(),
-            shell_word(&a.partner.display().to_string()),
-        ]);
-    }
-    say_other_hosts(&a.config, hosts, &host, &id, &extra);
     Ok(Some(true))
+}
+
+/// Says, once every check passed, the command that starts each other host's side: with
+/// `--real-time` as here, and `--hostile` only for a host that runs a replaced role.
+fn say_other_hosts_of_launch(a: &Args, cfg: &sc_ground::PartitionConfig, opts: &LaunchOptions) {
+    let (Some(hosts), Some(id)) = (&cfg.hosts, &opts.run_id) else {
+        return;
+    };
+    let home = &hosts.home;
+    for other in hosts.names().into_iter().filter(|h| h != home) {
+        let mut extra = Vec::new();
+        if a.real_time {
+            extra.push("--real-time".to_string());
+        }
+        let replaced_there = opts
+            .role_override
+            .iter()
+            .any(|(r, _, _)| cfg.host_of(r) == other);
+        if let (Some(case), true) = (&a.hostile, replaced_there) {
+            extra.extend(["--hostile".to_string(), shell_word(case)]);
+            extra.extend([
+                "--python".to_string(),
+                shell_word(&a.python.display().to_string()),
+            ]);
+            extra.extend([
+                "--partner".to_string(),
+                shell_word(&a.partner.display().to_string()),
+            ]);
+        }
+        say_other_hosts(&a.config, hosts, home, Some(other), id, &extra);
+    }
 }
 
 /// `w` as one word of a POSIX shell command line (quoted when it has to be).
@@ -271,6 +285,7 @@ pub fn say_other_hosts(
     config: &std::path::Path,
     hosts: &sc_flight::hosts::Hosts,
     host: &str,
+    only: Option<&str>,
     id: &str,
     extra: &[String],
 ) {
@@ -278,7 +293,11 @@ pub fn say_other_hosts(
     let config = shell_word(&config.display().to_string());
     let id = shell_word(id);
     let extra: String = extra.iter().map(|e| format!(" {e}")).collect();
-    for other in hosts.names().into_iter().filter(|h| *h != host) {
+    for other in hosts
+        .names()
+        .into_iter()
+        .filter(|h| *h != host && only.is_none_or(|o| o == *h))
+    {
         outln!(
             "launch: host {host} of {}; start host {other} with: safe-capture launch --config {config} --host {other} --run-id {id}{extra}",
             hosts.link.len(),
@@ -325,6 +344,9 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let staged = crate::out_folder::stage(&a.out, "launch", a.force)?;
     let out = staged.path().to_path_buf();
     opts.out = out.clone();
+    if home {
+        say_other_hosts_of_launch(&a, &cfg, &opts);
+    }
     let rep = launch(&opts)?;
     if !home {
         return away_end(&a, &rep, staged);

@@ -447,6 +447,8 @@ pub struct Subscriber<T: Debug + ZeroCopySend + Copy + 'static> {
     rejected: std::cell::Cell<u64>,
     /// Only this publisher may be pinned (with the run's config to look its node up).
     expected: Option<(ExpectedPublisher, iceoryx2::config::Config)>,
+    /// Nodes found not to be the expected publisher (not looked up again).
+    not_expected: std::cell::RefCell<Vec<UniqueNodeId>>,
 }
 
 impl<T: Debug + ZeroCopySend + Copy + 'static> Subscriber<T> {
@@ -501,12 +503,30 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Subscriber<T> {
             pinned: std::cell::Cell::new(None),
             rejected: std::cell::Cell::new(0),
             expected: None,
+            not_expected: std::cell::RefCell::new(Vec::new()),
         })
+    }
+
+    /// Whether `node` is the expected publisher (a node found not to be is remembered).
+    fn is_expected(&self, node: &UniqueNodeId) -> bool {
+        let Some((e, config)) = &self.expected else {
+            return true;
+        };
+        if self.not_expected.borrow().contains(node) {
+            return false;
+        }
+        let yes = e.is(config, node);
+        if !yes {
+            self.not_expected.borrow_mut().push(*node);
+        }
+        yes
     }
 
     /// Accepts samples only from `publisher`, a node of the run of `node`: the first
     /// publisher heard is pinned only if it is that one (by default, whichever is heard
-    /// first — on one host the owner, whose port exists before the first tick).
+    /// first — on one host the owner, whose port exists before the first tick). A later
+    /// publisher port of the same node (a re-opened bridge of the link) is accepted in
+    /// the first one's place.
     pub fn expect_publisher(&mut self, node: &BusNode, publisher: ExpectedPublisher) {
         self.expected = Some((publisher, node.config().clone()));
     }
@@ -587,12 +607,14 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Subscriber<T> {
                 Ok(Some(sample)) => {
                     let from = sample.header().publisher_id();
                     match self.pinned.get() {
-                        None if self.expected.as_ref().is_some_and(|(e, config)| {
-                            !e.is(config, &sample.header().node_id())
-                        }) =>
-                        {
-                            self.rejected.set(self.rejected.get() + 1);
-                            continue;
+                        // told whom to accept: a new publisher port of that node (the link
+                        // re-opens a bridge with a new port) is pinned again
+                        p if p != Some(from) && self.expected.is_some() => {
+                            if !self.is_expected(&sample.header().node_id()) {
+                                self.rejected.set(self.rejected.get() + 1);
+                                continue;
+                            }
+                            self.pinned.set(Some(from));
                         }
                         None => self.pinned.set(Some(from)),
                         Some(p) if p != from => {

@@ -340,6 +340,40 @@ fn a_subscriber_told_its_publisher_does_not_pin_an_intruder_heard_first() {
     run.teardown().unwrap();
 }
 
+/// The link re-opens a bridge with a new publisher port of its node: a subscriber told
+/// whom to accept takes the new port in the old one's place (pinned by arrival alone, it
+/// would refuse it).
+#[test]
+fn a_new_port_of_the_expected_publisher_is_pinned_again() {
+    let run = RunScope::unique("repin").unwrap();
+    {
+        let link = run.node("link").unwrap();
+        let reader = run.node("simulator").unwrap();
+        let qos = ServiceSettings::lock_step();
+        let tick = |tick| Tick {
+            tick,
+            ..Default::default()
+        };
+        let mut rx = Subscriber::<Tick>::with_name(&reader, "safe", &qos).unwrap();
+        rx.expect_publisher(
+            &reader,
+            sc_bus::ExpectedPublisher {
+                node_name: "link".into(),
+                pid: Some(std::process::id() as i32),
+            },
+        );
+        let first = Publisher::<Tick>::with_name(&link, "safe", &qos).unwrap();
+        first.send(&tick(1)).unwrap();
+        assert_eq!(rx.try_receive().unwrap().map(|t| t.tick), Some(1));
+        drop(first);
+        let reopened = Publisher::<Tick>::with_name(&link, "safe", &qos).unwrap();
+        reopened.send(&tick(2)).unwrap();
+        assert_eq!(rx.try_receive().unwrap().map(|t| t.tick), Some(2));
+        assert_eq!(rx.rejected(), 0);
+    }
+    run.teardown().unwrap();
+}
+
 /// Who may publish: a subscriber accepts samples only from the first publisher it heard
 /// (a second one's are dropped and counted), and a service created with room for more
 /// publishers than the settings say is refused at open (impersonation, issue #12).

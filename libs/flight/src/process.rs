@@ -127,9 +127,11 @@ impl Qos {
             return Self::one_host();
         }
         let here = cfg.host_of(role);
+        // a malformed value accepts no link at all (every sample across is refused,
+        // counted and logged), not any node named `link`
         let link_pid = std::env::var(LINK_PID_ENV)
             .ok()
-            .and_then(|p| p.parse::<i32>().ok());
+            .map(|p| p.parse::<i32>().unwrap_or(-1));
         let publishers = sc_icd::ROLES
             .iter()
             .flat_map(|owner| owner.publishes.iter().map(move |s| (*s, owner.name)))

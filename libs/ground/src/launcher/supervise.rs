@@ -192,6 +192,9 @@ impl<'a> Supervisor<'a> {
     /// cannot go on across hosts: tear down); stopped [`LINK_DRAIN`] after the last role
     /// ended, killed if it ignores SIGTERM.
     fn watch_link(&mut self) {
+        if self.roles_done_at.is_none() && self.procs.iter().all(|p| p.exit.is_some()) {
+            self.roles_done_at = Some(Instant::now());
+        }
         let Some(link) = self.link.as_mut() else {
             return;
         };
@@ -199,7 +202,9 @@ impl<'a> Supervisor<'a> {
             && let Ok(Some(st)) = link.child.try_wait()
         {
             use std::os::unix::process::ExitStatusExt;
-            let stopped = self.roles_done_at.is_some();
+            // after the mission's normal end (the scheduler here, or every role of this
+            // host) the other host leaving is no failure: it ended too
+            let stopped = self.roles_done_at.is_some() || self.normal_end;
             let ex = ProcessExit {
                 role: link.role.to_string(),
                 pid: link.child.id(),
@@ -217,14 +222,11 @@ impl<'a> Supervisor<'a> {
                     );
                 }
                 self.teardown_at = Some(Instant::now());
-            } else if !ex.ended_well() && ex.signal != Some(libc::SIGTERM) {
+            } else if !ex.ended_well() && ex.signal != Some(libc::SIGTERM) && !self.normal_end {
                 self.failed = true;
             }
             link.exit = Some(ex);
             return;
-        }
-        if self.roles_done_at.is_none() && self.procs.iter().all(|p| p.exit.is_some()) {
-            self.roles_done_at = Some(Instant::now());
         }
         let Some(done) = self.roles_done_at else {
             return;
