@@ -64,8 +64,8 @@ pub(super) struct Supervisor<'a> {
     procs: Vec<Watched>,
     /// This host's end of the link (a run across hosts): stopped after the roles.
     link: Option<Watched>,
-    /// This host is not the home host: no scheduler here, the stop tick comes through
-    /// the link and a role that ends well after it starts the teardown.
+    /// This host is not the home host: no scheduler and no telemetry here (no progress
+    /// to say); each role ends on the stop tick that comes through the link.
     away: bool,
     /// When the last role of this host ended.
     roles_done_at: Option<Instant>,
