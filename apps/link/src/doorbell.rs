@@ -84,22 +84,37 @@ impl Doorbells {
     }
 
     /// Reads every doorbell's queue and rings those where `link` published a sample.
+    /// One that fails does not keep the others from being read (their queues would fill
+    /// and their publishers report drops): the first failure is returned after all.
     pub fn ring(&self, link: &UniqueNodeId) -> Result<usize> {
         let mut rung = 0;
+        let mut first_failure = None;
         for (name, d) in &self.by_service {
-            if d.drain(link)
-                .with_context(|| format!("doorbell of {name}"))?
-            {
-                // not to the link's own listener on this event: that would send the ring
-                // back to the other host (as the link's own ports skip themselves)
-                d.notifier
-                    .__internal_notify(EventId::new(sc_bus::pubsub::EVENT_SAMPLE), true)
-                    .map_err(|e| anyhow!("{e:?}"))
-                    .with_context(|| format!("ringing {name}"))?;
-                rung += 1;
+            match Self::ring_one(name, d, link) {
+                Ok(true) => rung += 1,
+                Ok(false) => {}
+                Err(e) => {
+                    first_failure.get_or_insert(e);
+                }
             }
         }
-        Ok(rung)
+        first_failure.map_or(Ok(rung), Err)
+    }
+
+    fn ring_one(name: &str, d: &Doorbell, link: &UniqueNodeId) -> Result<bool> {
+        if !d
+            .drain(link)
+            .with_context(|| format!("doorbell of {name}"))?
+        {
+            return Ok(false);
+        }
+        // not to the link's own listener on this event: that would send the ring back
+        // to the other host (as the link's own ports skip themselves)
+        d.notifier
+            .__internal_notify(EventId::new(sc_bus::pubsub::EVENT_SAMPLE), true)
+            .map_err(|e| anyhow!("{e:?}"))
+            .with_context(|| format!("ringing {name}"))?;
+        Ok(true)
     }
 
     /// How many services have one.

@@ -61,9 +61,23 @@ struct Cli {
     /// How often pending samples and notifications are moved [µs].
     #[arg(long, default_value_t = 200, value_name = "US")]
     poll_us: u64,
-    /// How often the services on both hosts are listed [ms].
+    /// How often the services on both hosts are listed [ms] while bridges come and go.
     #[arg(long, default_value_t = 20, value_name = "MS")]
     discover_ms: u64,
+    /// How often they are listed once the bridges have not changed for 2 s [ms]; 0:
+    /// never again. A partition creates every service before its first tick, and a
+    /// listing costs: it stalls the link's passes for tens of milliseconds (measured: at
+    /// 1000 ms, 36 deadline misses in 980 real-time ticks), and it can re-open a bridge
+    /// (iceoryx2-link re-resolves a service that one pass of its listing missed), losing
+    /// what is in flight on it.
+    #[arg(long, default_value_t = 0, value_name = "MS")]
+    rediscover_ms: u64,
+    /// SCHED_FIFO priority of the link and of every thread it starts (Zenoh's), 1..=99;
+    /// 0: normal scheduling. In real time the launcher gives it the roles'
+    /// `real_time_priority`: at normal priority beside SCHED_FIFO roles it waits behind
+    /// them (measured: 39 deadline misses in 978 ticks).
+    #[arg(long, default_value_t = 0, value_name = "PRIO")]
+    priority: u32,
 }
 
 fn main() -> std::process::ExitCode {
@@ -78,6 +92,15 @@ fn main() -> std::process::ExitCode {
 
 fn run(cli: Cli) -> Result<()> {
     sc_bus::init_logging();
+    if cli.priority > 99 {
+        bail!(
+            "--priority {}: 1..=99, or 0 for normal scheduling",
+            cli.priority
+        );
+    }
+    if cli.priority > 0 {
+        set_fifo(cli.priority);
+    }
     if cli.poll_us == 0 || cli.discover_ms == 0 {
         bail!("--poll-us and --discover-ms must be positive");
     }
@@ -105,7 +128,10 @@ fn run(cli: Cli) -> Result<()> {
         &mut link,
         &mut peers,
         Duration::from_micros(cli.poll_us),
-        Duration::from_millis(cli.discover_ms),
+        Discovery::new(
+            Duration::from_millis(cli.discover_ms),
+            (cli.rediscover_ms > 0).then(|| Duration::from_millis(cli.rediscover_ms)),
+        ),
     );
     eprintln!("sc-link: stopped ({outcome:?})");
     match outcome? {
@@ -114,6 +140,21 @@ fn run(cli: Cli) -> Result<()> {
             PeerWatch::GONE_AFTER
         ),
         _ => Ok(()),
+    }
+}
+
+/// SCHED_FIFO at `prio` for this process, before it starts any thread (they inherit it);
+/// a refusal (no CAP_SYS_NICE) is a warning.
+fn set_fifo(prio: u32) {
+    let param = libc::sched_param {
+        sched_priority: prio as libc::c_int,
+    };
+    // SAFETY: sched_setscheduler on this process with a valid, initialised param.
+    if unsafe { libc::sched_setscheduler(0, libc::SCHED_FIFO, &param) } != 0 {
+        eprintln!(
+            "sc-link: warning: SCHED_FIFO priority {prio} refused ({}); normal scheduling",
+            std::io::Error::last_os_error()
+        );
     }
 }
 
@@ -221,16 +262,29 @@ struct PeerWatch {
     /// Every peer seen connected so far (each other host's link).
     known: Vec<zenoh::session::ZenohId>,
     missing_since: Option<Instant>,
+    looked: Option<Instant>,
 }
 
 impl PeerWatch {
     const GONE_AFTER: Duration = Duration::from_secs(3);
+    /// How often the peers are looked at.
+    const EVERY: Duration = Duration::from_millis(100);
+
+    /// Whether a look is due now (and if so, it counts as done).
+    fn due(&mut self) -> bool {
+        if self.looked.is_some_and(|t| t.elapsed() < Self::EVERY) {
+            return false;
+        }
+        self.looked = Some(Instant::now());
+        true
+    }
 
     fn new(session: zenoh::Session) -> Self {
         Self {
             session,
             known: Vec::new(),
             missing_since: None,
+            looked: None,
         }
     }
 
@@ -279,11 +333,60 @@ fn exists_here(name: &ServiceName, config: &iceoryx2::config::Config) -> bool {
 
 /// Moves samples every `poll` and on every wake from the other host (then rings the
 /// doorbells, `doorbell.rs`), lists the services every `discover`, until SIGINT/SIGTERM.
+/// When to list the services: every `fast` while the bridges change, every `slow` (or
+/// never) once they have not changed for [`Discovery::STABLE`].
+struct Discovery {
+    fast: Duration,
+    slow: Option<Duration>,
+    listed: Option<Instant>,
+    bridged: usize,
+    changed: Instant,
+}
+
+impl Discovery {
+    const STABLE: Duration = Duration::from_secs(2);
+
+    fn new(fast: Duration, slow: Option<Duration>) -> Self {
+        Self {
+            fast,
+            slow,
+            listed: None,
+            bridged: 0,
+            changed: Instant::now(),
+        }
+    }
+
+    /// Whether a listing is due now (and if so, it counts as done).
+    fn due(&mut self) -> bool {
+        let every = if self.changed.elapsed() >= Self::STABLE {
+            match self.slow {
+                Some(slow) => slow,
+                None => return false,
+            }
+        } else {
+            self.fast
+        };
+        if self.listed.is_some_and(|t| t.elapsed() < every) {
+            return false;
+        }
+        self.listed = Some(Instant::now());
+        true
+    }
+
+    /// After a listing: how many bridged data services there are now.
+    fn bridges(&mut self, n: usize) {
+        if n != self.bridged {
+            self.bridged = n;
+            self.changed = Instant::now();
+        }
+    }
+}
+
 fn spin(
     link: &mut ZenohLink,
     peers: &mut PeerWatch,
     poll: Duration,
-    discover: Duration,
+    mut discovery: Discovery,
 ) -> Result<WaitSetRunResult> {
     let wake = link
         .listener()
@@ -298,15 +401,13 @@ fn spin(
     let _woken = waitset
         .attach_notification(&wake)
         .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-    let mut listed: Option<Instant> = None;
     let mut doorbells = Doorbells::default();
     let mut complaints = Complaints::default();
     let link_node = *link.node().id();
     let result = waitset
         .wait_and_process(|_| {
             let _ = wake.try_wait(|_| {});
-            if listed.is_none_or(|t| t.elapsed() >= discover) {
-                listed = Some(Instant::now());
+            if discovery.due() {
                 if let Err(e) = link.discover() {
                     complaints.say(&format!("discovery failed: {e}"));
                 }
@@ -315,9 +416,11 @@ fn spin(
                 if let Err(e) = doorbells.discover(link.node(), &is_bridged) {
                     complaints.say(&format!("{e:#}"));
                 }
-                if peers.gone() {
-                    return CallbackProgression::Stop;
-                }
+                // the bridged data services, each with its doorbell: stable once all are up
+                discovery.bridges(doorbells.len());
+            }
+            if peers.due() && peers.gone() {
+                return CallbackProgression::Stop;
             }
             // a failed pass leaves the link usable (iceoryx2-link): say so, go on
             if let Err(e) = link.propagate() {

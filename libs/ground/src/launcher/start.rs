@@ -192,6 +192,11 @@ pub(super) fn spawn_link(
     for other in hosts.others(host) {
         cmd.arg("--connect").arg(other);
     }
+    // in real time the link carries the causal chain: it must not wait behind the roles
+    if cfg.clock == sc_flight::ClockMode::RealTime && cfg.real_time_priority > 0 {
+        cmd.arg("--priority")
+            .arg(cfg.real_time_priority.to_string());
+    }
     cmd.stdin(Stdio::null()).stdout(log.0).stderr(log.1);
     cmd.spawn().map(Some).map_err(|source| SpawnError::Exec {
         role: role.to_string(),
