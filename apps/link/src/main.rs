@@ -64,13 +64,13 @@ struct Cli {
     /// How often the services on both hosts are listed [ms] while bridges come and go.
     #[arg(long, default_value_t = 20, value_name = "MS")]
     discover_ms: u64,
-    /// How often they are listed once the bridges have not changed for 2 s [ms]; 0:
-    /// never again. A partition creates every service before its first tick, and a
-    /// listing costs: it stalls the link's passes for tens of milliseconds (measured: at
-    /// 1000 ms, 36 deadline misses in 980 real-time ticks), and it can re-open a bridge
-    /// (iceoryx2-link re-resolves a service that one pass of its listing missed), losing
-    /// what is in flight on it.
-    #[arg(long, default_value_t = 0, value_name = "MS")]
+    /// How often they are listed once some bridges are up and they have not changed for
+    /// 0.5 s [ms]; 0: never again. A partition creates every service before its first
+    /// tick, and a listing costs: it stalls the link's passes for tens of milliseconds,
+    /// and it can re-open a bridge (iceoryx2-link re-resolves a service that one pass of
+    /// its listing missed), losing what is in flight on it. Rare listings still bridge a
+    /// service that came late.
+    #[arg(long, default_value_t = 5000, value_name = "MS")]
     rediscover_ms: u64,
     /// SCHED_FIFO priority of the link and of every thread it starts (Zenoh's), 1..=99;
     /// 0: normal scheduling. In real time the launcher gives it the roles'
@@ -333,8 +333,8 @@ fn exists_here(name: &ServiceName, config: &iceoryx2::config::Config) -> bool {
 
 /// Moves samples every `poll` and on every wake from the other host (then rings the
 /// doorbells, `doorbell.rs`), lists the services every `discover`, until SIGINT/SIGTERM.
-/// When to list the services: every `fast` while the bridges change, every `slow` (or
-/// never) once they have not changed for [`Discovery::STABLE`].
+/// When to list the services: every `fast` until some bridges are up and have not changed
+/// for [`Discovery::STABLE`], then every `slow` (or never).
 struct Discovery {
     fast: Duration,
     slow: Option<Duration>,
@@ -344,7 +344,7 @@ struct Discovery {
 }
 
 impl Discovery {
-    const STABLE: Duration = Duration::from_secs(2);
+    const STABLE: Duration = Duration::from_millis(500);
 
     fn new(fast: Duration, slow: Option<Duration>) -> Self {
         Self {
@@ -358,7 +358,8 @@ impl Discovery {
 
     /// Whether a listing is due now (and if so, it counts as done).
     fn due(&mut self) -> bool {
-        let every = if self.changed.elapsed() >= Self::STABLE {
+        // nothing bridged yet (the other host not started): keep looking
+        let every = if self.bridged > 0 && self.changed.elapsed() >= Self::STABLE {
             match self.slow {
                 Some(slow) => slow,
                 None => return false,
