@@ -58,23 +58,31 @@ fn text(o: &std::process::Output) -> String {
     )
 }
 
-/// One run split across the two hosts: the home side (host a) with `home_args` after
-/// `launch`, the flight side (host b) with the command the home side printed; both must
-/// end well and leave nothing of the run on either host. Returns the home side's output.
-fn split_run(
+/// What both sides of a split run said.
+struct Sides {
+    /// The home side's first line (the other host's command).
+    said: String,
+    home: std::process::Output,
+    flight: std::process::Output,
+}
+
+/// Starts `safe-capture <home_args> --run-id <run_id> --config <across hosts> --out
+/// <dir/home_out>` on host a, then on host b the command it printed (`--out dir/flight`),
+/// waits for both, and checks that neither host keeps a file of the run.
+fn both_sides(
     hosts: &mut TwoHosts,
     dir: &std::path::Path,
     run_id: &str,
     home_args: &[&str],
-) -> String {
+    home_out: &str,
+) -> Sides {
     let exe = sibling("safe-capture");
-    let config = repo().join("config/partition_across_hosts.toml");
     let mut home = hosts.on("a", &exe);
-    home.args(["launch", "--no-figures", "--run-id", run_id, "--config"])
-        .arg(&config)
-        .args(home_args)
+    home.args(home_args)
+        .args(["--run-id", run_id, "--config"])
+        .arg(repo().join("config/partition_across_hosts.toml"))
         .arg("--out")
-        .arg(dir.join("ground"))
+        .arg(dir.join(home_out))
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
     let mut home = home.spawn().unwrap();
@@ -94,6 +102,22 @@ fn split_run(
     // one: give up on it after a grace period (the hosts' teardown kills it)
     let flight = hosts.wait_at_most(flight, std::time::Duration::from_secs(60));
     eprintln!("home: {said}\n{}\nflight: {}", text(&home), text(&flight));
+    for side in ["a", "b"] {
+        let left = hosts.run_files(side, run_id);
+        assert!(
+            left.is_empty(),
+            "host {side} keeps files of the run: {left}"
+        );
+    }
+    Sides { said, home, flight }
+}
+
+/// One mission split across the two hosts with `launch` (and `extra` arguments): both
+/// sides must end well. Returns the home side's output.
+fn split_run(hosts: &mut TwoHosts, dir: &std::path::Path, run_id: &str, extra: &[&str]) -> String {
+    let mut args = vec!["launch", "--no-figures"];
+    args.extend_from_slice(extra);
+    let Sides { home, flight, .. } = both_sides(hosts, dir, run_id, &args, "ground");
     // exit 0 captured safely, 1 stopped by --max-ticks before the capture
     assert!(
         matches!(home.status.code(), Some(0 | 1)),
@@ -111,14 +135,15 @@ fn split_run(
         "{}",
         text(&flight)
     );
-    for side in ["a", "b"] {
-        let left = hosts.run_files(side, run_id);
-        assert!(
-            left.is_empty(),
-            "host {side} keeps files of the run: {left}"
-        );
-    }
     text(&home)
+}
+
+/// A fresh scratch folder named after `tag` and this process.
+fn scratch(tag: &str) -> Scratch {
+    let s = Scratch(std::env::temp_dir().join(format!("sc-split-{tag}-{}", std::process::id())));
+    let _ = std::fs::remove_dir_all(&s.0);
+    std::fs::create_dir_all(&s.0).unwrap();
+    s
 }
 
 fn same_telemetry(a: &std::path::Path, b: &std::path::Path) -> bool {
@@ -132,10 +157,8 @@ fn a_lock_step_mission_split_across_two_hosts_is_the_same_bytes_as_run() {
     if !can_make_hosts() {
         return;
     }
-    let scratch = Scratch(std::env::temp_dir().join(format!("sc-split-{}", std::process::id())));
+    let scratch = scratch("mission");
     let dir = &scratch.0;
-    let _ = std::fs::remove_dir_all(dir);
-    std::fs::create_dir_all(dir).unwrap();
     let run = Command::new(sibling("safe-capture"))
         .args(["run", "--no-figures", "--out"])
         .arg(dir.join("run"))
@@ -173,11 +196,8 @@ fn an_impostor_on_the_home_host_is_not_taken_for_the_filter_across_the_link() {
     if !can_make_hosts() {
         return;
     }
-    let scratch =
-        Scratch(std::env::temp_dir().join(format!("sc-split-imp-{}", std::process::id())));
+    let scratch = scratch("imp");
     let dir = &scratch.0;
-    let _ = std::fs::remove_dir_all(dir);
-    std::fs::create_dir_all(dir).unwrap();
     let hostile = [
         "--hostile",
         "attitude/spin:x+impersonate",
@@ -226,39 +246,13 @@ fn bench_latency_across_the_link_reports_the_links_hops() {
     if !can_make_hosts() {
         return;
     }
-    let scratch =
-        Scratch(std::env::temp_dir().join(format!("sc-split-bench-{}", std::process::id())));
+    let scratch = scratch("bench");
     let dir = &scratch.0;
-    let _ = std::fs::remove_dir_all(dir);
-    std::fs::create_dir_all(dir).unwrap();
     let mut hosts = TwoHosts::up(&format!("b{:x}", std::process::id() % 0xfffffff));
-    let exe = sibling("safe-capture");
     let run_id = format!("bench-{}", std::process::id());
-    let mut home = hosts.on("a", &exe);
-    home.args([
-        "bench", "latency", "--ticks", "30", "--warmup", "5", "--run-id", &run_id,
-    ])
-    .arg("--config")
-    .arg(repo().join("config/partition_across_hosts.toml"))
-    .arg("--out")
-    .arg(dir.join("bench"))
-    .stdout(Stdio::piped())
-    .stderr(Stdio::piped());
-    let mut home = home.spawn().unwrap();
-    let said = first_line(&mut home);
-    let args = remote_command(&said);
-    assert!(args.iter().any(|a| a == "--real-time"), "{said}");
-    let mut flight = hosts.on("b", &exe);
-    flight
-        .args(&args)
-        .arg("--out")
-        .arg(dir.join("flight"))
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped());
-    let flight = hosts.spawn(flight);
-    let home = home.wait_with_output().unwrap();
-    let flight = hosts.wait_at_most(flight, std::time::Duration::from_secs(60));
-    eprintln!("home: {said}\n{}\nflight: {}", text(&home), text(&flight));
+    let bench = ["bench", "latency", "--ticks", "30", "--warmup", "5"];
+    let Sides { said, home, flight } = both_sides(&mut hosts, dir, &run_id, &bench, "bench");
+    assert!(said.contains("--real-time"), "{said}");
     assert!(home.status.success(), "bench latency: {}", text(&home));
     assert!(
         flight.status.success(),
@@ -276,12 +270,5 @@ fn bench_latency_across_the_link_reports_the_links_hops() {
         !report.contains("7 translational -> attitude filter out (across"),
         "{report}"
     );
-    for side in ["a", "b"] {
-        let left = hosts.run_files(side, &run_id);
-        assert!(
-            left.is_empty(),
-            "host {side} keeps files of the run: {left}"
-        );
-    }
     assert!(hosts.down(), "the two hosts were not removed");
 }

@@ -122,14 +122,7 @@ fn spawn_role(
     run: &RunScope,
 ) -> Result<Child, SpawnError> {
     let e = &cfg.roles[role];
-    let path = out.join("logs").join(format!("{role}.log"));
-    let log = std::fs::File::create(&path)
-        .and_then(|l| Ok((l.try_clone()?, l)))
-        .map_err(|source| SpawnError::Log {
-            role: role.to_string(),
-            path: path.display().to_string(),
-            source,
-        })?;
+    let log = open_log(out, role)?;
     let mut cmd = Command::new(&e.exec);
     cmd.args(&e.args);
     if !e.no_standard_args {
@@ -175,14 +168,7 @@ pub(super) fn spawn_link(
         return Ok(None);
     };
     let role = "link";
-    let path = out.join("logs").join("link.log");
-    let log = std::fs::File::create(&path)
-        .and_then(|l| Ok((l.try_clone()?, l)))
-        .map_err(|source| SpawnError::Log {
-            role: role.to_string(),
-            path: path.display().to_string(),
-            source,
-        })?;
+    let log = open_log(out, role)?;
     let exec = resolve_exec(LINK_EXEC, &abs(&cfg.base_dir), bin_dir);
     let mut cmd = Command::new(&exec);
     cmd.arg("--run-id").arg(run.run_id());
@@ -203,6 +189,18 @@ pub(super) fn spawn_link(
         exec: exec.display().to_string(),
         source,
     })
+}
+
+/// `logs/<name>.log` of the run, twice: the process's stdout and stderr.
+fn open_log(out: &Path, name: &str) -> Result<(std::fs::File, std::fs::File), SpawnError> {
+    let path = out.join("logs").join(format!("{name}.log"));
+    std::fs::File::create(&path)
+        .and_then(|l| Ok((l.try_clone()?, l)))
+        .map_err(|source| SpawnError::Log {
+            role: name.to_string(),
+            path: path.display().to_string(),
+            source,
+        })
 }
 
 /// Why a role's process could not be started.
