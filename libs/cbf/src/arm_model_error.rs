@@ -311,48 +311,12 @@ fn base_directions(robot: &Robot, model: &ModelBounds) -> Vec<Direction> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_draws::{ball, lcg};
+    use crate::test_draws::{lcg, pick, plant};
     use sc_multibody::Vector7;
 
     fn robot() -> Robot {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../config/servicer.urdf");
         Robot::from_urdf_file(std::path::Path::new(path)).unwrap()
-    }
-
-    /// A uniform draw in `[-e, e]`, the ends half the time (the bound's worst cases).
-    fn pick(seed: &mut u64, e: f64) -> f64 {
-        let u = lcg(seed);
-        if u < 0.25 {
-            -e
-        } else if u < 0.5 {
-            e
-        } else {
-            e * (2.0 * lcg(seed) - 1.0)
-        }
-    }
-
-    /// A plant at a random point of the declared box.
-    fn plant(seed: &mut u64, r: &Robot, m: &ModelBounds) -> Robot {
-        let com = ball(seed, 1.0).normalize() * m.servicer_com_m * (0.5 + 0.5 * lcg(seed));
-        let mut p = r
-            .with_body_mass_properties(
-                0,
-                1.0 + pick(seed, m.servicer_mass_rel),
-                1.0 + pick(seed, m.servicer_inertia_rel),
-                com,
-            )
-            .unwrap();
-        for k in 1..=NJ {
-            p = p
-                .with_body_mass_properties(
-                    k,
-                    1.0 + pick(seed, m.link_mass_rel),
-                    1.0 + pick(seed, m.link_inertia_rel),
-                    Vector3::zeros(),
-                )
-                .unwrap();
-        }
-        p
     }
 
     /// For plants anywhere in the `realistic` box, states and commands over the arm's

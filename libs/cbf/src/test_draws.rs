@@ -1,6 +1,8 @@
 //! Reproducible random draws for the unit tests (one generator for every module's tests).
 
 use nalgebra::Vector3;
+use sc_multibody::{NJ, Robot};
+use sc_scenario::uncertainty::ModelBounds;
 
 /// A uniform draw in `[0, 1)` from a 64-bit linear congruential generator.
 pub fn lcg(s: &mut u64) -> f64 {
@@ -19,4 +21,41 @@ pub fn ball(seed: &mut u64, radius: f64) -> Vector3<f64> {
             return v * radius;
         }
     }
+}
+
+/// A uniform draw in `[-e, e]`, the ends half the time (the bounds' worst cases).
+pub fn pick(seed: &mut u64, e: f64) -> f64 {
+    let u = lcg(seed);
+    if u < 0.25 {
+        -e
+    } else if u < 0.5 {
+        e
+    } else {
+        e * (2.0 * lcg(seed) - 1.0)
+    }
+}
+
+/// A plant at a random point of the declared mass-property box, as the simulator draws
+/// one: the base's mass, inertia and CoM, each link's mass and inertia.
+pub fn plant(seed: &mut u64, r: &Robot, m: &ModelBounds) -> Robot {
+    let com = ball(seed, 1.0).normalize() * m.servicer_com_m * (0.5 + 0.5 * lcg(seed));
+    let mut p = r
+        .with_body_mass_properties(
+            0,
+            1.0 + pick(seed, m.servicer_mass_rel),
+            1.0 + pick(seed, m.servicer_inertia_rel),
+            com,
+        )
+        .unwrap();
+    for k in 1..=NJ {
+        p = p
+            .with_body_mass_properties(
+                k,
+                1.0 + pick(seed, m.link_mass_rel),
+                1.0 + pick(seed, m.link_inertia_rel),
+                Vector3::zeros(),
+            )
+            .unwrap();
+    }
+    p
 }

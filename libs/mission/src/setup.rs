@@ -257,6 +257,41 @@ fn check_target_geometry(s: &Scenario, robot: &Robot) -> Result<(), SetupError> 
             ),
         });
     }
+    check_stowed_arm(s, robot, &model, target)
+}
+
+/// The stowed arm (`servicer.initial_theta_rad`, where the `hold` nominal keeps it) clears
+/// the target from anywhere outside the collision-avoidance zone, whatever the base's and
+/// the target's attitudes ([`sc_cbf::arm_target::arm_clearance_from_caz`]), for every plant
+/// the declared mass-property errors allow: the arm has a safe state against the target at
+/// the zone's edge. Without it a base turning at the zone's edge can sweep even a folded
+/// arm into the target, with its joints on their limits (docs/SAFETY.md, "The arm and the
+/// target").
+fn check_stowed_arm(
+    s: &Scenario,
+    robot: &Robot,
+    model: &sc_scenario::uncertainty::ModelBounds,
+    target: f64,
+) -> Result<(), SetupError> {
+    use sc_cbf::arm_target::{arm_clearance_from_caz, arm_reach_bound};
+    let stowed = sc_multibody::Vector7::from(s.servicer.initial_theta_rad);
+    let Some(reach) = arm_reach_bound(robot, &stowed, model) else {
+        return Err(SetupError::Other(
+            "the stowed arm cannot be shown off the target: the servicer model has no arm sphere, or the declared mass errors leave it no mass".into(),
+        ));
+    };
+    let r_caz = s.safety.translational.caz_radius_m;
+    let clear = arm_clearance_from_caz(r_caz, reach, target);
+    if clear < 0.0 {
+        return Err(SetupError::Inconsistent {
+            key: "safety.translational.caz_radius_m".into(),
+            value: r_caz.to_string(),
+            rule: format!(
+                "too small for the stowed arm to clear the target at the zone's edge: the arm at `servicer.initial_theta_rad` reaches {reach:.3} m from the system CoM (the declared mass errors' CoM shift included) and the target's keep-out spheres {target:.3} m from its CoM, so the zone needs at least {:.3} m — or a base turning at its edge can sweep the arm into the target",
+                r_caz - clear
+            ),
+        });
+    }
     Ok(())
 }
 
@@ -314,8 +349,9 @@ mod tests {
 
     /// The target's geometry against the servicer: a fixture the gripper's own spheres
     /// cannot reach without touching a keep-out sphere, and a collision-avoidance zone too
-    /// small to keep the base off the target, are refused on one line naming the key; the
-    /// default keeps both with room (its numbers below are the model's).
+    /// small to keep the base, or the stowed arm, off the target, are refused on one line
+    /// naming the key; the default keeps all three with room (its numbers below are the
+    /// model's).
     #[test]
     fn a_target_geometry_the_servicer_cannot_respect_is_refused() {
         use sc_cbf::arm_target::{base_com_offset_bound, gripper_overhang};
@@ -338,21 +374,27 @@ mod tests {
         s.target.collision_spheres[0].radius_m = 0.622;
         let msg = refused(s.clone(), "target.collision_spheres[0]");
         assert!(msg.contains("stick out 0.040 m"), "{msg}");
-        // 0.05 m off: accepted
+        // 0.05 m off: accepted (with a zone that leaves the stowed arm room from the
+        // larger sphere: 1.353 + 0.602 m)
         s.target.collision_spheres[0].radius_m = 0.602;
+        s.safety.translational.caz_radius_m = 1.96;
         Setup::from_scenario(s).expect("0.05 m off the sphere is accepted");
         // a zone that leaves the base's sphere (0.6 m) and the target's (0.45 m) no room
         let mut s = setup.scenario.clone();
         s.safety.translational.caz_radius_m = 1.05 + delta - 1e-3;
         let msg = refused(s.clone(), "safety.translational.caz_radius_m");
         assert!(msg.contains("keep the base off the target"), "{msg}");
+        // room for the base, none for the stowed arm (it reaches 1.353 m from the CoM)
         s.safety.translational.caz_radius_m = 1.05 + delta + 1e-3;
-        Setup::from_scenario(s).expect("room for the base is accepted");
+        let msg = refused(s.clone(), "safety.translational.caz_radius_m");
+        assert!(
+            msg.contains("stowed arm to clear the target") && msg.contains("at least 1.803 m"),
+            "{msg}"
+        );
+        s.safety.translational.caz_radius_m = 1.81;
+        let mut exact = Setup::from_scenario(s).expect("room for the stowed arm is accepted");
         // mass errors declared afterwards (`--uncertainty`) widen the CoM's offset: the
         // check after declaring them refuses what the exact model left room for
-        let mut s = setup.scenario.clone();
-        s.safety.translational.caz_radius_m = 1.05 + delta + 1e-3;
-        let mut exact = Setup::from_scenario(s).expect("room without mass errors");
         let spec =
             sc_scenario::UncertaintySpec::profile(sc_scenario::uncertainty::REALISTIC_NAME, 3);
         exact.scenario.set_uncertainty(spec).unwrap();
@@ -363,7 +405,8 @@ mod tests {
             .expect_err("refused")
             .to_string();
         assert!(
-            msg.starts_with("`safety.translational.caz_radius_m`"),
+            msg.starts_with("`safety.translational.caz_radius_m`")
+                && msg.contains("at least 1.849 m"),
             "{msg}"
         );
     }

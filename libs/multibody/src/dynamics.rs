@@ -445,6 +445,37 @@ impl Robot {
         self.inertias.get(k).map_or(0.0, |i| i.mass)
     }
 
+    /// A bound on how far the plant's system CoM lies from this model's at `θ` [m], for
+    /// every plant whose base mass is within `±base_mass_rel` of the model's, whose base
+    /// CoM is within `base_com_m` of it and whose link masses are each within
+    /// `±link_mass_rel` (links' CoMs as modelled). With `m'_k = m_k (1 + ε_k)` and
+    /// `Σ_k m_k (c_k − c) = 0`:
+    /// `c' − c = (Σ_k m_k ε_k (c_k − c) + m'_0 s) / Σ_k m'_k`, so
+    /// `‖c' − c‖ ≤ (Σ_k m_k ε̄_k ‖c_k − c‖ + m_0 (1 + ε̄_0) s̄) / Σ_k m_k (1 − ε̄_k)`.
+    /// `None` when the masses at their declared extremes leave the servicer none.
+    pub fn com_shift_bound(
+        &self,
+        theta: &Vector7,
+        base_mass_rel: f64,
+        base_com_m: f64,
+        link_mass_rel: f64,
+    ) -> Option<f64> {
+        let kin = self.kinematics(theta);
+        let c = self.center_of_mass(theta);
+        let rel = |k: usize| if k == 0 { base_mass_rel } else { link_mass_rel };
+        let (mut moved, mut low) = (0.0, 0.0);
+        for (k, (p, i)) in kin.pose.iter().zip(self.inertias.iter()).enumerate() {
+            if i.mass <= 0.0 {
+                continue;
+            }
+            let c_k = p.act_point(&(i.h / i.mass));
+            moved += i.mass * rel(k) * (c_k - c).norm();
+            low += i.mass * (1.0 - rel(k));
+        }
+        let shifted = self.body_mass(0) * (1.0 + base_mass_rel) * base_com_m;
+        (low > 0.0).then(|| (moved + shifted) / low)
+    }
+
     /// System centre of mass in the base frame (m).
     pub fn center_of_mass(&self, theta: &Vector7) -> Vector3<f64> {
         let kin = self.kinematics(theta);
