@@ -156,7 +156,7 @@ fn a_spin_up_puts_the_partition_in_safe_mode_as_in_process() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// The world's fixture 0.25 m farther off the spin axis than declared (undeclared to the
+/// The world's fixture 0.45 m farther off the spin axis than declared (undeclared to the
 /// filters): the simulator process takes it as the truth and estimates it, and the three
 /// filter processes go to safe mode on the first tick, as the mission in one process does,
 /// telemetry byte for byte; the summary names both fixtures.
@@ -167,7 +167,7 @@ fn a_fixture_elsewhere_puts_the_partition_in_safe_mode_as_in_process() {
     let config = write_config(&dir, Some(10.0), None, 20.0);
     let scenario = dir.join("scenario.toml");
     let mut text = std::fs::read_to_string(&scenario).unwrap();
-    text.push_str("\n[world]\ngrasp_point_m = [-0.55, 0.6, 0.0]\n");
+    text.push_str("\n[world]\ngrasp_point_m = [-0.55, 0.8, 0.0]\n");
     std::fs::write(&scenario, text).unwrap();
     let rep = sc_ground::launch(&options(&config, &out, "fixture")).unwrap();
     assert_eq!(rep.code, 1, "{rep:?}");
@@ -176,7 +176,7 @@ fn a_fixture_elsewhere_puts_the_partition_in_safe_mode_as_in_process() {
     let m = &b["safe_mode"];
     assert_eq!(m["entered_t_s"].as_f64(), Some(0.0), "{b}");
     assert_eq!(m["rule"], "line_of_sight_rate", "{b}");
-    assert_eq!(m["fixture_m"], serde_json::json!([-0.55, 0.6, 0.0]), "{b}");
+    assert_eq!(m["fixture_m"], serde_json::json!([-0.55, 0.8, 0.0]), "{b}");
     assert_eq!(m["undetected_t_s"], serde_json::Value::Null);
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -154,14 +154,14 @@ fn accepted_with_world(d: &Path, world: &str) -> (Output, String) {
 }
 
 /// The world's fixture elsewhere than declared is named with what the run-time watch will
-/// make of it: outside the envelope at 0.6 m off the spin axis, inside at 0.4 m; a
+/// make of it: outside the envelope at 0.8 m off the spin axis, inside at 0.4 m; a
 /// non-finite one is refused on one line.
 #[test]
 fn a_world_fixture_is_named_and_checked() {
     let d = tmp("check-world-fixture");
     for (y, after) in [
         (
-            "0.6",
+            "0.8",
             "outside the certified envelope (line_of_sight_rate): the run tests the safe mode",
         ),
         ("0.4", "inside the certified envelope"),

@@ -246,7 +246,8 @@ fn check_target_geometry(s: &Scenario, robot: &Robot) -> Result<(), SetupError> 
     let target = TargetBody::from_scenario(s).bounding_radius();
     let r_caz = s.safety.translational.caz_radius_m;
     let clear = base_clearance_from_caz(r_caz, delta, base.radius, target);
-    if clear < 0.0 {
+    // NaN is no clearance
+    if !(clear >= 0.0) {
         return Err(SetupError::Inconsistent {
             key: "safety.translational.caz_radius_m".into(),
             value: r_caz.to_string(),
@@ -282,7 +283,8 @@ fn check_stowed_arm(
     };
     let r_caz = s.safety.translational.caz_radius_m;
     let clear = arm_clearance_from_caz(r_caz, reach, target);
-    if clear < 0.0 {
+    // NaN is no clearance
+    if !(clear >= 0.0) {
         return Err(SetupError::Inconsistent {
             key: "safety.translational.caz_radius_m".into(),
             value: r_caz.to_string(),
@@ -354,7 +356,9 @@ mod tests {
     /// model's).
     #[test]
     fn a_target_geometry_the_servicer_cannot_respect_is_refused() {
-        use sc_cbf::arm_target::{base_com_offset_bound, gripper_overhang};
+        use sc_cbf::arm_target::{
+            base_clearance_from_caz, base_com_offset_bound, gripper_overhang,
+        };
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/scenario.toml");
         let setup = Setup::load(&path).expect("the default loads");
         // link 7's last sphere (radius 0.06) 0.02 m short of the end effector
@@ -399,7 +403,11 @@ mod tests {
             sc_scenario::UncertaintySpec::profile(sc_scenario::uncertainty::REALISTIC_NAME, 3);
         exact.scenario.set_uncertainty(spec).unwrap();
         let real = base_com_offset_bound(&exact.robot, &exact.scenario.uncertainty_bounds().model);
-        assert!((real.unwrap() - 0.1579).abs() < 1e-4, "{real:?} vs {delta}");
+        let real = real.unwrap();
+        assert!((real - 0.1579).abs() < 1e-4, "{real} vs {delta}");
+        // the base's own rule under them: 1.05 m + δ, here below the stowed arm's
+        let base_room = |r: f64| base_clearance_from_caz(r, real, 0.6, 0.45);
+        assert!(base_room(1.05 + real - 1e-3) < 0.0 && base_room(1.05 + real + 1e-3) > 0.0);
         let msg = exact
             .check_target_geometry()
             .expect_err("refused")

@@ -131,7 +131,7 @@ fn fixture_at(fixture: [f64; 3], realistic: bool) -> (sc_mission::Summary, Vec<S
     in_world(world, realistic)
 }
 
-/// A target whose fixture is 0.25 m farther off the spin axis than declared (0.6 m: at the
+/// A target whose fixture is 0.45 m farther off the spin axis than declared (0.8 m: at the
 /// declared 0.08 rad/s it turns the line of sight faster than the boresight may follow,
 /// (E1)) is detected on the first step — the estimate shows where the fixture is — in
 /// every filter, exact and under `realistic` navigation; the summary names both positions;
@@ -139,18 +139,18 @@ fn fixture_at(fixture: [f64; 3], realistic: bool) -> (sc_mission::Summary, Vec<S
 #[test]
 fn a_fixture_farther_out_than_declared_puts_the_layer_in_safe_mode_at_once() {
     for realistic in [false, true] {
-        let (s, records) = fixture_at([-0.55, 0.6, 0.0], realistic);
+        let (s, records) = fixture_at([-0.55, 0.8, 0.0], realistic);
         let m = s.safe_mode.as_ref().expect("a safe mode in the summary");
         assert_eq!(m.entered_t_s, Some(records[0].t), "{m:?}");
         assert_eq!(m.undetected_t_s, None, "{m:?}");
         assert_eq!(m.rule, "line_of_sight_rate");
-        assert_eq!(m.fixture_m, Some([-0.55, 0.6, 0.0]));
+        assert_eq!(m.fixture_m, Some([-0.55, 0.8, 0.0]));
         assert_eq!(m.declared_fixture_m, Some([-0.55, 0.35, 0.0]));
         assert!(m.line_of_sight_certifiable(), "{m:?}");
         assert!(records.iter().all(|r| in_safe_mode(r) == [true; 3]));
         assert!(
             s.verdict()
-                .contains("its true grasping fixture at [-0.550, 0.600, 0.000] m")
+                .contains("its true grasping fixture at [-0.550, 0.800, 0.000] m")
         );
         let los = "line_of_sight".to_string();
         assert!(!s.violated_constraints.contains(&los), "{}", s.verdict());
