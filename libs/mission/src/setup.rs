@@ -247,7 +247,7 @@ fn check_target_geometry(s: &Scenario, robot: &Robot) -> Result<(), SetupError> 
     let r_caz = s.safety.translational.caz_radius_m;
     let clear = base_clearance_from_caz(r_caz, delta, base.radius, target);
     // NaN is no clearance
-    if !(clear >= 0.0) {
+    if clear.is_nan() || clear < 0.0 {
         return Err(SetupError::Inconsistent {
             key: "safety.translational.caz_radius_m".into(),
             value: r_caz.to_string(),
@@ -284,7 +284,7 @@ fn check_stowed_arm(
     let r_caz = s.safety.translational.caz_radius_m;
     let clear = arm_clearance_from_caz(r_caz, reach, target);
     // NaN is no clearance
-    if !(clear >= 0.0) {
+    if clear.is_nan() || clear < 0.0 {
         return Err(SetupError::Inconsistent {
             key: "safety.translational.caz_radius_m".into(),
             value: r_caz.to_string(),
