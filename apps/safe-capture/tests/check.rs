@@ -173,8 +173,9 @@ fn a_world_fixture_is_named_and_checked() {
         );
         assert!(out.contains(&note), "{}", text(&o));
     }
-    // with the rate changed too, the fixture is judged at the changed rate as well
-    let world = "[world]\ngrasp_point_m = [-0.55, 0.4, 0.0]\n\n[world.target_spin_change]\nt_s = 100.0\nomega_rad_s = [-0.12, 0.0, 0.0]\n\n[mission]";
+    // with the rate changed too, the fixture is judged at the changed rate as well: 0.6 m
+    // off the axis is inside at 0.08 rad/s, outside at 0.12
+    let world = "[world]\ngrasp_point_m = [-0.55, 0.6, 0.0]\n\n[world.target_spin_change]\nt_s = 100.0\nomega_rad_s = [-0.12, 0.0, 0.0]\n\n[mission]";
     let (o, out) = accepted_with_world(&d, world);
     assert!(
         out.contains("inside the certified envelope; with the rate changed at t = 100 s: outside the certified envelope (line_of_sight_rate)"),

@@ -35,8 +35,9 @@ pub fn pick(seed: &mut u64, e: f64) -> f64 {
     }
 }
 
-/// A plant at a random point of the declared mass-property box, as the simulator draws
-/// one: the base's mass, inertia and CoM, each link's mass and inertia.
+/// A plant at a random point of the declared mass-property box — the quantities the
+/// simulator draws (the base's mass, inertia and CoM, each link's mass and inertia), with
+/// the corners favoured ([`pick`]) and the CoM's offset at least half its bound.
 pub fn plant(seed: &mut u64, r: &Robot, m: &ModelBounds) -> Robot {
     let com = ball(seed, 1.0).normalize() * m.servicer_com_m * (0.5 + 0.5 * lcg(seed));
     let mut p = r

@@ -217,8 +217,8 @@ impl Setup {
 /// target"): the grasping fixture stands off every sphere by at least what the gripper's
 /// own spheres stick out beyond it ([`sc_cbf::arm_target::gripper_overhang`]) — or
 /// capture itself would break an arm–target barrier — and the collision-avoidance zone keeps the base off the target
-/// ([`sc_cbf::arm_target::base_clearance_from_caz`]), for every plant the declared
-/// mass-property errors allow.
+/// ([`sc_cbf::arm_target::base_clearance_from_caz`]) and the stowed arm too
+/// ([`check_stowed_arm`]), for every plant the declared mass-property errors allow.
 fn check_target_geometry(s: &Scenario, robot: &Robot) -> Result<(), SetupError> {
     use sc_cbf::arm_target::{
         TargetBody, base_clearance_from_caz, base_com_offset_bound, gripper_overhang,
@@ -272,24 +272,24 @@ fn check_stowed_arm(
     s: &Scenario,
     robot: &Robot,
     model: &sc_scenario::uncertainty::ModelBounds,
-    target: f64,
+    r_target: f64,
 ) -> Result<(), SetupError> {
     use sc_cbf::arm_target::{arm_clearance_from_caz, arm_reach_bound};
     let stowed = sc_multibody::Vector7::from(s.servicer.initial_theta_rad);
     let Some(reach) = arm_reach_bound(robot, &stowed, model) else {
         return Err(SetupError::Other(
-            "the stowed arm cannot be shown off the target: the servicer model has no arm sphere, or the declared mass errors leave it no mass".into(),
+            "the stowed arm cannot be shown off the target: the servicer model has no arm sphere, a sphere's reach at `servicer.initial_theta_rad` is not finite, or the declared mass errors leave it no mass".into(),
         ));
     };
     let r_caz = s.safety.translational.caz_radius_m;
-    let clear = arm_clearance_from_caz(r_caz, reach, target);
+    let clear = arm_clearance_from_caz(r_caz, reach, r_target);
     // NaN is no clearance
     if clear.is_nan() || clear < 0.0 {
         return Err(SetupError::Inconsistent {
             key: "safety.translational.caz_radius_m".into(),
             value: r_caz.to_string(),
             rule: format!(
-                "too small for the stowed arm to clear the target at the zone's edge: the arm at `servicer.initial_theta_rad` reaches {reach:.3} m from the system CoM (the declared mass errors' CoM shift included) and the target's keep-out spheres {target:.3} m from its CoM, so the zone needs at least {:.3} m — or a base turning at its edge can sweep the arm into the target",
+                "too small for the stowed arm to clear the target at the zone's edge: the arm at `servicer.initial_theta_rad` reaches {reach:.3} m from the system CoM (the declared mass errors' CoM shift included) and the target's keep-out spheres {r_target:.3} m from its CoM, so the zone needs at least {:.3} m — or a base turning at its edge can sweep the arm into the target",
                 r_caz - clear
             ),
         });
@@ -356,9 +356,7 @@ mod tests {
     /// model's).
     #[test]
     fn a_target_geometry_the_servicer_cannot_respect_is_refused() {
-        use sc_cbf::arm_target::{
-            base_clearance_from_caz, base_com_offset_bound, gripper_overhang,
-        };
+        use sc_cbf::arm_target::{TargetBody, base_com_offset_bound, gripper_overhang};
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/scenario.toml");
         let setup = Setup::load(&path).expect("the default loads");
         // link 7's last sphere (radius 0.06) 0.02 m short of the end effector
@@ -405,9 +403,6 @@ mod tests {
         let real = base_com_offset_bound(&exact.robot, &exact.scenario.uncertainty_bounds().model);
         let real = real.unwrap();
         assert!((real - 0.1579).abs() < 1e-4, "{real} vs {delta}");
-        // the base's own rule under them: 1.05 m + δ, here below the stowed arm's
-        let base_room = |r: f64| base_clearance_from_caz(r, real, 0.6, 0.45);
-        assert!(base_room(1.05 + real - 1e-3) < 0.0 && base_room(1.05 + real + 1e-3) > 0.0);
         let msg = exact
             .check_target_geometry()
             .expect_err("refused")
@@ -417,5 +412,15 @@ mod tests {
                 && msg.contains("at least 1.849 m"),
             "{msg}"
         );
+        // and the base's own rule under them, just short of its room (the base's zone and
+        // the target's sphere plus the realistic δ)
+        let base = exact.robot.base_sphere().unwrap().radius;
+        let target = TargetBody::from_scenario(&exact.scenario).bounding_radius();
+        exact.scenario.safety.translational.caz_radius_m = base + target + real - 1e-3;
+        let msg = exact
+            .check_target_geometry()
+            .expect_err("refused")
+            .to_string();
+        assert!(msg.contains("keep the base off the target"), "{msg}");
     }
 }

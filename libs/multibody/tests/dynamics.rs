@@ -273,3 +273,43 @@ fn the_com_distance_bounds_hold_at_every_joint_state() {
         );
     }
 }
+
+/// The plant's CoM lies within `com_shift_bound` of the model's for plants anywhere in the
+/// box (the ends of every scale and the CoM's whole offset half the time); without errors
+/// the bound is 0, and mass scales that can take every body's mass give none.
+#[test]
+fn the_com_shift_bound_covers_every_plant_in_the_box() {
+    let (base_rel, com_m, link_rel) = (0.05, 0.02, 0.2);
+    for (name, r) in robots() {
+        let mut rng = Rng::new(11);
+        let th = rng.theta(&r);
+        assert_eq!(r.com_shift_bound(&th, 0.0, 0.0, 0.0), Some(0.0), "{name}");
+        assert_eq!(r.com_shift_bound(&th, 1.0, 0.0, 1.0), None, "{name}");
+        let mut widest = 0.0f64;
+        for _ in 0..300 {
+            let th = rng.theta(&r);
+            let mut end = |e: f64| {
+                if rng.next_f64() < 0.5 {
+                    if rng.next_f64() < 0.5 { -e } else { e }
+                } else {
+                    rng.uniform(-e, e)
+                }
+            };
+            let offset = Vector3::new(end(1.0), end(1.0), end(1.0)).normalize() * com_m;
+            let mut p = r
+                .with_body_mass_properties(0, 1.0 + end(base_rel), 1.0, offset)
+                .unwrap();
+            for k in 1..=NJ {
+                p = p
+                    .with_body_mass_properties(k, 1.0 + end(link_rel), 1.0, Vector3::zeros())
+                    .unwrap();
+            }
+            let bound = r.com_shift_bound(&th, base_rel, com_m, link_rel).unwrap();
+            let shift = (p.center_of_mass(&th) - r.center_of_mass(&th)).norm();
+            assert!(shift <= bound, "{name}: {shift} > {bound}");
+            widest = widest.max(shift / bound);
+        }
+        // not loose by orders of magnitude
+        assert!(widest > 0.2, "{name}: {widest}");
+    }
+}

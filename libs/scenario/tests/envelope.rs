@@ -94,10 +94,14 @@ fn a_budget_without_room_for_the_tumble_and_a_fixture_outside_the_zone_are_refus
         "{msg}"
     );
     let mut s = default();
-    s.target.grasp_point_m = [-1.7, 0.0, 0.0];
+    // 2.0 m out on the corridor's axis: beyond the zone (1.9 m), within the servicer's reach
+    s.target.grasp_point_m = [-2.0, 0.0, 0.0];
     s.target.initial_omega_rad_s = [0.0, 0.0, 0.0];
     let msg = s.validate().expect_err("refused").to_string();
-    assert!(msg.starts_with("`target.grasp_point_m` = "), "{msg}");
+    assert!(
+        msg.starts_with("`target.grasp_point_m` = ") && msg.contains("come to"),
+        "{msg}"
+    );
 }
 
 /// With the fixture close to the spin axis the base's rate limits bound the tumble: the
