@@ -193,11 +193,7 @@ mod tests {
     use sc_models::quat;
 
     fn default_scenario() -> (sc_scenario::Scenario, Robot) {
-        let s = sc_scenario::Scenario::load(std::path::Path::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../config/scenario.toml"
-        )))
-        .unwrap();
+        let s = crate::test_draws::default_scenario();
         let robot = Robot::from_urdf_file(&s.urdf_path()).unwrap();
         (s, robot)
     }

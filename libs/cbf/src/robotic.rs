@@ -1937,11 +1937,7 @@ mod tests {
     /// The default scenario and a moving arm near its limits, the base turning and
     /// pushed: every term of the robotic input non-zero.
     fn moving_arm() -> (sc_scenario::Scenario, RoboticInput) {
-        let s = sc_scenario::Scenario::load(std::path::Path::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../config/scenario.toml"
-        )))
-        .unwrap();
+        let s = crate::test_draws::default_scenario();
         let robot = Robot::from_urdf_file(&s.urdf_path()).unwrap();
         let theta = Vector7::from(s.safety.robotic.theta_max_rad) * 0.8;
         let theta_dot = Vector7::from_fn(|i, _| 0.05 * (i as f64 - 3.0));

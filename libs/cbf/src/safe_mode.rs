@@ -248,14 +248,7 @@ fn distance(a: &[f64; 3], b: &[f64; 3]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn default_scenario() -> Scenario {
-        Scenario::load(std::path::Path::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../config/scenario.toml"
-        )))
-        .unwrap()
-    }
+    use crate::test_draws::default_scenario;
 
     fn watch() -> EnvelopeWatch {
         EnvelopeWatch::from_scenario(&default_scenario())

@@ -1,4 +1,5 @@
-//! Reproducible random draws for the unit tests (one generator for every module's tests).
+//! Reproducible random draws for the unit tests (one generator for every module's tests),
+//! and the default scenario they start from.
 
 use nalgebra::Vector3;
 use sc_multibody::{NJ, Robot};
@@ -21,6 +22,15 @@ pub fn ball(seed: &mut u64, radius: f64) -> Vector3<f64> {
             return v * radius;
         }
     }
+}
+
+/// The shipped default scenario (`config/scenario.toml`).
+pub fn default_scenario() -> sc_scenario::Scenario {
+    sc_scenario::Scenario::load(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../config/scenario.toml"
+    )))
+    .unwrap()
 }
 
 /// A uniform draw in `[-e, e]`, the ends half the time (the bounds' worst cases).

@@ -248,17 +248,25 @@ fn check_target_geometry(s: &Scenario, robot: &Robot) -> Result<(), SetupError> 
     let clear = base_clearance_from_caz(r_caz, delta, base.radius, target);
     // NaN is no clearance
     if clear.is_nan() || clear < 0.0 {
-        return Err(SetupError::Inconsistent {
-            key: "safety.translational.caz_radius_m".into(),
-            value: r_caz.to_string(),
-            rule: format!(
+        return Err(zone_too_small(
+            r_caz,
+            format!(
                 "too small to keep the base off the target: the base's zone ({:.3} m), the target's keep-out spheres ({target:.3} m from its CoM) and the system CoM's offset from the base's centre (up to {delta:.3} m) need at least {:.3} m",
                 base.radius,
                 r_caz - clear
             ),
-        });
+        ));
     }
     check_stowed_arm(s, robot, &model, target)
+}
+
+/// The refusal of a collision-avoidance zone too small for `rule`.
+fn zone_too_small(r_caz: f64, rule: String) -> SetupError {
+    SetupError::Inconsistent {
+        key: "safety.translational.caz_radius_m".into(),
+        value: r_caz.to_string(),
+        rule,
+    }
 }
 
 /// The stowed arm (`servicer.initial_theta_rad`, where the `hold` nominal keeps it) clears
@@ -285,14 +293,13 @@ fn check_stowed_arm(
     let clear = arm_clearance_from_caz(r_caz, reach, r_target);
     // NaN is no clearance
     if clear.is_nan() || clear < 0.0 {
-        return Err(SetupError::Inconsistent {
-            key: "safety.translational.caz_radius_m".into(),
-            value: r_caz.to_string(),
-            rule: format!(
+        return Err(zone_too_small(
+            r_caz,
+            format!(
                 "too small for the stowed arm to clear the target at the zone's edge: the arm at `servicer.initial_theta_rad` reaches {reach:.3} m from the system CoM (the declared mass errors' CoM shift included) and the target's keep-out spheres {r_target:.3} m from its CoM, so the zone needs at least {:.3} m — or a base turning at its edge can sweep the arm into the target",
                 r_caz - clear
             ),
-        });
+        ));
     }
     Ok(())
 }
